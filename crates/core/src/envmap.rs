@@ -1,0 +1,280 @@
+//! The environment map: texels plus the projection that says which direction each one sees.
+
+use crate::projection::{Projection, WorldProjection};
+use crate::Image;
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+use std::fmt;
+
+/// Why layers do not make an environment map.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum EnvMapError {
+    /// The projection needs a different number of layers.
+    LayerCount {
+        /// Layers the projection has.
+        expected: usize,
+        /// Layers given.
+        got: usize,
+    },
+    /// Layers differ in size or channel count.
+    Mismatch,
+    /// A layer has no texels.
+    Empty,
+}
+
+impl fmt::Display for EnvMapError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            EnvMapError::LayerCount { expected, got } => {
+                write!(f, "the projection has {expected} layers but {got} images were given")
+            }
+            EnvMapError::Mismatch => f.write_str("layers differ in size or channel count"),
+            EnvMapError::Empty => f.write_str("an image has no texels"),
+        }
+    }
+}
+
+impl std::error::Error for EnvMapError {}
+
+/// A world projection filled with linear-light texels: one [`Image`] per layer, all the same
+/// size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvMap {
+    projection: Projection,
+    layers: Vec<Image>,
+}
+
+/// Radiance statistics of an environment map, over the texels the projection covers.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Smallest finite colour channel value.
+    pub min: f32,
+    /// Largest finite colour channel value.
+    pub max: f32,
+    /// Mean colour (RGB) over the sphere, each texel weighted by its exact solid angle.
+    pub mean: [f64; 3],
+    /// Texels with a NaN in a colour channel.
+    pub nan: u64,
+    /// Texels with an infinite colour channel.
+    pub inf: u64,
+    /// Texels with a negative colour channel.
+    pub negative: u64,
+    /// Solid angle the texels cover (should be the projection's covered solid angle).
+    pub solid_angle: f64,
+}
+
+impl EnvMap {
+    /// Wraps layers in a projection, checking their number and sizes.
+    pub fn new(projection: Projection, layers: Vec<Image>) -> Result<EnvMap, EnvMapError> {
+        let expected = projection.layer_count();
+        if layers.len() != expected {
+            return Err(EnvMapError::LayerCount { expected, got: layers.len() });
+        }
+        let first = &layers[0];
+        if first.width() == 0 || first.height() == 0 {
+            return Err(EnvMapError::Empty);
+        }
+        if layers.iter().any(|l| {
+            l.width() != first.width()
+                || l.height() != first.height()
+                || l.channels() != first.channels()
+        }) {
+            return Err(EnvMapError::Mismatch);
+        }
+        Ok(EnvMap { projection, layers })
+    }
+
+    /// Evaluates `f` at the centre direction of every texel, for edge `size` (see
+    /// [`WorldProjection::layer_extent`]). Texels outside the covered domain get the value
+    /// at the nearest covered point. Useful for analytic test environments.
+    pub fn from_fn<F>(projection: Projection, size: u32, channels: usize, f: F) -> EnvMap
+    where
+        F: Fn(DVec3) -> [f32; 4] + Sync,
+    {
+        let (w, h) = projection.layer_extent(size);
+        let layers = (0..projection.layer_count())
+            .map(|layer| {
+                let mut img = Image::new(w, h, channels);
+                img.data_mut().par_chunks_mut(w as usize * channels).enumerate().for_each(
+                    |(y, row)| {
+                        for x in 0..w as usize {
+                            let uv = DVec2::new(
+                                (x as f64 + 0.5) / w as f64,
+                                (y as f64 + 0.5) / h as f64,
+                            );
+                            let uv = projection.nearest_covered(layer, uv);
+                            let v = match projection.uv_to_dir(layer, uv) {
+                                Some(d) => f(d),
+                                None => [0.0; 4],
+                            };
+                            row[x * channels..(x + 1) * channels].copy_from_slice(&v[..channels]);
+                        }
+                    },
+                );
+                img
+            })
+            .collect();
+        EnvMap { projection, layers }
+    }
+
+    /// The projection.
+    pub fn projection(&self) -> &Projection {
+        &self.projection
+    }
+    /// The layers (cube faces in OpenGL order, paraboloid front then back).
+    pub fn layers(&self) -> &[Image] {
+        &self.layers
+    }
+    /// The layers, mutably (their sizes cannot change).
+    pub fn layers_mut(&mut self) -> &mut [Image] {
+        &mut self.layers
+    }
+    /// Gives up the layers.
+    pub fn into_layers(self) -> Vec<Image> {
+        self.layers
+    }
+    /// Width of each layer.
+    pub fn width(&self) -> u32 {
+        self.layers[0].width()
+    }
+    /// Height of each layer.
+    pub fn height(&self) -> u32 {
+        self.layers[0].height()
+    }
+    /// 3 or 4.
+    pub fn channels(&self) -> usize {
+        self.layers[0].channels()
+    }
+
+    /// Bilinear lookup at `(layer, uv)`, seamless across cube edges, the longitude wrap and
+    /// the poles (the neighbours come from [`WorldProjection::wrap_texel`]). Writes
+    /// `channels()` values to `out`.
+    #[inline]
+    pub fn bilinear_at(&self, layer: usize, uv: DVec2, out: &mut [f32]) {
+        bilinear(&self.projection, &self.layers, layer, uv, out);
+    }
+
+    /// Bilinear lookup in direction `dir` (unit length). Directions the projection does not
+    /// cover read as zero.
+    pub fn sample(&self, dir: DVec3) -> [f32; 4] {
+        let mut out = [0.0f32; 4];
+        if let Some((layer, uv)) = self.projection.dir_to_uv(dir) {
+            self.bilinear_at(layer, uv, &mut out[..self.channels()]);
+        }
+        out
+    }
+
+    /// Exact texel solid angles of one layer, row by row.
+    pub fn solid_angles(&self, layer: usize) -> Vec<f64> {
+        let (w, h) = (self.width(), self.height());
+        let p = self.projection;
+        (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| (0..w).map(move |x| p.texel_solid_angle(layer, x, y, w, h)))
+            .collect()
+    }
+
+    /// Radiance statistics over the covered texels.
+    pub fn stats(&self) -> Stats {
+        let mut s = Stats { min: f32::INFINITY, max: f32::NEG_INFINITY, ..Stats::default() };
+        let c = self.channels();
+        for (layer, img) in self.layers.iter().enumerate() {
+            let weights = self.solid_angles(layer);
+            for (px, &w) in img.data().chunks_exact(c).zip(&weights) {
+                let rgb = &px[..3];
+                if rgb.iter().any(|v| v.is_nan()) {
+                    s.nan += 1;
+                    continue;
+                }
+                if rgb.iter().any(|v| v.is_infinite()) {
+                    s.inf += 1;
+                    continue;
+                }
+                if rgb.iter().any(|&v| v < 0.0) {
+                    s.negative += 1;
+                }
+                if w <= 0.0 {
+                    continue;
+                }
+                for (i, &v) in rgb.iter().enumerate() {
+                    s.min = s.min.min(v);
+                    s.max = s.max.max(v);
+                    s.mean[i] += v as f64 * w;
+                }
+                s.solid_angle += w;
+            }
+        }
+        if s.solid_angle > 0.0 {
+            for m in &mut s.mean {
+                *m /= s.solid_angle;
+            }
+        } else {
+            s.min = 0.0;
+            s.max = 0.0;
+        }
+        s
+    }
+
+    /// Replaces NaN and infinite colour values by 0 and clamps negative ones to 0. Returns
+    /// how many texel values were changed.
+    pub fn sanitize(&mut self) -> u64 {
+        let c = self.channels();
+        let mut n = 0;
+        for img in &mut self.layers {
+            for px in img.data_mut().chunks_exact_mut(c) {
+                for v in &mut px[..3] {
+                    if !v.is_finite() || *v < 0.0 {
+                        *v = 0.0;
+                        n += 1;
+                    }
+                }
+            }
+        }
+        n
+    }
+}
+
+/// Bilinear filtering over `layers` of `proj` at `(layer, uv)`; texel centres at
+/// half-integers.
+#[inline]
+pub(crate) fn bilinear(proj: &Projection, layers: &[Image], layer: usize, uv: DVec2, out: &mut [f32]) {
+    let img = &layers[layer];
+    let (w, h) = (img.width(), img.height());
+    let c = img.channels();
+    let x = uv.x * w as f64 - 0.5;
+    let y = uv.y * h as f64 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let weights = [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy];
+    for o in out.iter_mut() {
+        *o = 0.0;
+    }
+    let n = out.len().min(c);
+    if x0 >= 0 && y0 >= 0 && x0 + 1 < w as i64 && y0 + 1 < h as i64 {
+        let data = img.data();
+        let stride = w as usize * c;
+        let i00 = y0 as usize * stride + x0 as usize * c;
+        let idx = [i00, i00 + c, i00 + stride, i00 + stride + c];
+        for k in 0..4 {
+            let t = &data[idx[k]..idx[k] + n];
+            for i in 0..n {
+                out[i] += weights[k] * t[i];
+            }
+        }
+    } else {
+        let corners = [(x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1)];
+        for k in 0..4 {
+            let (cx, cy) = corners[k];
+            let (l, tx, ty) = if cx >= 0 && cy >= 0 && cx < w as i64 && cy < h as i64 {
+                (layer, cx as u32, cy as u32)
+            } else {
+                proj.wrap_texel(layer, cx, cy, w, h)
+            };
+            let t = layers[l].get(tx, ty);
+            for i in 0..n {
+                out[i] += weights[k] * t[i];
+            }
+        }
+    }
+}

@@ -1,0 +1,173 @@
+//! A plain linear-light raster: the pixels of one layer (face) of an environment map.
+
+/// A rectangular raster of linear-light `f32` texels, RGB or RGBA, interleaved, stored
+/// top row first (row 0 is the top of the picture as a person looks at the file).
+///
+/// ```
+/// use mirrorball_core::Image;
+/// let mut img = Image::new(4, 2, 3);
+/// img.set(1, 0, &[1.0, 0.5, 0.25]);
+/// assert_eq!(img.get(1, 0), &[1.0, 0.5, 0.25]);
+/// assert_eq!(img.data().len(), 4 * 2 * 3);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    width: u32,
+    height: u32,
+    channels: usize,
+    data: Vec<f32>,
+}
+
+impl Image {
+    /// A black image. `channels` must be 3 (RGB) or 4 (RGBA).
+    ///
+    /// # Panics
+    /// If `channels` is not 3 or 4. Callers validating user input use [`Image::from_vec`].
+    pub fn new(width: u32, height: u32, channels: usize) -> Image {
+        assert!(channels == 3 || channels == 4, "channels must be 3 or 4");
+        let len = width as usize * height as usize * channels;
+        Image { width, height, channels, data: vec![0.0; len] }
+    }
+
+    /// Wraps interleaved texels, checking that the length matches.
+    pub fn from_vec(width: u32, height: u32, channels: usize, data: Vec<f32>) -> Option<Image> {
+        let ok = (channels == 3 || channels == 4)
+            && data.len() == width as usize * height as usize * channels;
+        ok.then_some(Image { width, height, channels, data })
+    }
+
+    /// Width in texels.
+    #[inline]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    /// Height in texels.
+    #[inline]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+    /// 3 for RGB, 4 for RGBA.
+    #[inline]
+    pub fn channels(&self) -> usize {
+        self.channels
+    }
+    /// The interleaved texels, top row first.
+    #[inline]
+    pub fn data(&self) -> &[f32] {
+        &self.data
+    }
+    /// The interleaved texels, mutably.
+    #[inline]
+    pub fn data_mut(&mut self) -> &mut [f32] {
+        &mut self.data
+    }
+    /// Gives up the texel buffer.
+    pub fn into_vec(self) -> Vec<f32> {
+        self.data
+    }
+    /// Row `y` as interleaved texels.
+    #[inline]
+    pub fn row(&self, y: u32) -> &[f32] {
+        let n = self.width as usize * self.channels;
+        &self.data[y as usize * n..(y as usize + 1) * n]
+    }
+    /// The texel at column `x`, row `y`.
+    #[inline]
+    pub fn get(&self, x: u32, y: u32) -> &[f32] {
+        let i = (y as usize * self.width as usize + x as usize) * self.channels;
+        &self.data[i..i + self.channels]
+    }
+    /// Sets the texel at column `x`, row `y` (extra channels in `v` are ignored; missing ones
+    /// are left as they were).
+    #[inline]
+    pub fn set(&mut self, x: u32, y: u32, v: &[f32]) {
+        let i = (y as usize * self.width as usize + x as usize) * self.channels;
+        let n = self.channels.min(v.len());
+        self.data[i..i + n].copy_from_slice(&v[..n]);
+    }
+
+    /// Copies a `w`×`h` block with its top-left corner at (`x`, `y`) into a new image.
+    /// Returns `None` if the block does not fit.
+    pub fn crop(&self, x: u32, y: u32, w: u32, h: u32) -> Option<Image> {
+        if x.checked_add(w)? > self.width || y.checked_add(h)? > self.height {
+            return None;
+        }
+        let c = self.channels;
+        let mut out = Image::new(w, h, c);
+        for row in 0..h {
+            let src = &self.row(y + row)[x as usize * c..(x + w) as usize * c];
+            let dst = (row as usize * w as usize) * c;
+            out.data[dst..dst + src.len()].copy_from_slice(src);
+        }
+        Some(out)
+    }
+
+    /// Pastes `src` with its top-left corner at (`x`, `y`). Parts outside are clipped.
+    pub fn paste(&mut self, src: &Image, x: u32, y: u32) {
+        let c = self.channels.min(src.channels);
+        for row in 0..src.height {
+            let ty = y + row;
+            if ty >= self.height {
+                break;
+            }
+            for col in 0..src.width {
+                let tx = x + col;
+                if tx >= self.width {
+                    break;
+                }
+                let v = src.get(col, row);
+                self.set(tx, ty, &v[..c]);
+            }
+        }
+    }
+
+    /// The same picture rotated by 180 degrees.
+    pub fn rotated_180(&self) -> Image {
+        let mut out = self.clone();
+        let c = self.channels;
+        let n = self.data.len() / c;
+        for i in 0..n {
+            let j = n - 1 - i;
+            out.data[i * c..i * c + c].copy_from_slice(&self.data[j * c..j * c + c]);
+        }
+        out
+    }
+
+    /// The same picture mirrored left to right (`horizontal`) or top to bottom.
+    pub fn flipped(&self, horizontal: bool) -> Image {
+        let mut out = self.clone();
+        let (w, h) = (self.width, self.height);
+        for y in 0..h {
+            for x in 0..w {
+                let (sx, sy) = if horizontal { (w - 1 - x, y) } else { (x, h - 1 - y) };
+                out.set(x, y, self.get(sx, sy));
+            }
+        }
+        out
+    }
+
+    /// The same texels with `channels` channels: dropping alpha, or adding alpha = 1.
+    pub fn with_channels(&self, channels: usize) -> Image {
+        if channels == self.channels {
+            return self.clone();
+        }
+        let mut out = Image::new(self.width, self.height, channels);
+        for (d, s) in out.data.chunks_exact_mut(channels).zip(self.data.chunks_exact(self.channels)) {
+            d[..3].copy_from_slice(&s[..3]);
+            if channels == 4 {
+                d[3] = 1.0;
+            }
+        }
+        out
+    }
+
+    /// Multiplies the colour channels (not alpha) by `k`.
+    pub fn scale(&mut self, k: f32) {
+        let c = self.channels;
+        for px in self.data.chunks_exact_mut(c) {
+            for v in &mut px[..3] {
+                *v *= k;
+            }
+        }
+    }
+}

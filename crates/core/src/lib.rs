@@ -1,0 +1,35 @@
+//! # mirrorball-core
+//!
+//! The I/O-free heart of mirrorball: every world projection, exact in both directions and
+//! with exact texel solid angles; environment maps; layouts; and antialiased conversion
+//! between any two projections. No file I/O and no argument parsing happen here, so other
+//! programs can embed it.
+//!
+//! ```
+//! use mirrorball_core::{EnvMap, Projection, ProjectionKind, WorldProjection, resample, ResampleOptions};
+//! // A small analytic environment: brightness = height of the direction.
+//! let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 64, 3, |d| {
+//!     [d.y as f32 + 1.0, 1.0, 1.0, 1.0]
+//! });
+//! let cube = resample(&src, ProjectionKind::Cube.default_projection(), 16, &ResampleOptions::default());
+//! assert_eq!(cube.layers().len(), 6);
+//! ```
+#![warn(missing_docs)]
+
+mod envmap;
+mod image;
+pub mod layout;
+pub mod projection;
+mod resample;
+
+pub use envmap::{EnvMap, EnvMapError, Stats};
+pub use image::Image;
+pub use layout::{guess, Guess, Layout};
+pub use projection::{
+    AngularMap, ContinuousCube, CubeFace, CubeMap, DualParaboloid, EqualAreaOctahedral,
+    Fisheye, Frame, LatLong, Lens, Mercator, Octahedral, Projection, ProjectionKind,
+    RadialMap, SphereMap, UnknownProjection, WorldProjection,
+};
+pub use resample::{resample, resample_to_extent, ResampleOptions, Rotation};
+
+pub use glam;

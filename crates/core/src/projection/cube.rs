@@ -1,0 +1,145 @@
+//! The cube projection (Greene 1986, §3), exactly as OpenGL samples a cube map.
+
+use super::{texel_range, WorldProjection};
+use glam::{DVec2, DVec3};
+
+/// One face of a cube map, in OpenGL's order (ARB_texture_cube_map, OpenGL 4.6 §8.13):
+/// `TEXTURE_CUBE_MAP_POSITIVE_X` = layer 0 … `NEGATIVE_Z` = layer 5. KTX2, DDS and Vulkan
+/// use the same order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum CubeFace {
+    /// +X, layer 0.
+    PosX = 0,
+    /// −X, layer 1.
+    NegX = 1,
+    /// +Y, layer 2.
+    PosY = 2,
+    /// −Y, layer 3.
+    NegY = 3,
+    /// +Z, layer 4.
+    PosZ = 4,
+    /// −Z, layer 5.
+    NegZ = 5,
+}
+
+impl CubeFace {
+    /// All six, in layer order.
+    pub const ALL: [CubeFace; 6] = [
+        CubeFace::PosX,
+        CubeFace::NegX,
+        CubeFace::PosY,
+        CubeFace::NegY,
+        CubeFace::PosZ,
+        CubeFace::NegZ,
+    ];
+
+    /// The face with this layer index (0..6).
+    pub fn from_index(i: usize) -> Option<CubeFace> {
+        CubeFace::ALL.get(i).copied()
+    }
+
+    /// Short name: `+x`, `-x`, …
+    pub fn name(self) -> &'static str {
+        ["+x", "-x", "+y", "-y", "+z", "-z"][self as usize]
+    }
+
+    /// The face OpenGL selects for direction `r`, with its `(sc, tc, ma)` from the
+    /// major-axis table (OpenGL 4.6, table 8.19). Ties go to x, then y (the specification
+    /// leaves them to the implementation).
+    #[inline]
+    pub fn select(r: DVec3) -> (CubeFace, f64, f64, f64) {
+        let a = r.abs();
+        if a.x >= a.y && a.x >= a.z {
+            if r.x >= 0.0 {
+                (CubeFace::PosX, -r.z, -r.y, a.x)
+            } else {
+                (CubeFace::NegX, r.z, -r.y, a.x)
+            }
+        } else if a.y >= a.z {
+            if r.y >= 0.0 {
+                (CubeFace::PosY, r.x, r.z, a.y)
+            } else {
+                (CubeFace::NegY, r.x, -r.z, a.y)
+            }
+        } else if r.z >= 0.0 {
+            (CubeFace::PosZ, r.x, -r.y, a.z)
+        } else {
+            (CubeFace::NegZ, -r.x, -r.y, a.z)
+        }
+    }
+
+    /// The point on the unit cube for face coordinates `sc`, `tc` ∈ `[-1, 1]` (the inverse
+    /// of the table; also meaningful a little outside the face, which filtering uses).
+    #[inline]
+    pub fn point(self, sc: f64, tc: f64) -> DVec3 {
+        match self {
+            CubeFace::PosX => DVec3::new(1.0, -tc, -sc),
+            CubeFace::NegX => DVec3::new(-1.0, -tc, sc),
+            CubeFace::PosY => DVec3::new(sc, 1.0, tc),
+            CubeFace::NegY => DVec3::new(sc, -1.0, -tc),
+            CubeFace::PosZ => DVec3::new(sc, -tc, 1.0),
+            CubeFace::NegZ => DVec3::new(-sc, -tc, -1.0),
+        }
+    }
+}
+
+/// The OpenGL cube map. Direction `r` selects the face of its major axis and
+/// `s = (sc/|ma| + 1)/2`, `t = (tc/|ma| + 1)/2` (OpenGL 4.6 eq. 8.8). Face images are stored
+/// as OpenGL reads them: row 0 is `t = 0`, so `(u, v) = (s, t)`. Laid out as a horizontal
+/// cross these faces join up without mirroring (tested).
+///
+/// Area element: with `a = 2u − 1`, `b = 2v − 1`, the face point is `(a, b, 1)` and
+/// `dω = da db / (1 + a² + b²)^{3/2}`, whose antiderivative is
+/// `F(a, b) = atan(ab / √(1 + a² + b²))`, so texel solid angles are exact in closed form.
+///
+/// ```
+/// use mirrorball_core::{CubeMap, WorldProjection};
+/// use glam::DVec3;
+/// let (face, uv) = CubeMap.dir_to_uv(DVec3::new(0.0, 0.0, -1.0)).unwrap();
+/// assert_eq!(face, 5); // -Z
+/// assert!((uv.x - 0.5).abs() < 1e-12 && (uv.y - 0.5).abs() < 1e-12);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CubeMap;
+
+/// `atan(ab/√(1+a²+b²))`: the solid angle of the face rectangle `[0,a]×[0,b]`.
+#[inline]
+fn cube_area(a: f64, b: f64) -> f64 {
+    (a * b / (1.0 + a * a + b * b).sqrt()).atan()
+}
+
+impl WorldProjection for CubeMap {
+    fn layer_count(&self) -> usize {
+        6
+    }
+    fn layer_extent(&self, size: u32) -> (u32, u32) {
+        (size, size)
+    }
+    #[inline]
+    fn dir_to_uv(&self, dir: DVec3) -> Option<(usize, DVec2)> {
+        let (face, sc, tc, ma) = CubeFace::select(dir);
+        if ma <= 0.0 || !ma.is_finite() {
+            return None;
+        }
+        let inv = 0.5 / ma;
+        Some((face as usize, DVec2::new(sc * inv + 0.5, tc * inv + 0.5)))
+    }
+    #[inline]
+    fn uv_to_dir(&self, layer: usize, uv: DVec2) -> Option<DVec3> {
+        let face = CubeFace::from_index(layer)?;
+        Some(face.point(2.0 * uv.x - 1.0, 2.0 * uv.y - 1.0).normalize())
+    }
+    #[inline]
+    fn density(&self, _layer: usize, uv: DVec2) -> f64 {
+        let (a, b) = (2.0 * uv.x - 1.0, 2.0 * uv.y - 1.0);
+        let q = 1.0 + a * a + b * b;
+        4.0 / (q * q.sqrt())
+    }
+    fn texel_solid_angle(&self, _layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
+        let (u0, u1) = texel_range(x, w);
+        let (v0, v1) = texel_range(y, h);
+        let (a0, a1, b0, b1) = (2.0 * u0 - 1.0, 2.0 * u1 - 1.0, 2.0 * v0 - 1.0, 2.0 * v1 - 1.0);
+        cube_area(a1, b1) - cube_area(a0, b1) - cube_area(a1, b0) + cube_area(a0, b0)
+    }
+}

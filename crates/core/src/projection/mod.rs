@@ -1,0 +1,339 @@
+//! World projections: every way of flattening the sphere of directions onto images.
+//!
+//! A world projection maps a unit direction (where the light comes *from*, in world space)
+//! to a layer (cube face, paraboloid half) and texture coordinates `(u, v)` in `[0, 1]²`, and
+//! back. `u` grows to the right and `v` grows downwards in the stored picture, so texel
+//! `(x, y)` of a `w`×`h` layer covers `[x/w, (x+1)/w] × [y/h, (y+1)/h]` and its centre sits at
+//! `((x + ½)/w, (y + ½)/h)`. The conventions are collected in `ARCHITECTURE.md`.
+//!
+//! Every projection also knows its exact area element ([`WorldProjection::density`], solid
+//! angle per unit of `u·v` area) and the exact solid angle of any texel
+//! ([`WorldProjection::texel_solid_angle`]), in closed form where one exists and by
+//! high-order quadrature of an exact one-dimensional integral where it does not.
+
+mod azimuthal;
+mod continuous_cube;
+mod cube;
+mod latlong;
+mod octahedral;
+pub(crate) mod quadrature;
+
+pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap, SphereMap};
+pub use continuous_cube::ContinuousCube;
+pub use cube::{CubeFace, CubeMap};
+pub use latlong::{LatLong, Mercator};
+pub use octahedral::{EqualAreaOctahedral, Octahedral};
+
+use glam::{DVec2, DVec3};
+use std::fmt;
+use std::str::FromStr;
+
+/// The behaviour every world projection shares. All math is in `f64`.
+pub trait WorldProjection {
+    /// Number of layers: 6 for the cube types (OpenGL order +X −X +Y −Y +Z −Z), 2 for the
+    /// dual paraboloid (front, back), 1 otherwise.
+    fn layer_count(&self) -> usize;
+
+    /// Width and height of one layer when the user asks for edge `size` (the face edge of a
+    /// cube, the width of a lat-long or Mercator image, the diameter of a disk map).
+    fn layer_extent(&self, size: u32) -> (u32, u32);
+
+    /// The layer and texture coordinates of unit direction `dir`, or `None` where the
+    /// projection does not cover `dir` (outside a fisheye's field of view, beyond Mercator's
+    /// latitude limit).
+    fn dir_to_uv(&self, dir: DVec3) -> Option<(usize, DVec2)>;
+
+    /// The unit direction at texture coordinates `uv` of `layer`, or `None` outside the
+    /// covered domain (the corners of a disk-shaped map).
+    fn uv_to_dir(&self, layer: usize, uv: DVec2) -> Option<DVec3>;
+
+    /// Solid angle per unit `uv` area at `uv`: `|∂d/∂u × ∂d/∂v|`. Zero outside the domain.
+    fn density(&self, layer: usize, uv: DVec2) -> f64;
+
+    /// Exact solid angle, in steradians, of texel `(x, y)` of a `w`×`h` layer (only the part
+    /// that lies inside the covered domain counts).
+    fn texel_solid_angle(&self, layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64;
+
+    /// The solid angle the projection covers: 4π for all but the fisheye and Mercator.
+    fn covered_solid_angle(&self) -> f64 {
+        4.0 * std::f64::consts::PI
+    }
+
+    /// The closest coordinates to `uv` inside the covered domain. Texels outside a disk map's
+    /// rim are filled from here, so that filtering near the rim never pulls in black.
+    fn nearest_covered(&self, _layer: usize, uv: DVec2) -> DVec2 {
+        uv
+    }
+
+    /// Where texel `(x, y)`, which may lie one or more texels outside `layer`, really is: the
+    /// neighbouring texel across a cube edge, around the longitude wrap or over a pole. The
+    /// default extends the projection's formula past the edge and maps the direction back,
+    /// falling back to clamping.
+    fn wrap_texel(&self, layer: usize, x: i64, y: i64, w: u32, h: u32) -> (usize, u32, u32) {
+        let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+        if let Some((l, t)) = self.uv_to_dir(layer, uv).and_then(|d| self.dir_to_uv(d)) {
+            let tx = ((t.x * w as f64).floor() as i64).clamp(0, w as i64 - 1);
+            let ty = ((t.y * h as f64).floor() as i64).clamp(0, h as i64 - 1);
+            return (l, tx as u32, ty as u32);
+        }
+        (layer, x.clamp(0, w as i64 - 1) as u32, y.clamp(0, h as i64 - 1) as u32)
+    }
+}
+
+/// The names of the projections, as the command line spells them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ProjectionKind {
+    /// Latitude-longitude (equirectangular).
+    LatLong,
+    /// OpenGL cube map.
+    Cube,
+    /// OpenGL sphere map.
+    Sphere,
+    /// Dual paraboloid.
+    Paraboloid,
+    /// Continuous cube map.
+    ContinuousCube,
+    /// Mercator.
+    Mercator,
+    /// Angular map (light probe).
+    Angular,
+    /// Fisheye.
+    Fisheye,
+    /// Octahedral.
+    Octahedral,
+    /// Equal-area octahedral.
+    EqualAreaOctahedral,
+}
+
+impl ProjectionKind {
+    /// Every kind, in the order the documentation lists them.
+    pub const ALL: [ProjectionKind; 10] = [
+        ProjectionKind::LatLong,
+        ProjectionKind::Cube,
+        ProjectionKind::Sphere,
+        ProjectionKind::Paraboloid,
+        ProjectionKind::ContinuousCube,
+        ProjectionKind::Mercator,
+        ProjectionKind::Angular,
+        ProjectionKind::Fisheye,
+        ProjectionKind::Octahedral,
+        ProjectionKind::EqualAreaOctahedral,
+    ];
+
+    /// The canonical command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ProjectionKind::LatLong => "latlong",
+            ProjectionKind::Cube => "cube",
+            ProjectionKind::Sphere => "sphere",
+            ProjectionKind::Paraboloid => "paraboloid",
+            ProjectionKind::ContinuousCube => "continuous-cube",
+            ProjectionKind::Mercator => "mercator",
+            ProjectionKind::Angular => "angular",
+            ProjectionKind::Fisheye => "fisheye",
+            ProjectionKind::Octahedral => "octahedral",
+            ProjectionKind::EqualAreaOctahedral => "equal-area-octahedral",
+        }
+    }
+
+    /// The projection with its documented default parameters.
+    pub fn default_projection(self) -> Projection {
+        match self {
+            ProjectionKind::LatLong => Projection::LatLong(LatLong),
+            ProjectionKind::Cube => Projection::Cube(CubeMap),
+            ProjectionKind::Sphere => Projection::Sphere(SphereMap::default()),
+            ProjectionKind::Paraboloid => Projection::Paraboloid(DualParaboloid::default()),
+            ProjectionKind::ContinuousCube => Projection::ContinuousCube(ContinuousCube),
+            ProjectionKind::Mercator => Projection::Mercator(Mercator::default()),
+            ProjectionKind::Angular => Projection::Angular(AngularMap::default()),
+            ProjectionKind::Fisheye => Projection::Fisheye(Fisheye::default()),
+            ProjectionKind::Octahedral => Projection::Octahedral(Octahedral),
+            ProjectionKind::EqualAreaOctahedral => {
+                Projection::EqualAreaOctahedral(EqualAreaOctahedral)
+            }
+        }
+    }
+}
+
+impl fmt::Display for ProjectionKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A projection name that is not known; the message lists the known ones.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownProjection(pub String);
+
+impl fmt::Display for UnknownProjection {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<&str> = ProjectionKind::ALL.iter().map(|k| k.name()).collect();
+        write!(f, "unknown projection '{}' (known: {})", self.0, names.join(", "))
+    }
+}
+
+impl std::error::Error for UnknownProjection {}
+
+impl FromStr for ProjectionKind {
+    type Err = UnknownProjection;
+    /// Accepts the canonical names and common aliases, case-insensitively.
+    ///
+    /// ```
+    /// use mirrorball_core::ProjectionKind;
+    /// assert_eq!("equirect".parse::<ProjectionKind>().unwrap(), ProjectionKind::LatLong);
+    /// assert_eq!("cubemap".parse::<ProjectionKind>().unwrap(), ProjectionKind::Cube);
+    /// assert!("banana".parse::<ProjectionKind>().is_err());
+    /// ```
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let k = s.trim().to_ascii_lowercase().replace('_', "-");
+        Ok(match k.as_str() {
+            "latlong" | "lat-long" | "latlon" | "equirect" | "equirectangular" | "longlat"
+            | "spherical" => ProjectionKind::LatLong,
+            "cube" | "cubemap" | "cube-map" => ProjectionKind::Cube,
+            "sphere" | "spheremap" | "sphere-map" | "matcap" | "mirrorball" | "mirror-ball" => {
+                ProjectionKind::Sphere
+            }
+            "paraboloid" | "dual-paraboloid" | "parabolic" | "dp" => ProjectionKind::Paraboloid,
+            "continuous-cube" | "continuouscube" | "ccube" => ProjectionKind::ContinuousCube,
+            "mercator" => ProjectionKind::Mercator,
+            "angular" | "angular-map" | "lightprobe" | "light-probe" | "probe" => {
+                ProjectionKind::Angular
+            }
+            "fisheye" | "omnimax" | "dome" => ProjectionKind::Fisheye,
+            "octahedral" | "octahedron" | "oct" => ProjectionKind::Octahedral,
+            "equal-area-octahedral" | "eao" | "clarberg" | "equal-area-oct" => {
+                ProjectionKind::EqualAreaOctahedral
+            }
+            _ => return Err(UnknownProjection(s.to_string())),
+        })
+    }
+}
+
+/// Any world projection, with its parameters. Implements [`WorldProjection`] by delegating
+/// to the named type inside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// See [`LatLong`].
+    LatLong(LatLong),
+    /// See [`CubeMap`].
+    Cube(CubeMap),
+    /// See [`SphereMap`].
+    Sphere(SphereMap),
+    /// See [`DualParaboloid`].
+    Paraboloid(DualParaboloid),
+    /// See [`ContinuousCube`].
+    ContinuousCube(ContinuousCube),
+    /// See [`Mercator`].
+    Mercator(Mercator),
+    /// See [`AngularMap`].
+    Angular(AngularMap),
+    /// See [`Fisheye`].
+    Fisheye(Fisheye),
+    /// See [`Octahedral`].
+    Octahedral(Octahedral),
+    /// See [`EqualAreaOctahedral`].
+    EqualAreaOctahedral(EqualAreaOctahedral),
+}
+
+macro_rules! delegate {
+    ($self:ident, $p:ident => $e:expr) => {
+        match $self {
+            Projection::LatLong($p) => $e,
+            Projection::Cube($p) => $e,
+            Projection::Sphere($p) => $e,
+            Projection::Paraboloid($p) => $e,
+            Projection::ContinuousCube($p) => $e,
+            Projection::Mercator($p) => $e,
+            Projection::Angular($p) => $e,
+            Projection::Fisheye($p) => $e,
+            Projection::Octahedral($p) => $e,
+            Projection::EqualAreaOctahedral($p) => $e,
+        }
+    };
+}
+
+impl Projection {
+    /// Which kind of projection this is.
+    pub fn kind(&self) -> ProjectionKind {
+        match self {
+            Projection::LatLong(_) => ProjectionKind::LatLong,
+            Projection::Cube(_) => ProjectionKind::Cube,
+            Projection::Sphere(_) => ProjectionKind::Sphere,
+            Projection::Paraboloid(_) => ProjectionKind::Paraboloid,
+            Projection::ContinuousCube(_) => ProjectionKind::ContinuousCube,
+            Projection::Mercator(_) => ProjectionKind::Mercator,
+            Projection::Angular(_) => ProjectionKind::Angular,
+            Projection::Fisheye(_) => ProjectionKind::Fisheye,
+            Projection::Octahedral(_) => ProjectionKind::Octahedral,
+            Projection::EqualAreaOctahedral(_) => ProjectionKind::EqualAreaOctahedral,
+        }
+    }
+
+    /// The canonical name of this projection's kind.
+    pub fn name(&self) -> &'static str {
+        self.kind().name()
+    }
+}
+
+impl WorldProjection for Projection {
+    #[inline]
+    fn layer_count(&self) -> usize {
+        delegate!(self, p => p.layer_count())
+    }
+    #[inline]
+    fn layer_extent(&self, size: u32) -> (u32, u32) {
+        delegate!(self, p => p.layer_extent(size))
+    }
+    #[inline]
+    fn dir_to_uv(&self, dir: DVec3) -> Option<(usize, DVec2)> {
+        delegate!(self, p => p.dir_to_uv(dir))
+    }
+    #[inline]
+    fn uv_to_dir(&self, layer: usize, uv: DVec2) -> Option<DVec3> {
+        delegate!(self, p => p.uv_to_dir(layer, uv))
+    }
+    #[inline]
+    fn density(&self, layer: usize, uv: DVec2) -> f64 {
+        delegate!(self, p => p.density(layer, uv))
+    }
+    fn texel_solid_angle(&self, layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
+        delegate!(self, p => p.texel_solid_angle(layer, x, y, w, h))
+    }
+    fn covered_solid_angle(&self) -> f64 {
+        delegate!(self, p => p.covered_solid_angle())
+    }
+    #[inline]
+    fn nearest_covered(&self, layer: usize, uv: DVec2) -> DVec2 {
+        delegate!(self, p => p.nearest_covered(layer, uv))
+    }
+    #[inline]
+    fn wrap_texel(&self, layer: usize, x: i64, y: i64, w: u32, h: u32) -> (usize, u32, u32) {
+        delegate!(self, p => p.wrap_texel(layer, x, y, w, h))
+    }
+}
+
+macro_rules! impl_from {
+    ($($v:ident($t:ty)),*) => {$(
+        impl From<$t> for Projection {
+            fn from(p: $t) -> Projection { Projection::$v(p) }
+        }
+    )*};
+}
+impl_from!(
+    LatLong(LatLong),
+    Cube(CubeMap),
+    Sphere(SphereMap),
+    Paraboloid(DualParaboloid),
+    ContinuousCube(ContinuousCube),
+    Mercator(Mercator),
+    Angular(AngularMap),
+    Fisheye(Fisheye),
+    Octahedral(Octahedral),
+    EqualAreaOctahedral(EqualAreaOctahedral)
+);
+
+/// The `[lo, hi]` range in `uv` of texel index `i` of `n`.
+#[inline]
+pub(crate) fn texel_range(i: u32, n: u32) -> (f64, f64) {
+    (i as f64 / n as f64, (i as f64 + 1.0) / n as f64)
+}

@@ -1,0 +1,280 @@
+//! Conversion between any two projections, antialiased.
+//!
+//! For each output texel the ratio `r` of its solid angle to that of the source texels under
+//! it (from the two projections' exact area elements) decides the filter:
+//!
+//! * `r < 2.25` (the output texel covers about one source texel or less): one bilinear
+//!   lookup at the texel centre, seamless across cube edges, the longitude wrap and poles;
+//! * otherwise the output texel is integrated: an `n×n` grid of points over the texel
+//!   (`n ≈ √r`, at most [`ResampleOptions::max_samples`]), each weighted by its solid angle
+//!   and looked up bilinearly, on a solid-angle-weighted mip level of the source once `r`
+//!   exceeds `n_max²`, so that each point stands for about one source texel.
+//!
+//! The work runs in parallel over rows with rayon and allocates nothing per texel.
+
+use crate::envmap::bilinear;
+use crate::projection::{Projection, WorldProjection};
+use crate::{EnvMap, Image};
+use glam::{DMat3, DVec2, DVec3};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+/// An orthogonal transform of the environment (a rotation, or a mirroring to switch
+/// handedness conventions): the output shows the source turned by it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rotation {
+    /// Maps an output direction to the source direction it shows (the inverse transform).
+    to_source: DMat3,
+}
+
+impl Default for Rotation {
+    fn default() -> Self {
+        Rotation { to_source: DMat3::IDENTITY }
+    }
+}
+
+impl Rotation {
+    /// Turns the environment by `yaw` about +Y, then `pitch` about +X, then `roll` about −Z
+    /// (degrees; positive yaw turns what was straight ahead, −Z, towards −X, i.e. to the
+    /// left).
+    ///
+    /// ```
+    /// use mirrorball_core::Rotation;
+    /// use glam::DVec3;
+    /// let r = Rotation::from_euler_deg(90.0, 0.0, 0.0);
+    /// // After turning 90° left, what was ahead (-Z) is seen at -X:
+    /// assert!((r.source_of(DVec3::NEG_X) - DVec3::NEG_Z).length() < 1e-12);
+    /// ```
+    pub fn from_euler_deg(yaw: f64, pitch: f64, roll: f64) -> Rotation {
+        let m = DMat3::from_rotation_y(yaw.to_radians())
+            * DMat3::from_rotation_x(pitch.to_radians())
+            * DMat3::from_rotation_z(-roll.to_radians());
+        Rotation { to_source: m.transpose() }
+    }
+
+    /// A general orthogonal transform (forward: source direction → output direction).
+    /// `None` unless `m` is orthogonal to 1e-6.
+    pub fn from_matrix(m: DMat3) -> Option<Rotation> {
+        let e = (m.transpose() * m - DMat3::IDENTITY).to_cols_array();
+        if e.iter().any(|v| v.abs() > 1e-6 || !v.is_finite()) {
+            return None;
+        }
+        Some(Rotation { to_source: m.transpose() })
+    }
+
+    /// Mirrors the environment across the plane through the origin normal to `axis`
+    /// (0 = x, 1 = y, 2 = z): for example z, to go between right- and left-handed worlds.
+    pub fn mirror(axis: usize) -> Rotation {
+        let mut d = DVec3::ONE;
+        d[axis.min(2)] = -1.0;
+        Rotation { to_source: DMat3::from_diagonal(d) }
+    }
+
+    /// First `self`, then `then`.
+    pub fn then(self, then: Rotation) -> Rotation {
+        Rotation { to_source: self.to_source * then.to_source }
+    }
+
+    /// The source direction seen at output direction `d`.
+    #[inline]
+    pub fn source_of(&self, d: DVec3) -> DVec3 {
+        self.to_source * d
+    }
+
+    /// Whether this is the identity.
+    pub fn is_identity(&self) -> bool {
+        self.to_source == DMat3::IDENTITY
+    }
+}
+
+/// Options for [`resample`].
+#[derive(Clone, Debug)]
+pub struct ResampleOptions {
+    /// Turn (or mirror) the environment.
+    pub rotation: Rotation,
+    /// Exposure in stops: texels are multiplied by `2^exposure`.
+    pub exposure: f32,
+    /// Most points per axis when integrating one output texel (default 4; 1 turns
+    /// integration off and leaves plain bilinear interpolation).
+    pub max_samples: u32,
+    /// Counts finished output rows, for progress bars.
+    pub progress: Option<Arc<AtomicU64>>,
+}
+
+impl Default for ResampleOptions {
+    fn default() -> Self {
+        ResampleOptions { rotation: Rotation::default(), exposure: 0.0, max_samples: 4, progress: None }
+    }
+}
+
+/// Below this footprint ratio one bilinear lookup is used.
+const BILINEAR_MAX_RATIO: f64 = 2.25;
+
+/// A source map with its solid-angle-weighted mip pyramid.
+struct Pyramid<'a> {
+    base: &'a [Image],
+    levels: Vec<Vec<Image>>,
+}
+
+impl<'a> Pyramid<'a> {
+    fn new(src: &'a EnvMap, max_level: usize) -> Pyramid<'a> {
+        let mut levels: Vec<Vec<Image>> = Vec::new();
+        for _ in 0..max_level {
+            let prev = levels.last().map(|l| l.as_slice()).unwrap_or(src.layers());
+            if prev[0].width() == 1 && prev[0].height() == 1 {
+                break;
+            }
+            let next = prev
+                .iter()
+                .enumerate()
+                .map(|(layer, img)| downsample(src.projection(), layer, img))
+                .collect();
+            levels.push(next);
+        }
+        Pyramid { base: src.layers(), levels }
+    }
+
+    #[inline]
+    fn level(&self, l: usize) -> &[Image] {
+        if l == 0 {
+            self.base
+        } else {
+            &self.levels[(l - 1).min(self.levels.len() - 1)]
+        }
+    }
+
+    fn level_count(&self) -> usize {
+        self.levels.len() + 1
+    }
+}
+
+/// Halves `img` (layer `layer` of `proj`), each 2×2 block averaged with the source texels'
+/// solid angles as weights.
+fn downsample(proj: &Projection, layer: usize, img: &Image) -> Image {
+    let (w, h) = (img.width(), img.height());
+    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+    let c = img.channels();
+    let mut out = Image::new(nw, nh, c);
+    out.data_mut().par_chunks_mut(nw as usize * c).enumerate().for_each(|(y, row)| {
+        let ys = [(2 * y as u32).min(h - 1), (2 * y as u32 + 1).min(h - 1)];
+        for x in 0..nw as usize {
+            let xs = [(2 * x as u32).min(w - 1), (2 * x as u32 + 1).min(w - 1)];
+            let mut acc = [0.0f64; 4];
+            let mut wsum = 0.0;
+            for &sy in &ys {
+                for &sx in &xs {
+                    let uv = DVec2::new((sx as f64 + 0.5) / w as f64, (sy as f64 + 0.5) / h as f64);
+                    let wt = proj.density(layer, uv).max(1e-12);
+                    for (a, v) in acc.iter_mut().zip(img.get(sx, sy)) {
+                        *a += wt * *v as f64;
+                    }
+                    wsum += wt;
+                }
+            }
+            for i in 0..c {
+                row[x * c + i] = (acc[i] / wsum) as f32;
+            }
+        }
+    });
+    out
+}
+
+/// Converts `src` into projection `dst` at edge `size` (see
+/// [`WorldProjection::layer_extent`]).
+pub fn resample(src: &EnvMap, dst: Projection, size: u32, opts: &ResampleOptions) -> EnvMap {
+    let (w, h) = dst.layer_extent(size.max(1));
+    resample_to_extent(src, dst, w, h, opts)
+}
+
+/// Converts `src` into projection `dst` with layers of `w`×`h` texels.
+pub fn resample_to_extent(src: &EnvMap, dst: Projection, w: u32, h: u32, opts: &ResampleOptions) -> EnvMap {
+    let max_n = opts.max_samples.clamp(1, 16);
+    let levels_needed = if max_n > 1 { 16 } else { 0 };
+    let pyr = Pyramid::new(src, levels_needed);
+    let c = src.channels();
+    let scale = 2f32.powf(opts.exposure);
+    let src_texel_area = 1.0 / (src.width() as f64 * src.height() as f64);
+    let dst_texel_area = 1.0 / (w as f64 * h as f64);
+    let rot = opts.rotation;
+    let rotate = !rot.is_identity();
+    let sproj = *src.projection();
+    let layers = (0..dst.layer_count())
+        .map(|layer| {
+            let mut img = Image::new(w, h, c);
+            img.data_mut().par_chunks_mut(w as usize * c).enumerate().for_each(|(y, row)| {
+                let mut acc = [0.0f32; 4];
+                let mut tmp = [0.0f32; 4];
+                for x in 0..w as usize {
+                    let out = &mut row[x * c..(x + 1) * c];
+                    let uv0 = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                    let uv = dst.nearest_covered(layer, uv0);
+                    let Some(d) = dst.uv_to_dir(layer, uv) else { continue };
+                    let ds = if rotate { rot.source_of(d) } else { d };
+                    let Some((sl, suv)) = sproj.dir_to_uv(ds) else { continue };
+                    let sdens = sproj.density(sl, suv);
+                    let ddens = dst.density(layer, uv);
+                    let ratio = if sdens > 0.0 {
+                        (ddens * dst_texel_area) / (sdens * src_texel_area)
+                    } else {
+                        f64::INFINITY
+                    };
+                    if ratio < BILINEAR_MAX_RATIO || max_n == 1 || uv != uv0 {
+                        bilinear(&sproj, pyr.level(0), sl, suv, out);
+                    } else {
+                        // Integrate: n×n points, on a mip level where each stands for about
+                        // one source texel.
+                        let cap = (max_n * max_n) as f64;
+                        let level = if ratio > cap {
+                            (((ratio / cap).log2() * 0.5).ceil() as usize).min(pyr.level_count() - 1)
+                        } else {
+                            0
+                        };
+                        let r_l = ratio / 4f64.powi(level as i32);
+                        let n = (r_l.sqrt().round() as u32).clamp(1, max_n);
+                        let lv = pyr.level(level);
+                        acc[..c].fill(0.0);
+                        let mut wsum = 0.0f32;
+                        let inv = 1.0 / n as f64;
+                        for j in 0..n {
+                            let v = (y as f64 + (j as f64 + 0.5) * inv) / h as f64;
+                            for i in 0..n {
+                                let u = (x as f64 + (i as f64 + 0.5) * inv) / w as f64;
+                                let p = DVec2::new(u, v);
+                                let wt = dst.density(layer, p) as f32;
+                                if wt <= 0.0 {
+                                    continue;
+                                }
+                                let Some(d) = dst.uv_to_dir(layer, p) else { continue };
+                                let ds = if rotate { rot.source_of(d) } else { d };
+                                let Some((sl, suv)) = sproj.dir_to_uv(ds) else { continue };
+                                bilinear(&sproj, lv, sl, suv, &mut tmp[..c]);
+                                for k in 0..c {
+                                    acc[k] += wt * tmp[k];
+                                }
+                                wsum += wt;
+                            }
+                        }
+                        if wsum > 0.0 {
+                            for k in 0..c {
+                                out[k] = acc[k] / wsum;
+                            }
+                        } else {
+                            bilinear(&sproj, pyr.level(0), sl, suv, out);
+                        }
+                    }
+                    if scale != 1.0 {
+                        for v in &mut out[..3] {
+                            *v *= scale;
+                        }
+                    }
+                }
+                if let Some(p) = &opts.progress {
+                    p.fetch_add(1, Ordering::Relaxed);
+                }
+            });
+            img
+        })
+        .collect();
+    EnvMap::new(dst, layers).expect("layers built to the projection's shape")
+}

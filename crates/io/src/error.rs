@@ -1,0 +1,71 @@
+//! Errors that say whose fault they are.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Whose fault an [`Error`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// The input file is missing, truncated, corrupt, or uses something we do not decode.
+    Input,
+    /// The request cannot be met (wrong extension for the data, unsupported option).
+    Request,
+    /// The system failed (permissions, disk full).
+    System,
+}
+
+/// A file problem, naming the file.
+#[derive(Debug)]
+pub struct Error {
+    path: PathBuf,
+    fault: Fault,
+    problem: String,
+    source: Option<std::io::Error>,
+}
+
+impl Error {
+    /// The input file's fault.
+    pub fn input(path: &Path, problem: String) -> Error {
+        Error { path: path.to_path_buf(), fault: Fault::Input, problem, source: None }
+    }
+    /// The request's fault.
+    pub fn request(path: &Path, problem: String) -> Error {
+        Error { path: path.to_path_buf(), fault: Fault::Request, problem, source: None }
+    }
+    /// The system's fault, from an I/O error. A missing input file is the input's fault.
+    pub fn io(path: &Path, e: std::io::Error) -> Error {
+        let (fault, problem) = match e.kind() {
+            std::io::ErrorKind::NotFound => (Fault::Input, "no such file".to_string()),
+            std::io::ErrorKind::UnexpectedEof => {
+                (Fault::Input, "file is truncated (unexpected end of file)".to_string())
+            }
+            std::io::ErrorKind::PermissionDenied => (Fault::System, "permission denied".into()),
+            _ => (Fault::System, e.to_string()),
+        };
+        Error { path: path.to_path_buf(), fault, problem, source: Some(e) }
+    }
+    /// Whose fault it is.
+    pub fn fault(&self) -> Fault {
+        self.fault
+    }
+    /// The file concerned.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+    /// What went wrong, without the file name.
+    pub fn problem(&self) -> &str {
+        &self.problem
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.path.display(), self.problem)
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.source.as_ref().map(|e| e as _)
+    }
+}

@@ -1,0 +1,181 @@
+//! Environment-map files for mirrorball: OpenEXR, Radiance HDR, PNG, JPEG (and WebP in),
+//! KTX2 and DDS cube maps. Everything that touches the file system lives here, so the core
+//! crate stays free of I/O.
+//!
+//! Reading gives linear `f32` [`Image`]s (sRGB-encoded 8/16-bit files are decoded to linear
+//! light); writing goes to a temporary file beside the target that is renamed into place, so
+//! a failed write never leaves a half-written output. Every error names the file and says
+//! whose fault it is ([`Fault`]).
+
+mod error;
+mod atomic;
+mod exr_io;
+mod hdr_io;
+mod ldr_io;
+mod ktx2_io;
+mod dds_io;
+
+pub use error::{Error, Fault};
+pub use atomic::atomic_write;
+
+use mirrorball_core::{Image, ProjectionKind};
+use std::path::Path;
+
+/// File formats mirrorball reads and writes, chosen by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// OpenEXR (`.exr`): half or float, any compression the `exr` crate decodes.
+    Exr,
+    /// Radiance RGBE (`.hdr`, `.pic`).
+    Hdr,
+    /// PNG, 8 or 16 bits, sRGB transfer.
+    Png,
+    /// JPEG, 8 bits, sRGB transfer.
+    Jpeg,
+    /// WebP (read only), sRGB transfer.
+    Webp,
+    /// KTX 2.0 cube map (Khronos), RGBA16F or RGBA32F, optional mip chain.
+    Ktx2,
+    /// DirectDraw Surface cube map (DX10 header), RGBA16F or RGBA32F, optional mip chain.
+    Dds,
+}
+
+impl Format {
+    /// The format of `path`'s extension, case-insensitively.
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "exr" => Format::Exr,
+            "hdr" | "pic" | "rgbe" => Format::Hdr,
+            "png" => Format::Png,
+            "jpg" | "jpeg" => Format::Jpeg,
+            "webp" => Format::Webp,
+            "ktx2" => Format::Ktx2,
+            "dds" => Format::Dds,
+            _ => return None,
+        })
+    }
+
+    /// Whether the format holds a whole cube (six faces) in one file.
+    pub fn is_cube_container(self) -> bool {
+        matches!(self, Format::Ktx2 | Format::Dds)
+    }
+}
+
+/// Bounds checked against a file's declared size before anything is allocated.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Largest texel count of one image or face (default 2²⁸ ≈ 268 million: a
+    /// 23170×11585 lat-long).
+    pub max_texels: u64,
+    /// Largest width or height (default 65536).
+    pub max_dimension: u32,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits { max_texels: 1 << 28, max_dimension: 65536 }
+    }
+}
+
+/// Numeric precision of the written texels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Precision {
+    /// 16-bit float (EXR, KTX2, DDS). The default for HDR containers.
+    #[default]
+    Half,
+    /// 32-bit float (EXR, KTX2, DDS).
+    Float,
+    /// 8-bit sRGB-encoded integer (PNG, JPEG).
+    U8,
+    /// 16-bit sRGB-encoded integer (PNG).
+    U16,
+}
+
+/// OpenEXR compression for written files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ExrCompression {
+    /// No compression.
+    None,
+    /// Run-length.
+    Rle,
+    /// zlib, one scan line per block.
+    Zips,
+    /// zlib, 16 scan lines per block (the default).
+    #[default]
+    Zip,
+    /// Wavelet (PIZ).
+    Piz,
+    /// Lossy 24-bit float (PXR24).
+    Pxr24,
+}
+
+/// How to write a file.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WriteOptions {
+    /// Texel precision; `None` picks the format's natural one (half for EXR/KTX2/DDS, 8-bit
+    /// for PNG/JPEG; Radiance HDR is always RGBE).
+    pub precision: Option<Precision>,
+    /// EXR compression.
+    pub exr_compression: ExrCompression,
+    /// JPEG quality 1..=100 (default 92 when 0).
+    pub jpeg_quality: u8,
+}
+
+/// What [`read`] found in a file.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// The pictures: one for flat images; the six cube faces (level 0, OpenGL order) from a
+    /// KTX2 or DDS cube.
+    pub layers: Vec<Image>,
+    /// The projection the file declares, if it does: the EXR `envmap` attribute (latlong or
+    /// cube), or cube for KTX2/DDS cube maps.
+    pub declared: Option<ProjectionKind>,
+    /// The container.
+    pub format: Format,
+    /// A one-line description for people: "OpenEXR, half, ZIP compression, RGB".
+    pub description: String,
+}
+
+/// Reads an image or cube map, checking declared sizes against `limits` before allocating.
+pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+    let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
+    match format {
+        Format::Exr => exr_io::read(path, limits),
+        Format::Hdr => hdr_io::read(path, limits),
+        Format::Png | Format::Jpeg | Format::Webp => ldr_io::read(path, format, limits),
+        Format::Ktx2 => ktx2_io::read(path, limits),
+        Format::Dds => dds_io::read(path, limits),
+    }
+}
+
+/// Writes one flat image (EXR, HDR, PNG or JPEG), atomically.
+pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
+    let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
+    match format {
+        Format::Exr => exr_io::write(path, image, opts),
+        Format::Hdr => hdr_io::write(path, image),
+        Format::Png | Format::Jpeg => ldr_io::write(path, format, image, opts),
+        Format::Webp => Err(Error::request(path, "writing WebP is not supported; use .png".into())),
+        Format::Ktx2 | Format::Dds => Err(Error::request(
+            path,
+            "KTX2 and DDS hold cube maps: convert with --to cube".into(),
+        )),
+    }
+}
+
+/// Writes a cube map with its mip chain to KTX2 or DDS, atomically. `levels[0]` holds the
+/// six level-0 faces in OpenGL order (+X −X +Y −Y +Z −Z), `levels[i]` the faces of level i,
+/// each half the size of the one before (rounded down, at least 1).
+pub fn write_cube(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<(), Error> {
+    let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
+    match format {
+        Format::Ktx2 => ktx2_io::write(path, levels, opts),
+        Format::Dds => dds_io::write(path, levels, opts),
+        _ => Err(Error::request(path, "only .ktx2 and .dds hold a whole cube map".into())),
+    }
+}
+
+fn unknown_ext() -> String {
+    "unknown file extension (known: .exr .hdr .png .jpg .jpeg .webp .ktx2 .dds)".to_string()
+}

@@ -1,0 +1,1 @@
+// cube-container tests (KTX2, DDS)

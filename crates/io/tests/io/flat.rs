@@ -1,0 +1,1 @@
+// flat-image tests (EXR, HDR, PNG, JPEG)

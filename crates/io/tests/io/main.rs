@@ -1,0 +1,3 @@
+//! The mirrorball-io integration tests: one binary, one module per concern.
+mod cube;
+mod flat;
