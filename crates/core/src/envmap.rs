@@ -26,7 +26,10 @@ impl fmt::Display for EnvMapError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             EnvMapError::LayerCount { expected, got } => {
-                write!(f, "the projection has {expected} layers but {got} images were given")
+                write!(
+                    f,
+                    "the projection has {expected} layers but {got} images were given"
+                )
             }
             EnvMapError::Mismatch => f.write_str("layers differ in size or channel count"),
             EnvMapError::Empty => f.write_str("an image has no texels"),
@@ -68,7 +71,10 @@ impl EnvMap {
     pub fn new(projection: Projection, layers: Vec<Image>) -> Result<EnvMap, EnvMapError> {
         let expected = projection.layer_count();
         if layers.len() != expected {
-            return Err(EnvMapError::LayerCount { expected, got: layers.len() });
+            return Err(EnvMapError::LayerCount {
+                expected,
+                got: layers.len(),
+            });
         }
         let first = &layers[0];
         if first.width() == 0 || first.height() == 0 {
@@ -95,8 +101,10 @@ impl EnvMap {
         let layers = (0..projection.layer_count())
             .map(|layer| {
                 let mut img = Image::new(w, h, channels);
-                img.data_mut().par_chunks_mut(w as usize * channels).enumerate().for_each(
-                    |(y, row)| {
+                img.data_mut()
+                    .par_chunks_mut(w as usize * channels)
+                    .enumerate()
+                    .for_each(|(y, row)| {
                         for x in 0..w as usize {
                             let uv = DVec2::new(
                                 (x as f64 + 0.5) / w as f64,
@@ -109,8 +117,7 @@ impl EnvMap {
                             };
                             row[x * channels..(x + 1) * channels].copy_from_slice(&v[..channels]);
                         }
-                    },
-                );
+                    });
                 img
             })
             .collect();
@@ -176,7 +183,11 @@ impl EnvMap {
 
     /// Radiance statistics over the covered texels.
     pub fn stats(&self) -> Stats {
-        let mut s = Stats { min: f32::INFINITY, max: f32::NEG_INFINITY, ..Stats::default() };
+        let mut s = Stats {
+            min: f32::INFINITY,
+            max: f32::NEG_INFINITY,
+            ..Stats::default()
+        };
         let c = self.channels();
         for (layer, img) in self.layers.iter().enumerate() {
             let weights = self.solid_angles(layer);
@@ -237,7 +248,13 @@ impl EnvMap {
 /// Bilinear filtering over `layers` of `proj` at `(layer, uv)`; texel centres at
 /// half-integers.
 #[inline]
-pub(crate) fn bilinear(proj: &Projection, layers: &[Image], layer: usize, uv: DVec2, out: &mut [f32]) {
+pub(crate) fn bilinear(
+    proj: &Projection,
+    layers: &[Image],
+    layer: usize,
+    uv: DVec2,
+    out: &mut [f32],
+) {
     let img = &layers[layer];
     let (w, h) = (img.width(), img.height());
     let c = img.channels();
@@ -246,7 +263,12 @@ pub(crate) fn bilinear(proj: &Projection, layers: &[Image], layer: usize, uv: DV
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
     let (x0, y0) = (x0 as i64, y0 as i64);
-    let weights = [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy];
+    let weights = [
+        (1.0 - fx) * (1.0 - fy),
+        fx * (1.0 - fy),
+        (1.0 - fx) * fy,
+        fx * fy,
+    ];
     for o in out.iter_mut() {
         *o = 0.0;
     }

@@ -26,14 +26,24 @@ impl Image {
     pub fn new(width: u32, height: u32, channels: usize) -> Image {
         assert!(channels == 3 || channels == 4, "channels must be 3 or 4");
         let len = width as usize * height as usize * channels;
-        Image { width, height, channels, data: vec![0.0; len] }
+        Image {
+            width,
+            height,
+            channels,
+            data: vec![0.0; len],
+        }
     }
 
     /// Wraps interleaved texels, checking that the length matches.
     pub fn from_vec(width: u32, height: u32, channels: usize, data: Vec<f32>) -> Option<Image> {
         let ok = (channels == 3 || channels == 4)
             && data.len() == width as usize * height as usize * channels;
-        ok.then_some(Image { width, height, channels, data })
+        ok.then_some(Image {
+            width,
+            height,
+            channels,
+            data,
+        })
     }
 
     /// Width in texels.
@@ -139,7 +149,11 @@ impl Image {
         let (w, h) = (self.width, self.height);
         for y in 0..h {
             for x in 0..w {
-                let (sx, sy) = if horizontal { (w - 1 - x, y) } else { (x, h - 1 - y) };
+                let (sx, sy) = if horizontal {
+                    (w - 1 - x, y)
+                } else {
+                    (x, h - 1 - y)
+                };
                 out.set(x, y, self.get(sx, sy));
             }
         }
@@ -152,7 +166,11 @@ impl Image {
             return self.clone();
         }
         let mut out = Image::new(self.width, self.height, channels);
-        for (d, s) in out.data.chunks_exact_mut(channels).zip(self.data.chunks_exact(self.channels)) {
+        for (d, s) in out
+            .data
+            .chunks_exact_mut(channels)
+            .zip(self.data.chunks_exact(self.channels))
+        {
             d[..3].copy_from_slice(&s[..3]);
             if channels == 4 {
                 d[3] = 1.0;

@@ -35,10 +35,22 @@ pub enum Layout {
 }
 
 /// Cell `(column, row)` of each cube face (OpenGL order) and whether it is turned 180°.
-const HCROSS: [(u32, u32, bool); 6] =
-    [(2, 1, false), (0, 1, false), (1, 0, false), (1, 2, false), (1, 1, false), (3, 1, false)];
-const VCROSS: [(u32, u32, bool); 6] =
-    [(2, 1, false), (0, 1, false), (1, 0, false), (1, 2, false), (1, 1, false), (1, 3, true)];
+const HCROSS: [(u32, u32, bool); 6] = [
+    (2, 1, false),
+    (0, 1, false),
+    (1, 0, false),
+    (1, 2, false),
+    (1, 1, false),
+    (3, 1, false),
+];
+const VCROSS: [(u32, u32, bool); 6] = [
+    (2, 1, false),
+    (0, 1, false),
+    (1, 0, false),
+    (1, 2, false),
+    (1, 1, false),
+    (1, 3, true),
+];
 
 impl Layout {
     /// Every layout.
@@ -99,7 +111,12 @@ impl Layout {
         if layers == 1 {
             return Some((Layout::Separate, w, h));
         }
-        for l in [Layout::HorizontalCross, Layout::VerticalCross, Layout::HorizontalStrip, Layout::VerticalStrip] {
+        for l in [
+            Layout::HorizontalCross,
+            Layout::VerticalCross,
+            Layout::HorizontalStrip,
+            Layout::VerticalStrip,
+        ] {
             if !l.fits(layers) {
                 continue;
             }
@@ -139,7 +156,12 @@ impl Layout {
             return EnvMap::new(projection, vec![image.clone()]).map_err(|e| e.to_string());
         }
         if !self.fits(n) {
-            return Err(format!("layout {} needs 6 layers; {} has {}", self, projection.name(), n));
+            return Err(format!(
+                "layout {} needs 6 layers; {} has {}",
+                self,
+                projection.name(),
+                n
+            ));
         }
         let (gc, gr) = self.grid(n);
         let (w, h) = (image.width(), image.height());
@@ -153,7 +175,9 @@ impl Layout {
         let layers = (0..n)
             .map(|i| {
                 let (col, row, turned) = self.cell(i);
-                let img = image.crop(col * cell, row * cell, cell, cell).expect("in range");
+                let img = image
+                    .crop(col * cell, row * cell, cell, cell)
+                    .expect("in range");
                 if turned {
                     img.rotated_180()
                 } else {
@@ -211,20 +235,40 @@ pub fn guess(w: u32, h: u32, declared: Option<ProjectionKind>) -> Option<Guess> 
         let n = kind.default_projection().layer_count();
         if let Some((layout, _, _)) = Layout::from_extent(w, h, n) {
             let reason = format!("the file declares a {kind} map; {w}x{h} fits {layout}");
-            return Some(Guess { kind, layout, reason });
+            return Some(Guess {
+                kind,
+                layout,
+                reason,
+            });
         }
     }
     let g = |kind, layout, why: &str| {
-        Some(Guess { kind, layout, reason: format!("{w}x{h} is {why}") })
+        Some(Guess {
+            kind,
+            layout,
+            reason: format!("{w}x{h} is {why}"),
+        })
     };
     if w == 2 * h {
-        return g(ProjectionKind::LatLong, Layout::Separate, "2:1, the lat-long shape");
+        return g(
+            ProjectionKind::LatLong,
+            Layout::Separate,
+            "2:1, the lat-long shape",
+        );
     }
     if let Some((layout, _, _)) = Layout::from_extent(w, h, 6) {
-        return g(ProjectionKind::Cube, layout, &format!("the shape of a cube {layout}"));
+        return g(
+            ProjectionKind::Cube,
+            layout,
+            &format!("the shape of a cube {layout}"),
+        );
     }
     if w == h {
-        return g(ProjectionKind::Sphere, Layout::Separate, "square, taken as a sphere map (mirror ball)");
+        return g(
+            ProjectionKind::Sphere,
+            Layout::Separate,
+            "square, taken as a sphere map (mirror ball)",
+        );
     }
     None
 }

@@ -26,9 +26,9 @@ pub use envmap::{EnvMap, EnvMapError, Stats};
 pub use image::Image;
 pub use layout::{guess, Guess, Layout};
 pub use projection::{
-    AngularMap, ContinuousCube, CubeFace, CubeMap, DualParaboloid, EqualAreaOctahedral,
-    Fisheye, Frame, LatLong, Lens, Mercator, Octahedral, Projection, ProjectionKind,
-    RadialMap, SphereMap, UnknownProjection, WorldProjection,
+    AngularMap, ContinuousCube, CubeFace, CubeMap, DualParaboloid, EqualAreaOctahedral, Fisheye,
+    Frame, LatLong, Lens, Mercator, Octahedral, Projection, ProjectionKind, RadialMap, SphereMap,
+    UnknownProjection, WorldProjection,
 };
 pub use resample::{resample, resample_to_extent, ResampleOptions, Rotation};
 

@@ -30,7 +30,9 @@ pub struct Rotation {
 
 impl Default for Rotation {
     fn default() -> Self {
-        Rotation { to_source: DMat3::IDENTITY }
+        Rotation {
+            to_source: DMat3::IDENTITY,
+        }
     }
 }
 
@@ -50,7 +52,9 @@ impl Rotation {
         let m = DMat3::from_rotation_y(yaw.to_radians())
             * DMat3::from_rotation_x(pitch.to_radians())
             * DMat3::from_rotation_z(-roll.to_radians());
-        Rotation { to_source: m.transpose() }
+        Rotation {
+            to_source: m.transpose(),
+        }
     }
 
     /// A general orthogonal transform (forward: source direction → output direction).
@@ -60,7 +64,9 @@ impl Rotation {
         if e.iter().any(|v| v.abs() > 1e-6 || !v.is_finite()) {
             return None;
         }
-        Some(Rotation { to_source: m.transpose() })
+        Some(Rotation {
+            to_source: m.transpose(),
+        })
     }
 
     /// Mirrors the environment across the plane through the origin normal to `axis`
@@ -68,12 +74,16 @@ impl Rotation {
     pub fn mirror(axis: usize) -> Rotation {
         let mut d = DVec3::ONE;
         d[axis.min(2)] = -1.0;
-        Rotation { to_source: DMat3::from_diagonal(d) }
+        Rotation {
+            to_source: DMat3::from_diagonal(d),
+        }
     }
 
     /// First `self`, then `then`.
     pub fn then(self, then: Rotation) -> Rotation {
-        Rotation { to_source: self.to_source * then.to_source }
+        Rotation {
+            to_source: self.to_source * then.to_source,
+        }
     }
 
     /// The source direction seen at output direction `d`.
@@ -104,7 +114,12 @@ pub struct ResampleOptions {
 
 impl Default for ResampleOptions {
     fn default() -> Self {
-        ResampleOptions { rotation: Rotation::default(), exposure: 0.0, max_samples: 4, progress: None }
+        ResampleOptions {
+            rotation: Rotation::default(),
+            exposure: 0.0,
+            max_samples: 4,
+            progress: None,
+        }
     }
 }
 
@@ -132,7 +147,10 @@ impl<'a> Pyramid<'a> {
                 .collect();
             levels.push(next);
         }
-        Pyramid { base: src.layers(), levels }
+        Pyramid {
+            base: src.layers(),
+            levels,
+        }
     }
 
     #[inline]
@@ -156,27 +174,31 @@ fn downsample(proj: &Projection, layer: usize, img: &Image) -> Image {
     let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
     let c = img.channels();
     let mut out = Image::new(nw, nh, c);
-    out.data_mut().par_chunks_mut(nw as usize * c).enumerate().for_each(|(y, row)| {
-        let ys = [(2 * y as u32).min(h - 1), (2 * y as u32 + 1).min(h - 1)];
-        for x in 0..nw as usize {
-            let xs = [(2 * x as u32).min(w - 1), (2 * x as u32 + 1).min(w - 1)];
-            let mut acc = [0.0f64; 4];
-            let mut wsum = 0.0;
-            for &sy in &ys {
-                for &sx in &xs {
-                    let uv = DVec2::new((sx as f64 + 0.5) / w as f64, (sy as f64 + 0.5) / h as f64);
-                    let wt = proj.density(layer, uv).max(1e-12);
-                    for (a, v) in acc.iter_mut().zip(img.get(sx, sy)) {
-                        *a += wt * *v as f64;
+    out.data_mut()
+        .par_chunks_mut(nw as usize * c)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let ys = [(2 * y as u32).min(h - 1), (2 * y as u32 + 1).min(h - 1)];
+            for x in 0..nw as usize {
+                let xs = [(2 * x as u32).min(w - 1), (2 * x as u32 + 1).min(w - 1)];
+                let mut acc = [0.0f64; 4];
+                let mut wsum = 0.0;
+                for &sy in &ys {
+                    for &sx in &xs {
+                        let uv =
+                            DVec2::new((sx as f64 + 0.5) / w as f64, (sy as f64 + 0.5) / h as f64);
+                        let wt = proj.density(layer, uv).max(1e-12);
+                        for (a, v) in acc.iter_mut().zip(img.get(sx, sy)) {
+                            *a += wt * *v as f64;
+                        }
+                        wsum += wt;
                     }
-                    wsum += wt;
+                }
+                for i in 0..c {
+                    row[x * c + i] = (acc[i] / wsum) as f32;
                 }
             }
-            for i in 0..c {
-                row[x * c + i] = (acc[i] / wsum) as f32;
-            }
-        }
-    });
+        });
     out
 }
 
@@ -188,7 +210,13 @@ pub fn resample(src: &EnvMap, dst: Projection, size: u32, opts: &ResampleOptions
 }
 
 /// Converts `src` into projection `dst` with layers of `w`×`h` texels.
-pub fn resample_to_extent(src: &EnvMap, dst: Projection, w: u32, h: u32, opts: &ResampleOptions) -> EnvMap {
+pub fn resample_to_extent(
+    src: &EnvMap,
+    dst: Projection,
+    w: u32,
+    h: u32,
+    opts: &ResampleOptions,
+) -> EnvMap {
     let max_n = opts.max_samples.clamp(1, 16);
     let levels_needed = if max_n > 1 { 16 } else { 0 };
     let pyr = Pyramid::new(src, levels_needed);
@@ -202,77 +230,90 @@ pub fn resample_to_extent(src: &EnvMap, dst: Projection, w: u32, h: u32, opts: &
     let layers = (0..dst.layer_count())
         .map(|layer| {
             let mut img = Image::new(w, h, c);
-            img.data_mut().par_chunks_mut(w as usize * c).enumerate().for_each(|(y, row)| {
-                let mut acc = [0.0f32; 4];
-                let mut tmp = [0.0f32; 4];
-                for x in 0..w as usize {
-                    let out = &mut row[x * c..(x + 1) * c];
-                    let uv0 = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-                    let uv = dst.nearest_covered(layer, uv0);
-                    let Some(d) = dst.uv_to_dir(layer, uv) else { continue };
-                    let ds = if rotate { rot.source_of(d) } else { d };
-                    let Some((sl, suv)) = sproj.dir_to_uv(ds) else { continue };
-                    let sdens = sproj.density(sl, suv);
-                    let ddens = dst.density(layer, uv);
-                    let ratio = if sdens > 0.0 {
-                        (ddens * dst_texel_area) / (sdens * src_texel_area)
-                    } else {
-                        f64::INFINITY
-                    };
-                    if ratio < BILINEAR_MAX_RATIO || max_n == 1 || uv != uv0 {
-                        bilinear(&sproj, pyr.level(0), sl, suv, out);
-                    } else {
-                        // Integrate: n×n points, on a mip level where each stands for about
-                        // one source texel.
-                        let cap = (max_n * max_n) as f64;
-                        let level = if ratio > cap {
-                            (((ratio / cap).log2() * 0.5).ceil() as usize).min(pyr.level_count() - 1)
-                        } else {
-                            0
+            img.data_mut()
+                .par_chunks_mut(w as usize * c)
+                .enumerate()
+                .for_each(|(y, row)| {
+                    let mut acc = [0.0f32; 4];
+                    let mut tmp = [0.0f32; 4];
+                    for x in 0..w as usize {
+                        let out = &mut row[x * c..(x + 1) * c];
+                        let uv0 =
+                            DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                        let uv = dst.nearest_covered(layer, uv0);
+                        let Some(d) = dst.uv_to_dir(layer, uv) else {
+                            continue;
                         };
-                        let r_l = ratio / 4f64.powi(level as i32);
-                        let n = (r_l.sqrt().round() as u32).clamp(1, max_n);
-                        let lv = pyr.level(level);
-                        acc[..c].fill(0.0);
-                        let mut wsum = 0.0f32;
-                        let inv = 1.0 / n as f64;
-                        for j in 0..n {
-                            let v = (y as f64 + (j as f64 + 0.5) * inv) / h as f64;
-                            for i in 0..n {
-                                let u = (x as f64 + (i as f64 + 0.5) * inv) / w as f64;
-                                let p = DVec2::new(u, v);
-                                let wt = dst.density(layer, p) as f32;
-                                if wt <= 0.0 {
-                                    continue;
-                                }
-                                let Some(d) = dst.uv_to_dir(layer, p) else { continue };
-                                let ds = if rotate { rot.source_of(d) } else { d };
-                                let Some((sl, suv)) = sproj.dir_to_uv(ds) else { continue };
-                                bilinear(&sproj, lv, sl, suv, &mut tmp[..c]);
-                                for k in 0..c {
-                                    acc[k] += wt * tmp[k];
-                                }
-                                wsum += wt;
-                            }
-                        }
-                        if wsum > 0.0 {
-                            for k in 0..c {
-                                out[k] = acc[k] / wsum;
-                            }
+                        let ds = if rotate { rot.source_of(d) } else { d };
+                        let Some((sl, suv)) = sproj.dir_to_uv(ds) else {
+                            continue;
+                        };
+                        let sdens = sproj.density(sl, suv);
+                        let ddens = dst.density(layer, uv);
+                        let ratio = if sdens > 0.0 {
+                            (ddens * dst_texel_area) / (sdens * src_texel_area)
                         } else {
+                            f64::INFINITY
+                        };
+                        if ratio < BILINEAR_MAX_RATIO || max_n == 1 || uv != uv0 {
                             bilinear(&sproj, pyr.level(0), sl, suv, out);
+                        } else {
+                            // Integrate: n×n points, on a mip level where each stands for about
+                            // one source texel.
+                            let cap = (max_n * max_n) as f64;
+                            let level = if ratio > cap {
+                                (((ratio / cap).log2() * 0.5).ceil() as usize)
+                                    .min(pyr.level_count() - 1)
+                            } else {
+                                0
+                            };
+                            let r_l = ratio / 4f64.powi(level as i32);
+                            let n = (r_l.sqrt().round() as u32).clamp(1, max_n);
+                            let lv = pyr.level(level);
+                            acc[..c].fill(0.0);
+                            let mut wsum = 0.0f32;
+                            let inv = 1.0 / n as f64;
+                            for j in 0..n {
+                                let v = (y as f64 + (j as f64 + 0.5) * inv) / h as f64;
+                                for i in 0..n {
+                                    let u = (x as f64 + (i as f64 + 0.5) * inv) / w as f64;
+                                    let p = DVec2::new(u, v);
+                                    let wt = dst.density(layer, p) as f32;
+                                    if wt <= 0.0 {
+                                        continue;
+                                    }
+                                    let Some(d) = dst.uv_to_dir(layer, p) else {
+                                        continue;
+                                    };
+                                    let ds = if rotate { rot.source_of(d) } else { d };
+                                    let Some((sl, suv)) = sproj.dir_to_uv(ds) else {
+                                        continue;
+                                    };
+                                    bilinear(&sproj, lv, sl, suv, &mut tmp[..c]);
+                                    for k in 0..c {
+                                        acc[k] += wt * tmp[k];
+                                    }
+                                    wsum += wt;
+                                }
+                            }
+                            if wsum > 0.0 {
+                                for k in 0..c {
+                                    out[k] = acc[k] / wsum;
+                                }
+                            } else {
+                                bilinear(&sproj, pyr.level(0), sl, suv, out);
+                            }
+                        }
+                        if scale != 1.0 {
+                            for v in &mut out[..3] {
+                                *v *= scale;
+                            }
                         }
                     }
-                    if scale != 1.0 {
-                        for v in &mut out[..3] {
-                            *v *= scale;
-                        }
+                    if let Some(p) = &opts.progress {
+                        p.fetch_add(1, Ordering::Relaxed);
                     }
-                }
-                if let Some(p) = &opts.progress {
-                    p.fetch_add(1, Ordering::Relaxed);
-                }
-            });
+                });
             img
         })
         .collect();

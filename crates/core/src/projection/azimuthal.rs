@@ -34,7 +34,11 @@ pub struct Frame {
 impl Default for Frame {
     /// Looking along −Z with +Y up and +X to the right, as an OpenGL camera does.
     fn default() -> Self {
-        Frame { right: DVec3::X, up: DVec3::Y, forward: DVec3::NEG_Z }
+        Frame {
+            right: DVec3::X,
+            up: DVec3::Y,
+            forward: DVec3::NEG_Z,
+        }
     }
 }
 
@@ -51,10 +55,18 @@ impl Frame {
     /// ```
     pub fn looking_along(forward: DVec3) -> Option<Frame> {
         let f = forward.try_normalize()?;
-        let hint = if f.y.abs() > 1.0 - 1e-9 { DVec3::new(0.0, 0.0, f.y.signum()) } else { DVec3::Y };
+        let hint = if f.y.abs() > 1.0 - 1e-9 {
+            DVec3::new(0.0, 0.0, f.y.signum())
+        } else {
+            DVec3::Y
+        };
         let right = f.cross(hint).normalize();
         let up = right.cross(f);
-        Some(Frame { right, up, forward: f })
+        Some(Frame {
+            right,
+            up,
+            forward: f,
+        })
     }
 
     /// `(right·d, up·d, forward·d)`.
@@ -65,7 +77,11 @@ impl Frame {
 
     /// The same frame turned half a turn about its up axis (looking backwards).
     pub fn turned_around(&self) -> Frame {
-        Frame { right: -self.right, up: self.up, forward: -self.forward }
+        Frame {
+            right: -self.right,
+            up: self.up,
+            forward: -self.forward,
+        }
     }
 }
 
@@ -127,7 +143,12 @@ impl RadialMap {
             Lens::Stereographic => (0.5 * theta_max).tan(),
             Lens::Orthographic => theta_max.sin(),
         };
-        Some(RadialMap { frame, lens, theta_max, k })
+        Some(RadialMap {
+            frame,
+            lens,
+            theta_max,
+            k,
+        })
     }
 
     /// The frame.
@@ -295,7 +316,11 @@ impl RadialMap {
             return 0.0; // radial segment: ψ is constant
         }
         // Split at the rim: |p0 + t e|² = 1.
-        let (qa, qb, qc) = (e.length_squared(), 2.0 * p0.dot(e), p0.length_squared() - 1.0);
+        let (qa, qb, qc) = (
+            e.length_squared(),
+            2.0 * p0.dot(e),
+            p0.length_squared() - 1.0,
+        );
         let mut cuts = [0.0, 1.0, 1.0, 1.0];
         let mut n = 1;
         let disc = qb * qb - 4.0 * qa * qc;
@@ -409,8 +434,15 @@ impl SphereMap {
     /// The sphere map seen by a camera with frame `eye` (its `forward` is the view
     /// direction).
     pub fn new(eye: Frame) -> SphereMap {
-        let centre = Frame { right: eye.right, up: eye.up, forward: -eye.forward };
-        SphereMap { eye, map: RadialMap::new(centre, Lens::Equisolid, PI).expect("valid") }
+        let centre = Frame {
+            right: eye.right,
+            up: eye.up,
+            forward: -eye.forward,
+        };
+        SphereMap {
+            eye,
+            map: RadialMap::new(centre, Lens::Equisolid, PI).expect("valid"),
+        }
     }
 
     /// The camera frame the map was taken with.
@@ -444,7 +476,9 @@ impl Default for AngularMap {
 impl AngularMap {
     /// An angular map looking along `frame.forward`.
     pub fn new(frame: Frame) -> AngularMap {
-        AngularMap { map: RadialMap::new(frame, Lens::Equidistant, PI).expect("valid") }
+        AngularMap {
+            map: RadialMap::new(frame, Lens::Equidistant, PI).expect("valid"),
+        }
     }
     /// The underlying disk map.
     pub fn radial(&self) -> &RadialMap {
@@ -509,8 +543,8 @@ impl DualParaboloid {
     /// A dual paraboloid whose front half looks along `frame.forward`.
     pub fn new(frame: Frame) -> DualParaboloid {
         let front = RadialMap::new(frame, Lens::Stereographic, FRAC_PI_2).expect("valid");
-        let back = RadialMap::new(frame.turned_around(), Lens::Stereographic, FRAC_PI_2)
-            .expect("valid");
+        let back =
+            RadialMap::new(frame.turned_around(), Lens::Stereographic, FRAC_PI_2).expect("valid");
         DualParaboloid { front, back }
     }
 
@@ -533,8 +567,14 @@ impl WorldProjection for DualParaboloid {
     }
     #[inline]
     fn dir_to_uv(&self, d: DVec3) -> Option<(usize, DVec2)> {
-        let layer = if self.front.frame.forward.dot(d) >= 0.0 { 0 } else { 1 };
-        self.half(layer).dir_to_ab(d).map(|ab| (layer, RadialMap::ab_to_uv(ab)))
+        let layer = if self.front.frame.forward.dot(d) >= 0.0 {
+            0
+        } else {
+            1
+        };
+        self.half(layer)
+            .dir_to_ab(d)
+            .map(|ab| (layer, RadialMap::ab_to_uv(ab)))
     }
     #[inline]
     fn uv_to_dir(&self, layer: usize, uv: DVec2) -> Option<DVec3> {
@@ -545,7 +585,9 @@ impl WorldProjection for DualParaboloid {
     }
     #[inline]
     fn density(&self, layer: usize, uv: DVec2) -> f64 {
-        4.0 * self.half(layer).area_density_ab(RadialMap::uv_to_ab(uv).length())
+        4.0 * self
+            .half(layer)
+            .area_density_ab(RadialMap::uv_to_ab(uv).length())
     }
     fn texel_solid_angle(&self, layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
         let (u0, u1) = texel_range(x, w);
@@ -558,12 +600,18 @@ impl WorldProjection for DualParaboloid {
     fn wrap_texel(&self, layer: usize, x: i64, y: i64, w: u32, h: u32) -> (usize, u32, u32) {
         // Past the rim the paraboloid formula continues into the other hemisphere.
         let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-        let d = self.half(layer.min(1)).ab_to_dir(RadialMap::uv_to_ab(uv), true);
+        let d = self
+            .half(layer.min(1))
+            .ab_to_dir(RadialMap::uv_to_ab(uv), true);
         if let Some((l, t)) = d.and_then(|d| self.dir_to_uv(d)) {
             let tx = ((t.x * w as f64) as i64).clamp(0, w as i64 - 1);
             let ty = ((t.y * h as f64) as i64).clamp(0, h as i64 - 1);
             return (l, tx as u32, ty as u32);
         }
-        (layer, x.clamp(0, w as i64 - 1) as u32, y.clamp(0, h as i64 - 1) as u32)
+        (
+            layer,
+            x.clamp(0, w as i64 - 1) as u32,
+            y.clamp(0, h as i64 - 1) as u32,
+        )
     }
 }

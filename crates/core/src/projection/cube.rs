@@ -139,7 +139,12 @@ impl WorldProjection for CubeMap {
     fn texel_solid_angle(&self, _layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
         let (u0, u1) = texel_range(x, w);
         let (v0, v1) = texel_range(y, h);
-        let (a0, a1, b0, b1) = (2.0 * u0 - 1.0, 2.0 * u1 - 1.0, 2.0 * v0 - 1.0, 2.0 * v1 - 1.0);
+        let (a0, a1, b0, b1) = (
+            2.0 * u0 - 1.0,
+            2.0 * u1 - 1.0,
+            2.0 * v0 - 1.0,
+            2.0 * v1 - 1.0,
+        );
         cube_area(a1, b1) - cube_area(a0, b1) - cube_area(a1, b0) + cube_area(a0, b0)
     }
 }

@@ -123,11 +123,17 @@ impl Mercator {
             return None;
         }
         let max_lat = max_lat_deg.to_radians();
-        Some(Mercator { max_lat, y_max: max_lat.sin().atanh() })
+        Some(Mercator {
+            max_lat,
+            y_max: max_lat.sin().atanh(),
+        })
     }
 
     fn with_ordinate_limit(y_max: f64) -> Mercator {
-        Mercator { max_lat: y_max.sinh().atan(), y_max }
+        Mercator {
+            max_lat: y_max.sinh().atan(),
+            y_max,
+        }
     }
 
     /// The latitude limit in degrees.

@@ -76,7 +76,11 @@ pub trait WorldProjection {
             let ty = ((t.y * h as f64).floor() as i64).clamp(0, h as i64 - 1);
             return (l, tx as u32, ty as u32);
         }
-        (layer, x.clamp(0, w as i64 - 1) as u32, y.clamp(0, h as i64 - 1) as u32)
+        (
+            layer,
+            x.clamp(0, w as i64 - 1) as u32,
+            y.clamp(0, h as i64 - 1) as u32,
+        )
     }
 }
 
@@ -168,7 +172,12 @@ pub struct UnknownProjection(pub String);
 impl fmt::Display for UnknownProjection {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let names: Vec<&str> = ProjectionKind::ALL.iter().map(|k| k.name()).collect();
-        write!(f, "unknown projection '{}' (known: {})", self.0, names.join(", "))
+        write!(
+            f,
+            "unknown projection '{}' (known: {})",
+            self.0,
+            names.join(", ")
+        )
     }
 }
 

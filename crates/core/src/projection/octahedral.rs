@@ -38,7 +38,11 @@ fn octa_point(ab: DVec2) -> DVec3 {
     if y >= 0.0 {
         DVec3::new(ab.x, y, ab.y)
     } else {
-        DVec3::new((1.0 - ab.y.abs()) * sgn(ab.x), y, (1.0 - ab.x.abs()) * sgn(ab.y))
+        DVec3::new(
+            (1.0 - ab.y.abs()) * sgn(ab.x),
+            y,
+            (1.0 - ab.x.abs()) * sgn(ab.y),
+        )
     }
 }
 
@@ -141,7 +145,11 @@ impl WorldProjection for Octahedral {
         for sa in [-1.0, 1.0] {
             for sb in [-1.0, 1.0] {
                 // Quadrant sa·a ≥ 0, sb·b ≥ 0.
-                let q = clip(&clip(&rect, DVec2::new(-sa, 0.0), 0.0), DVec2::new(0.0, -sb), 0.0);
+                let q = clip(
+                    &clip(&rect, DVec2::new(-sa, 0.0), 0.0),
+                    DVec2::new(0.0, -sb),
+                    0.0,
+                );
                 if q.len() < 3 {
                     continue;
                 }
@@ -192,7 +200,11 @@ impl WorldProjection for EqualAreaOctahedral {
         let phi = d.z.abs().atan2(d.x.abs());
         let bb = r * phi / FRAC_PI_2;
         let aa = r - bb;
-        let (aa, bb) = if d.y >= 0.0 { (aa, bb) } else { (1.0 - bb, 1.0 - aa) };
+        let (aa, bb) = if d.y >= 0.0 {
+            (aa, bb)
+        } else {
+            (1.0 - bb, 1.0 - aa)
+        };
         Some((0, ab_to_uv(DVec2::new(aa * sgn(d.x), bb * sgn(d.z)))))
     }
     #[inline]
@@ -204,7 +216,11 @@ impl WorldProjection for EqualAreaOctahedral {
         }
         let dd = 1.0 - (aa + bb);
         let r = 1.0 - dd.abs();
-        let phi = if r == 0.0 { PI / 4.0 } else { ((bb - aa) / r + 1.0) * PI / 4.0 };
+        let phi = if r == 0.0 {
+            PI / 4.0
+        } else {
+            ((bb - aa) / r + 1.0) * PI / 4.0
+        };
         let y = sgn(dd) * (1.0 - r * r);
         let s = r * (2.0 - r * r).max(0.0).sqrt();
         let (sp, cp) = phi.sin_cos();

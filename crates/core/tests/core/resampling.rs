@@ -1,0 +1,209 @@
+//! Conversion quality: accuracy on smooth environments, no aliasing when shrinking, no seams
+//! when growing, rotations that turn the right way.
+use glam::{DVec2, DVec3};
+use mirrorball_core::{
+    resample, EnvMap, Projection, ProjectionKind, ResampleOptions, Rotation, WorldProjection,
+};
+
+fn smooth(d: DVec3) -> [f32; 4] {
+    let v = 1.0 + 0.5 * d.x + 0.25 * d.y * d.z + 0.3 * (3.0 * d.y).sin();
+    [v as f32, (2.0 - d.y) as f32, (1.5 + d.z * d.x) as f32, 1.0]
+}
+
+/// Solid-angle-weighted RMS error of `e` against the analytic `f`, relative to the mean.
+fn rel_rms(e: &EnvMap, f: impl Fn(DVec3) -> [f32; 4]) -> f64 {
+    rel_rms_where(e, f, |_| true)
+}
+
+/// [`rel_rms`] over the directions where `keep` holds.
+fn rel_rms_where(e: &EnvMap, f: impl Fn(DVec3) -> [f32; 4], keep: impl Fn(DVec3) -> bool) -> f64 {
+    let p = *e.projection();
+    let (w, h) = (e.width(), e.height());
+    let (mut err, mut norm, mut wsum) = (0.0, 0.0, 0.0);
+    for (layer, img) in e.layers().iter().enumerate() {
+        for y in 0..h {
+            for x in 0..w {
+                let sa = p.texel_solid_angle(layer, x, y, w, h);
+                let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                if sa <= 0.0 {
+                    continue;
+                }
+                let Some(d) = p.uv_to_dir(layer, uv) else {
+                    continue;
+                };
+                if !keep(d) {
+                    continue;
+                }
+                let want = f(d);
+                for c in 0..3 {
+                    let diff = img.get(x, y)[c] as f64 - want[c] as f64;
+                    err += sa * diff * diff;
+                    norm += sa * (want[c] as f64).powi(2);
+                }
+                wsum += sa;
+            }
+        }
+    }
+    let _ = wsum;
+    (err / norm).sqrt()
+}
+
+#[test]
+fn every_projection_converts_a_smooth_environment_accurately() {
+    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 512, 3, smooth);
+    for kind in ProjectionKind::ALL {
+        let dst = kind.default_projection();
+        let out = resample(&src, dst, 128, &ResampleOptions::default());
+        let e = rel_rms(&out, smooth);
+        eprintln!("{kind}: {e:.2e}");
+        assert!(e < 4e-3, "{kind}: relative RMS {e}");
+        // And back to lat-long.
+        let back = resample(
+            &out,
+            src.projection().to_owned(),
+            256,
+            &ResampleOptions::default(),
+        );
+        // Only where the intermediate projection covers (Mercator stops short of the poles).
+        let e2 = rel_rms_where(&back, smooth, |d| dst.dir_to_uv(d).is_some());
+        eprintln!("{kind} round trip: {e2:.2e}");
+        assert!(e2 < 5e-3, "{kind} round trip: relative RMS {e2}");
+    }
+}
+
+/// A zone plate: rings whose frequency grows away from +Y, far above what a 16² cube face
+/// can hold. Integrated, each output texel is close to the mean (0.5); point-sampled, it
+/// aliases into large errors.
+#[test]
+fn shrinking_a_zone_plate_does_not_alias() {
+    let zone = |d: DVec3| {
+        let t = d.y.clamp(-1.0, 1.0).acos();
+        let v = 0.5 + 0.5 * (200.0 * t * t).cos();
+        [v as f32, v as f32, v as f32, 1.0]
+    };
+    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 4096, 3, zone);
+    let cube = ProjectionKind::Cube.default_projection();
+    let dev = |e: &EnvMap| {
+        let mut m: f64 = 0.0;
+        for (layer, img) in e.layers().iter().enumerate() {
+            for y in 0..e.height() {
+                for x in 0..e.width() {
+                    // Skip the +Y face's centre where the rings are still resolvable.
+                    let uv = DVec2::new((x as f64 + 0.5) / 16.0, (y as f64 + 0.5) / 16.0);
+                    let d = cube.uv_to_dir(layer, uv).unwrap();
+                    if d.y.acos() < 0.6 {
+                        continue;
+                    }
+                    m = m.max((img.get(x, y)[0] as f64 - 0.5).abs());
+                }
+            }
+        }
+        m
+    };
+    let good = resample(&src, cube, 16, &ResampleOptions::default());
+    let point = resample(
+        &src,
+        cube,
+        16,
+        &ResampleOptions {
+            max_samples: 1,
+            ..Default::default()
+        },
+    );
+    let (g, p) = (dev(&good), dev(&point));
+    assert!(g < 0.1, "antialiased deviation {g}");
+    assert!(
+        p > 0.3,
+        "point sampling should alias (deviation {p}): the test must be able to fail"
+    );
+}
+
+/// Growing a small map: the values across every cube edge change no more than inside faces.
+#[test]
+fn growing_leaves_no_seams() {
+    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 64, 3, smooth);
+    for kind in [ProjectionKind::Cube, ProjectionKind::ContinuousCube] {
+        let out = resample(
+            &src,
+            kind.default_projection(),
+            128,
+            &ResampleOptions::default(),
+        );
+        let p = *out.projection();
+        let n = out.width();
+        // Compare each border texel with its neighbour across the edge (via wrap_texel) and
+        // with its neighbour inside the face.
+        let (mut across, mut inside) = (0.0f32, 0.0f32);
+        for layer in 0..6 {
+            for k in 0..n {
+                for (x, y, ox, oy, ix, iy) in [
+                    (0, k, -1i64, k as i64, 1, k),
+                    (n - 1, k, n as i64, k as i64, n - 2, k),
+                    (k, 0, k as i64, -1, k, 1),
+                    (k, n - 1, k as i64, n as i64, k, n - 2),
+                ] {
+                    let v = out.layers()[layer].get(x, y)[0];
+                    let (l2, x2, y2) = p.wrap_texel(layer, ox, oy, n, n);
+                    across = across.max((v - out.layers()[l2].get(x2, y2)[0]).abs());
+                    inside = inside.max((v - out.layers()[layer].get(ix, iy)[0]).abs());
+                }
+            }
+        }
+        assert!(
+            across < 2.0 * inside,
+            "{kind}: across edges {across}, inside {inside}"
+        );
+    }
+}
+
+#[test]
+fn rotation_and_exposure() {
+    // A single bright region straight ahead (-Z).
+    let spot = |d: DVec3| {
+        let v = if d.dot(DVec3::NEG_Z) > 0.95 { 1.0 } else { 0.0 };
+        [v, v, v, 1.0]
+    };
+    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 256, 3, spot);
+    let opts = ResampleOptions {
+        rotation: Rotation::from_euler_deg(90.0, 0.0, 0.0),
+        exposure: 1.0,
+        ..Default::default()
+    };
+    let out = resample(&src, Projection::from(mirrorball_core::CubeMap), 32, &opts);
+    // Yaw 90° turns what was ahead to the left: -X, with exposure +1 stop doubling it.
+    let at = |d: DVec3| out.sample(d)[0];
+    assert!(
+        (at(DVec3::NEG_X) - 2.0).abs() < 1e-3,
+        "{}",
+        at(DVec3::NEG_X)
+    );
+    assert!(at(DVec3::NEG_Z).abs() < 1e-6);
+    // Mirroring z puts it behind.
+    let m = resample(
+        &src,
+        Projection::from(mirrorball_core::CubeMap),
+        32,
+        &ResampleOptions {
+            rotation: Rotation::mirror(2),
+            ..Default::default()
+        },
+    );
+    assert!((m.sample(DVec3::Z)[0] - 1.0).abs() < 1e-3 && m.sample(DVec3::NEG_Z)[0].abs() < 1e-6);
+}
+
+#[test]
+fn env_map_refuses_wrong_layer_counts() {
+    let img = mirrorball_core::Image::new(4, 4, 3);
+    let err = EnvMap::new(
+        ProjectionKind::Cube.default_projection(),
+        vec![img.clone(); 5],
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("6 layers"));
+    let other = mirrorball_core::Image::new(4, 5, 3);
+    assert!(EnvMap::new(
+        ProjectionKind::Paraboloid.default_projection(),
+        vec![img, other]
+    )
+    .is_err());
+}
