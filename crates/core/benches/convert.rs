@@ -1,1 +1,53 @@
-fn main() {}
+//! `cargo bench -p mirrorball-core`: conversion throughput in memory.
+//!
+//! The headline case of BENCHMARKS.md: a 4096×2048 float RGB lat-long to a 6×1024² cube and
+//! back. The source is a synthetic environment with detail at every scale (the bench/
+//! scripts run the same conversion on a real HDR beside OpenCV).
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
+use std::hint::black_box;
+
+fn source() -> EnvMap {
+    EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 4096, 3, |d| {
+        let v = 1.0 + (40.0 * d.x).sin() * (30.0 * d.y).cos() + (d.z * 200.0).sin().abs();
+        [v as f32, (2.0 * v) as f32, (1.0 + d.y) as f32, 1.0]
+    })
+}
+
+fn bench(c: &mut Criterion) {
+    let src = source();
+    let cube = ProjectionKind::Cube.default_projection();
+    let latlong = ProjectionKind::LatLong.default_projection();
+    let opts = ResampleOptions::default();
+    let mut g = c.benchmark_group("latlong4096_cube1024");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(6 * 1024 * 1024));
+    g.bench_function("forward", |b| {
+        b.iter(|| black_box(resample(&src, cube, 1024, &opts)))
+    });
+    let faces = resample(&src, cube, 1024, &opts);
+    g.throughput(Throughput::Elements(4096 * 2048));
+    g.bench_function("back", |b| {
+        b.iter(|| black_box(resample(&faces, latlong, 4096, &opts)))
+    });
+    g.finish();
+
+    let mut g = c.benchmark_group("every_projection_from_latlong4096");
+    g.sample_size(10);
+    for kind in ProjectionKind::ALL {
+        let p = kind.default_projection();
+        let size = match kind {
+            ProjectionKind::LatLong | ProjectionKind::Mercator => 2048,
+            ProjectionKind::Cube | ProjectionKind::ContinuousCube => 512,
+            _ => 1024,
+        };
+        g.bench_function(kind.name(), |b| {
+            b.iter(|| black_box(resample(&src, p, size, &opts)))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

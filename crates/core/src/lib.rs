@@ -19,6 +19,7 @@
 mod envmap;
 mod image;
 pub mod layout;
+pub mod metrics;
 pub mod projection;
 mod resample;
 

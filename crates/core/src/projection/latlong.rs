@@ -129,6 +129,12 @@ impl Mercator {
         })
     }
 
+    /// The Mercator map whose picture has this width and height (the aspect ratio fixes the
+    /// latitude limit: `Y_max = π h / w`), or `None` for a zero size.
+    pub fn from_extent(w: u32, h: u32) -> Option<Mercator> {
+        (w > 0 && h > 0).then(|| Mercator::with_ordinate_limit(PI * h as f64 / w as f64))
+    }
+
     fn with_ordinate_limit(y_max: f64) -> Mercator {
         Mercator {
             max_lat: y_max.sinh().atan(),

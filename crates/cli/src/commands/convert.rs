@@ -1,0 +1,207 @@
+//! `mirrorball convert`: any projection, size, layout or container to any other.
+
+use super::InputPlan;
+use crate::error::CliError;
+use crate::progress::with_progress;
+use crate::save::{self, SaveOptions};
+use crate::spec::{bad, ProjSpec};
+use crate::{load, ConvertArgs};
+use mirrorball_core::{resample, Layout, ResampleOptions, Rotation, WorldProjection};
+use mirrorball_io::{ExrCompression, Format, Precision, WriteOptions};
+use std::path::Path;
+use std::time::Instant;
+
+/// Everything `convert` will do, checked before any work starts.
+struct Plan {
+    input: InputPlan,
+    to: ProjSpec,
+    size: Option<u32>,
+    save: SaveOptions,
+    resample: ResampleOptions,
+}
+
+pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
+    let Some(p) = p else { return Ok(None) };
+    Ok(Some(match p.to_ascii_lowercase().as_str() {
+        "half" | "f16" | "16f" => Precision::Half,
+        "float" | "f32" | "32f" | "full" => Precision::Float,
+        "8" | "u8" | "8bit" => Precision::U8,
+        "16" | "u16" | "16bit" => Precision::U16,
+        other => {
+            return Err(CliError::request(format!(
+                "--precision: unknown '{other}' (half, float, 8, 16)"
+            )))
+        }
+    }))
+}
+
+fn parse_compression(c: &str) -> Result<ExrCompression, CliError> {
+    Ok(match c.to_ascii_lowercase().as_str() {
+        "none" | "uncompressed" => ExrCompression::None,
+        "rle" => ExrCompression::Rle,
+        "zips" => ExrCompression::Zips,
+        "zip" => ExrCompression::Zip,
+        "piz" => ExrCompression::Piz,
+        "pxr24" => ExrCompression::Pxr24,
+        other => {
+            return Err(CliError::request(format!(
+                "--compression: unknown '{other}' (none, rle, zips, zip, piz, pxr24)"
+            )))
+        }
+    })
+}
+
+impl Plan {
+    fn new(a: &ConvertArgs) -> Result<Plan, CliError> {
+        let input = InputPlan::new(&a.input_args)?;
+        let to = ProjSpec::parse(&a.to).map_err(|e| bad("--to", e))?;
+        let layout = a
+            .layout
+            .as_deref()
+            .map(str::parse::<Layout>)
+            .transpose()
+            .map_err(|e| bad("--layout", e))?;
+        if let Some(s) = a.size {
+            if s == 0 || s > 32768 {
+                return Err(CliError::request(format!(
+                    "--size: {s} is outside 1..=32768"
+                )));
+            }
+        }
+        let format = save::check(&a.output, to.kind, layout)?;
+        let precision = parse_precision(a.precision.as_deref())?;
+        match (format, precision) {
+            (Format::Png, Some(Precision::Half | Precision::Float))
+            | (Format::Jpeg, Some(Precision::Half | Precision::Float | Precision::U16)) => {
+                return Err(CliError::request(format!(
+                    "{}: --precision {:?} does not fit this container",
+                    a.output,
+                    precision.unwrap()
+                )))
+            }
+            (Format::Exr | Format::Ktx2 | Format::Dds, Some(Precision::U8 | Precision::U16)) => {
+                return Err(CliError::request(format!(
+                    "{}: 8/16-bit integers are for PNG; use half or float",
+                    a.output
+                )))
+            }
+            _ => {}
+        }
+        if a.mips && !format.is_cube_container() {
+            return Err(CliError::request(
+                "--mips applies to .ktx2 and .dds outputs",
+            ));
+        }
+        if Path::new(&a.input) == Path::new(&a.output) {
+            return Err(CliError::request("the output would overwrite the input"));
+        }
+        let mut rotation = Rotation::from_euler_deg(a.yaw, a.pitch, a.roll);
+        for f in &a.flip {
+            let axis = match f.to_ascii_lowercase().as_str() {
+                "x" => 0,
+                "y" => 1,
+                "z" => 2,
+                other => {
+                    return Err(CliError::request(format!(
+                        "--flip: '{other}' is not x, y or z"
+                    )))
+                }
+            };
+            rotation = rotation.then(Rotation::mirror(axis));
+        }
+        if !a.exposure.is_finite() {
+            return Err(CliError::request("--exposure must be a finite number"));
+        }
+        let write = WriteOptions {
+            precision,
+            exr_compression: parse_compression(&a.compression)?,
+            jpeg_quality: 92,
+        };
+        Ok(Plan {
+            input,
+            to,
+            size: a.size,
+            save: SaveOptions {
+                layout,
+                write,
+                mips: a.mips,
+            },
+            resample: ResampleOptions {
+                rotation,
+                exposure: a.exposure,
+                max_samples: a.max_samples.max(1),
+                progress: None,
+            },
+        })
+    }
+}
+
+pub fn run(a: ConvertArgs) -> Result<(), CliError> {
+    let mut plan = Plan::new(&a)?;
+    let t0 = Instant::now();
+    let limits = mirrorball_io::Limits::default();
+    let mut src = load::load(
+        &a.input,
+        plan.input.from.as_ref(),
+        plan.input.layout,
+        &limits,
+    )?;
+    let say = |s: String| {
+        if !a.quiet {
+            eprintln!("{s}");
+        }
+    };
+    say(format!(
+        "read {} ({}): {} {}x{}{} — {}",
+        a.input,
+        src.description,
+        src.env.projection().name(),
+        src.env.width(),
+        src.env.height(),
+        if src.env.layers().len() > 1 {
+            format!(" x{}", src.env.layers().len())
+        } else {
+            String::new()
+        },
+        src.decided
+    ));
+    if !plan.input.keep_invalid {
+        let fixed = src.env.sanitize();
+        if fixed > 0 {
+            say(format!("warning: {}: {fixed} NaN, infinite or negative values set to 0 (--keep-invalid keeps them)", a.input));
+        }
+    }
+    let t_read = t0.elapsed();
+    let dst = plan.to.build(None).map_err(|e| bad("--to", e))?;
+    let size = plan
+        .size
+        .unwrap_or_else(|| save::default_size(&src.env, dst.kind()));
+    let (w, h) = dst.layer_extent(size);
+    let rows = h as u64 * dst.layer_count() as u64;
+    let t1 = Instant::now();
+    let out = with_progress("converting", rows, a.quiet, |counter| {
+        plan.resample.progress = Some(counter);
+        resample(&src.env, dst, size, &plan.resample)
+    });
+    let t_conv = t1.elapsed();
+    drop(src);
+    let t2 = Instant::now();
+    let files = save::save(&out, &a.output, &plan.save)?;
+    let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+    say(format!(
+        "wrote {}: {} {}x{}{} (read {:.2}s, convert {:.2}s, write {:.2}s)",
+        names.join(", "),
+        dst.name(),
+        w,
+        h,
+        if dst.layer_count() > 1 {
+            format!(" x{}", dst.layer_count())
+        } else {
+            String::new()
+        },
+        t_read.as_secs_f64(),
+        t_conv.as_secs_f64(),
+        t2.elapsed().as_secs_f64()
+    ));
+    Ok(())
+}

@@ -1,0 +1,167 @@
+//! `mirrorball demo`: the bundled HDR environment in every projection, with previews and the
+//! round-trip quality of each, in a folder a person can open (`index.html`).
+
+use crate::error::CliError;
+use crate::progress::with_progress;
+use crate::save::{self, SaveOptions};
+use crate::{load, DemoArgs};
+use mirrorball_core::metrics::log_psnr_where;
+use mirrorball_core::{resample, ProjectionKind, ResampleOptions, WorldProjection};
+use mirrorball_io::{Precision, WriteOptions};
+use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+/// Poly Haven's "city" environment (CC0), 512×256 half-float lat-long, bundled.
+const CITY_EXR: &[u8] = include_bytes!("../../../../assets/env/city.exr");
+
+/// The edge each projection gets for a lat-long of width `size`: about equal texel budgets.
+fn edge(kind: ProjectionKind, size: u32) -> u32 {
+    match kind {
+        ProjectionKind::LatLong | ProjectionKind::Mercator => size,
+        ProjectionKind::Cube | ProjectionKind::ContinuousCube => (size / 4).max(1),
+        _ => (size / 2).max(1),
+    }
+}
+
+pub fn run(a: DemoArgs) -> Result<(), CliError> {
+    if a.size < 8 || a.size > 16384 {
+        return Err(CliError::request(format!(
+            "--size {} is outside 8..=16384",
+            a.size
+        )));
+    }
+    let dir = Path::new(&a.out);
+    std::fs::create_dir_all(dir).map_err(|e| {
+        CliError::input(format!("{}: cannot create the folder: {e}", dir.display()))
+    })?;
+    let src_path = dir.join("source-city.exr");
+    std::fs::write(&src_path, CITY_EXR)
+        .map_err(|e| CliError::input(format!("{}: {e}", src_path.display())))?;
+    let t0 = Instant::now();
+    let src_str = src_path.display().to_string();
+    let mut src = load::load(&src_str, None, None, &mirrorball_io::Limits::default())?;
+    src.env.sanitize();
+    let src = src.env;
+    eprintln!(
+        "source: {src_str} (lat-long {}x{}); writing every projection to {}",
+        src.width(),
+        src.height(),
+        dir.display()
+    );
+
+    let preview = WriteOptions {
+        precision: Some(Precision::U8),
+        ..Default::default()
+    };
+    let exr = WriteOptions::default();
+    let opts = ResampleOptions::default();
+    let bright = ResampleOptions {
+        exposure: a.exposure,
+        ..Default::default()
+    };
+    let mut rows = Vec::new();
+    with_progress(
+        "demo",
+        ProjectionKind::ALL.len() as u64,
+        false,
+        |done| -> Result<(), CliError> {
+            for kind in ProjectionKind::ALL {
+                let proj = kind.default_projection();
+                let size = edge(kind, a.size);
+                let t = Instant::now();
+                let out = resample(&src, proj, size, &opts);
+                let secs = t.elapsed().as_secs_f64();
+                let name = kind.name();
+                let layout = save::default_layout(proj.layer_count());
+                let save_opts = |w: WriteOptions| SaveOptions {
+                    layout: Some(layout),
+                    write: w,
+                    mips: false,
+                };
+                save::save(
+                    &out,
+                    &dir.join(format!("{name}.exr")).display().to_string(),
+                    &save_opts(exr),
+                )?;
+                let shown = if a.exposure != 0.0 {
+                    resample(&src, proj, size, &bright)
+                } else {
+                    out.clone()
+                };
+                save::save(
+                    &shown,
+                    &dir.join(format!("{name}.png")).display().to_string(),
+                    &save_opts(preview),
+                )?;
+                if kind == ProjectionKind::Cube {
+                    let m = SaveOptions {
+                        layout: None,
+                        write: exr,
+                        mips: true,
+                    };
+                    save::save(&out, &dir.join("cube.ktx2").display().to_string(), &m)?;
+                    save::save(&out, &dir.join("cube.dds").display().to_string(), &m)?;
+                }
+                // Round trip back to the source's projection and size.
+                let back = resample(&out, *src.projection(), src.width(), &opts);
+                let covered = proj.covered_solid_angle() / (4.0 * std::f64::consts::PI);
+                let psnr = log_psnr_where(&src, &back, |d| proj.dir_to_uv(d).is_some())
+                    .unwrap_or(f64::NAN);
+                let (w, h) = (out.width(), out.height());
+                rows.push((name, layout, w, h, out.layers().len(), secs, psnr, covered));
+                done.fetch_add(1, Ordering::Relaxed);
+            }
+            Ok(())
+        },
+    )?;
+
+    let mut table = String::new();
+    let mut html = String::from(
+        "<!doctype html><meta charset=utf-8><title>mirrorball demo</title>\
+         <style>body{font:14px sans-serif;background:#222;color:#ddd;margin:2em}\
+         figure{display:inline-block;margin:1em;vertical-align:top}img{max-width:512px;max-height:384px;background:#000}\
+         td,th{padding:2px 10px;text-align:right}</style>\
+         <h1>mirrorball demo</h1><p>The bundled <code>city</code> environment (Poly Haven, CC0) in every world projection. \
+         PNGs are previews (clamped, sRGB); the EXR files beside them hold the linear values.</p>\
+         <table><tr><th>projection</th><th>layout</th><th>layers × size</th><th>covers</th><th>convert (s)</th><th>round-trip log-PSNR (dB), over what it covers</th></tr>",
+    );
+    eprintln!(
+        "{:<24} {:<8} {:>14} {:>7} {:>9} {:>10}",
+        "projection", "layout", "size", "covers", "time (s)", "log-PSNR"
+    );
+    for (name, layout, w, h, n, secs, psnr, covered) in &rows {
+        let line = format!(
+            "{:<24} {:<8} {:>14} {:>6.1}% {:>9.3} {:>10.2}",
+            name,
+            layout.to_string(),
+            format!("{n}x{w}x{h}"),
+            covered * 100.0,
+            secs,
+            psnr
+        );
+        eprintln!("{line}");
+        let _ = writeln!(table, "{line}");
+        let _ = write!(html, "<tr><td>{name}</td><td>{layout}</td><td>{n}×{w}×{h}</td><td>{:.1}%</td><td>{secs:.3}</td><td>{psnr:.2}</td></tr>", covered * 100.0);
+    }
+    html.push_str("</table>");
+    for (name, layout, ..) in &rows {
+        let _ = write!(
+            html,
+            "<figure><img src=\"{name}.png\"><figcaption>{name} ({layout})</figcaption></figure>"
+        );
+    }
+    html.push_str("<p>cube.ktx2 and cube.dds hold the cube with its full mip chain, faces in OpenGL/Vulkan/Direct3D order.</p>");
+    let index = dir.join("index.html");
+    std::fs::write(&index, html)
+        .map_err(|e| CliError::input(format!("{}: {e}", index.display())))?;
+    std::fs::write(dir.join("summary.txt"), table)
+        .map_err(|e| CliError::input(format!("{}: {e}", dir.display())))?;
+    eprintln!(
+        "done in {:.1}s: open {}",
+        t0.elapsed().as_secs_f64(),
+        index.display()
+    );
+    Ok(())
+}

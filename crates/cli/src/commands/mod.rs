@@ -1,0 +1,39 @@
+//! One module per subcommand.
+pub mod compare;
+pub mod convert;
+pub mod demo;
+pub mod info;
+
+use crate::error::CliError;
+use crate::spec::{bad, ProjSpec};
+use crate::InputArgs;
+use mirrorball_core::Layout;
+
+/// The validated input options.
+pub struct InputPlan {
+    pub from: Option<ProjSpec>,
+    pub layout: Option<Layout>,
+    pub keep_invalid: bool,
+}
+
+impl InputPlan {
+    pub fn new(a: &InputArgs) -> Result<InputPlan, CliError> {
+        let from = a
+            .from
+            .as_deref()
+            .map(ProjSpec::parse)
+            .transpose()
+            .map_err(|e| bad("--from", e))?;
+        let layout = a
+            .in_layout
+            .as_deref()
+            .map(str::parse::<Layout>)
+            .transpose()
+            .map_err(|e| bad("--in-layout", e))?;
+        Ok(InputPlan {
+            from,
+            layout,
+            keep_invalid: a.keep_invalid,
+        })
+    }
+}

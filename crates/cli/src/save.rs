@@ -1,0 +1,141 @@
+//! Writing an environment map: the extension picks the container, the layout packs the
+//! layers, KTX2/DDS cubes get their mip chain.
+
+use crate::error::CliError;
+use crate::load::{layer_names, FACE};
+use mirrorball_core::{resample, EnvMap, Layout, ProjectionKind, ResampleOptions, WorldProjection};
+use mirrorball_io::{Format, WriteOptions};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// What to write.
+pub struct SaveOptions {
+    /// The layout of multi-layer maps in flat images (`None`: a cross for cubes, side by
+    /// side for the paraboloid).
+    pub layout: Option<Layout>,
+    /// Container options.
+    pub write: WriteOptions,
+    /// Write the full mip chain into KTX2/DDS.
+    pub mips: bool,
+}
+
+/// The layout used when the user names none.
+pub fn default_layout(layers: usize) -> Layout {
+    match layers {
+        6 => Layout::HorizontalCross,
+        2 => Layout::HorizontalStrip,
+        _ => Layout::Separate,
+    }
+}
+
+/// Checks that `out` can hold a map of `kind` before any work starts.
+pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<Format, CliError> {
+    let path = Path::new(out);
+    let format = Format::from_path(path).ok_or_else(|| {
+        CliError::request(format!(
+            "{out}: unknown output extension (use .exr .hdr .png .jpg .ktx2 .dds)"
+        ))
+    })?;
+    if format == Format::Webp {
+        return Err(CliError::request(format!(
+            "{out}: WebP is read-only here; write .png"
+        )));
+    }
+    if format.is_cube_container() && kind != ProjectionKind::Cube {
+        return Err(CliError::request(format!(
+            "{out}: KTX2 and DDS files are sampled by GPUs as OpenGL/Direct3D cube maps, so they hold --to cube only (not {kind})"
+        )));
+    }
+    let layers = kind.default_projection().layer_count();
+    if let Some(l) = layout {
+        if !l.fits(layers) {
+            return Err(CliError::request(format!(
+                "--layout {l} needs six faces; a {kind} map has {layers} layer(s)"
+            )));
+        }
+        if l == Layout::Separate && layers > 1 && !out.contains(FACE) {
+            // Fine: names get a _px … suffix.
+        }
+    }
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(CliError::request(format!(
+                "{out}: the folder {} does not exist",
+                dir.display()
+            )));
+        }
+    }
+    Ok(format)
+}
+
+/// The file for layer `name` of a separate-layout output.
+fn layer_path(out: &str, name: &str) -> PathBuf {
+    if out.contains(FACE) {
+        return PathBuf::from(out.replace(FACE, name));
+    }
+    let p = Path::new(out);
+    let stem = p
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = p
+        .extension()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    p.with_file_name(format!("{stem}_{name}.{ext}"))
+}
+
+/// Writes `env` to `out`; returns the files written.
+pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>, CliError> {
+    let path = Path::new(out);
+    let format = check(out, env.projection().kind(), opts.layout)?;
+    if format.is_cube_container() {
+        let mut levels = vec![env.layers().to_vec()];
+        if opts.mips {
+            let mut size = env.width() / 2;
+            while size >= 1 {
+                let lv = resample(env, *env.projection(), size, &ResampleOptions::default());
+                levels.push(lv.into_layers());
+                if size == 1 {
+                    break;
+                }
+                size /= 2;
+            }
+        }
+        mirrorball_io::write_cube(path, &levels, &opts.write)?;
+        return Ok(vec![path.to_path_buf()]);
+    }
+    let n = env.layers().len();
+    let layout = opts.layout.unwrap_or_else(|| default_layout(n));
+    if layout == Layout::Separate && n > 1 {
+        let names = layer_names(n);
+        let paths: Vec<PathBuf> = names.iter().map(|nm| layer_path(out, nm)).collect();
+        paths
+            .par_iter()
+            .zip(env.layers().par_iter())
+            .map(|(p, img)| mirrorball_io::write_image(p, img, &opts.write))
+            .collect::<Result<Vec<()>, _>>()?;
+        return Ok(paths);
+    }
+    let img = layout.pack(env).ok_or_else(|| {
+        CliError::request(format!(
+            "{out}: layout {layout} does not fit a map of {n} layer(s)"
+        ))
+    })?;
+    mirrorball_io::write_image(path, &img, &opts.write)?;
+    Ok(vec![path.to_path_buf()])
+}
+
+/// The natural default edge for a conversion from `src` to `kind`: about the same number of
+/// texels per steradian as the source has at its finest.
+pub fn default_size(src: &EnvMap, kind: ProjectionKind) -> u32 {
+    // Texels per steradian of the source, spread evenly.
+    let n_src = src.width() as f64 * src.height() as f64 * src.layers().len() as f64;
+    let per_sr = n_src / src.projection().covered_solid_angle();
+    let dst = kind.default_projection();
+    let (w1, h1) = dst.layer_extent(1024);
+    let texels_1024 = w1 as f64 * h1 as f64 * dst.layer_count() as f64;
+    let want = per_sr * dst.covered_solid_angle();
+    let size = 1024.0 * (want / texels_1024).sqrt();
+    (size.round() as u32).clamp(1, 16384)
+}
