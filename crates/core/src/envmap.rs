@@ -245,8 +245,19 @@ impl EnvMap {
     }
 }
 
+/// `floor` as an integer without a libm call.
+#[inline(always)]
+fn floor_i(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) > x {
+        i - 1
+    } else {
+        i
+    }
+}
+
 /// Bilinear filtering over `layers` of `proj` at `(layer, uv)`; texel centres at
-/// half-integers.
+/// half-integers. Writes `out.len()` channels (at most the image's).
 #[inline]
 pub(crate) fn bilinear(
     proj: &Projection,
@@ -255,48 +266,70 @@ pub(crate) fn bilinear(
     uv: DVec2,
     out: &mut [f32],
 ) {
+    match (layers[layer].channels(), out.len()) {
+        (3, 3) => bilinear_n::<3>(proj, layers, layer, uv, out),
+        (4, 4) => bilinear_n::<4>(proj, layers, layer, uv, out),
+        (4, 3) => {
+            let mut t = [0.0; 4];
+            bilinear_n::<4>(proj, layers, layer, uv, &mut t);
+            out.copy_from_slice(&t[..3]);
+        }
+        _ => {
+            let mut t = [0.0; 3];
+            bilinear_n::<3>(proj, layers, layer, uv, &mut t);
+            out[..3].copy_from_slice(&t);
+            out[3..].fill(1.0);
+        }
+    }
+}
+
+/// [`bilinear`] for images of `C` channels.
+#[inline(always)]
+fn bilinear_n<const C: usize>(
+    proj: &Projection,
+    layers: &[Image],
+    layer: usize,
+    uv: DVec2,
+    out: &mut [f32],
+) {
     let img = &layers[layer];
-    let (w, h) = (img.width(), img.height());
-    let c = img.channels();
+    let (w, h) = (img.width() as i64, img.height() as i64);
     let x = uv.x * w as f64 - 0.5;
     let y = uv.y * h as f64 - 0.5;
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let (x0, y0) = (x0 as i64, y0 as i64);
+    let (x0, y0) = (floor_i(x), floor_i(y));
+    let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
+    let out = &mut out[..C];
+    if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h {
+        let data = img.data();
+        let stride = w as usize * C;
+        let i00 = y0 as usize * stride + x0 as usize * C;
+        let r0 = &data[i00..i00 + 2 * C];
+        let r1 = &data[i00 + stride..i00 + stride + 2 * C];
+        for i in 0..C {
+            let top = r0[i] + fx * (r0[C + i] - r0[i]);
+            let bot = r1[i] + fx * (r1[C + i] - r1[i]);
+            out[i] = top + fy * (bot - top);
+        }
+        return;
+    }
     let weights = [
         (1.0 - fx) * (1.0 - fy),
         fx * (1.0 - fy),
         (1.0 - fx) * fy,
         fx * fy,
     ];
-    for o in out.iter_mut() {
-        *o = 0.0;
-    }
-    let n = out.len().min(c);
-    if x0 >= 0 && y0 >= 0 && x0 + 1 < w as i64 && y0 + 1 < h as i64 {
-        let data = img.data();
-        let stride = w as usize * c;
-        let i00 = y0 as usize * stride + x0 as usize * c;
-        let idx = [i00, i00 + c, i00 + stride, i00 + stride + c];
-        for k in 0..4 {
-            let t = &data[idx[k]..idx[k] + n];
-            for i in 0..n {
-                out[i] += weights[k] * t[i];
-            }
-        }
-    } else {
-        let corners = [(x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1)];
-        for k in 0..4 {
-            let (cx, cy) = corners[k];
-            let (l, tx, ty) = if cx >= 0 && cy >= 0 && cx < w as i64 && cy < h as i64 {
-                (layer, cx as u32, cy as u32)
-            } else {
-                proj.wrap_texel(layer, cx, cy, w, h)
-            };
-            let t = layers[l].get(tx, ty);
-            for i in 0..n {
-                out[i] += weights[k] * t[i];
-            }
+    let corners = [(x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1)];
+    out.fill(0.0);
+    for k in 0..4 {
+        let (cx, cy) = corners[k];
+        let (l, tx, ty) = if cx >= 0 && cy >= 0 && cx < w && cy < h {
+            (layer, cx as u32, cy as u32)
+        } else {
+            proj.wrap_texel(layer, cx, cy, w as u32, h as u32)
+        };
+        let t = layers[l].get(tx, ty);
+        for i in 0..C {
+            out[i] += weights[k] * t[i];
         }
     }
 }

@@ -126,16 +126,16 @@ impl Default for ResampleOptions {
 /// Below this footprint ratio one bilinear lookup is used.
 const BILINEAR_MAX_RATIO: f64 = 2.25;
 
-/// A source map with its solid-angle-weighted mip pyramid.
+/// A source map with its solid-angle-weighted mip pyramid (only as deep as needed).
 struct Pyramid<'a> {
     base: &'a [Image],
     levels: Vec<Vec<Image>>,
 }
 
 impl<'a> Pyramid<'a> {
-    fn new(src: &'a EnvMap, max_level: usize) -> Pyramid<'a> {
+    fn new(src: &'a EnvMap, depth: usize) -> Pyramid<'a> {
         let mut levels: Vec<Vec<Image>> = Vec::new();
-        for _ in 0..max_level {
+        for _ in 0..depth {
             let prev = levels.last().map(|l| l.as_slice()).unwrap_or(src.layers());
             if prev[0].width() == 1 && prev[0].height() == 1 {
                 break;
@@ -155,7 +155,7 @@ impl<'a> Pyramid<'a> {
 
     #[inline]
     fn level(&self, l: usize) -> &[Image] {
-        if l == 0 {
+        if l == 0 || self.levels.is_empty() {
             self.base
         } else {
             &self.levels[(l - 1).min(self.levels.len() - 1)]
@@ -168,7 +168,7 @@ impl<'a> Pyramid<'a> {
 }
 
 /// Halves `img` (layer `layer` of `proj`), each 2×2 block averaged with the source texels'
-/// solid angles as weights.
+/// solid angles (density at their centres) as weights.
 fn downsample(proj: &Projection, layer: usize, img: &Image) -> Image {
     let (w, h) = (img.width(), img.height());
     let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
@@ -177,28 +177,32 @@ fn downsample(proj: &Projection, layer: usize, img: &Image) -> Image {
     out.data_mut()
         .par_chunks_mut(nw as usize * c)
         .enumerate()
-        .for_each(|(y, row)| {
-            let ys = [(2 * y as u32).min(h - 1), (2 * y as u32 + 1).min(h - 1)];
-            for x in 0..nw as usize {
-                let xs = [(2 * x as u32).min(w - 1), (2 * x as u32 + 1).min(w - 1)];
-                let mut acc = [0.0f64; 4];
-                let mut wsum = 0.0;
-                for &sy in &ys {
-                    for &sx in &xs {
-                        let uv =
-                            DVec2::new((sx as f64 + 0.5) / w as f64, (sy as f64 + 0.5) / h as f64);
-                        let wt = proj.density(layer, uv).max(1e-12);
-                        for (a, v) in acc.iter_mut().zip(img.get(sx, sy)) {
-                            *a += wt * *v as f64;
+        .for_each_init(
+            || (vec![None; w as usize], vec![None; w as usize]),
+            |(d0, d1), (y, row)| {
+                let ys = [(2 * y as u32).min(h - 1), (2 * y as u32 + 1).min(h - 1)];
+                proj.row_dirs(layer, ys[0], w, h, d0);
+                proj.row_dirs(layer, ys[1], w, h, d1);
+                for x in 0..nw as usize {
+                    let xs = [(2 * x as u32).min(w - 1), (2 * x as u32 + 1).min(w - 1)];
+                    let mut acc = [0.0f64; 4];
+                    let mut wsum = 0.0;
+                    for (k, &sy) in ys.iter().enumerate() {
+                        let dens = if k == 0 { &*d0 } else { &*d1 };
+                        for &sx in &xs {
+                            let wt = dens[sx as usize].map_or(0.0, |(_, dn)| dn).max(1e-12);
+                            for (a, v) in acc.iter_mut().zip(img.get(sx, sy)) {
+                                *a += wt * *v as f64;
+                            }
+                            wsum += wt;
                         }
-                        wsum += wt;
+                    }
+                    for i in 0..c {
+                        row[x * c + i] = (acc[i] / wsum) as f32;
                     }
                 }
-                for i in 0..c {
-                    row[x * c + i] = (acc[i] / wsum) as f32;
-                }
-            }
-        });
+            },
+        );
     out
 }
 
@@ -207,6 +211,57 @@ fn downsample(proj: &Projection, layer: usize, img: &Image) -> Image {
 pub fn resample(src: &EnvMap, dst: Projection, size: u32, opts: &ResampleOptions) -> EnvMap {
     let (w, h) = dst.layer_extent(size.max(1));
     resample_to_extent(src, dst, w, h, opts)
+}
+
+/// Footprint ratio of an output texel of density `ddens` over the source texels at source
+/// density `sdens` (`area` = output texel area / source texel area in their `uv` units).
+#[inline]
+fn footprint_ratio(ddens: f64, sdens: f64, area: f64) -> f64 {
+    if sdens > 0.0 {
+        ddens * area / sdens
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// How many mip levels the conversion needs, judged on a sparse grid of output texels: deep
+/// enough that all but the top 1% of footprint ratios are integrated by at most `cap` points
+/// per texel. (A few extreme ratios, such as a cube texel over a lat-long pole, come from
+/// footprints that are long and thin on the source rather than large: `cap` points on the
+/// full-resolution source integrate those better than a blurred level would.)
+fn levels_needed(
+    src: &EnvMap,
+    dst: &Projection,
+    w: u32,
+    h: u32,
+    area: f64,
+    cap: f64,
+    rot: &Rotation,
+) -> usize {
+    let sproj = src.projection();
+    let step = (w.max(h) / 64).max(1);
+    let mut ratios = Vec::new();
+    let mut dirs = vec![None; w as usize];
+    for layer in 0..dst.layer_count() {
+        for y in (0..h).step_by(step as usize) {
+            dst.row_dirs(layer, y, w, h, &mut dirs);
+            for (d, dd) in dirs.iter().step_by(step as usize).flatten() {
+                ratios.push(
+                    footprint_ratio(*dd, sproj.density_of_dir(rot.source_of(*d)), area).min(1e12),
+                );
+            }
+        }
+    }
+    if ratios.is_empty() {
+        return 0;
+    }
+    let k = (ratios.len() * 99 / 100).min(ratios.len() - 1);
+    let (_, p99, _) = ratios.select_nth_unstable_by(k, f64::total_cmp);
+    if *p99 <= cap {
+        0
+    } else {
+        ((*p99 / cap).log2() * 0.5).ceil() as usize + 1
+    }
 }
 
 /// Converts `src` into projection `dst` with layers of `w`×`h` texels.
@@ -218,14 +273,19 @@ pub fn resample_to_extent(
     opts: &ResampleOptions,
 ) -> EnvMap {
     let max_n = opts.max_samples.clamp(1, 16);
-    let levels_needed = if max_n > 1 { 16 } else { 0 };
-    let pyr = Pyramid::new(src, levels_needed);
+    let cap = (max_n * max_n) as f64;
     let c = src.channels();
     let scale = 2f32.powf(opts.exposure);
-    let src_texel_area = 1.0 / (src.width() as f64 * src.height() as f64);
-    let dst_texel_area = 1.0 / (w as f64 * h as f64);
+    // Output texel area over source texel area, in uv units.
+    let area = (src.width() as f64 * src.height() as f64) / (w as f64 * h as f64);
     let rot = opts.rotation;
     let rotate = !rot.is_identity();
+    let depth = if max_n > 1 {
+        levels_needed(src, &dst, w, h, area, cap, &rot)
+    } else {
+        0
+    };
+    let pyr = Pyramid::new(src, depth);
     let sproj = *src.projection();
     let layers = (0..dst.layer_count())
         .map(|layer| {
@@ -233,87 +293,79 @@ pub fn resample_to_extent(
             img.data_mut()
                 .par_chunks_mut(w as usize * c)
                 .enumerate()
-                .for_each(|(y, row)| {
-                    let mut acc = [0.0f32; 4];
-                    let mut tmp = [0.0f32; 4];
-                    for x in 0..w as usize {
-                        let out = &mut row[x * c..(x + 1) * c];
-                        let uv0 =
-                            DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-                        let uv = dst.nearest_covered(layer, uv0);
-                        let Some(d) = dst.uv_to_dir(layer, uv) else {
-                            continue;
-                        };
-                        let ds = if rotate { rot.source_of(d) } else { d };
-                        let Some((sl, suv)) = sproj.dir_to_uv(ds) else {
-                            continue;
-                        };
-                        let sdens = sproj.density(sl, suv);
-                        let ddens = dst.density(layer, uv);
-                        let ratio = if sdens > 0.0 {
-                            (ddens * dst_texel_area) / (sdens * src_texel_area)
-                        } else {
-                            f64::INFINITY
-                        };
-                        if ratio < BILINEAR_MAX_RATIO || max_n == 1 || uv != uv0 {
-                            bilinear(&sproj, pyr.level(0), sl, suv, out);
-                        } else {
-                            // Integrate: n×n points, on a mip level where each stands for about
-                            // one source texel.
-                            let cap = (max_n * max_n) as f64;
-                            let level = if ratio > cap {
-                                (((ratio / cap).log2() * 0.5).ceil() as usize)
-                                    .min(pyr.level_count() - 1)
-                            } else {
-                                0
+                .for_each_init(
+                    || vec![None; w as usize],
+                    |dirs, (y, row)| {
+                        dst.row_dirs(layer, y as u32, w, h, dirs);
+                        let mut acc = [0.0f32; 4];
+                        let mut tmp = [0.0f32; 4];
+                        for (x, texel) in dirs.iter().enumerate() {
+                            let Some((d, ddens)) = *texel else { continue };
+                            let out = &mut row[x * c..(x + 1) * c];
+                            let ds = if rotate { rot.source_of(d) } else { d };
+                            let Some((sl, suv)) = sproj.dir_to_uv(ds) else {
+                                continue;
                             };
-                            let r_l = ratio / 4f64.powi(level as i32);
-                            let n = (r_l.sqrt().round() as u32).clamp(1, max_n);
-                            let lv = pyr.level(level);
-                            acc[..c].fill(0.0);
-                            let mut wsum = 0.0f32;
-                            let inv = 1.0 / n as f64;
-                            for j in 0..n {
-                                let v = (y as f64 + (j as f64 + 0.5) * inv) / h as f64;
-                                for i in 0..n {
-                                    let u = (x as f64 + (i as f64 + 0.5) * inv) / w as f64;
-                                    let p = DVec2::new(u, v);
-                                    let wt = dst.density(layer, p) as f32;
-                                    if wt <= 0.0 {
-                                        continue;
-                                    }
-                                    let Some(d) = dst.uv_to_dir(layer, p) else {
-                                        continue;
-                                    };
-                                    let ds = if rotate { rot.source_of(d) } else { d };
-                                    let Some((sl, suv)) = sproj.dir_to_uv(ds) else {
-                                        continue;
-                                    };
-                                    bilinear(&sproj, lv, sl, suv, &mut tmp[..c]);
-                                    for k in 0..c {
-                                        acc[k] += wt * tmp[k];
-                                    }
-                                    wsum += wt;
-                                }
-                            }
-                            if wsum > 0.0 {
-                                for k in 0..c {
-                                    out[k] = acc[k] / wsum;
-                                }
-                            } else {
+                            let ratio = footprint_ratio(ddens, sproj.density_of_dir(ds), area);
+                            if ratio < BILINEAR_MAX_RATIO || max_n == 1 || ddens == 0.0 {
                                 bilinear(&sproj, pyr.level(0), sl, suv, out);
+                            } else {
+                                // Integrate: n×n points over the texel, on a mip level where each
+                                // stands for about one source texel.
+                                let level = if ratio > cap {
+                                    (((ratio / cap).log2() * 0.5).ceil() as usize)
+                                        .min(pyr.level_count() - 1)
+                                } else {
+                                    0
+                                };
+                                let r_l = ratio / 4f64.powi(level as i32);
+                                let n = (r_l.sqrt().round() as u32).clamp(1, max_n);
+                                let lv = pyr.level(level);
+                                acc[..c].fill(0.0);
+                                let mut wsum = 0.0f32;
+                                let inv = 1.0 / n as f64;
+                                for j in 0..n {
+                                    let v = (y as f64 + (j as f64 + 0.5) * inv) / h as f64;
+                                    for i in 0..n {
+                                        let u = (x as f64 + (i as f64 + 0.5) * inv) / w as f64;
+                                        let p = DVec2::new(u, v);
+                                        let wt = dst.density(layer, p) as f32;
+                                        if wt <= 0.0 {
+                                            continue;
+                                        }
+                                        let Some(d) = dst.uv_to_dir(layer, p) else {
+                                            continue;
+                                        };
+                                        let Some((sl, suv)) = sproj.dir_to_uv(rot.source_of(d))
+                                        else {
+                                            continue;
+                                        };
+                                        bilinear(&sproj, lv, sl, suv, &mut tmp[..c]);
+                                        for k in 0..c {
+                                            acc[k] += wt * tmp[k];
+                                        }
+                                        wsum += wt;
+                                    }
+                                }
+                                if wsum > 0.0 {
+                                    for k in 0..c {
+                                        out[k] = acc[k] / wsum;
+                                    }
+                                } else {
+                                    bilinear(&sproj, pyr.level(0), sl, suv, out);
+                                }
+                            }
+                            if scale != 1.0 {
+                                for v in &mut out[..3] {
+                                    *v *= scale;
+                                }
                             }
                         }
-                        if scale != 1.0 {
-                            for v in &mut out[..3] {
-                                *v *= scale;
-                            }
+                        if let Some(p) = &opts.progress {
+                            p.fetch_add(1, Ordering::Relaxed);
                         }
-                    }
-                    if let Some(p) = &opts.progress {
-                        p.fetch_add(1, Ordering::Relaxed);
-                    }
-                });
+                    },
+                );
             img
         })
         .collect();

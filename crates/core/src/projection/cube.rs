@@ -136,6 +136,25 @@ impl WorldProjection for CubeMap {
         let q = 1.0 + a * a + b * b;
         4.0 / (q * q.sqrt())
     }
+    fn row_dirs(&self, layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
+        let Some(face) = CubeFace::from_index(layer) else {
+            return;
+        };
+        let tc = 2.0 * (y as f64 + 0.5) / h as f64 - 1.0;
+        let step = 2.0 / w as f64;
+        for (x, o) in out.iter_mut().enumerate().take(w as usize) {
+            let sc = (x as f64 + 0.5) * step - 1.0;
+            let inv = 1.0 / (1.0 + sc * sc + tc * tc).sqrt();
+            // density 4/(1 + a² + b²)^{3/2}
+            *o = Some((face.point(sc, tc) * inv, 4.0 * inv * inv * inv));
+        }
+    }
+    #[inline]
+    fn density_of_dir(&self, d: DVec3) -> f64 {
+        // 1 + a² + b² = 1/m_a² for a unit direction.
+        let m = d.abs().max_element();
+        4.0 * m * m * m
+    }
     fn texel_solid_angle(&self, _layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
         let (u0, u1) = texel_range(x, w);
         let (v0, v1) = texel_range(y, h);

@@ -1,6 +1,7 @@
 //! Cylindrical projections: latitude-longitude (Blinn & Newell 1976) and Mercator (Miller &
 //! Hoffman 1984, Greene 1986 §6).
 
+use super::fastmath;
 use super::{texel_range, WorldProjection};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -22,7 +23,7 @@ fn dir_from_lon_lat(lon: f64, lat: f64) -> DVec3 {
 
 #[inline]
 fn u_of_dir(d: DVec3) -> f64 {
-    d.x.atan2(-d.z) / TAU + 0.5
+    fastmath::atan2(d.x, -d.z) / TAU + 0.5
 }
 
 /// Mirrors a texel index around the longitude wrap and over the poles.
@@ -66,7 +67,8 @@ impl WorldProjection for LatLong {
     }
     #[inline]
     fn dir_to_uv(&self, d: DVec3) -> Option<(usize, DVec2)> {
-        let lat = d.y.clamp(-1.0, 1.0).asin();
+        // asin(y) as atan2(y, √(x² + z²)): accurate near the poles too.
+        let lat = fastmath::atan2(d.y, (d.x * d.x + d.z * d.z).sqrt());
         Some((0, DVec2::new(u_of_dir(d), 0.5 - lat / PI)))
     }
     #[inline]
@@ -80,6 +82,23 @@ impl WorldProjection for LatLong {
             return 0.0;
         }
         2.0 * PI * PI * lat.cos()
+    }
+    #[inline]
+    fn density_of_dir(&self, d: DVec3) -> f64 {
+        2.0 * PI * PI * (d.x * d.x + d.z * d.z).sqrt()
+    }
+    fn row_dirs(&self, _layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
+        // Latitude is fixed along a row; longitude advances by a fixed step, so its sine and
+        // cosine follow by the angle-addition recurrence (drift < 1e-12 over 65536 steps).
+        let (sp, cp) = (PI * (0.5 - (y as f64 + 0.5) / h as f64)).sin_cos();
+        let dens = 2.0 * PI * PI * cp;
+        let step = TAU / w as f64;
+        let (sd, cd) = step.sin_cos();
+        let (mut s, mut c) = lon_of_u(0.5 / w as f64).sin_cos();
+        for o in out.iter_mut().take(w as usize) {
+            *o = Some((DVec3::new(s * cp, sp, -c * cp), dens));
+            (s, c) = (s * cd + c * sd, c * cd - s * sd);
+        }
     }
     fn texel_solid_angle(&self, _layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
         let _ = x;
@@ -194,6 +213,13 @@ impl WorldProjection for Mercator {
     }
     fn covered_solid_angle(&self) -> f64 {
         4.0 * PI * self.max_lat.sin()
+    }
+    #[inline]
+    fn density_of_dir(&self, d: DVec3) -> f64 {
+        if d.y.abs() > self.max_lat.sin() {
+            return 0.0;
+        }
+        4.0 * PI * self.y_max * (d.x * d.x + d.z * d.z)
     }
     fn nearest_covered(&self, _layer: usize, uv: DVec2) -> DVec2 {
         DVec2::new(uv.x, uv.y.clamp(0.0, 1.0))

@@ -14,6 +14,7 @@
 mod azimuthal;
 mod continuous_cube;
 mod cube;
+pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
 pub(crate) mod quadrature;
@@ -53,6 +54,37 @@ pub trait WorldProjection {
     /// Exact solid angle, in steradians, of texel `(x, y)` of a `w`×`h` layer (only the part
     /// that lies inside the covered domain counts).
     fn texel_solid_angle(&self, layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64;
+
+    /// [`density`](WorldProjection::density) at the texture coordinates of unit direction
+    /// `dir` (0 where not covered). Projections with a cheaper form in terms of the direction
+    /// override it; the resampler calls it once per texel.
+    #[inline]
+    fn density_of_dir(&self, dir: DVec3) -> f64 {
+        self.dir_to_uv(dir)
+            .map_or(0.0, |(l, uv)| self.density(l, uv))
+    }
+
+    /// The centre directions of texel row `y` of a `w`×`h` layer, with the density there:
+    /// `out[x] = Some((dir, density))`, where texels outside the covered domain take the
+    /// direction of the nearest covered point and density 0. Projections override it to hoist
+    /// per-row work out of the per-texel loop.
+    fn row_dirs(&self, layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
+        let v = (y as f64 + 0.5) / h as f64;
+        for (x, o) in out.iter_mut().enumerate().take(w as usize) {
+            let uv0 = DVec2::new((x as f64 + 0.5) / w as f64, v);
+            let uv = self.nearest_covered(layer, uv0);
+            *o = self.uv_to_dir(layer, uv).map(|d| {
+                (
+                    d,
+                    if uv == uv0 {
+                        self.density(layer, uv)
+                    } else {
+                        0.0
+                    },
+                )
+            });
+        }
+    }
 
     /// The solid angle the projection covers: 4π for all but the fisheye and Mercator.
     fn covered_solid_angle(&self) -> f64 {
@@ -310,6 +342,13 @@ impl WorldProjection for Projection {
     }
     fn covered_solid_angle(&self) -> f64 {
         delegate!(self, p => p.covered_solid_angle())
+    }
+    #[inline]
+    fn density_of_dir(&self, dir: DVec3) -> f64 {
+        delegate!(self, p => p.density_of_dir(dir))
+    }
+    fn row_dirs(&self, layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
+        delegate!(self, p => p.row_dirs(layer, y, w, h, out))
     }
     #[inline]
     fn nearest_covered(&self, layer: usize, uv: DVec2) -> DVec2 {

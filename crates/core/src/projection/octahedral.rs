@@ -130,6 +130,12 @@ impl WorldProjection for Octahedral {
         let p = octa_point(uv_to_ab(uv));
         4.0 / p.length().powi(3)
     }
+    #[inline]
+    fn density_of_dir(&self, d: DVec3) -> f64 {
+        // The octahedron point is d/|d|₁, so |P| = 1/|d|₁.
+        let l1 = d.x.abs() + d.y.abs() + d.z.abs();
+        4.0 * l1 * l1 * l1
+    }
     fn texel_solid_angle(&self, _layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
         let (u0, u1) = texel_range(x, w);
         let (v0, v1) = texel_range(y, h);
@@ -231,6 +237,10 @@ impl WorldProjection for EqualAreaOctahedral {
         if ab.x.abs() > 1.0 || ab.y.abs() > 1.0 {
             return 0.0;
         }
+        4.0 * PI
+    }
+    #[inline]
+    fn density_of_dir(&self, _d: DVec3) -> f64 {
         4.0 * PI
     }
     fn texel_solid_angle(&self, _layer: usize, _x: u32, _y: u32, w: u32, h: u32) -> f64 {

@@ -1,0 +1,26 @@
+//! A small, deterministic workload for `valgrind --tool=callgrind` (instruction counts do not
+//! depend on what else the machine is doing):
+//! `cargo build --release -p mirrorball-core --example profile &&
+//!  RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/profile forward`.
+use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
+
+fn main() {
+    let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());
+    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 1024, 3, |d| {
+        [
+            (1.0 + d.x) as f32,
+            (1.0 + d.y) as f32,
+            (1.0 + d.z) as f32,
+            1.0,
+        ]
+    });
+    let cube_p = ProjectionKind::Cube.default_projection();
+    let opts = ResampleOptions::default();
+    let cube = EnvMap::from_fn(cube_p, 256, 3, |d| [(1.0 + d.x) as f32, 1.0, 1.0, 1.0]);
+    if which != "back" {
+        std::hint::black_box(resample(&src, cube_p, 256, &opts));
+    }
+    if which != "forward" {
+        std::hint::black_box(resample(&cube, *src.projection(), 1024, &opts));
+    }
+}
