@@ -1,1 +1,239 @@
-//! TODO: being written.
+//! DirectDraw Surface cube maps, with the headers of the `ddsfile` crate.
+//!
+//! Written files have the DX10 extension header: `DXGI_FORMAT_R16G16B16A16_FLOAT` or
+//! `DXGI_FORMAT_R32G32B32A32_FLOAT`, `D3D10_RESOURCE_MISC_TEXTURECUBE` with an array size of
+//! 1 (one cube; Direct3D counts cubes, not faces, there), `DDSCAPS2_CUBEMAP` with all six face
+//! bits, and the mip count. The data is face-major: face 0 (+X) with its whole mip chain,
+//! then face 1 (−X) and so on, in Direct3D's face order +X −X +Y −Y +Z −Z, which is
+//! OpenGL's.
+//!
+//! Direct3D selects cube faces with the same major-axis table as OpenGL and addresses each
+//! face with row 0 at the top (v = 0), which is mirrorball's `t = 0` row, so face images are
+//! stored unchanged, exactly as in KTX2.
+//!
+//! The reader takes level 0 of DX10 RGBA16F, RGBA32F, RGB32F, R11G11B10F and RGB9E5 files and
+//! of legacy `D3DFMT_A16B16G16R16F` (113) and `D3DFMT_A32B32G32R32F` (116) files, cube maps or
+//! 2D textures. It parses the headers with `ddsfile`, checks the declared size against the
+//! [`Limits`] and the file length, and only then reads the texels it needs.
+
+use crate::ktx2_io::{
+    check_limits, max_levels, mip_phrase, validate_cube, written_format, TexelFormat,
+};
+use crate::{atomic_write, Error, Format, Limits, Loaded, WriteOptions};
+use ddsfile::{
+    AlphaMode, Caps2, D3D10ResourceDimension, DxgiFormat, FourCC, Header, Header10, MiscFlag,
+    PixelFormat, PixelFormatFlags,
+};
+use mirrorball_core::{Image, ProjectionKind};
+use std::fs::File;
+use std::io::{BufReader, Read, Write};
+use std::path::Path;
+
+/// `"DDS "`, the magic number at the start of every DDS file.
+const MAGIC: &[u8; 4] = b"DDS ";
+/// Magic plus the 124-byte header.
+const HEADER_LEN: u64 = 4 + 124;
+/// The DX10 extension header.
+const HEADER10_LEN: u64 = 20;
+
+fn dds_error(path: &Path, e: ddsfile::Error) -> Error {
+    match e {
+        ddsfile::Error::Io(e) => Error::io(path, e),
+        e => Error::input(path, format!("invalid DDS header: {e}")),
+    }
+}
+
+/// Writes a cube map with its mip chain as DDS with a DX10 header, face-major (each face with
+/// its whole mip chain). Face images are stored unchanged: Direct3D uses OpenGL's face order
+/// and major-axis table and puts row 0 at the top, mirrorball's `t = 0` row.
+pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<(), Error> {
+    let format = written_format(path, opts, "DDS")?;
+    let size = validate_cube(path, levels)?;
+    let dxgi = match format {
+        TexelFormat::Rgba16F => DxgiFormat::R16G16B16A16_Float,
+        _ => DxgiFormat::R32G32B32A32_Float,
+    };
+    let mut header = Header::new_dxgi(
+        size,
+        size,
+        None,
+        dxgi,
+        Some(levels.len() as u32),
+        Some(6),
+        Some(Caps2::CUBEMAP | Caps2::CUBEMAP_ALLFACES),
+    )
+    .map_err(|e| Error::request(path, format!("cannot make a DDS header: {e}")))?;
+    // With a DX10 header the pixel format is only the "DX10" FourCC (as Direct3D's own
+    // writers have it), not also an RGB bit count.
+    header.spf = PixelFormat {
+        flags: PixelFormatFlags::FOURCC,
+        fourcc: Some(FourCC(FourCC::DX10)),
+        ..PixelFormat::default()
+    };
+    let header10 = Header10::new(
+        dxgi,
+        true,
+        D3D10ResourceDimension::Texture2D,
+        1,
+        AlphaMode::Unknown,
+    );
+
+    atomic_write(path, |w| {
+        w.write_all(MAGIC).map_err(|e| Error::io(path, e))?;
+        header.write(w).map_err(|e| dds_error(path, e))?;
+        header10.write(w).map_err(|e| dds_error(path, e))?;
+        let mut buf = Vec::new();
+        for face in 0..6 {
+            for level in levels {
+                format.encode_rgba(&level[face], &mut buf);
+                w.write_all(&buf).map_err(|e| Error::io(path, e))?;
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Reads level 0 of a DDS cube map (the six faces, declared cube) or 2D texture (one flat
+/// image). See the module documentation for the formats.
+pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+    let io = |e| Error::io(path, e);
+    let invalid = |problem: String| Error::input(path, problem);
+    let file = File::open(path).map_err(io)?;
+    let file_len = file.metadata().map_err(io)?.len();
+    let mut r = BufReader::new(file);
+
+    let mut magic = [0u8; 4];
+    r.read_exact(&mut magic).map_err(io)?;
+    if &magic != MAGIC {
+        return Err(invalid("not a DDS file (bad magic number)".into()));
+    }
+    let header = Header::read(&mut r).map_err(|e| dds_error(path, e))?;
+    let header10 = match header.spf.fourcc {
+        Some(FourCC(FourCC::DX10)) => Some(Header10::read(&mut r).map_err(|e| dds_error(path, e))?),
+        _ => None,
+    };
+
+    let (format, cube, kind) = match &header10 {
+        Some(h10) => {
+            let format = match h10.dxgi_format {
+                DxgiFormat::R16G16B16A16_Float => TexelFormat::Rgba16F,
+                DxgiFormat::R32G32B32A32_Float => TexelFormat::Rgba32F,
+                DxgiFormat::R32G32B32_Float => TexelFormat::Rgb32F,
+                DxgiFormat::R11G11B10_Float => TexelFormat::Rg11B10F,
+                DxgiFormat::R9G9B9E5_SharedExp => TexelFormat::Rgb9E5,
+                other => return Err(unsupported_format(path, &format!("{other:?}"))),
+            };
+            if h10.resource_dimension != D3D10ResourceDimension::Texture2D {
+                return Err(invalid(format!(
+                    "DDS {:?} resources are not supported (only 2D textures and cube maps)",
+                    h10.resource_dimension
+                )));
+            }
+            let cube = h10.misc_flag.contains(MiscFlag::TEXTURECUBE);
+            if h10.array_size > 1 {
+                return Err(invalid(format!(
+                    "DDS {} arrays ({} elements) are not supported",
+                    if cube { "cube-map" } else { "texture" },
+                    h10.array_size
+                )));
+            }
+            (format, cube, "DX10")
+        }
+        None => {
+            let format = match header.spf.fourcc {
+                Some(FourCC(FourCC::A16B16G16R16F)) => TexelFormat::Rgba16F,
+                Some(FourCC(FourCC::A32B32G32R32F)) => TexelFormat::Rgba32F,
+                Some(FourCC(code)) => {
+                    return Err(unsupported_format(path, &format!("FourCC {code:#010x}")))
+                }
+                None => return Err(unsupported_format(path, "uncompressed integer (bit masks)")),
+            };
+            let cube = header.caps2.contains(Caps2::CUBEMAP);
+            if cube && !header.caps2.contains(Caps2::CUBEMAP_ALLFACES) {
+                return Err(invalid(
+                    "DDS cube map without all six faces is not supported".into(),
+                ));
+            }
+            (format, cube, "legacy header")
+        }
+    };
+    if header.caps2.contains(Caps2::VOLUME) || header.depth.unwrap_or(1) > 1 {
+        return Err(invalid("DDS volume textures are not supported".into()));
+    }
+    let (width, height) = (header.width, header.height);
+    if width == 0 || height == 0 {
+        return Err(invalid(format!(
+            "DDS texture declares an empty size {width}×{height}"
+        )));
+    }
+    if cube && width != height {
+        return Err(invalid(format!(
+            "DDS cube map with non-square faces ({width}×{height})"
+        )));
+    }
+    check_limits(path, width, height, limits)?;
+    let mips = header.mip_map_count.unwrap_or(1).max(1);
+    if mips > max_levels(width, height) {
+        return Err(invalid(format!(
+            "{mips} mip levels declared for a {width}×{height} texture, which has at most {}",
+            max_levels(width, height)
+        )));
+    }
+
+    // Each face (array layer) holds its whole mip chain; check the file holds them all.
+    let texel = format.bytes() as u64;
+    let level0 = u64::from(width) * u64::from(height) * texel;
+    let chain: u64 = (0..mips)
+        .map(|p| u64::from((width >> p).max(1)) * u64::from((height >> p).max(1)) * texel)
+        .sum();
+    let faces: u64 = if cube { 6 } else { 1 };
+    let data_start = HEADER_LEN + if header10.is_some() { HEADER10_LEN } else { 0 };
+    let need = data_start + faces * chain;
+    if file_len < need {
+        return Err(invalid(format!(
+            "file is truncated: its header declares {need} bytes, but the file has {file_len}"
+        )));
+    }
+
+    let mut layers = Vec::with_capacity(faces as usize);
+    let mut bytes = vec![0u8; level0 as usize];
+    for face in 0..faces {
+        r.read_exact(&mut bytes).map_err(io)?;
+        let image = Image::from_vec(width, height, format.channels(), format.decode(&bytes))
+            .expect("decoded length matches the face size");
+        layers.push(image);
+        if face + 1 < faces {
+            // Skip this face's smaller mips (bounded by the file length checked above).
+            r.seek_relative((chain - level0) as i64).map_err(io)?;
+        }
+    }
+
+    let levels = mip_phrase(mips);
+    let (declared, description) = if cube {
+        (
+            Some(ProjectionKind::Cube),
+            format!("DDS cube map ({kind}), {}, {levels}", format.name()),
+        )
+    } else {
+        (
+            None,
+            format!("DDS 2D texture ({kind}), {}, {levels}", format.name()),
+        )
+    };
+    Ok(Loaded {
+        layers,
+        declared,
+        format: Format::Dds,
+        description,
+    })
+}
+
+fn unsupported_format(path: &Path, what: &str) -> Error {
+    Error::input(
+        path,
+        format!(
+            "unsupported DDS pixel format {what}; mirrorball reads float formats: RGBA16F, \
+             RGBA32F, RGB32F, R11G11B10F and RGB9E5"
+        ),
+    )
+}
