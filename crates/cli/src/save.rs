@@ -53,8 +53,10 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
                 "--layout {l} needs six faces; a {kind} map has {layers} layer(s)"
             )));
         }
-        if l == Layout::Separate && layers > 1 && !out.contains(FACE) {
-            // Fine: names get a _px … suffix.
+        if l != Layout::Separate && out.contains(FACE) {
+            return Err(CliError::request(format!(
+                "{out}: {FACE} in the name writes one file per layer, which --layout {l} does not"
+            )));
         }
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -106,7 +108,11 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
         return Ok(vec![path.to_path_buf()]);
     }
     let n = env.layers().len();
-    let layout = opts.layout.unwrap_or_else(|| default_layout(n));
+    let layout = match opts.layout {
+        Some(l) => l,
+        None if out.contains(FACE) => Layout::Separate,
+        None => default_layout(n),
+    };
     if layout == Layout::Separate && n > 1 {
         let names = layer_names(n);
         let paths: Vec<PathBuf> = names.iter().map(|nm| layer_path(out, nm)).collect();

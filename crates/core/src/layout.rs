@@ -121,7 +121,7 @@ impl Layout {
                 continue;
             }
             let (c, r) = l.grid(layers);
-            if w % c == 0 && h % r == 0 && w / c == h / r && w / c > 0 {
+            if w.is_multiple_of(c) && h.is_multiple_of(r) && w / c == h / r && w / c > 0 {
                 return Some((l, w / c, h / r));
             }
         }

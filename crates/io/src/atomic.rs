@@ -18,7 +18,9 @@ where
         let mut w = BufWriter::with_capacity(1 << 20, file);
         write(&mut w)?;
         w.flush().map_err(|e| Error::io(path, e))?;
-        let file = w.into_inner().map_err(|e| Error::io(path, e.into_error()))?;
+        let file = w
+            .into_inner()
+            .map_err(|e| Error::io(path, e.into_error()))?;
         file.sync_all().map_err(|e| Error::io(path, e))?;
         drop(file);
         std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
@@ -30,7 +32,10 @@ where
 }
 
 fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let unique = format!(".{}.{}.tmp", name, std::process::id());
     path.with_file_name(unique)
 }

@@ -26,23 +26,39 @@ pub struct Error {
 impl Error {
     /// The input file's fault.
     pub fn input(path: &Path, problem: String) -> Error {
-        Error { path: path.to_path_buf(), fault: Fault::Input, problem, source: None }
+        Error {
+            path: path.to_path_buf(),
+            fault: Fault::Input,
+            problem,
+            source: None,
+        }
     }
     /// The request's fault.
     pub fn request(path: &Path, problem: String) -> Error {
-        Error { path: path.to_path_buf(), fault: Fault::Request, problem, source: None }
+        Error {
+            path: path.to_path_buf(),
+            fault: Fault::Request,
+            problem,
+            source: None,
+        }
     }
     /// The system's fault, from an I/O error. A missing input file is the input's fault.
     pub fn io(path: &Path, e: std::io::Error) -> Error {
         let (fault, problem) = match e.kind() {
             std::io::ErrorKind::NotFound => (Fault::Input, "no such file".to_string()),
-            std::io::ErrorKind::UnexpectedEof => {
-                (Fault::Input, "file is truncated (unexpected end of file)".to_string())
-            }
+            std::io::ErrorKind::UnexpectedEof => (
+                Fault::Input,
+                "file is truncated (unexpected end of file)".to_string(),
+            ),
             std::io::ErrorKind::PermissionDenied => (Fault::System, "permission denied".into()),
             _ => (Fault::System, e.to_string()),
         };
-        Error { path: path.to_path_buf(), fault, problem, source: Some(e) }
+        Error {
+            path: path.to_path_buf(),
+            fault,
+            problem,
+            source: Some(e),
+        }
     }
     /// Whose fault it is.
     pub fn fault(&self) -> Fault {

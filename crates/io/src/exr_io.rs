@@ -1,1 +1,377 @@
-//! TODO: being written.
+//! OpenEXR reading and writing with the `exr` crate, decompressing and compressing blocks
+//! on all cores.
+//!
+//! Reading takes the first layer (part) that has `R`, `G` and `B` channels (and `A` when
+//! present), whatever their sample type (half, float or 32-bit unsigned), at its largest
+//! resolution level, with any compression the `exr` crate decodes: none, RLE, ZIPS, ZIP,
+//! PIZ, PXR24, B44(A) and, since `exr` 1.74.1, DWAA/DWAB. The header is read and checked
+//! first: the declared size against the [`Limits`], and the compression against what the
+//! crate decodes, so that neither a huge declared size nor an undecodable file (HTJ2K) gets
+//! as far as allocating texels.
+
+use crate::ldr_io::{check_limits, check_writable_size, guard_decoder, open_input};
+use crate::{atomic_write, Error, ExrCompression, Format, Limits, Loaded, Precision, WriteOptions};
+use exr::meta::attribute::EnvironmentMap;
+use exr::meta::header::Header;
+use exr::prelude::{
+    ChannelDescription, Compression, Encoding, LayerAttributes, LineOrder, ReadChannels,
+    ReadLayers, SampleType, SpecificChannels, Vec2, WritableImage,
+};
+use mirrorball_core::{Image, ProjectionKind};
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+/// Largest finite half-float: values beyond it are clamped when writing half, so that a
+/// bright sun does not turn into infinity.
+const HALF_MAX: f32 = 65504.0;
+
+/// Reads the first RGB(A) layer of an OpenEXR file as linear `f32` texels.
+///
+/// The `envmap` header attribute, if present, becomes [`Loaded::declared`] (latlong or
+/// cube). Files using a compression the `exr` crate cannot decode (HTJ2K) are refused
+/// before any texel is decoded, with a message that says how to re-save them.
+pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+    let file = open_input(path)?;
+    guard_decoder(path, "OpenEXR", || read_file(path, file, limits))
+}
+
+fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> {
+    // Headers only: nothing sized by the file is allocated yet.
+    let chunks = exr::block::read(BufReader::new(file), false).map_err(|e| read_error(path, e))?;
+    let headers = chunks.headers();
+
+    let Some(header) = headers.iter().find(|h| is_rgb_layer(h)) else {
+        return Err(Error::input(path, no_rgb_layer_problem(headers)));
+    };
+    // The reader picks the first layer it can read, which is this one unless the file is
+    // odd; checking every RGB layer guarantees nothing larger than the limits is allocated.
+    for h in headers.iter().filter(|h| is_rgb_layer(h)) {
+        check_limits(
+            path,
+            h.layer_size.width() as u64,
+            h.layer_size.height() as u64,
+            limits,
+        )?;
+    }
+    if let Some(problem) = undecodable_compression(header.compression) {
+        return Err(Error::input(path, problem));
+    }
+
+    let layer_count = headers.len();
+
+    let exr_image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(create_texels, set_texel)
+        .first_valid_layer()
+        .all_attributes()
+        .from_chunks(chunks)
+        .map_err(|e| read_error(path, e))?;
+
+    // Describe the layer that was read (the first readable RGB one).
+    let layer = exr_image.layer_data;
+    let declared = layer.attributes.environment_map.map(|m| match m {
+        EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
+        EnvironmentMap::Cube => ProjectionKind::Cube,
+    });
+    let compression = layer.encoding.compression;
+    let tiled = matches!(layer.encoding.blocks, exr::image::Blocks::Tiles(_));
+    let layer_name = layer.attributes.layer_name.as_ref().map(|n| n.to_string());
+    let channels = layer.channel_data.channels;
+    let texels = layer.channel_data.pixels;
+    let (width, height) = (layer.size.width(), layer.size.height());
+    let nchannels = texels.channels;
+    let image = Image::from_vec(width as u32, height as u32, nchannels, texels.data)
+        .ok_or_else(|| Error::input(path, "the decoded layer has an inconsistent size".into()))?;
+
+    let mut sample_types = vec![
+        channels.0.sample_type,
+        channels.1.sample_type,
+        channels.2.sample_type,
+    ];
+    if let Some(alpha) = &channels.3 {
+        sample_types.push(alpha.sample_type);
+    }
+    let mut description = format!(
+        "OpenEXR, {}, {}, {}",
+        sample_type_names(&sample_types),
+        compression_description(compression),
+        if nchannels == 4 { "RGBA" } else { "RGB" }
+    );
+    if tiled {
+        description.push_str(", tiled");
+    }
+    if layer_count > 1 {
+        match layer_name {
+            Some(name) => description.push_str(&format!(", layer \"{name}\" of {layer_count}")),
+            None => description.push_str(&format!(", first RGB layer of {layer_count}")),
+        }
+    }
+
+    Ok(Loaded {
+        layers: vec![image],
+        declared,
+        format: Format::Exr,
+        description,
+    })
+}
+
+/// Writes `image` as a single-part scan-line OpenEXR file: half texels unless
+/// `opts.precision` asks for float, compressed with `opts.exr_compression`, RGB or RGBA by
+/// the image's channel count. Blocks are compressed on all cores; the file is written
+/// atomically.
+///
+/// Half output clamps finite values to ±65504 (the largest half) instead of overflowing to
+/// infinity.
+pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
+    let sample_type = match opts.precision {
+        None | Some(Precision::Half) => SampleType::F16,
+        Some(Precision::Float) => SampleType::F32,
+        Some(other) => {
+            return Err(Error::request(
+                path,
+                format!(
+                    "OpenEXR stores half or float texels, not {}; use .png for integer texels",
+                    crate::ldr_io::precision_name(other)
+                ),
+            ))
+        }
+    };
+    check_writable_size(path, image)?;
+    let compression = match opts.exr_compression {
+        ExrCompression::None => Compression::Uncompressed,
+        ExrCompression::Rle => Compression::RLE,
+        ExrCompression::Zips => Compression::ZIP1,
+        ExrCompression::Zip => Compression::ZIP16,
+        ExrCompression::Piz => Compression::PIZ,
+        ExrCompression::Pxr24 => Compression::PXR24,
+    };
+    let encoding = Encoding {
+        compression,
+        blocks: exr::image::Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
+    let size = Vec2(image.width() as usize, image.height() as usize);
+    let width = size.width();
+    let data = image.data();
+    let half = sample_type == SampleType::F16;
+    let describe = |name: &str| ChannelDescription::named(name, sample_type);
+    // Half clamps to the finite range (NaN stays NaN); float passes values through.
+    let fit = move |v: f32| {
+        if half {
+            v.clamp(-HALF_MAX, HALF_MAX)
+        } else {
+            v
+        }
+    };
+
+    if image.channels() == 4 {
+        let texels = SpecificChannels {
+            channels: (describe("R"), describe("G"), describe("B"), describe("A")),
+            pixels: move |p: Vec2<usize>| {
+                let i = (p.y() * width + p.x()) * 4;
+                (
+                    fit(data[i]),
+                    fit(data[i + 1]),
+                    fit(data[i + 2]),
+                    fit(data[i + 3]),
+                )
+            },
+        };
+        let layer = exr::image::Layer::new(size, LayerAttributes::default(), encoding, texels);
+        let exr_image = exr::image::Image::from_layer(layer);
+        atomic_write(path, |out| {
+            exr_image
+                .write()
+                .to_buffered(out)
+                .map_err(|e| write_error(path, e))
+        })
+    } else {
+        let texels = SpecificChannels {
+            channels: (describe("R"), describe("G"), describe("B")),
+            pixels: move |p: Vec2<usize>| {
+                let i = (p.y() * width + p.x()) * 3;
+                (fit(data[i]), fit(data[i + 1]), fit(data[i + 2]))
+            },
+        };
+        let layer = exr::image::Layer::new(size, LayerAttributes::default(), encoding, texels);
+        let exr_image = exr::image::Image::from_layer(layer);
+        atomic_write(path, |out| {
+            exr_image
+                .write()
+                .to_buffered(out)
+                .map_err(|e| write_error(path, e))
+        })
+    }
+}
+
+/// The decoded texels of one layer, interleaved RGB or RGBA, top row first.
+struct Texels {
+    width: usize,
+    channels: usize,
+    data: Vec<f32>,
+}
+
+/// Allocates the texels of a layer whose size was checked against the limits.
+fn create_texels(size: Vec2<usize>, channels: &exr::image::RgbaChannels) -> Texels {
+    let nchannels = if channels.3.is_some() { 4 } else { 3 };
+    Texels {
+        width: size.width(),
+        channels: nchannels,
+        data: vec![0.0; size.area() * nchannels],
+    }
+}
+
+/// Stores one decoded texel (the crate has already converted a whole line of samples).
+#[inline]
+fn set_texel(texels: &mut Texels, p: Vec2<usize>, (r, g, b, a): (f32, f32, f32, f32)) {
+    let c = texels.channels;
+    let i = (p.y() * texels.width + p.x()) * c;
+    if let Some(dst) = texels.data.get_mut(i..i + c) {
+        if c == 4 {
+            dst.copy_from_slice(&[r, g, b, a]);
+        } else {
+            dst.copy_from_slice(&[r, g, b]);
+        }
+    }
+}
+
+/// Whether a header is a flat layer with red, green and blue channels.
+fn is_rgb_layer(header: &Header) -> bool {
+    let has = |name: &str| header.channels.list.iter().any(|c| c.name.eq(name));
+    !header.deep && has("R") && has("G") && has("B")
+}
+
+fn no_rgb_layer_problem(headers: &[Header]) -> String {
+    let names: Vec<String> = headers
+        .iter()
+        .flat_map(|h| h.channels.list.iter().map(|c| c.name.to_string()))
+        .collect();
+    if headers.iter().all(|h| h.deep) {
+        "holds only deep data, which mirrorball cannot use".to_string()
+    } else {
+        format!(
+            "has no layer with R, G and B channels (channels found: {}); mirrorball reads RGB \
+             or RGBA images",
+            if names.is_empty() {
+                "none".to_string()
+            } else {
+                names.join(", ")
+            }
+        )
+    }
+}
+
+/// The problem with a compression the linked `exr` crate does not decode, if it is one.
+fn undecodable_compression(compression: Compression) -> Option<String> {
+    match compression {
+        Compression::HTJ2K32 | Compression::HTJ2K256 => {
+            Some(undecodable_message(compression_name(compression)))
+        }
+        _ => None,
+    }
+}
+
+fn undecodable_message(name: &str) -> String {
+    format!(
+        "uses {name} compression, which mirrorball cannot decode; re-save it with ZIP or PIZ \
+         compression (for example `oiiotool in.exr --compression zip -o out.exr`, or export it \
+         as OpenEXR with ZIP compression from Blender, Photoshop or GIMP)"
+    )
+}
+
+/// The OpenEXR name of a compression method.
+fn compression_name(compression: Compression) -> &'static str {
+    match compression {
+        Compression::Uncompressed => "no",
+        Compression::RLE => "RLE",
+        Compression::ZIP1 => "ZIPS",
+        Compression::ZIP16 => "ZIP",
+        Compression::PIZ => "PIZ",
+        Compression::PXR24 => "PXR24",
+        Compression::B44 => "B44",
+        Compression::B44A => "B44A",
+        Compression::DWAA(_) => "DWAA",
+        Compression::DWAB(_) => "DWAB",
+        Compression::HTJ2K32 => "HTJ2K32",
+        Compression::HTJ2K256 => "HTJ2K256",
+    }
+}
+
+fn compression_description(compression: Compression) -> String {
+    match compression {
+        Compression::Uncompressed => "uncompressed".to_string(),
+        Compression::B44 | Compression::B44A | Compression::DWAA(_) | Compression::DWAB(_) => {
+            format!("{} compression (lossy)", compression_name(compression))
+        }
+        other => format!("{} compression", compression_name(other)),
+    }
+}
+
+fn sample_type_name(t: SampleType) -> &'static str {
+    match t {
+        SampleType::F16 => "half",
+        SampleType::F32 => "float",
+        SampleType::U32 => "uint",
+    }
+}
+
+/// "half", or "mixed half/float" when the channels differ.
+fn sample_type_names(types: &[SampleType]) -> String {
+    let mut names: Vec<&str> = Vec::new();
+    for &t in types {
+        let name = sample_type_name(t);
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    if names.len() == 1 {
+        names[0].to_string()
+    } else {
+        format!("mixed {}", names.join("/"))
+    }
+}
+
+/// Turns an `exr` reading error into an input error naming the problem.
+fn read_error(path: &Path, e: exr::error::Error) -> Error {
+    use exr::error::Error as E;
+    match e {
+        E::Io(io) => Error::io(path, io),
+        E::Invalid(msg) if msg.contains("missing bytes") => Error::input(
+            path,
+            "file is truncated (unexpected end of file)".to_string(),
+        ),
+        E::Invalid(msg) => Error::input(path, format!("not a valid OpenEXR file ({msg})")),
+        E::NotSupported(msg) => {
+            // Older `exr` versions report undecodable compressions only when they meet the
+            // first block; name them the way the header check does.
+            let lower = msg.to_ascii_lowercase();
+            for name in ["dwaa", "dwab", "b44a", "b44", "htj2k", "ht j2k"] {
+                if lower.contains(name) && lower.contains("compression") {
+                    return Error::input(
+                        path,
+                        undecodable_message(&name.replace(' ', "").to_ascii_uppercase()),
+                    );
+                }
+            }
+            Error::input(
+                path,
+                format!("uses an OpenEXR feature mirrorball cannot read ({msg})"),
+            )
+        }
+        E::Aborted => Error::input(path, "reading was cancelled".to_string()),
+    }
+}
+
+/// Turns an `exr` writing error into an error naming the problem.
+fn write_error(path: &Path, e: exr::error::Error) -> Error {
+    use exr::error::Error as E;
+    match e {
+        E::Io(io) => Error::io(path, io),
+        E::Invalid(msg) | E::NotSupported(msg) => {
+            Error::request(path, format!("cannot write this image as OpenEXR ({msg})"))
+        }
+        E::Aborted => Error::request(path, "writing was cancelled".to_string()),
+    }
+}

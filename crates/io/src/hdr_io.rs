@@ -1,1 +1,183 @@
-//! TODO: being written.
+//! Radiance RGBE (`.hdr`): read with the `image` crate's decoder, written here with the
+//! standard new-style run-length encoding.
+
+use crate::ldr_io::{check_limits, check_writable_size, decode_error, guard_decoder, open_input};
+use crate::{atomic_write, Error, Format, Limits, Loaded};
+use image::codecs::hdr::HdrDecoder;
+use image::{DynamicImage, ImageDecoder};
+use mirrorball_core::Image;
+use rayon::prelude::*;
+use std::io::{BufRead, BufReader, Write};
+use std::path::Path;
+
+/// Rows encoded per parallel work item.
+const ROWS_PER_BAND: usize = 16;
+
+/// Largest value RGBE holds: mantissa 255 with the largest exponent (byte 255).
+const RGBE_MAX: f32 = 255.0 * (1u128 << 119) as f32;
+
+/// Smallest value written as non-zero (as in Ward's reference encoder).
+const RGBE_MIN: f32 = 1e-32;
+
+/// Bytes read ahead to check the signature and header.
+const PEEK: usize = 1 << 16;
+
+/// Reads a Radiance RGBE file as linear `f32` RGB.
+///
+/// Accepts the `#?RADIANCE` and `#?RGBE` signatures and the standard `-Y H +X W`
+/// orientation; the declared size is checked against `limits` before decoding.
+pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+    let file = open_input(path)?;
+    guard_decoder(path, "Radiance HDR", || {
+        let mut reader = BufReader::with_capacity(PEEK, file);
+        let head = reader.fill_buf().map_err(|e| Error::io(path, e))?;
+        if !head.starts_with(b"#?") {
+            return Err(Error::input(
+                path,
+                "not a Radiance HDR file (it does not start with the #?RADIANCE signature)".into(),
+            ));
+        }
+        // A file shorter than the peek holds its whole header: check it ends properly, so a
+        // cut-off header is reported as such rather than as a strange attribute.
+        if head.len() < PEEK && !header_is_complete(head) {
+            return Err(Error::input(
+                path,
+                "file is truncated (the header ends before the image size line)".into(),
+            ));
+        }
+        // Non-strict: also accepts other signatures such as #?RGBE, which some tools write.
+        let decoder =
+            HdrDecoder::new_nonstrict(reader).map_err(|e| decode_error(path, "Radiance HDR", e))?;
+        let (width, height) = decoder.dimensions();
+        check_limits(path, width as u64, height as u64, limits)?;
+        let decoded = DynamicImage::from_decoder(decoder)
+            .map_err(|e| decode_error(path, "Radiance HDR", e))?;
+        let data = match decoded {
+            DynamicImage::ImageRgb32F(b) => b.into_raw(),
+            other => other.to_rgb32f().into_raw(),
+        };
+        let image = Image::from_vec(width, height, 3, data).ok_or_else(|| {
+            Error::input(path, "the decoded image has an inconsistent size".into())
+        })?;
+        Ok(Loaded {
+            layers: vec![image],
+            declared: None,
+            format: Format::Hdr,
+            description: "Radiance RGBE".to_string(),
+        })
+    })
+}
+
+/// Whether `head` holds the header lines, the blank line and the whole size line.
+fn header_is_complete(head: &[u8]) -> bool {
+    match head.windows(2).position(|w| w == b"\n\n") {
+        Some(blank) => head[blank + 2..].contains(&b'\n'),
+        None => false,
+    }
+}
+
+/// Writes `image` as Radiance RGBE (alpha is dropped), run-length encoded for widths from
+/// 8 to 32767 and flat otherwise, rows encoded on all cores. Negative and NaN values are
+/// written as 0, values beyond the RGBE range as its largest value. The file is written
+/// atomically.
+pub fn write(path: &Path, image: &Image) -> Result<(), Error> {
+    check_writable_size(path, image)?;
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    let c = image.channels();
+    let header = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n");
+    let bands: Vec<Vec<u8>> = image
+        .data()
+        .par_chunks(w * c * ROWS_PER_BAND)
+        .map(|band| {
+            let mut out = Vec::with_capacity(band.len() / c * 4 + 64);
+            let mut rgbe = vec![[0u8; 4]; w];
+            for row in band.chunks_exact(w * c) {
+                for (dst, src) in rgbe.iter_mut().zip(row.chunks_exact(c)) {
+                    *dst = to_rgbe(src[0], src[1], src[2]);
+                }
+                encode_scanline(&rgbe, &mut out);
+            }
+            out
+        })
+        .collect();
+    atomic_write(path, |out| {
+        out.write_all(header.as_bytes())
+            .map_err(|e| Error::io(path, e))?;
+        for band in &bands {
+            out.write_all(band).map_err(|e| Error::io(path, e))?;
+        }
+        Ok(())
+    })
+}
+
+/// One texel as RGBE, rounding each mantissa to nearest (readers compute `m · 2^(e-136)`).
+/// The largest mantissa is always at least 128, so a texel never looks like a run-length
+/// marker (`1 1 1 e`) or a new-style scan-line header (`2 2 <128 e`).
+fn to_rgbe(r: f32, g: f32, b: f32) -> [u8; 4] {
+    // `v > 0` is false for NaN and negatives: both become 0.
+    let fit = |v: f32| if v > 0.0 { v.min(RGBE_MAX) } else { 0.0 };
+    let (r, g, b) = (fit(r), fit(g), fit(b));
+    let max = r.max(g).max(b);
+    if max < RGBE_MIN {
+        return [0; 4];
+    }
+    // max = 1.f · 2^e2 (a normal float); the mantissas scale by 2^(7 - e2) so max lands in
+    // [128, 256).
+    let mut e2 = ((max.to_bits() >> 23) & 0xff) as i32 - 127;
+    let scale_for = |e2: i32| f32::from_bits(((7 - e2 + 127) as u32) << 23);
+    let mut scale = scale_for(e2);
+    if (max * scale + 0.5) as u32 >= 256 {
+        e2 += 1;
+        scale = scale_for(e2);
+    }
+    let q = |v: f32| (v * scale + 0.5) as u8;
+    [q(r), q(g), q(b), (e2 + 129) as u8]
+}
+
+/// Appends one scan line: new-style run-length encoded (per component) when the width
+/// allows it, flat otherwise.
+fn encode_scanline(texels: &[[u8; 4]], out: &mut Vec<u8>) {
+    let w = texels.len();
+    if !(8..=0x7fff).contains(&w) {
+        for t in texels {
+            out.extend_from_slice(t);
+        }
+        return;
+    }
+    out.extend_from_slice(&[2, 2, (w >> 8) as u8, (w & 0xff) as u8]);
+    let mut component = Vec::with_capacity(w);
+    for k in 0..4 {
+        component.clear();
+        component.extend(texels.iter().map(|t| t[k]));
+        encode_runs(&component, out);
+    }
+}
+
+/// Run-length encodes one component: runs of at least 4 equal bytes as `128 + n, byte`
+/// (n ≤ 127), everything else as literals `n, bytes…` (n ≤ 128).
+fn encode_runs(data: &[u8], out: &mut Vec<u8>) {
+    const MIN_RUN: usize = 4;
+    let run_at = |i: usize| {
+        data[i..]
+            .iter()
+            .take(127)
+            .take_while(|&&b| b == data[i])
+            .count()
+    };
+    let mut i = 0;
+    while i < data.len() {
+        let run = run_at(i);
+        if run >= MIN_RUN {
+            out.extend_from_slice(&[128 + run as u8, data[i]]);
+            i += run;
+            continue;
+        }
+        // A literal stretch up to the next worthwhile run (or 128 bytes).
+        let start = i;
+        while i < data.len() && i - start < 128 && run_at(i) < MIN_RUN {
+            i += 1;
+        }
+        out.push((i - start) as u8);
+        out.extend_from_slice(&data[start..i]);
+    }
+}

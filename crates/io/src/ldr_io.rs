@@ -1,1 +1,582 @@
-//! TODO: being written.
+//! PNG, JPEG and WebP (8/16-bit, sRGB-encoded) with the `image` crate, converted to and
+//! from linear light with the exact sRGB transfer functions.
+//!
+//! Also holds the small helpers the flat-image readers and writers share: the size check
+//! against [`Limits`], the guard that turns a decoder panic into an error, and the mapping
+//! of `image` crate errors.
+
+use crate::{atomic_write, Error, Format, Limits, Loaded, Precision, WriteOptions};
+use image::codecs::jpeg::JpegEncoder;
+use image::codecs::png::PngEncoder;
+use image::{DynamicImage, ExtendedColorType, ImageDecoder, ImageEncoder, ImageError, ImageFormat};
+use mirrorball_core::Image;
+use rayon::prelude::*;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Cursor, Read, Seek};
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// JPEG quality used when [`WriteOptions::jpeg_quality`] is 0.
+const DEFAULT_JPEG_QUALITY: u8 = 92;
+
+/// Texels per parallel work item when converting between linear and sRGB.
+const CHUNK_TEXELS: usize = 1 << 14;
+
+/// Reads a PNG, JPEG or WebP file as linear `f32` texels: RGB, or RGBA when the file has
+/// alpha (grey is expanded to RGB). Colour channels are sRGB-decoded; alpha is kept
+/// linear, as stored.
+///
+/// The declared size is checked against `limits` from the header, before any texel is
+/// decoded.
+pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Error> {
+    let (image_format, name) = match format {
+        Format::Png => (ImageFormat::Png, "PNG"),
+        Format::Jpeg => (ImageFormat::Jpeg, "JPEG"),
+        Format::Webp => (ImageFormat::WebP, "WebP"),
+        other => {
+            return Err(Error::request(
+                path,
+                format!("{other:?} is not an 8/16-bit image format"),
+            ))
+        }
+    };
+    let file = open_input(path)?;
+    guard_decoder(path, name, || {
+        if format != Format::Jpeg {
+            return decode(
+                path,
+                BufReader::new(file),
+                image_format,
+                format,
+                name,
+                limits,
+            );
+        }
+        // JPEG decoders fill in whatever a truncated file lacks: check for the end marker.
+        let mut bytes = Vec::new();
+        BufReader::new(file)
+            .read_to_end(&mut bytes)
+            .map_err(|e| Error::io(path, e))?;
+        if !bytes.starts_with(&[0xff, 0xd8]) {
+            return Err(Error::input(
+                path,
+                "not a valid JPEG file (no start-of-image marker)".into(),
+            ));
+        }
+        if !jpeg_is_complete(&bytes) {
+            return Err(Error::input(
+                path,
+                "file is truncated (the JPEG end-of-image marker is missing)".into(),
+            ));
+        }
+        decode(path, Cursor::new(bytes), image_format, format, name, limits)
+    })
+}
+
+/// Decodes with the `image` crate after checking the declared size.
+fn decode<R: BufRead + Seek>(
+    path: &Path,
+    reader: R,
+    image_format: ImageFormat,
+    format: Format,
+    name: &str,
+    limits: &Limits,
+) -> Result<Loaded, Error> {
+    let mut reader = image::ImageReader::with_format(reader, image_format);
+    reader.limits(image_limits(limits));
+    let decoder = reader.into_decoder().map_err(|e| match e {
+        ImageError::Limits(_) => Error::input(
+            path,
+            format!(
+                "declares an image larger than allowed (at most {} texels wide or high, {} in all)",
+                limits.max_dimension, limits.max_texels
+            ),
+        ),
+        e => decode_error(path, name, e),
+    })?;
+    let (width, height) = decoder.dimensions();
+    check_limits(path, width as u64, height as u64, limits)?;
+    let decoded = DynamicImage::from_decoder(decoder).map_err(|e| decode_error(path, name, e))?;
+    let (image, depth, layout) = to_linear(path, decoded)?;
+    let description = format!("{name}, {depth} sRGB, {layout}");
+    Ok(Loaded {
+        layers: vec![image],
+        declared: None,
+        format,
+        description,
+    })
+}
+
+/// Whether the last scan of a JPEG stream is followed by an end-of-image marker. Marker
+/// bytes cannot occur inside entropy-coded data (0xFF is stuffed), so the last
+/// start-of-scan is the real one; anything after the end marker is ignored.
+fn jpeg_is_complete(bytes: &[u8]) -> bool {
+    match bytes.windows(2).rposition(|w| w == [0xff, 0xda]) {
+        Some(sos) => bytes[sos..].windows(2).any(|w| w == [0xff, 0xd9]),
+        // No scan at all: the decoder says what is wrong.
+        None => true,
+    }
+}
+
+/// Writes `image` as PNG (8-bit, or 16-bit with [`Precision::U16`]) or JPEG (8-bit,
+/// quality [`WriteOptions::jpeg_quality`], 92 when 0; alpha dropped), encoding linear light
+/// to sRGB with clamping to [0, 1] and rounding to nearest. Alpha is stored linearly.
+/// The file is written atomically.
+pub fn write(path: &Path, format: Format, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
+    let sixteen = match (format, opts.precision) {
+        (Format::Png | Format::Jpeg, None | Some(Precision::U8)) => false,
+        (Format::Png, Some(Precision::U16)) => true,
+        (Format::Png, Some(p)) => {
+            return Err(Error::request(
+                path,
+                format!(
+                    "PNG stores 8- or 16-bit integer texels, not {}; use .exr for half or float",
+                    precision_name(p)
+                ),
+            ))
+        }
+        (Format::Jpeg, Some(p)) => {
+            return Err(Error::request(
+                path,
+                format!(
+                    "JPEG stores 8-bit integer texels, not {}; use .png for 16 bits or .exr \
+                     for half or float",
+                    precision_name(p)
+                ),
+            ))
+        }
+        (other, _) => {
+            let problem = format!("writing {other:?} as an 8/16-bit image is not supported");
+            return Err(Error::request(path, problem));
+        }
+    };
+    check_writable_size(path, image)?;
+    let (w, h) = (image.width(), image.height());
+    if format == Format::Jpeg && (w > u16::MAX as u32 || h > u16::MAX as u32) {
+        return Err(Error::request(
+            path,
+            format!("JPEG images are at most 65535 texels wide and high; this one is {w}×{h}"),
+        ));
+    }
+
+    if format == Format::Jpeg {
+        let quality = match opts.jpeg_quality {
+            0 => DEFAULT_JPEG_QUALITY,
+            q => q.min(100),
+        };
+        let bytes = encode_u8(image, 3);
+        return atomic_write(path, |out| {
+            JpegEncoder::new_with_quality(out, quality)
+                .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
+                .map_err(|e| encode_error(path, "JPEG", e))
+        });
+    }
+
+    let c = image.channels();
+    let (bytes, color) = if sixteen {
+        let samples = encode_u16(image);
+        let bytes: Vec<u8> = samples.iter().flat_map(|s| s.to_ne_bytes()).collect();
+        (
+            bytes,
+            if c == 4 {
+                ExtendedColorType::Rgba16
+            } else {
+                ExtendedColorType::Rgb16
+            },
+        )
+    } else {
+        (
+            encode_u8(image, c),
+            if c == 4 {
+                ExtendedColorType::Rgba8
+            } else {
+                ExtendedColorType::Rgb8
+            },
+        )
+    };
+    atomic_write(path, |out| {
+        PngEncoder::new(out)
+            .write_image(&bytes, w, h, color)
+            .map_err(|e| encode_error(path, "PNG", e))
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// sRGB transfer functions.
+
+/// The sRGB EOTF: encoded value in [0, 1] to linear light, computed in `f64`.
+fn srgb_to_linear(s: f64) -> f64 {
+    if s <= 0.04045 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The inverse sRGB EOTF: linear light in [0, 1] to an encoded value, in `f64` so that
+/// 16-bit codes round to nearest exactly.
+#[inline]
+fn linear_to_srgb(l: f64) -> f64 {
+    if l <= 0.003_130_8 {
+        l * 12.92
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Linear light of each 8-bit sRGB code.
+fn lut8() -> &'static [f32; 256] {
+    static LUT: OnceLock<[f32; 256]> = OnceLock::new();
+    LUT.get_or_init(|| std::array::from_fn(|k| srgb_to_linear(k as f64 / 255.0) as f32))
+}
+
+/// Linear light of each 16-bit sRGB code.
+fn lut16() -> &'static [f32] {
+    static LUT: OnceLock<Vec<f32>> = OnceLock::new();
+    LUT.get_or_init(|| {
+        (0..=u16::MAX)
+            .map(|k| srgb_to_linear(k as f64 / 65535.0) as f32)
+            .collect()
+    })
+}
+
+/// The linear values halfway between consecutive 8-bit codes: code k covers
+/// `[T[k-1], T[k])`, so encoding is a binary search that rounds to nearest exactly.
+fn thresholds8() -> &'static [f32; 255] {
+    static T: OnceLock<[f32; 255]> = OnceLock::new();
+    T.get_or_init(|| std::array::from_fn(|k| srgb_to_linear((k as f64 + 0.5) / 255.0) as f32))
+}
+
+/// Linear light to the nearest 8-bit sRGB code, clamping to [0, 1] (NaN gives 0).
+#[inline]
+fn encode8(l: f32, t: &[f32; 255]) -> u8 {
+    t.partition_point(|&x| x <= l) as u8
+}
+
+/// Linear light to the nearest 16-bit sRGB code, clamping to [0, 1] (NaN gives 0).
+#[inline]
+fn encode16(l: f32) -> u16 {
+    if l > 0.0 {
+        (linear_to_srgb(l.min(1.0) as f64) * 65535.0 + 0.5) as u16
+    } else {
+        0
+    }
+}
+
+/// Alpha (linear, clamped to [0, 1]) to an integer of `max`.
+#[inline]
+fn encode_alpha(a: f32, max: f32) -> f32 {
+    if a > 0.0 {
+        (a.min(1.0) * max + 0.5).floor()
+    } else {
+        0.0
+    }
+}
+
+/// 8-bit sRGB samples of `image` with `out_channels` channels (3 drops alpha).
+fn encode_u8(image: &Image, out_channels: usize) -> Vec<u8> {
+    let c = image.channels();
+    let t = thresholds8();
+    let texels = image.data().len() / c;
+    let mut out = vec![0u8; texels * out_channels];
+    out.par_chunks_mut(CHUNK_TEXELS * out_channels)
+        .zip(image.data().par_chunks(CHUNK_TEXELS * c))
+        .for_each(|(dst, src)| {
+            for (d, s) in dst.chunks_exact_mut(out_channels).zip(src.chunks_exact(c)) {
+                d[0] = encode8(s[0], t);
+                d[1] = encode8(s[1], t);
+                d[2] = encode8(s[2], t);
+                if out_channels == 4 {
+                    d[3] = encode_alpha(s[3], 255.0) as u8;
+                }
+            }
+        });
+    out
+}
+
+/// 16-bit sRGB samples of `image`, RGB or RGBA as the image is.
+fn encode_u16(image: &Image) -> Vec<u16> {
+    let c = image.channels();
+    let mut out = vec![0u16; image.data().len()];
+    out.par_chunks_mut(CHUNK_TEXELS * c)
+        .zip(image.data().par_chunks(CHUNK_TEXELS * c))
+        .for_each(|(dst, src)| {
+            for (d, s) in dst.chunks_exact_mut(c).zip(src.chunks_exact(c)) {
+                d[0] = encode16(s[0]);
+                d[1] = encode16(s[1]);
+                d[2] = encode16(s[2]);
+                if c == 4 {
+                    d[3] = encode_alpha(s[3], 65535.0) as u16;
+                }
+            }
+        });
+    out
+}
+
+/// Expands `src` (with `sc` interleaved channels: 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA) to
+/// linear RGB or RGBA through `lut`, alpha divided by `max`.
+fn decode_samples<T: Copy + Into<usize> + Sync>(
+    src: &[T],
+    sc: usize,
+    lut: &[f32],
+    max: f32,
+) -> Vec<f32> {
+    let alpha = sc == 2 || sc == 4;
+    let dc = if alpha { 4 } else { 3 };
+    let texels = src.len() / sc;
+    let mut out = vec![0.0f32; texels * dc];
+    let lookup = |v: T| lut.get(v.into()).copied().unwrap_or(1.0);
+    out.par_chunks_mut(CHUNK_TEXELS * dc)
+        .zip(src.par_chunks(CHUNK_TEXELS * sc))
+        .for_each(|(dst, src)| {
+            for (d, s) in dst.chunks_exact_mut(dc).zip(src.chunks_exact(sc)) {
+                if sc >= 3 {
+                    d[0] = lookup(s[0]);
+                    d[1] = lookup(s[1]);
+                    d[2] = lookup(s[2]);
+                } else {
+                    let g = lookup(s[0]);
+                    d[0] = g;
+                    d[1] = g;
+                    d[2] = g;
+                }
+                if alpha {
+                    d[3] = s[sc - 1].into() as f32 / max;
+                }
+            }
+        });
+    out
+}
+
+/// The decoded picture as linear light, with its bit depth and channel layout for the
+/// description.
+fn to_linear(
+    path: &Path,
+    decoded: DynamicImage,
+) -> Result<(Image, &'static str, &'static str), Error> {
+    let (w, h) = (decoded.width(), decoded.height());
+    let (data, depth, layout, channels) = match decoded {
+        DynamicImage::ImageLuma8(b) => (
+            decode_samples(b.as_raw(), 1, lut8(), 255.0),
+            "8-bit",
+            "grey",
+            3,
+        ),
+        DynamicImage::ImageLumaA8(b) => (
+            decode_samples(b.as_raw(), 2, lut8(), 255.0),
+            "8-bit",
+            "grey with alpha",
+            4,
+        ),
+        DynamicImage::ImageRgb8(b) => (
+            decode_samples(b.as_raw(), 3, lut8(), 255.0),
+            "8-bit",
+            "RGB",
+            3,
+        ),
+        DynamicImage::ImageRgba8(b) => (
+            decode_samples(b.as_raw(), 4, lut8(), 255.0),
+            "8-bit",
+            "RGBA",
+            4,
+        ),
+        DynamicImage::ImageLuma16(b) => (
+            decode_samples(b.as_raw(), 1, lut16(), 65535.0),
+            "16-bit",
+            "grey",
+            3,
+        ),
+        DynamicImage::ImageLumaA16(b) => (
+            decode_samples(b.as_raw(), 2, lut16(), 65535.0),
+            "16-bit",
+            "grey with alpha",
+            4,
+        ),
+        DynamicImage::ImageRgb16(b) => (
+            decode_samples(b.as_raw(), 3, lut16(), 65535.0),
+            "16-bit",
+            "RGB",
+            3,
+        ),
+        DynamicImage::ImageRgba16(b) => (
+            decode_samples(b.as_raw(), 4, lut16(), 65535.0),
+            "16-bit",
+            "RGBA",
+            4,
+        ),
+        other => {
+            // Not produced by the PNG, JPEG or WebP decoders today; go through 16 bits.
+            if other.color().has_alpha() {
+                let b = other.to_rgba16();
+                (
+                    decode_samples(b.as_raw(), 4, lut16(), 65535.0),
+                    "16-bit",
+                    "RGBA",
+                    4,
+                )
+            } else {
+                let b = other.to_rgb16();
+                (
+                    decode_samples(b.as_raw(), 3, lut16(), 65535.0),
+                    "16-bit",
+                    "RGB",
+                    3,
+                )
+            }
+        }
+    };
+    let image = Image::from_vec(w, h, channels, data)
+        .ok_or_else(|| Error::input(path, "the decoded image has an inconsistent size".into()))?;
+    Ok((image, depth, layout))
+}
+
+// ---------------------------------------------------------------------------------------
+// Shared by the flat-image readers and writers.
+
+/// Checks a declared width × height against `limits` (and that it is not empty), before
+/// anything of that size is allocated.
+pub(crate) fn check_limits(
+    path: &Path,
+    width: u64,
+    height: u64,
+    limits: &Limits,
+) -> Result<(), Error> {
+    if width == 0 || height == 0 {
+        return Err(Error::input(
+            path,
+            format!("declares an empty {width}×{height} image"),
+        ));
+    }
+    let max_dim = limits.max_dimension as u64;
+    if width > max_dim || height > max_dim {
+        return Err(Error::input(
+            path,
+            format!(
+                "declares a {width}×{height} image; the largest width or height allowed is \
+                 {max_dim}"
+            ),
+        ));
+    }
+    let texels = width.saturating_mul(height);
+    if texels > limits.max_texels {
+        return Err(Error::input(
+            path,
+            format!(
+                "declares a {width}×{height} image ({texels} texels); at most {} texels are \
+                 allowed",
+                limits.max_texels
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Opens a file to read, refusing directories (which open fine on Unix but fail to read
+/// with an unhelpful system error).
+pub(crate) fn open_input(path: &Path) -> Result<File, Error> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let meta = file.metadata().map_err(|e| Error::io(path, e))?;
+    if meta.is_dir() {
+        return Err(Error::input(
+            path,
+            "is a directory, not an image file".into(),
+        ));
+    }
+    Ok(file)
+}
+
+/// Refuses to write an empty image.
+pub(crate) fn check_writable_size(path: &Path, image: &Image) -> Result<(), Error> {
+    if image.width() == 0 || image.height() == 0 {
+        return Err(Error::request(
+            path,
+            format!(
+                "cannot write an empty {}×{} image",
+                image.width(),
+                image.height()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Runs a decoder, turning a panic inside it (a bug the malformed file triggered) into an
+/// input error instead of bringing the program down.
+pub(crate) fn guard_decoder<T>(
+    path: &Path,
+    format_name: &str,
+    decode: impl FnOnce() -> Result<T, Error>,
+) -> Result<T, Error> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode)).unwrap_or_else(|_| {
+        Err(Error::input(
+            path,
+            format!("the {format_name} decoder failed on malformed data"),
+        ))
+    })
+}
+
+/// How a [`Precision`] is named in messages.
+pub(crate) fn precision_name(p: Precision) -> &'static str {
+    match p {
+        Precision::Half => "half",
+        Precision::Float => "float",
+        Precision::U8 => "8-bit",
+        Precision::U16 => "16-bit",
+    }
+}
+
+/// The `image` crate's limits matching ours (its own check happens while it reads the
+/// header; ours, with a clearer message, right after).
+fn image_limits(limits: &Limits) -> image::Limits {
+    let mut l = image::Limits::default();
+    l.max_image_width = Some(limits.max_dimension);
+    l.max_image_height = Some(limits.max_dimension);
+    // 16-bit RGBA output plus room for the decoder's own buffers.
+    l.max_alloc = Some(limits.max_texels.saturating_mul(16).max(64 << 20));
+    l
+}
+
+/// Turns an `image` crate decoding error into an input error naming the problem.
+pub(crate) fn decode_error(path: &Path, format_name: &str, e: ImageError) -> Error {
+    match e {
+        ImageError::IoError(io) => match io.kind() {
+            std::io::ErrorKind::UnexpectedEof => Error::io(path, io),
+            std::io::ErrorKind::InvalidData
+            | std::io::ErrorKind::InvalidInput
+            | std::io::ErrorKind::Other => {
+                Error::input(path, format!("not a valid {format_name} file ({io})"))
+            }
+            _ => Error::io(path, io),
+        },
+        ImageError::Limits(l) => {
+            Error::input(path, format!("declares an image larger than allowed ({l})"))
+        }
+        ImageError::Unsupported(u) => Error::input(
+            path,
+            format!("uses a {format_name} feature mirrorball cannot read ({u})"),
+        ),
+        other => {
+            let msg = other.to_string();
+            let lower = msg.to_ascii_lowercase();
+            if ["eof", "end of file", "not enough bytes", "truncated"]
+                .iter()
+                .any(|s| lower.contains(s))
+            {
+                Error::input(path, format!("file is truncated ({msg})"))
+            } else {
+                Error::input(path, format!("not a valid {format_name} file ({msg})"))
+            }
+        }
+    }
+}
+
+/// Turns an `image` crate encoding error into an error naming the problem.
+pub(crate) fn encode_error(path: &Path, format_name: &str, e: ImageError) -> Error {
+    match e {
+        ImageError::IoError(io) => Error::io(path, io),
+        other => Error::request(
+            path,
+            format!("cannot write this image as {format_name} ({other})"),
+        ),
+    }
+}

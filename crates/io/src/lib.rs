@@ -7,16 +7,16 @@
 //! a failed write never leaves a half-written output. Every error names the file and says
 //! whose fault it is ([`Fault`]).
 
-mod error;
 mod atomic;
+mod dds_io;
+mod error;
 mod exr_io;
 mod hdr_io;
-mod ldr_io;
 mod ktx2_io;
-mod dds_io;
+mod ldr_io;
 
-pub use error::{Error, Fault};
 pub use atomic::atomic_write;
+pub use error::{Error, Fault};
 
 use mirrorball_core::{Image, ProjectionKind};
 use std::path::Path;
@@ -74,7 +74,10 @@ pub struct Limits {
 
 impl Default for Limits {
     fn default() -> Self {
-        Limits { max_texels: 1 << 28, max_dimension: 65536 }
+        Limits {
+            max_texels: 1 << 28,
+            max_dimension: 65536,
+        }
     }
 }
 
@@ -156,7 +159,10 @@ pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<()
         Format::Exr => exr_io::write(path, image, opts),
         Format::Hdr => hdr_io::write(path, image),
         Format::Png | Format::Jpeg => ldr_io::write(path, format, image, opts),
-        Format::Webp => Err(Error::request(path, "writing WebP is not supported; use .png".into())),
+        Format::Webp => Err(Error::request(
+            path,
+            "writing WebP is not supported; use .png".into(),
+        )),
         Format::Ktx2 | Format::Dds => Err(Error::request(
             path,
             "KTX2 and DDS hold cube maps: convert with --to cube".into(),
@@ -172,7 +178,10 @@ pub fn write_cube(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Re
     match format {
         Format::Ktx2 => ktx2_io::write(path, levels, opts),
         Format::Dds => dds_io::write(path, levels, opts),
-        _ => Err(Error::request(path, "only .ktx2 and .dds hold a whole cube map".into())),
+        _ => Err(Error::request(
+            path,
+            "only .ktx2 and .dds hold a whole cube map".into(),
+        )),
     }
 }
 

@@ -1,3 +1,4 @@
+#![allow(clippy::excessive_precision)] // the published Cephes constants, digit for digit
 //! A fast, accurate `atan2` for the per-texel paths (lat-long and Mercator lookups).
 //!
 //! Cephes' `atan` (S. L. Moshier): reduce `|x|` to `[0, 0.66]` with

@@ -199,7 +199,7 @@ impl WorldProjection for EqualAreaOctahedral {
     fn dir_to_uv(&self, d: DVec3) -> Option<(usize, DVec2)> {
         let hz2 = d.x * d.x + d.z * d.z;
         let len2 = hz2 + d.y * d.y;
-        if !(len2 > 0.0) || !len2.is_finite() {
+        if len2.is_nan() || len2 <= 0.0 || !len2.is_finite() {
             return None;
         }
         let r = (hz2 / (len2 + d.y.abs() * len2.sqrt())).sqrt();

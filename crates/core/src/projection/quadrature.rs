@@ -5,6 +5,7 @@ use glam::DVec3;
 
 /// 16-point Gauss–Legendre nodes on `[-1, 1]` (positive half; the rule is symmetric) and
 /// their weights (Abramowitz & Stegun, table 25.4). Exact for polynomials of degree 31.
+#[allow(clippy::excessive_precision)]
 const GL16_X: [f64; 8] = [
     0.095_012_509_837_637_44,
     0.281_603_550_779_258_9,
@@ -15,6 +16,7 @@ const GL16_X: [f64; 8] = [
     0.944_575_023_073_232_6,
     0.989_400_934_991_649_9,
 ];
+#[allow(clippy::excessive_precision)]
 const GL16_W: [f64; 8] = [
     0.189_450_610_455_068_5,
     0.182_603_415_044_923_6,

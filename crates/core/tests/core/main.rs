@@ -1,4 +1,5 @@
 //! mirrorball-core integration tests: one binary, one module per concern.
+#![allow(clippy::needless_range_loop)]
 mod conventions;
 mod layouts;
 mod projections;

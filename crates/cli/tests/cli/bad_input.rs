@@ -1,0 +1,206 @@
+//! Bad input: a clear message naming the file and the problem, a non-zero exit, no panic, no
+//! output file left behind.
+use crate::util::{asset, files, run, stderr};
+use mirrorball_core::Image;
+
+fn fails(args: &[&str], expect: &[&str]) -> String {
+    let o = run(args);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "mirrorball {args:?} should fail");
+    assert!(!e.contains("panicked"), "panic: {e}");
+    for s in expect {
+        assert!(
+            e.to_lowercase().contains(&s.to_lowercase()),
+            "'{s}' not in: {e}"
+        );
+    }
+    e
+}
+
+#[test]
+fn missing_truncated_and_corrupt_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.exr");
+    let o = out.to_str().unwrap();
+    fails(
+        &["convert", "no/such/file.exr", o, "--to", "cube"],
+        &["no/such/file.exr", "no such file"],
+    );
+    let bytes = std::fs::read(asset("city.exr")).unwrap();
+    let cut = dir.path().join("cut.exr");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    fails(
+        &["convert", cut.to_str().unwrap(), o, "--to", "cube"],
+        &["cut.exr"],
+    );
+    let junk = dir.path().join("junk.exr");
+    std::fs::write(&junk, b"this is not an image at all, just text").unwrap();
+    fails(
+        &["convert", junk.to_str().unwrap(), o, "--to", "cube"],
+        &["junk.exr"],
+    );
+    let junk_png = dir.path().join("junk.png");
+    std::fs::write(&junk_png, [0u8; 100]).unwrap();
+    fails(&["info", junk_png.to_str().unwrap()], &["junk.png"]);
+    assert!(!out.exists());
+}
+
+/// DWAB (lossy, common in downloads) decodes: the shipped city-dwab.exr gives exactly the
+/// texels of city.exr, which is the same data re-saved with ZIP.
+#[test]
+fn dwab_compressed_files_decode() {
+    let a = mirrorball_io::read(&asset("city-dwab.exr"), &Default::default()).unwrap();
+    let b = mirrorball_io::read(&asset("city.exr"), &Default::default()).unwrap();
+    assert_eq!(a.layers, b.layers);
+    assert!(a.description.contains("DWAB"), "{}", a.description);
+}
+
+#[test]
+fn absurd_declared_size_is_refused_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let hdr = dir.path().join("huge.hdr");
+    let mut bytes = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 40000 +X 40000\n".to_vec();
+    bytes.extend_from_slice(&[1, 2, 3, 4]);
+    std::fs::write(&hdr, bytes).unwrap();
+    // 1.6 billion texels: refused from the header, long before 19 GB could be allocated.
+    fails(&["info", hdr.to_str().unwrap()], &["huge.hdr"]);
+}
+
+#[test]
+fn pictures_that_fit_no_layout_or_projection() {
+    let dir = tempfile::tempdir().unwrap();
+    let odd = dir.path().join("odd.exr");
+    mirrorball_io::write_image(&odd, &Image::new(100, 60, 3), &Default::default()).unwrap();
+    let out = dir.path().join("o.exr");
+    fails(
+        &[
+            "convert",
+            odd.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--to",
+            "cube",
+        ],
+        &["odd.exr", "100x60", "--from"],
+    );
+    fails(
+        &[
+            "convert",
+            odd.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--to",
+            "latlong",
+            "--from",
+            "cube",
+        ],
+        &["odd.exr", "fits no layout"],
+    );
+    fails(
+        &[
+            "convert",
+            odd.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--to",
+            "cube",
+            "--from",
+            "latlong",
+        ],
+        &["odd.exr", "2:1"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn bad_requests_fail_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = asset("city.exr");
+    let s = src.to_str().unwrap();
+    let o = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    fails(
+        &["convert", s, &o("a.exr"), "--to", "banana"],
+        &["unknown projection", "latlong"],
+    );
+    fails(
+        &["convert", s, &o("a.ktx2"), "--to", "sphere"],
+        &["a.ktx2", "cube"],
+    );
+    fails(
+        &["convert", s, &o("a.xyz"), "--to", "cube"],
+        &["a.xyz", "extension"],
+    );
+    fails(
+        &[
+            "convert",
+            s,
+            &o("a.png"),
+            "--to",
+            "cube",
+            "--precision",
+            "float",
+        ],
+        &["a.png"],
+    );
+    fails(
+        &["convert", s, &o("a.exr"), "--to", "cube", "--mips"],
+        &["--mips"],
+    );
+    fails(
+        &[
+            "convert",
+            s,
+            &o("a.exr"),
+            "--to",
+            "fisheye:fov=400:lens=stereographic",
+        ],
+        &["fisheye"],
+    );
+    fails(
+        &["convert", s, &o("a.exr"), "--to", "cube", "--size", "0"],
+        &["--size"],
+    );
+    fails(
+        &["convert", s, "/no/such/dir/a.exr", "--to", "cube"],
+        &["does not exist"],
+    );
+    assert!(files(dir.path()).is_empty());
+}
+
+#[test]
+fn nan_inf_and_negative_texels_are_reported_and_fixed() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut img = Image::new(64, 32, 3);
+    img.data_mut().fill(0.5);
+    img.set(3, 3, &[f32::NAN, 0.5, 0.5]);
+    img.set(4, 3, &[f32::INFINITY, 0.5, 0.5]);
+    img.set(5, 3, &[-1.0, 0.5, 0.5]);
+    let bad = dir.path().join("bad.exr");
+    mirrorball_io::write_image(
+        &bad,
+        &img,
+        &mirrorball_io::WriteOptions {
+            precision: Some(mirrorball_io::Precision::Float),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let o = run(&["info", bad.to_str().unwrap()]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("1 NaN, 1 infinite, 1 negative"), "{out}");
+    let conv = dir.path().join("fixed.exr");
+    let r = run(&[
+        "convert",
+        bad.to_str().unwrap(),
+        conv.to_str().unwrap(),
+        "--to",
+        "cube",
+        "--size",
+        "16",
+    ]);
+    assert!(r.status.success());
+    assert!(
+        stderr(&r).contains("3 NaN, infinite or negative values set to 0"),
+        "{}",
+        stderr(&r)
+    );
+    let o = run(&["info", conv.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("0 NaN, 0 infinite, 0 negative"));
+}

@@ -1,0 +1,295 @@
+//! The commands as a user runs them.
+use crate::util::{asset, files, ok, run, stderr, stdout};
+use mirrorball_core::glam::DVec3;
+use mirrorball_core::metrics::log_psnr;
+use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
+
+fn read_env(path: &std::path::Path, kind: ProjectionKind) -> EnvMap {
+    let l = mirrorball_io::read(path, &Default::default()).unwrap();
+    EnvMap::new(kind.default_projection(), l.layers).unwrap()
+}
+
+#[test]
+fn convert_to_every_projection_and_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = asset("city.exr");
+    for kind in ProjectionKind::ALL {
+        let out = dir.path().join(format!("{}.exr", kind.name()));
+        let log = ok(&[
+            "convert",
+            src.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--to",
+            kind.name(),
+            "--size",
+            "128",
+        ]);
+        assert!(log.contains("wrote"), "{log}");
+        let back = dir.path().join(format!("{}-back.exr", kind.name()));
+        // Read it back without saying what it is where the shape tells; say it otherwise.
+        let mut args = vec![
+            "convert",
+            out.to_str().unwrap(),
+            back.to_str().unwrap(),
+            "--to",
+            "latlong",
+            "--size",
+            "256",
+        ];
+        let from = match kind {
+            ProjectionKind::LatLong | ProjectionKind::Cube => None,
+            k => Some(k.name()),
+        };
+        if let Some(f) = from {
+            args.extend(["--from", f]);
+        }
+        ok(&args);
+        assert!(back.exists());
+    }
+    // Nothing but the outputs: no temporary files left behind.
+    assert!(
+        files(dir.path()).iter().all(|f| f.ends_with(".exr")),
+        "{:?}",
+        files(dir.path())
+    );
+}
+
+#[test]
+fn ktx2_and_dds_cubes_convert_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = asset("venice.exr");
+    let reference = read_env(&src, ProjectionKind::LatLong);
+    for ext in ["ktx2", "dds"] {
+        let cube = dir.path().join(format!("cube.{ext}"));
+        ok(&[
+            "convert",
+            src.to_str().unwrap(),
+            cube.to_str().unwrap(),
+            "--to",
+            "cube",
+            "--size",
+            "128",
+            "--mips",
+            "--precision",
+            "float",
+        ]);
+        let info = ok(&["info", cube.to_str().unwrap()]);
+        assert!(info.contains("cube") && info.contains("128x128"), "{info}");
+        let back = dir.path().join(format!("back-{ext}.exr"));
+        ok(&[
+            "convert",
+            cube.to_str().unwrap(),
+            back.to_str().unwrap(),
+            "--to",
+            "latlong",
+            "--size",
+            "512",
+            "--precision",
+            "float",
+        ]);
+        let b = read_env(&back, ProjectionKind::LatLong);
+        let mut r = reference.clone();
+        r.sanitize();
+        let psnr = log_psnr(&r, &b).unwrap();
+        assert!(psnr > 35.0, "{ext}: {psnr}");
+    }
+}
+
+#[test]
+fn separate_faces_out_and_in() {
+    let dir = tempfile::tempdir().unwrap();
+    let pattern = dir.path().join("face_{face}.exr");
+    ok(&[
+        "convert",
+        asset("studio.exr").to_str().unwrap(),
+        pattern.to_str().unwrap(),
+        "--to",
+        "cube",
+        "--size",
+        "32",
+    ]);
+    for f in ["px", "nx", "py", "ny", "pz", "nz"] {
+        assert!(dir.path().join(format!("face_{f}.exr")).exists());
+    }
+    let cross = dir.path().join("cross.exr");
+    ok(&[
+        "convert",
+        pattern.to_str().unwrap(),
+        cross.to_str().unwrap(),
+        "--to",
+        "cube",
+        "--layout",
+        "vcross",
+    ]);
+    let l = mirrorball_io::read(&cross, &Default::default()).unwrap();
+    assert_eq!((l.layers[0].width(), l.layers[0].height()), (96, 128));
+}
+
+#[test]
+fn orientation_conventions_round_trip() {
+    // Each convention option, applied going out and again coming back, is the identity;
+    // applied once, it really changes the map.
+    let dir = tempfile::tempdir().unwrap();
+    let src = asset("city.exr");
+    let reference = {
+        let mut e = read_env(&src, ProjectionKind::LatLong);
+        e.sanitize();
+        e
+    };
+    for flags in [
+        vec!["--flip", "z"],
+        vec!["--flip", "x"],
+        vec!["--flip", "y"],
+        vec!["--yaw", "90"],
+    ] {
+        let cube = dir.path().join("c.exr");
+        let back = dir.path().join("b.exr");
+        let mut a = vec![
+            "convert",
+            src.to_str().unwrap(),
+            cube.to_str().unwrap(),
+            "--to",
+            "cube",
+            "--size",
+            "256",
+            "--precision",
+            "float",
+        ];
+        a.extend(flags.iter());
+        ok(&a);
+        // Undo: mirrors are their own inverse; a yaw is undone by the opposite yaw.
+        let undo: Vec<&str> = if flags[0] == "--yaw" {
+            vec!["--yaw", "-90"]
+        } else {
+            flags.clone()
+        };
+        let mut b = vec![
+            "convert",
+            cube.to_str().unwrap(),
+            back.to_str().unwrap(),
+            "--to",
+            "latlong",
+            "--size",
+            "512",
+            "--precision",
+            "float",
+        ];
+        b.extend(undo.iter());
+        ok(&b);
+        let psnr = log_psnr(&reference, &read_env(&back, ProjectionKind::LatLong)).unwrap();
+        assert!(psnr > 38.0, "{flags:?}: {psnr}");
+        // Only one way: clearly different.
+        let once = dir.path().join("once.exr");
+        let mut c = vec![
+            "convert",
+            cube.to_str().unwrap(),
+            once.to_str().unwrap(),
+            "--to",
+            "latlong",
+            "--size",
+            "512",
+            "--precision",
+            "float",
+        ];
+        c.extend(["--yaw", "0"]);
+        ok(&c);
+        let psnr_once = log_psnr(&reference, &read_env(&once, ProjectionKind::LatLong)).unwrap();
+        assert!(
+            psnr_once < 30.0,
+            "{flags:?} should change the map: {psnr_once}"
+        );
+    }
+}
+
+#[test]
+fn info_reports_guess_stats_and_json() {
+    let out = ok(&["info", asset("sky.exr").to_str().unwrap()]);
+    assert!(out.contains("latlong") && out.contains("guessed"), "{out}");
+    assert!(out.contains("512x256"), "{out}");
+    let o = run(&["info", asset("city.exr").to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("valid JSON");
+    assert_eq!(v["projection"], "latlong");
+    assert!((v["solid_angle_sr"].as_f64().unwrap() - 4.0 * std::f64::consts::PI).abs() < 1e-6);
+    assert!(v["negative_texels"].as_u64().is_some());
+}
+
+#[test]
+fn compare_prints_psnr() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("c.exr");
+    ok(&[
+        "convert",
+        asset("city.exr").to_str().unwrap(),
+        cube.to_str().unwrap(),
+        "--to",
+        "cube",
+        "--size",
+        "128",
+    ]);
+    let o = run(&[
+        "compare",
+        asset("city.exr").to_str().unwrap(),
+        cube.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = stdout(&o);
+    let db: f64 = s.split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!(db > 35.0 && db < 100.0, "{s}");
+}
+
+#[test]
+fn demo_writes_every_projection() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    let log = ok(&["demo", "--out", out.to_str().unwrap(), "--size", "128"]);
+    for kind in ProjectionKind::ALL {
+        assert!(out.join(format!("{}.png", kind.name())).exists(), "{log}");
+        assert!(out.join(format!("{}.exr", kind.name())).exists());
+    }
+    assert!(out.join("cube.ktx2").exists() && out.join("cube.dds").exists());
+    assert!(out.join("index.html").exists());
+}
+
+/// A converted map samples like its source in every direction (direction conventions agree
+/// end to end through the files).
+#[test]
+fn converted_cube_samples_like_its_source() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = read_env(&asset("city.exr"), ProjectionKind::LatLong);
+    let cube_path = dir.path().join("c.ktx2");
+    ok(&[
+        "convert",
+        asset("city.exr").to_str().unwrap(),
+        cube_path.to_str().unwrap(),
+        "--to",
+        "cube",
+        "--size",
+        "256",
+        "--precision",
+        "float",
+    ]);
+    let cube = EnvMap::new(
+        ProjectionKind::Cube.default_projection(),
+        mirrorball_io::read(&cube_path, &Default::default())
+            .unwrap()
+            .layers,
+    )
+    .unwrap();
+    let smooth_src = resample(&src, *src.projection(), 128, &ResampleOptions::default());
+    let smooth_cube = resample(&cube, *src.projection(), 128, &ResampleOptions::default());
+    for d in [
+        DVec3::X,
+        DVec3::NEG_X,
+        DVec3::Y,
+        DVec3::NEG_Y,
+        DVec3::Z,
+        DVec3::NEG_Z,
+        DVec3::new(0.3, 0.4, -0.8).normalize(),
+    ] {
+        let (a, b) = (smooth_src.sample(d), smooth_cube.sample(d));
+        for c in 0..3 {
+            let rel = (a[c] - b[c]).abs() / a[c].abs().max(1e-3);
+            assert!(rel < 0.1, "{d}: {a:?} vs {b:?}");
+        }
+    }
+}

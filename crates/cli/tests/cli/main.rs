@@ -1,0 +1,6 @@
+//! mirrorball-cli integration tests: the binary as a user runs it, and conversion quality on
+//! the bundled HDRs.
+mod bad_input;
+mod commands;
+mod quality;
+mod util;

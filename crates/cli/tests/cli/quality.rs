@@ -1,0 +1,71 @@
+//! Conversion quality on the bundled HDRs must not drop: lat-long → projection → lat-long,
+//! log-domain PSNR over what the projection covers, at the source's texel budget. The
+//! floors are the values recorded in BENCHMARKS.md minus 0.5 dB
+//! (`cargo run --release -p mirrorball-cli --example quality` prints them).
+use crate::util::asset;
+use mirrorball_core::metrics::log_psnr_where;
+use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions, WorldProjection};
+
+fn edge_for_budget(kind: ProjectionKind, budget: f64) -> u32 {
+    let p = kind.default_projection();
+    let (w, h) = p.layer_extent(1024);
+    let per = w as f64 * h as f64 * p.layer_count() as f64;
+    (1024.0 * (budget / per).sqrt()).round() as u32
+}
+
+/// Recorded log-PSNR (dB) at 1× budget: city, venice, studio, sky.
+const RECORDED: [(ProjectionKind, [f64; 4]); 9] = [
+    (ProjectionKind::Cube, [43.76, 41.30, 39.36, 43.91]),
+    (ProjectionKind::Sphere, [40.88, 35.12, 38.93, 42.85]),
+    (ProjectionKind::Paraboloid, [43.00, 40.31, 39.89, 43.96]),
+    (ProjectionKind::ContinuousCube, [44.82, 42.65, 39.95, 43.66]),
+    (ProjectionKind::Mercator, [42.05, 38.93, 38.85, 44.22]),
+    (ProjectionKind::Angular, [41.29, 39.25, 38.47, 42.57]),
+    (ProjectionKind::Fisheye, [44.93, 41.91, 45.44, 40.97]),
+    (ProjectionKind::Octahedral, [44.56, 41.81, 39.12, 43.27]),
+    (
+        ProjectionKind::EqualAreaOctahedral,
+        [44.45, 41.34, 39.11, 43.68],
+    ),
+];
+
+#[test]
+fn round_trip_quality_does_not_drop() {
+    for (i, name) in ["city", "venice", "studio", "sky"].iter().enumerate() {
+        let loaded =
+            mirrorball_io::read(&asset(&format!("{name}.exr")), &Default::default()).unwrap();
+        let mut src =
+            EnvMap::new(ProjectionKind::LatLong.default_projection(), loaded.layers).unwrap();
+        src.sanitize();
+        let budget = (src.width() * src.height()) as f64;
+        // The identity conversion is exact.
+        let same = resample(
+            &src,
+            *src.projection(),
+            src.width(),
+            &ResampleOptions::default(),
+        );
+        assert!(log_psnr_where(&src, &same, |_| true).unwrap() > 120.0);
+        for (kind, floors) in RECORDED {
+            let p = kind.default_projection();
+            let out = resample(
+                &src,
+                p,
+                edge_for_budget(kind, budget),
+                &ResampleOptions::default(),
+            );
+            let back = resample(
+                &out,
+                *src.projection(),
+                src.width(),
+                &ResampleOptions::default(),
+            );
+            let psnr = log_psnr_where(&src, &back, |d| p.dir_to_uv(d).is_some()).unwrap();
+            assert!(
+                psnr >= floors[i] - 0.5,
+                "{name} via {kind}: {psnr:.2} dB < recorded {:.2}",
+                floors[i]
+            );
+        }
+    }
+}
