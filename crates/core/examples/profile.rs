@@ -17,6 +17,9 @@ fn main() {
     let cube_p = ProjectionKind::Cube.default_projection();
     let opts = ResampleOptions::default();
     let cube = EnvMap::from_fn(cube_p, 256, 3, |d| [(1.0 + d.x) as f32, 1.0, 1.0, 1.0]);
+    if which == "none" {
+        return;
+    }
     if which != "back" {
         std::hint::black_box(resample(&src, cube_p, 256, &opts));
     }

@@ -283,6 +283,62 @@ pub(crate) fn bilinear(
     }
 }
 
+/// [`bilinear`] at `f32` coordinates, for the conversion's batch path.
+#[inline]
+pub(crate) fn bilinear32(
+    proj: &Projection,
+    layers: &[Image],
+    layer: usize,
+    u: f32,
+    v: f32,
+    out: &mut [f32],
+) {
+    let img = &layers[layer];
+    let (w, h) = (img.width() as i32, img.height() as i32);
+    let x = u * w as f32 - 0.5;
+    let y = v * h as f32 - 0.5;
+    let (xi, yi) = (x as i32, y as i32);
+    let x0 = if (xi as f32) > x { xi - 1 } else { xi };
+    let y0 = if (yi as f32) > y { yi - 1 } else { yi };
+    if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h && img.channels() == out.len() {
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let c = out.len();
+        let data = img.data();
+        let stride = w as usize * c;
+        let i00 = y0 as usize * stride + x0 as usize * c;
+        if c == 3 {
+            lerp4::<3>(
+                &data[i00..i00 + 6],
+                &data[i00 + stride..i00 + stride + 6],
+                fx,
+                fy,
+                out,
+            );
+        } else {
+            lerp4::<4>(
+                &data[i00..i00 + 8],
+                &data[i00 + stride..i00 + stride + 8],
+                fx,
+                fy,
+                out,
+            );
+        }
+        return;
+    }
+    bilinear(proj, layers, layer, DVec2::new(u as f64, v as f64), out);
+}
+
+/// Bilinear blend of two rows of two `C`-channel texels.
+#[inline(always)]
+fn lerp4<const C: usize>(r0: &[f32], r1: &[f32], fx: f32, fy: f32, out: &mut [f32]) {
+    let out = &mut out[..C];
+    for i in 0..C {
+        let top = r0[i] + fx * (r0[C + i] - r0[i]);
+        let bot = r1[i] + fx * (r1[C + i] - r1[i]);
+        out[i] = top + fy * (bot - top);
+    }
+}
+
 /// [`bilinear`] for images of `C` channels.
 #[inline(always)]
 fn bilinear_n<const C: usize>(

@@ -28,8 +28,8 @@ pub use image::Image;
 pub use layout::{guess, Guess, Layout};
 pub use projection::{
     AngularMap, ContinuousCube, CubeFace, CubeMap, DualParaboloid, EqualAreaOctahedral, Fisheye,
-    Frame, LatLong, Lens, Mercator, Octahedral, Projection, ProjectionKind, RadialMap, SphereMap,
-    UnknownProjection, WorldProjection,
+    Frame, LatLong, Lens, Lookup, Mercator, Octahedral, Projection, ProjectionKind, RadialMap,
+    SphereMap, UnknownProjection, WorldProjection,
 };
 pub use resample::{resample, resample_to_extent, ResampleOptions, Rotation};
 

@@ -12,8 +12,8 @@
 //!
 //! The work runs in parallel over rows with rayon and allocates nothing per texel.
 
-use crate::envmap::bilinear;
-use crate::projection::{Projection, WorldProjection};
+use crate::envmap::bilinear32;
+use crate::projection::{Lookup, Projection, WorldProjection};
 use crate::{EnvMap, Image};
 use glam::{DMat3, DVec2, DVec3};
 use rayon::prelude::*;
@@ -264,6 +264,41 @@ fn levels_needed(
     }
 }
 
+/// Most integration points per output texel (16×16).
+const MAX_POINTS: usize = 256;
+
+/// Per-thread buffers for one output row.
+struct RowScratch {
+    dirs: Vec<Option<(DVec3, f64)>>,
+    xs: Vec<f32>,
+    ys: Vec<f32>,
+    zs: Vec<f32>,
+    look: Vec<Lookup>,
+    /// One texel's integration points: directions, weights, lookups.
+    sx: Vec<f32>,
+    sy: Vec<f32>,
+    sz: Vec<f32>,
+    sw: Vec<f32>,
+    slook: Vec<Lookup>,
+}
+
+impl RowScratch {
+    fn new(w: usize) -> RowScratch {
+        RowScratch {
+            dirs: vec![None; w],
+            xs: vec![0.0; w],
+            ys: vec![0.0; w],
+            zs: vec![0.0; w],
+            look: vec![Lookup::default(); w],
+            sx: vec![0.0; MAX_POINTS],
+            sy: vec![0.0; MAX_POINTS],
+            sz: vec![0.0; MAX_POINTS],
+            sw: vec![0.0; MAX_POINTS],
+            slook: vec![Lookup::default(); MAX_POINTS],
+        }
+    }
+}
+
 /// Converts `src` into projection `dst` with layers of `w`×`h` texels.
 pub fn resample_to_extent(
     src: &EnvMap,
@@ -278,6 +313,7 @@ pub fn resample_to_extent(
     let scale = 2f32.powf(opts.exposure);
     // Output texel area over source texel area, in uv units.
     let area = (src.width() as f64 * src.height() as f64) / (w as f64 * h as f64);
+    let area32 = area as f32;
     let rot = opts.rotation;
     let rotate = !rot.is_identity();
     let depth = if max_n > 1 {
@@ -294,24 +330,47 @@ pub fn resample_to_extent(
                 .par_chunks_mut(w as usize * c)
                 .enumerate()
                 .for_each_init(
-                    || vec![None; w as usize],
-                    |dirs, (y, row)| {
-                        dst.row_dirs(layer, y as u32, w, h, dirs);
+                    || RowScratch::new(w as usize),
+                    |s, (y, row)| {
+                        // Stage 1: the row's directions (per-row work hoisted by the projection).
+                        dst.row_dirs(layer, y as u32, w, h, &mut s.dirs);
+                        for (x, t) in s.dirs.iter().enumerate() {
+                            let d = match t {
+                                Some((d, _)) if rotate => rot.source_of(*d),
+                                Some((d, _)) => *d,
+                                None => DVec3::Z,
+                            };
+                            (s.xs[x], s.ys[x], s.zs[x]) = (d.x as f32, d.y as f32, d.z as f32);
+                        }
+                        // Stage 2: where they land in the source, as a batch.
+                        sproj.lookup_batch(&s.xs, &s.ys, &s.zs, &mut s.look);
+                        // Stage 3: filter.
                         let mut acc = [0.0f32; 4];
                         let mut tmp = [0.0f32; 4];
-                        for (x, texel) in dirs.iter().enumerate() {
-                            let Some((d, ddens)) = *texel else { continue };
-                            let out = &mut row[x * c..(x + 1) * c];
-                            let ds = if rotate { rot.source_of(d) } else { d };
-                            let Some((sl, suv)) = sproj.dir_to_uv(ds) else {
+                        for (x, (texel, lk)) in s.dirs.iter().zip(&s.look).enumerate() {
+                            let Some((_, ddens)) = *texel else { continue };
+                            if lk.layer == u32::MAX {
                                 continue;
+                            }
+                            let out = &mut row[x * c..(x + 1) * c];
+                            let ratio = if lk.density > 0.0 {
+                                ddens as f32 * area32 / lk.density
+                            } else {
+                                f32::INFINITY
                             };
-                            let ratio = footprint_ratio(ddens, sproj.density_of_dir(ds), area);
-                            if ratio < BILINEAR_MAX_RATIO || max_n == 1 || ddens == 0.0 {
-                                bilinear(&sproj, pyr.level(0), sl, suv, out);
+                            if ratio < BILINEAR_MAX_RATIO as f32 || max_n == 1 || ddens == 0.0 {
+                                bilinear32(
+                                    &sproj,
+                                    pyr.level(0),
+                                    lk.layer as usize,
+                                    lk.u,
+                                    lk.v,
+                                    out,
+                                );
                             } else {
                                 // Integrate: n×n points over the texel, on a mip level where each
                                 // stands for about one source texel.
+                                let ratio = ratio as f64;
                                 let level = if ratio > cap {
                                     (((ratio / cap).log2() * 0.5).ceil() as usize)
                                         .min(pyr.level_count() - 1)
@@ -321,38 +380,64 @@ pub fn resample_to_extent(
                                 let r_l = ratio / 4f64.powi(level as i32);
                                 let n = (r_l.sqrt().round() as u32).clamp(1, max_n);
                                 let lv = pyr.level(level);
-                                acc[..c].fill(0.0);
-                                let mut wsum = 0.0f32;
+                                // The n×n points' directions, then one batch of source lookups.
                                 let inv = 1.0 / n as f64;
+                                let mut m = 0;
                                 for j in 0..n {
                                     let v = (y as f64 + (j as f64 + 0.5) * inv) / h as f64;
                                     for i in 0..n {
                                         let u = (x as f64 + (i as f64 + 0.5) * inv) / w as f64;
                                         let p = DVec2::new(u, v);
                                         let wt = dst.density(layer, p) as f32;
-                                        if wt <= 0.0 {
-                                            continue;
-                                        }
-                                        let Some(d) = dst.uv_to_dir(layer, p) else {
-                                            continue;
-                                        };
-                                        let Some((sl, suv)) = sproj.dir_to_uv(rot.source_of(d))
+                                        let Some(d) = dst.uv_to_dir(layer, p).filter(|_| wt > 0.0)
                                         else {
                                             continue;
                                         };
-                                        bilinear(&sproj, lv, sl, suv, &mut tmp[..c]);
-                                        for k in 0..c {
-                                            acc[k] += wt * tmp[k];
-                                        }
-                                        wsum += wt;
+                                        let d = if rotate { rot.source_of(d) } else { d };
+                                        (s.sx[m], s.sy[m], s.sz[m], s.sw[m]) =
+                                            (d.x as f32, d.y as f32, d.z as f32, wt);
+                                        m += 1;
                                     }
+                                }
+                                sproj.lookup_batch(
+                                    &s.sx[..m],
+                                    &s.sy[..m],
+                                    &s.sz[..m],
+                                    &mut s.slook[..m],
+                                );
+                                acc[..c].fill(0.0);
+                                let mut wsum = 0.0f32;
+                                for (k, sl) in s.slook[..m].iter().enumerate() {
+                                    if sl.layer == u32::MAX {
+                                        continue;
+                                    }
+                                    bilinear32(
+                                        &sproj,
+                                        lv,
+                                        sl.layer as usize,
+                                        sl.u,
+                                        sl.v,
+                                        &mut tmp[..c],
+                                    );
+                                    let wt = s.sw[k];
+                                    for q in 0..c {
+                                        acc[q] += wt * tmp[q];
+                                    }
+                                    wsum += wt;
                                 }
                                 if wsum > 0.0 {
                                     for k in 0..c {
                                         out[k] = acc[k] / wsum;
                                     }
                                 } else {
-                                    bilinear(&sproj, pyr.level(0), sl, suv, out);
+                                    bilinear32(
+                                        &sproj,
+                                        pyr.level(0),
+                                        lk.layer as usize,
+                                        lk.u,
+                                        lk.v,
+                                        out,
+                                    );
                                 }
                             }
                             if scale != 1.0 {

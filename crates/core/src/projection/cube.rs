@@ -1,6 +1,6 @@
 //! The cube projection (Greene 1986, §3), exactly as OpenGL samples a cube map.
 
-use super::{texel_range, WorldProjection};
+use super::{texel_range, Lookup, WorldProjection};
 use glam::{DVec2, DVec3};
 
 /// One face of a cube map, in OpenGL's order (ARB_texture_cube_map, OpenGL 4.6 §8.13):
@@ -135,6 +135,66 @@ impl WorldProjection for CubeMap {
         let (a, b) = (2.0 * uv.x - 1.0, 2.0 * uv.y - 1.0);
         let q = 1.0 + a * a + b * b;
         4.0 / (q * q.sqrt())
+    }
+    fn lookup_batch(&self, xs: &[f32], ys: &[f32], zs: &[f32], out: &mut [Lookup]) {
+        // The major-axis table with selects instead of branches.
+        let n = out.len().min(xs.len()).min(ys.len()).min(zs.len());
+        let (xs, ys, zs) = (&xs[..n], &ys[..n], &zs[..n]);
+        for (i, o) in out[..n].iter_mut().enumerate() {
+            let (x, y, z) = (xs[i], ys[i], zs[i]);
+            let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
+            let is_x = ax >= ay && ax >= az;
+            let is_y = !is_x && ay >= az;
+            let ma = if is_x {
+                ax
+            } else if is_y {
+                ay
+            } else {
+                az
+            };
+            let neg = if is_x {
+                x < 0.0
+            } else if is_y {
+                y < 0.0
+            } else {
+                z < 0.0
+            };
+            // sc: +X −z, −X +z, ±Y +x, +Z +x, −Z −x;  tc: ±X −y, +Y +z, −Y −z, ±Z −y.
+            let sc = if is_x {
+                if neg {
+                    z
+                } else {
+                    -z
+                }
+            } else if is_y || !neg {
+                x
+            } else {
+                -x
+            };
+            let tc = if is_y {
+                if neg {
+                    -z
+                } else {
+                    z
+                }
+            } else {
+                -y
+            };
+            let base: u32 = if is_x {
+                0
+            } else if is_y {
+                2
+            } else {
+                4
+            };
+            let inv = 0.5 / ma;
+            *o = Lookup {
+                layer: base + neg as u32,
+                u: sc * inv + 0.5,
+                v: tc * inv + 0.5,
+                density: 4.0 * ma * ma * ma,
+            };
+        }
     }
     fn row_dirs(&self, layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
         let Some(face) = CubeFace::from_index(layer) else {

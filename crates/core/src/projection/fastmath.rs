@@ -80,6 +80,50 @@ pub fn atan2(y: f64, x: f64) -> f64 {
     }
 }
 
+/// `atan(a)` for `a ∈ [0, 1]` in `f32`: an odd degree-15 polynomial fitted for the least
+/// maximum error, 1.2e-7 rad (f32 rounding included).
+#[inline(always)]
+fn atan01_f32(a: f32) -> f32 {
+    const C: [f32; 8] = [
+        0.999_999_34,
+        -0.333_298_6,
+        0.199_465_78,
+        -0.139_086_59,
+        0.096_421_99,
+        -0.055_911_478,
+        0.021_861_862,
+        -0.004_054_144,
+    ];
+    let s = a * a;
+    let p = C[7];
+    let p = p * s + C[6];
+    let p = p * s + C[5];
+    let p = p * s + C[4];
+    let p = p * s + C[3];
+    let p = p * s + C[2];
+    let p = p * s + C[1];
+    let p = p * s + C[0];
+    a * p
+}
+
+/// `atan2(y, x)` in `f32`, branch-free (selects only) so loops over it vectorise; error
+/// about 2e-7 rad. `atan2_f32(0, 0) = 0`.
+#[inline(always)]
+pub fn atan2_f32(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (mx, mn) = (ax.max(ay), ax.min(ay));
+    let a = mn / mx.max(f32::MIN_POSITIVE);
+    let r = atan01_f32(a);
+    let r = if ay > ax { FRAC_PI_2 - r } else { r };
+    let r = if x < 0.0 { PI - r } else { r };
+    if y < 0.0 {
+        -r
+    } else {
+        r
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,5 +149,20 @@ mod tests {
         assert_eq!(atan2(1.0, 0.0), FRAC_PI_2);
         assert!((atan2(0.0, -1.0) - PI).abs() < 1e-16);
         assert!((atan2(-1e-300, -1.0) + PI).abs() < 1e-15);
+    }
+
+    #[test]
+    fn f32_version_is_within_3e_7_rad() {
+        let mut worst: f64 = 0.0;
+        for i in 0..200_000 {
+            let t = i as f64 / 200_000.0 * std::f64::consts::TAU;
+            let r = 0.3 + (i % 7) as f64;
+            let (y, x) = (r * t.sin(), r * t.cos());
+            let a = atan2_f32(y as f32, x as f32) as f64;
+            let e = (a - (y as f32 as f64).atan2(x as f32 as f64)).abs();
+            worst = worst.max(e.min(std::f64::consts::TAU - e));
+        }
+        assert!(worst < 3e-7, "worst {worst:e}");
+        assert_eq!(atan2_f32(0.0, 0.0), 0.0);
     }
 }

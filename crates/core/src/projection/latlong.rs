@@ -2,7 +2,7 @@
 //! Hoffman 1984, Greene 1986 §6).
 
 use super::fastmath;
-use super::{texel_range, WorldProjection};
+use super::{texel_range, Lookup, WorldProjection};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -86,6 +86,24 @@ impl WorldProjection for LatLong {
     #[inline]
     fn density_of_dir(&self, d: DVec3) -> f64 {
         2.0 * PI * PI * (d.x * d.x + d.z * d.z).sqrt()
+    }
+    fn lookup_batch(&self, xs: &[f32], ys: &[f32], zs: &[f32], out: &mut [Lookup]) {
+        use std::f32::consts::{PI as PI32, TAU as TAU32};
+        let k = (2.0 * PI * PI) as f32;
+        let n = out.len().min(xs.len()).min(ys.len()).min(zs.len());
+        let (xs, ys, zs) = (&xs[..n], &ys[..n], &zs[..n]);
+        for (i, o) in out[..n].iter_mut().enumerate() {
+            let (x, y, z) = (xs[i], ys[i], zs[i]);
+            let hz = (x * x + z * z).sqrt();
+            let u = fastmath::atan2_f32(x, -z) * (1.0 / TAU32) + 0.5;
+            let v = 0.5 - fastmath::atan2_f32(y, hz) * (1.0 / PI32);
+            *o = Lookup {
+                layer: 0,
+                u,
+                v,
+                density: k * hz,
+            };
+        }
     }
     fn row_dirs(&self, _layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
         // Latitude is fixed along a row; longitude advances by a fixed step, so its sine and

@@ -29,6 +29,21 @@ use glam::{DVec2, DVec3};
 use std::fmt;
 use std::str::FromStr;
 
+/// One source lookup of the conversion's texel loop, from [`WorldProjection::lookup_batch`]:
+/// the layer (`u32::MAX` where the direction is not covered), the texture coordinates and the
+/// density there.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Lookup {
+    /// Layer, or `u32::MAX` when not covered.
+    pub layer: u32,
+    /// Texture coordinate `u`.
+    pub u: f32,
+    /// Texture coordinate `v`.
+    pub v: f32,
+    /// Solid angle per unit `uv` area there.
+    pub density: f32,
+}
+
 /// The behaviour every world projection shares. All math is in `f64`.
 pub trait WorldProjection {
     /// Number of layers: 6 for the cube types (OpenGL order +X −X +Y −Y +Z −Z), 2 for the
@@ -89,6 +104,30 @@ pub trait WorldProjection {
     /// The solid angle the projection covers: 4π for all but the fisheye and Mercator.
     fn covered_solid_angle(&self) -> f64 {
         4.0 * std::f64::consts::PI
+    }
+
+    /// [`dir_to_uv`](WorldProjection::dir_to_uv) and
+    /// [`density_of_dir`](WorldProjection::density_of_dir) for a batch of unit directions
+    /// given as separate x, y, z arrays, in `f32`: the texel loop's fast path. Projections
+    /// override it with branch-free code the compiler vectorises; their results agree with
+    /// the `f64` methods to about 1e-6 in `uv` (tested), a two-hundredth of a texel on a 16k
+    /// map. The default calls the `f64` methods one direction at a time.
+    fn lookup_batch(&self, xs: &[f32], ys: &[f32], zs: &[f32], out: &mut [Lookup]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            let d = DVec3::new(xs[i] as f64, ys[i] as f64, zs[i] as f64);
+            *o = match self.dir_to_uv(d) {
+                Some((l, uv)) => Lookup {
+                    layer: l as u32,
+                    u: uv.x as f32,
+                    v: uv.y as f32,
+                    density: self.density_of_dir(d) as f32,
+                },
+                None => Lookup {
+                    layer: u32::MAX,
+                    ..Lookup::default()
+                },
+            };
+        }
     }
 
     /// The closest coordinates to `uv` inside the covered domain. Texels outside a disk map's
@@ -349,6 +388,9 @@ impl WorldProjection for Projection {
     }
     fn row_dirs(&self, layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
         delegate!(self, p => p.row_dirs(layer, y, w, h, out))
+    }
+    fn lookup_batch(&self, xs: &[f32], ys: &[f32], zs: &[f32], out: &mut [Lookup]) {
+        delegate!(self, p => p.lookup_batch(xs, ys, zs, out))
     }
     #[inline]
     fn nearest_covered(&self, layer: usize, uv: DVec2) -> DVec2 {

@@ -374,3 +374,57 @@ fn sphere_map_rim_is_one_direction() {
         );
     }
 }
+
+/// The f32 batch path of the conversion loop agrees with the exact f64 methods.
+#[test]
+fn batch_lookups_agree_with_the_f64_methods() {
+    use mirrorball_core::Lookup;
+    for p in all_projections() {
+        let mut rng = Rng(13);
+        let dirs: Vec<DVec3> = (0..20_000).map(|_| rng.dir()).collect();
+        let xs: Vec<f32> = dirs.iter().map(|d| d.x as f32).collect();
+        let ys: Vec<f32> = dirs.iter().map(|d| d.y as f32).collect();
+        let zs: Vec<f32> = dirs.iter().map(|d| d.z as f32).collect();
+        let mut out = vec![Lookup::default(); dirs.len()];
+        p.lookup_batch(&xs, &ys, &zs, &mut out);
+        let mut checked = 0;
+        for (i, d) in dirs.iter().enumerate() {
+            // The f32 direction is what the batch saw.
+            let d32 = DVec3::new(xs[i] as f64, ys[i] as f64, zs[i] as f64);
+            match p.dir_to_uv(d32) {
+                None => assert_eq!(out[i].layer, u32::MAX, "{}", p.name()),
+                Some((l, uv)) => {
+                    if out[i].layer as usize != l {
+                        // Only on a face boundary, where both faces agree.
+                        let b = p
+                            .uv_to_dir(
+                                out[i].layer as usize,
+                                DVec2::new(out[i].u as f64, out[i].v as f64),
+                            )
+                            .unwrap();
+                        assert!(angle(b, *d) < 1e-5, "{}", p.name());
+                        continue;
+                    }
+                    let e = (DVec2::new(out[i].u as f64, out[i].v as f64) - uv).length();
+                    // The lat-long seam: u = 0 and u = 1 are the same meridian.
+                    let e = if p.kind() == mirrorball_core::ProjectionKind::LatLong
+                        || p.kind() == mirrorball_core::ProjectionKind::Mercator
+                    {
+                        e.min((e - 1.0).abs())
+                    } else {
+                        e
+                    };
+                    assert!(e < 2e-6, "{}: uv error {e:e} at {d}", p.name());
+                    let dens = p.density_of_dir(d32);
+                    assert!(
+                        (out[i].density as f64 - dens).abs() <= 1e-5 * dens.max(1e-3),
+                        "{}",
+                        p.name()
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 1000, "{}", p.name());
+    }
+}

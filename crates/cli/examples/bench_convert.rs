@@ -1,0 +1,120 @@
+//! In-memory conversion benchmark, driven by `bench/convert_peers.py`.
+//!
+//! ```text
+//! cargo run --release -p mirrorball-cli --example bench_convert -- INPUT.exr [REPS] [FACE] [WIDTH] [MAX_SAMPLES]
+//! ```
+//!
+//! Reads a lat-long EXR, then times (best of REPS, default 5) the conversion to a cube of
+//! FACE² texels per face (default 1024) and back to a lat-long WIDTH texels wide (default
+//! 4096), with the default resampling options (MAX_SAMPLES, when given, overrides
+//! `ResampleOptions::max_samples`; 1 is plain bilinear). File reading is not timed. Prints one JSON
+//! line: the best times, output texels per second, and the round-trip log-domain PSNR of the
+//! lat-long that came back against the input (`mirrorball_core::metrics::log_psnr`).
+
+use mirrorball_core::{metrics, resample, EnvMap, ProjectionKind, ResampleOptions};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.is_empty() || args.iter().any(|a| a == "-h" || a == "--help") {
+        eprintln!("usage: bench_convert INPUT.exr [REPS=5] [FACE=1024] [WIDTH=4096] [MAX_SAMPLES]");
+        return ExitCode::from(2);
+    }
+    let input = PathBuf::from(&args[0]);
+    let num =
+        |i: usize, default: u32| -> Result<u32, String> {
+            match args.get(i) {
+                None => Ok(default),
+                Some(s) => s.parse::<u32>().ok().filter(|&n| n > 0).ok_or_else(|| {
+                    format!("argument {} must be a positive integer, got {s:?}", i + 1)
+                }),
+            }
+        };
+    let defaults = ResampleOptions::default();
+    let parsed = (
+        num(1, 5),
+        num(2, 1024),
+        num(3, 4096),
+        num(4, defaults.max_samples),
+    );
+    let (reps, face, width, max_samples) = match parsed {
+        (Ok(r), Ok(f), Ok(w), Ok(m)) => (r, f, w, m),
+        (Err(e), ..) | (_, Err(e), ..) | (.., Err(e), _) | (.., Err(e)) => {
+            eprintln!("bench_convert: {e}");
+            return ExitCode::from(2);
+        }
+    };
+
+    let loaded = match mirrorball_io::read(&input, &mirrorball_io::Limits::default()) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("bench_convert: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let env = match EnvMap::new(ProjectionKind::LatLong.default_projection(), loaded.layers) {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("bench_convert: {}: {e}", input.display());
+            return ExitCode::FAILURE;
+        }
+    };
+    let opts = ResampleOptions {
+        max_samples,
+        ..defaults
+    };
+    let cube_proj = ProjectionKind::Cube.default_projection();
+    let ll_proj = ProjectionKind::LatLong.default_projection();
+
+    // Forward: lat-long → cube, best of `reps`.
+    let mut forward_s = f64::INFINITY;
+    let mut cube = None;
+    for _ in 0..reps {
+        let t = Instant::now();
+        let c = resample(&env, cube_proj, face, &opts);
+        forward_s = forward_s.min(t.elapsed().as_secs_f64());
+        cube = Some(c);
+    }
+    let cube = cube.expect("reps > 0");
+
+    // Back: cube → lat-long, best of `reps`.
+    let mut back_s = f64::INFINITY;
+    let mut back = None;
+    for _ in 0..reps {
+        let t = Instant::now();
+        let b = resample(&cube, ll_proj, width, &opts);
+        back_s = back_s.min(t.elapsed().as_secs_f64());
+        back = Some(b);
+    }
+    let back = back.expect("reps > 0");
+
+    let texels = |m: &EnvMap| m.layers().len() as f64 * m.width() as f64 * m.height() as f64;
+    let forward_texels = texels(&cube);
+    let back_texels = texels(&back);
+    let psnr = metrics::log_psnr(&env, &back);
+
+    let json = serde_json::json!({
+        "input": input.display().to_string(),
+        "input_width": env.width(),
+        "input_height": env.height(),
+        "channels": env.channels(),
+        "face": cube.width(),
+        "back_width": back.width(),
+        "back_height": back.height(),
+        "reps": reps,
+        "max_samples": max_samples,
+        "threads": rayon::current_num_threads(),
+        "forward_s": forward_s,
+        "back_s": back_s,
+        "forward_texels": forward_texels,
+        "back_texels": back_texels,
+        "forward_texels_per_s": forward_texels / forward_s,
+        "back_texels_per_s": back_texels / back_s,
+        // JSON has no infinity: an exact round trip (or a mismatch, None) prints null.
+        "roundtrip_log_psnr_db": psnr.filter(|p| p.is_finite()),
+    });
+    println!("{json}");
+    ExitCode::SUCCESS
+}
