@@ -283,9 +283,9 @@ pub(crate) fn bilinear(
     }
 }
 
-/// [`bilinear`] at `f32` coordinates, for the conversion's batch path.
-#[inline]
-pub(crate) fn bilinear32(
+/// [`bilinear`] at `f32` coordinates for `C`-channel images, for the conversion's batch path.
+#[inline(always)]
+pub(crate) fn bilinear32<const C: usize>(
     proj: &Projection,
     layers: &[Image],
     layer: usize,
@@ -298,32 +298,20 @@ pub(crate) fn bilinear32(
     let x = u * w as f32 - 0.5;
     let y = v * h as f32 - 0.5;
     let (xi, yi) = (x as i32, y as i32);
-    let x0 = if (xi as f32) > x { xi - 1 } else { xi };
-    let y0 = if (yi as f32) > y { yi - 1 } else { yi };
-    if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h && img.channels() == out.len() {
+    let x0 = xi - ((xi as f32) > x) as i32;
+    let y0 = yi - ((yi as f32) > y) as i32;
+    if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h {
         let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        let c = out.len();
         let data = img.data();
-        let stride = w as usize * c;
-        let i00 = y0 as usize * stride + x0 as usize * c;
-        if c == 3 {
-            lerp4::<3>(
-                &data[i00..i00 + 6],
-                &data[i00 + stride..i00 + stride + 6],
-                fx,
-                fy,
-                out,
-            );
-        } else {
-            lerp4::<4>(
-                &data[i00..i00 + 8],
-                &data[i00 + stride..i00 + stride + 8],
-                fx,
-                fy,
-                out,
-            );
+        let stride = w as usize * C;
+        let i00 = y0 as usize * stride + x0 as usize * C;
+        if let (Some(r0), Some(r1)) = (
+            data.get(i00..i00 + 2 * C),
+            data.get(i00 + stride..i00 + stride + 2 * C),
+        ) {
+            lerp4::<C>(r0, r1, fx, fy, out);
+            return;
         }
-        return;
     }
     bilinear(proj, layers, layer, DVec2::new(u as f64, v as f64), out);
 }

@@ -274,7 +274,10 @@ struct RowScratch {
     ys: Vec<f32>,
     zs: Vec<f32>,
     look: Vec<Lookup>,
-    /// One texel's integration points: directions, weights, lookups.
+}
+
+/// Per-thread buffers for one texel's integration points: directions, weights, lookups.
+struct PointScratch {
     sx: Vec<f32>,
     sy: Vec<f32>,
     sz: Vec<f32>,
@@ -290,12 +293,177 @@ impl RowScratch {
             ys: vec![0.0; w],
             zs: vec![0.0; w],
             look: vec![Lookup::default(); w],
+        }
+    }
+}
+
+impl PointScratch {
+    fn new() -> PointScratch {
+        PointScratch {
             sx: vec![0.0; MAX_POINTS],
             sy: vec![0.0; MAX_POINTS],
             sz: vec![0.0; MAX_POINTS],
             sw: vec![0.0; MAX_POINTS],
             slook: vec![Lookup::default(); MAX_POINTS],
         }
+    }
+}
+
+/// Everything one output row needs, shared by all rows.
+struct Job<'a> {
+    dst: Projection,
+    sproj: Projection,
+    pyr: Pyramid<'a>,
+    rot: Rotation,
+    rotate: bool,
+    area: f32,
+    cap: f64,
+    max_n: u32,
+    scale: f32,
+    w: u32,
+    h: u32,
+}
+
+impl Job<'_> {
+    /// Fills output row `y` of `layer` (`C` channels per texel).
+    #[inline(always)]
+    fn row<const C: usize>(
+        &self,
+        s: &mut RowScratch,
+        ps: &mut PointScratch,
+        layer: usize,
+        y: usize,
+        row: &mut [f32],
+    ) {
+        let (dst, sproj, rot) = (&self.dst, &self.sproj, &self.rot);
+        let (w, h) = (self.w, self.h);
+        // Stage 1: the row's directions (per-row work hoisted by the projection).
+        dst.row_dirs(layer, y as u32, w, h, &mut s.dirs);
+        for (x, t) in s.dirs.iter().enumerate() {
+            let d = match t {
+                Some((d, _)) if self.rotate => rot.source_of(*d),
+                Some((d, _)) => *d,
+                None => DVec3::Z,
+            };
+            (s.xs[x], s.ys[x], s.zs[x]) = (d.x as f32, d.y as f32, d.z as f32);
+        }
+        // Stage 2: where they land in the source, as one batch.
+        sproj.lookup_batch(&s.xs, &s.ys, &s.zs, &mut s.look);
+        // Stage 3: filter.
+        let base = self.pyr.level(0);
+        for (x, (texel, lk)) in s.dirs.iter().zip(&s.look).enumerate() {
+            let Some((_, ddens)) = *texel else { continue };
+            if lk.layer == u32::MAX {
+                continue;
+            }
+            let out = &mut row[x * C..(x + 1) * C];
+            let ratio = if lk.density > 0.0 {
+                ddens as f32 * self.area / lk.density
+            } else {
+                f32::INFINITY
+            };
+            if ratio < BILINEAR_MAX_RATIO as f32 || self.max_n == 1 || ddens == 0.0 {
+                bilinear32::<C>(sproj, base, lk.layer as usize, lk.u, lk.v, out);
+            } else {
+                self.integrate::<C>(ps, layer, x, y, ratio as f64, lk, out);
+            }
+            if self.scale != 1.0 {
+                for v in &mut out[..3] {
+                    *v *= self.scale;
+                }
+            }
+        }
+    }
+
+    /// Integrates output texel `(x, y)` whose footprint covers `ratio` source texels: n×n
+    /// points over the texel, weighted by solid angle, on a mip level where each stands for
+    /// about one source texel.
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn integrate<const C: usize>(
+        &self,
+        s: &mut PointScratch,
+        layer: usize,
+        x: usize,
+        y: usize,
+        ratio: f64,
+        lk: &Lookup,
+        out: &mut [f32],
+    ) {
+        let (dst, sproj) = (&self.dst, &self.sproj);
+        let (w, h) = (self.w as f64, self.h as f64);
+        let level = if ratio > self.cap {
+            (((ratio / self.cap).log2() * 0.5).ceil() as usize).min(self.pyr.level_count() - 1)
+        } else {
+            0
+        };
+        let r_l = ratio / 4f64.powi(level as i32);
+        let n = (r_l.sqrt().round() as u32).clamp(1, self.max_n);
+        let lv = self.pyr.level(level);
+        let inv = 1.0 / n as f64;
+        let mut m = 0;
+        for j in 0..n {
+            let v = (y as f64 + (j as f64 + 0.5) * inv) / h;
+            for i in 0..n {
+                let u = (x as f64 + (i as f64 + 0.5) * inv) / w;
+                let p = DVec2::new(u, v);
+                let wt = dst.density(layer, p) as f32;
+                let Some(d) = dst.uv_to_dir(layer, p).filter(|_| wt > 0.0) else {
+                    continue;
+                };
+                let d = if self.rotate {
+                    self.rot.source_of(d)
+                } else {
+                    d
+                };
+                (s.sx[m], s.sy[m], s.sz[m], s.sw[m]) = (d.x as f32, d.y as f32, d.z as f32, wt);
+                m += 1;
+            }
+        }
+        sproj.lookup_batch(&s.sx[..m], &s.sy[..m], &s.sz[..m], &mut s.slook[..m]);
+        let mut acc = [0.0f32; C];
+        let mut tmp = [0.0f32; C];
+        let mut wsum = 0.0f32;
+        for (k, sl) in s.slook[..m].iter().enumerate() {
+            if sl.layer == u32::MAX {
+                continue;
+            }
+            bilinear32::<C>(sproj, lv, sl.layer as usize, sl.u, sl.v, &mut tmp);
+            let wt = s.sw[k];
+            for q in 0..C {
+                acc[q] += wt * tmp[q];
+            }
+            wsum += wt;
+        }
+        if wsum > 0.0 {
+            for k in 0..C {
+                out[k] = acc[k] / wsum;
+            }
+        } else {
+            bilinear32::<C>(sproj, self.pyr.level(0), lk.layer as usize, lk.u, lk.v, out);
+        }
+    }
+
+    /// Fills one layer.
+    fn layer<const C: usize>(
+        &self,
+        layer: usize,
+        img: &mut Image,
+        progress: Option<&Arc<AtomicU64>>,
+    ) {
+        let w = self.w as usize;
+        img.data_mut()
+            .par_chunks_mut(w * C)
+            .enumerate()
+            .for_each_init(
+                || (RowScratch::new(w), PointScratch::new()),
+                |(s, ps), (y, row)| {
+                    self.row::<C>(s, ps, layer, y, row);
+                    if let Some(p) = progress {
+                        p.fetch_add(1, Ordering::Relaxed);
+                    }
+                },
+            );
     }
 }
 
@@ -310,147 +478,34 @@ pub fn resample_to_extent(
     let max_n = opts.max_samples.clamp(1, 16);
     let cap = (max_n * max_n) as f64;
     let c = src.channels();
-    let scale = 2f32.powf(opts.exposure);
     // Output texel area over source texel area, in uv units.
     let area = (src.width() as f64 * src.height() as f64) / (w as f64 * h as f64);
-    let area32 = area as f32;
     let rot = opts.rotation;
-    let rotate = !rot.is_identity();
     let depth = if max_n > 1 {
         levels_needed(src, &dst, w, h, area, cap, &rot)
     } else {
         0
     };
-    let pyr = Pyramid::new(src, depth);
-    let sproj = *src.projection();
+    let job = Job {
+        dst,
+        sproj: *src.projection(),
+        pyr: Pyramid::new(src, depth),
+        rot,
+        rotate: !rot.is_identity(),
+        area: area as f32,
+        cap,
+        max_n,
+        scale: 2f32.powf(opts.exposure),
+        w,
+        h,
+    };
     let layers = (0..dst.layer_count())
         .map(|layer| {
             let mut img = Image::new(w, h, c);
-            img.data_mut()
-                .par_chunks_mut(w as usize * c)
-                .enumerate()
-                .for_each_init(
-                    || RowScratch::new(w as usize),
-                    |s, (y, row)| {
-                        // Stage 1: the row's directions (per-row work hoisted by the projection).
-                        dst.row_dirs(layer, y as u32, w, h, &mut s.dirs);
-                        for (x, t) in s.dirs.iter().enumerate() {
-                            let d = match t {
-                                Some((d, _)) if rotate => rot.source_of(*d),
-                                Some((d, _)) => *d,
-                                None => DVec3::Z,
-                            };
-                            (s.xs[x], s.ys[x], s.zs[x]) = (d.x as f32, d.y as f32, d.z as f32);
-                        }
-                        // Stage 2: where they land in the source, as a batch.
-                        sproj.lookup_batch(&s.xs, &s.ys, &s.zs, &mut s.look);
-                        // Stage 3: filter.
-                        let mut acc = [0.0f32; 4];
-                        let mut tmp = [0.0f32; 4];
-                        for (x, (texel, lk)) in s.dirs.iter().zip(&s.look).enumerate() {
-                            let Some((_, ddens)) = *texel else { continue };
-                            if lk.layer == u32::MAX {
-                                continue;
-                            }
-                            let out = &mut row[x * c..(x + 1) * c];
-                            let ratio = if lk.density > 0.0 {
-                                ddens as f32 * area32 / lk.density
-                            } else {
-                                f32::INFINITY
-                            };
-                            if ratio < BILINEAR_MAX_RATIO as f32 || max_n == 1 || ddens == 0.0 {
-                                bilinear32(
-                                    &sproj,
-                                    pyr.level(0),
-                                    lk.layer as usize,
-                                    lk.u,
-                                    lk.v,
-                                    out,
-                                );
-                            } else {
-                                // Integrate: n×n points over the texel, on a mip level where each
-                                // stands for about one source texel.
-                                let ratio = ratio as f64;
-                                let level = if ratio > cap {
-                                    (((ratio / cap).log2() * 0.5).ceil() as usize)
-                                        .min(pyr.level_count() - 1)
-                                } else {
-                                    0
-                                };
-                                let r_l = ratio / 4f64.powi(level as i32);
-                                let n = (r_l.sqrt().round() as u32).clamp(1, max_n);
-                                let lv = pyr.level(level);
-                                // The n×n points' directions, then one batch of source lookups.
-                                let inv = 1.0 / n as f64;
-                                let mut m = 0;
-                                for j in 0..n {
-                                    let v = (y as f64 + (j as f64 + 0.5) * inv) / h as f64;
-                                    for i in 0..n {
-                                        let u = (x as f64 + (i as f64 + 0.5) * inv) / w as f64;
-                                        let p = DVec2::new(u, v);
-                                        let wt = dst.density(layer, p) as f32;
-                                        let Some(d) = dst.uv_to_dir(layer, p).filter(|_| wt > 0.0)
-                                        else {
-                                            continue;
-                                        };
-                                        let d = if rotate { rot.source_of(d) } else { d };
-                                        (s.sx[m], s.sy[m], s.sz[m], s.sw[m]) =
-                                            (d.x as f32, d.y as f32, d.z as f32, wt);
-                                        m += 1;
-                                    }
-                                }
-                                sproj.lookup_batch(
-                                    &s.sx[..m],
-                                    &s.sy[..m],
-                                    &s.sz[..m],
-                                    &mut s.slook[..m],
-                                );
-                                acc[..c].fill(0.0);
-                                let mut wsum = 0.0f32;
-                                for (k, sl) in s.slook[..m].iter().enumerate() {
-                                    if sl.layer == u32::MAX {
-                                        continue;
-                                    }
-                                    bilinear32(
-                                        &sproj,
-                                        lv,
-                                        sl.layer as usize,
-                                        sl.u,
-                                        sl.v,
-                                        &mut tmp[..c],
-                                    );
-                                    let wt = s.sw[k];
-                                    for q in 0..c {
-                                        acc[q] += wt * tmp[q];
-                                    }
-                                    wsum += wt;
-                                }
-                                if wsum > 0.0 {
-                                    for k in 0..c {
-                                        out[k] = acc[k] / wsum;
-                                    }
-                                } else {
-                                    bilinear32(
-                                        &sproj,
-                                        pyr.level(0),
-                                        lk.layer as usize,
-                                        lk.u,
-                                        lk.v,
-                                        out,
-                                    );
-                                }
-                            }
-                            if scale != 1.0 {
-                                for v in &mut out[..3] {
-                                    *v *= scale;
-                                }
-                            }
-                        }
-                        if let Some(p) = &opts.progress {
-                            p.fetch_add(1, Ordering::Relaxed);
-                        }
-                    },
-                );
+            match c {
+                3 => job.layer::<3>(layer, &mut img, opts.progress.as_ref()),
+                _ => job.layer::<4>(layer, &mut img, opts.progress.as_ref()),
+            }
             img
         })
         .collect();
