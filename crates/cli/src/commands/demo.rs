@@ -6,7 +6,7 @@ use crate::progress::with_progress;
 use crate::save::{self, SaveOptions};
 use crate::{load, DemoArgs};
 use mirrorball_core::metrics::log_psnr_where;
-use mirrorball_core::{resample, ProjectionKind, ResampleOptions, WorldProjection};
+use mirrorball_core::{resample, Image, ProjectionKind, ResampleOptions, WorldProjection};
 use mirrorball_io::{Precision, WriteOptions};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -15,6 +15,36 @@ use std::time::Instant;
 
 /// Poly Haven's "city" environment (CC0), 512×256 half-float lat-long, bundled.
 const CITY_EXR: &[u8] = include_bytes!("../../../../assets/env/city.exr");
+
+/// Edge of one contact-sheet cell, in pixels.
+const SHEET_CELL: u32 = 240;
+
+/// `img` scaled (box filter) to fit a `cell`×`cell` square, keeping its aspect ratio.
+fn fit(img: &Image, cell: u32) -> Image {
+    let k = (cell as f64 / img.width() as f64).min(cell as f64 / img.height() as f64);
+    let (w, h) = (((img.width() as f64 * k) as u32).max(1), ((img.height() as f64 * k) as u32).max(1));
+    let c = img.channels();
+    let mut out = Image::new(w, h, c);
+    for y in 0..h {
+        let (y0, y1) = ((y as f64 / k) as u32, (((y + 1) as f64 / k) as u32).clamp(1, img.height()));
+        for x in 0..w {
+            let (x0, x1) = ((x as f64 / k) as u32, (((x + 1) as f64 / k) as u32).clamp(1, img.width()));
+            let mut acc = [0.0f32; 4];
+            let mut n = 0.0;
+            for sy in y0..y1.max(y0 + 1) {
+                for sx in x0..x1.max(x0 + 1) {
+                    for (a, v) in acc.iter_mut().zip(img.get(sx.min(img.width() - 1), sy.min(img.height() - 1))) {
+                        *a += v;
+                    }
+                    n += 1.0;
+                }
+            }
+            let px: Vec<f32> = acc[..c].iter().map(|a| a / n).collect();
+            out.set(x, y, &px);
+        }
+    }
+    out
+}
 
 /// The edge each projection gets for a lat-long of width `size`: about equal texel budgets.
 fn edge(kind: ProjectionKind, size: u32) -> u32 {
@@ -62,6 +92,7 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         ..Default::default()
     };
     let mut rows = Vec::new();
+    let mut sheet_cells: Vec<Image> = Vec::new();
     with_progress(
         "demo",
         ProjectionKind::ALL.len() as u64,
@@ -95,6 +126,9 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                     &dir.join(format!("{name}.png")).display().to_string(),
                     &save_opts(preview),
                 )?;
+                if let Some(packed) = layout.pack(&shown) {
+                    sheet_cells.push(fit(&packed, SHEET_CELL));
+                }
                 if kind == ProjectionKind::Cube {
                     let m = SaveOptions {
                         layout: None,
@@ -116,6 +150,17 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
             Ok(())
         },
     )?;
+
+    // A contact sheet of every projection, in the order of the table, five to a row.
+    let cols = 5u32;
+    let rows_n = (sheet_cells.len() as u32).div_ceil(cols);
+    let mut sheet = Image::new(cols * SHEET_CELL, rows_n * SHEET_CELL, 3);
+    for (i, cell) in sheet_cells.iter().enumerate() {
+        let (cx, cy) = ((i as u32 % cols) * SHEET_CELL, (i as u32 / cols) * SHEET_CELL);
+        let (ox, oy) = ((SHEET_CELL - cell.width()) / 2, (SHEET_CELL - cell.height()) / 2);
+        sheet.paste(&cell.with_channels(3), cx + ox, cy + oy);
+    }
+    mirrorball_io::write_image(&dir.join("sheet.png"), &sheet, &preview)?;
 
     let mut table = String::new();
     let mut html = String::from(
@@ -145,7 +190,7 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         let _ = writeln!(table, "{line}");
         let _ = write!(html, "<tr><td>{name}</td><td>{layout}</td><td>{n}×{w}×{h}</td><td>{:.1}%</td><td>{secs:.3}</td><td>{psnr:.2}</td></tr>", covered * 100.0);
     }
-    html.push_str("</table>");
+    html.push_str("</table><p><img src=\"sheet.png\" style=\"max-width:100%\"></p>");
     for (name, layout, ..) in &rows {
         let _ = write!(
             html,
