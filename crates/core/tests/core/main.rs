@@ -3,5 +3,6 @@
 mod conventions;
 mod layouts;
 mod projections;
+mod properties;
 mod resampling;
 mod util;
