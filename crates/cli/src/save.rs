@@ -123,12 +123,14 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
             .collect::<Result<Vec<()>, _>>()?;
         return Ok(paths);
     }
+    let mut write = opts.write;
+    write.declared = Some(env.projection().kind());
     let img = layout.pack(env).ok_or_else(|| {
         CliError::request(format!(
             "{out}: layout {layout} does not fit a map of {n} layer(s)"
         ))
     })?;
-    mirrorball_io::write_image(path, &img, &opts.write)?;
+    mirrorball_io::write_image(path, &img, &write)?;
     Ok(vec![path.to_path_buf()])
 }
 

@@ -124,6 +124,15 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
 ///
 /// Half output clamps finite values to ±65504 (the largest half) instead of overflowing to
 /// infinity.
+/// Layer attributes for a written file: the `envmap` attribute for lat-long maps.
+fn layer_attributes(opts: &WriteOptions) -> LayerAttributes {
+    LayerAttributes {
+        environment_map: (opts.declared == Some(ProjectionKind::LatLong))
+            .then_some(EnvironmentMap::LatitudeLongitude),
+        ..LayerAttributes::default()
+    }
+}
+
 pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
     let sample_type = match opts.precision {
         None | Some(Precision::Half) => SampleType::F16,
@@ -179,7 +188,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Erro
                 )
             },
         };
-        let layer = exr::image::Layer::new(size, LayerAttributes::default(), encoding, texels);
+        let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
         let exr_image = exr::image::Image::from_layer(layer);
         atomic_write(path, |out| {
             exr_image
@@ -195,7 +204,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Erro
                 (fit(data[i]), fit(data[i + 1]), fit(data[i + 2]))
             },
         };
-        let layer = exr::image::Layer::new(size, LayerAttributes::default(), encoding, texels);
+        let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
         let exr_image = exr::image::Image::from_layer(layer);
         atomic_write(path, |out| {
             exr_image

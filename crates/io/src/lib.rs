@@ -123,6 +123,10 @@ pub struct WriteOptions {
     pub exr_compression: ExrCompression,
     /// JPEG quality 1..=100 (default 92 when 0).
     pub jpeg_quality: u8,
+    /// The projection of the picture, recorded where the container has a place for it: a
+    /// lat-long EXR gets the standard `envmap` attribute. (OpenEXR's cube-map convention
+    /// differs from OpenGL's, so cubes are not tagged.)
+    pub declared: Option<ProjectionKind>,
 }
 
 /// What [`read`] found in a file.

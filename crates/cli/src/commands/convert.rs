@@ -116,6 +116,7 @@ impl Plan {
             precision,
             exr_compression: parse_compression(&a.compression)?,
             jpeg_quality: 92,
+            declared: None,
         };
         Ok(Plan {
             input,

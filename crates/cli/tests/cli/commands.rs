@@ -293,3 +293,36 @@ fn converted_cube_samples_like_its_source() {
         }
     }
 }
+
+#[test]
+fn latlong_exr_outputs_declare_their_projection() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ll.exr");
+    ok(&[
+        "convert",
+        asset("city.exr").to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--to",
+        "latlong",
+        "--size",
+        "64",
+    ]);
+    let l = mirrorball_io::read(&out, &Default::default()).unwrap();
+    assert_eq!(l.declared, Some(ProjectionKind::LatLong));
+    let cube = dir.path().join("c.exr");
+    ok(&[
+        "convert",
+        asset("city.exr").to_str().unwrap(),
+        cube.to_str().unwrap(),
+        "--to",
+        "cube",
+        "--size",
+        "16",
+    ]);
+    assert_eq!(
+        mirrorball_io::read(&cube, &Default::default())
+            .unwrap()
+            .declared,
+        None
+    );
+}
