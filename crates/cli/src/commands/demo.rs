@@ -22,18 +22,30 @@ const SHEET_CELL: u32 = 240;
 /// `img` scaled (box filter) to fit a `cell`×`cell` square, keeping its aspect ratio.
 fn fit(img: &Image, cell: u32) -> Image {
     let k = (cell as f64 / img.width() as f64).min(cell as f64 / img.height() as f64);
-    let (w, h) = (((img.width() as f64 * k) as u32).max(1), ((img.height() as f64 * k) as u32).max(1));
+    let (w, h) = (
+        ((img.width() as f64 * k) as u32).max(1),
+        ((img.height() as f64 * k) as u32).max(1),
+    );
     let c = img.channels();
     let mut out = Image::new(w, h, c);
     for y in 0..h {
-        let (y0, y1) = ((y as f64 / k) as u32, (((y + 1) as f64 / k) as u32).clamp(1, img.height()));
+        let (y0, y1) = (
+            (y as f64 / k) as u32,
+            (((y + 1) as f64 / k) as u32).clamp(1, img.height()),
+        );
         for x in 0..w {
-            let (x0, x1) = ((x as f64 / k) as u32, (((x + 1) as f64 / k) as u32).clamp(1, img.width()));
+            let (x0, x1) = (
+                (x as f64 / k) as u32,
+                (((x + 1) as f64 / k) as u32).clamp(1, img.width()),
+            );
             let mut acc = [0.0f32; 4];
             let mut n = 0.0;
             for sy in y0..y1.max(y0 + 1) {
                 for sx in x0..x1.max(x0 + 1) {
-                    for (a, v) in acc.iter_mut().zip(img.get(sx.min(img.width() - 1), sy.min(img.height() - 1))) {
+                    for (a, v) in acc
+                        .iter_mut()
+                        .zip(img.get(sx.min(img.width() - 1), sy.min(img.height() - 1)))
+                    {
                         *a += v;
                     }
                     n += 1.0;
@@ -156,8 +168,14 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
     let rows_n = (sheet_cells.len() as u32).div_ceil(cols);
     let mut sheet = Image::new(cols * SHEET_CELL, rows_n * SHEET_CELL, 3);
     for (i, cell) in sheet_cells.iter().enumerate() {
-        let (cx, cy) = ((i as u32 % cols) * SHEET_CELL, (i as u32 / cols) * SHEET_CELL);
-        let (ox, oy) = ((SHEET_CELL - cell.width()) / 2, (SHEET_CELL - cell.height()) / 2);
+        let (cx, cy) = (
+            (i as u32 % cols) * SHEET_CELL,
+            (i as u32 / cols) * SHEET_CELL,
+        );
+        let (ox, oy) = (
+            (SHEET_CELL - cell.width()) / 2,
+            (SHEET_CELL - cell.height()) / 2,
+        );
         sheet.paste(&cell.with_channels(3), cx + ox, cy + oy);
     }
     mirrorball_io::write_image(&dir.join("sheet.png"), &sheet, &preview)?;
