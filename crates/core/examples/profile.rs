@@ -6,7 +6,8 @@ use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
 
 fn main() {
     let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());
-    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 1024, 3, |d| {
+    let size: u32 = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(1024);
+    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), size, 3, |d| {
         [
             (1.0 + d.x) as f32,
             (1.0 + d.y) as f32,
@@ -16,14 +17,18 @@ fn main() {
     });
     let cube_p = ProjectionKind::Cube.default_projection();
     let opts = ResampleOptions::default();
-    let cube = EnvMap::from_fn(cube_p, 256, 3, |d| [(1.0 + d.x) as f32, 1.0, 1.0, 1.0]);
+    let cube = EnvMap::from_fn(cube_p, size / 4, 3, |d| [(1.0 + d.x) as f32, 1.0, 1.0, 1.0]);
     if which == "none" {
         return;
     }
     if which != "back" {
-        std::hint::black_box(resample(&src, cube_p, 256, &opts));
+        for _ in 0..5 {
+            std::hint::black_box(resample(&src, cube_p, size / 4, &opts));
+        }
     }
     if which != "forward" {
-        std::hint::black_box(resample(&cube, *src.projection(), 1024, &opts));
+        for _ in 0..5 {
+            std::hint::black_box(resample(&cube, *src.projection(), size, &opts));
+        }
     }
 }
