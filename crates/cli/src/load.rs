@@ -3,7 +3,7 @@
 
 use crate::error::CliError;
 use crate::spec::ProjSpec;
-use mirrorball_core::{guess, EnvMap, Image, Layout, ProjectionKind, WorldProjection};
+use mirrorball_core::{guess, EnvMap, Image, Layout, Projection, ProjectionKind, WorldProjection};
 use mirrorball_io::{Limits, Loaded};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -50,12 +50,7 @@ pub fn load(
     } = loaded;
     if layers.len() == 6 {
         // A cube container: KTX2 or DDS.
-        let spec = from
-            .cloned()
-            .unwrap_or_else(|| ProjSpec::of(ProjectionKind::Cube));
-        let proj = spec
-            .build(None)
-            .map_err(|e| CliError::request(format!("--from: {e}")))?;
+        let (spec, proj) = multi_layer(from)?;
         if proj.layer_count() != 6 {
             return Err(CliError::request(format!(
                 "{input}: holds six cube faces, which cannot be read as {}",
@@ -159,14 +154,20 @@ fn gcd(a: u32, b: u32) -> u32 {
     }
 }
 
-/// Reads one file per layer: `{face}` becomes px nx py ny pz nz (cube) or front back.
-fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<Source, CliError> {
+/// The projection of a multi-layer input: as asked, or a cube.
+fn multi_layer(from: Option<&ProjSpec>) -> Result<(ProjSpec, Projection), CliError> {
     let spec = from
         .cloned()
         .unwrap_or_else(|| ProjSpec::of(ProjectionKind::Cube));
     let proj = spec
         .build(None)
         .map_err(|e| CliError::request(format!("--from: {e}")))?;
+    Ok((spec, proj))
+}
+
+/// Reads one file per layer: `{face}` becomes px nx py ny pz nz (cube) or front back.
+fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<Source, CliError> {
+    let (spec, proj) = multi_layer(from)?;
     let names = layer_names(proj.layer_count());
     if names.len() < 2 {
         return Err(CliError::request(format!("{input}: {FACE} files need a projection with several layers (cube, continuous-cube, paraboloid), not {}", spec.kind)));

@@ -34,3 +34,4 @@ pub use projection::{
 pub use resample::{resample, resample_to_extent, ResampleOptions, Rotation};
 
 pub use glam;
+pub use projection::quadrature;

@@ -17,7 +17,7 @@ mod cube;
 pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
-pub(crate) mod quadrature;
+pub mod quadrature;
 
 pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap, SphereMap};
 pub use continuous_cube::ContinuousCube;

@@ -29,7 +29,7 @@ const GL16_W: [f64; 8] = [
 ];
 
 /// ∫ₐᵇ f(t) dt by 16-point Gauss–Legendre.
-pub(crate) fn gauss_legendre<F: FnMut(f64) -> f64>(a: f64, b: f64, mut f: F) -> f64 {
+pub fn gauss_legendre<F: FnMut(f64) -> f64>(a: f64, b: f64, mut f: F) -> f64 {
     let m = 0.5 * (a + b);
     let r = 0.5 * (b - a);
     let mut s = 0.0;
@@ -43,7 +43,7 @@ pub(crate) fn gauss_legendre<F: FnMut(f64) -> f64>(a: f64, b: f64, mut f: F) -> 
 /// Signed solid angle of the spherical triangle with vertices in the directions `a`, `b`,
 /// `c` (need not be unit length), by Van Oosterom & Strackee (1983):
 /// `tan(Ω/2) = a·(b×c) / (|a||b||c| + (a·b)|c| + (a·c)|b| + (b·c)|a|)`.
-pub(crate) fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+pub fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let (la, lb, lc) = (a.length(), b.length(), c.length());
     let num = a.dot(b.cross(c));
     let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
@@ -52,7 +52,7 @@ pub(crate) fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 
 /// Unsigned solid angle of a convex spherical polygon given by its vertex directions in
 /// order (a triangle fan; the edges are great-circle arcs).
-pub(crate) fn polygon_solid_angle(v: &[DVec3]) -> f64 {
+pub fn polygon_solid_angle(v: &[DVec3]) -> f64 {
     if v.len() < 3 {
         return 0.0;
     }
