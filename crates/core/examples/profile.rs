@@ -6,7 +6,10 @@ use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
 
 fn main() {
     let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());
-    let size: u32 = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(1024);
+    let size: u32 = std::env::args()
+        .nth(2)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1024);
     let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), size, 3, |d| {
         [
             (1.0 + d.x) as f32,
