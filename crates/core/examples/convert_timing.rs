@@ -1,4 +1,4 @@
-//! Quick timing of the headline conversion: `cargo run --release -p mirrorball-core --example timing`.
+//! Quick timing of the headline conversion: `cargo run --release -p mirrorball-core --example convert_timing`.
 use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
 use std::time::Instant;
 
