@@ -33,6 +33,12 @@ enum Command {
     Compare(CompareArgs),
     /// Convert a bundled HDR environment into every projection and write previews.
     Demo(DemoArgs),
+    /// Render environment-mapped objects with a chosen indexing mode (1 texgen, 2 per-vertex
+    /// reflection, 3 per-pixel, 4 Greene's cones).
+    Render(Box<RenderArgs>),
+    /// Measure each projection's distortion and error exactly and write a report (HTML with
+    /// SVG plots, the plots as SVG files, and the numbers as JSON).
+    Analyze(AnalyzeArgs),
 }
 
 /// How to read an input file.
@@ -144,6 +150,137 @@ pub struct DemoArgs {
     exposure: f32,
 }
 
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// A scene file (JSON: meshes with model matrices, camera, environment, material,
+    /// indexing); its values override the flags.
+    scene: Option<String>,
+    /// Output image: .png/.jpg (exposure, tone curve, sRGB) or .exr/.hdr (linear).
+    #[arg(short, long, default_value = "render.png")]
+    output: String,
+    /// Object: sphere, torus, cube, quad, teapot, or a .glb/.gltf/.obj file (centred and
+    /// scaled to unit size).
+    #[arg(long, default_value = "sphere")]
+    object: String,
+    /// Tessellation of a built-in (sphere/torus segments, quad/cube cells per edge, teapot
+    /// subdivisions per patch edge).
+    #[arg(long)]
+    tessellation: Option<u32>,
+    /// Environment map file.
+    #[arg(long)]
+    env: Option<String>,
+    #[command(flatten)]
+    input_args: InputArgs,
+    /// Convert the environment to this projection first (`NAME[:key=value…]`, as --from).
+    #[arg(long, value_name = "PROJECTION")]
+    env_as: Option<String>,
+    /// Size for --env-as (face edge, width or diameter).
+    #[arg(long)]
+    env_size: Option<u32>,
+    /// Indexing mode: 1|texgen, 2|vertex, 3|pixel, 4|cone.
+    #[arg(long, default_value = "pixel")]
+    mode: String,
+    /// What the environment is attached to: world (view-independent) or eye.
+    #[arg(long, default_value = "world")]
+    attach: String,
+    /// Lookup filter: nearest or bilinear (mode 4 filters cones itself).
+    #[arg(long, default_value = "bilinear")]
+    filter: String,
+    /// Material: mirror, fresnel, cheap-chrome, diffuse.
+    #[arg(long, default_value = "mirror")]
+    material: String,
+    /// Tint of a mirror, base colour of fresnel/diffuse: r,g,b.
+    #[arg(long, default_value = "1,1,1")]
+    tint: String,
+    /// Reflectance at normal incidence for fresnel.
+    #[arg(long, default_value_t = 0.04)]
+    f0: f32,
+    /// Camera position x,y,z.
+    #[arg(long, default_value = "0,0,3.5", allow_hyphen_values = true)]
+    eye: String,
+    /// Point looked at x,y,z.
+    #[arg(long, default_value = "0,0,0", allow_hyphen_values = true)]
+    target: String,
+    /// Up direction.
+    #[arg(long, default_value = "+y", allow_hyphen_values = true)]
+    up: String,
+    /// Vertical field of view in degrees (perspective).
+    #[arg(long, default_value_t = 40.0)]
+    fov: f32,
+    /// Orthographic camera with this half height instead of perspective.
+    #[arg(long)]
+    ortho: Option<f32>,
+    /// Fisheye (Omnimax, Greene §10) camera with this full field of view in degrees: the
+    /// scene is captured as a cube at --eye and resampled to a WIDTHxWIDTH fisheye picture.
+    #[arg(long)]
+    fisheye: Option<f64>,
+    /// Lens of --fisheye: equidistant, equisolid, stereographic, orthographic.
+    #[arg(long, default_value = "equidistant")]
+    fisheye_lens: String,
+    /// Near clipping distance.
+    #[arg(long, default_value_t = 0.05)]
+    near: f32,
+    /// Far clipping distance.
+    #[arg(long, default_value_t = 1000.0)]
+    far: f32,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x480")]
+    size: String,
+    /// Supersampling: NxN samples per pixel.
+    #[arg(long, default_value_t = 2)]
+    ss: u32,
+    /// Exposure in stops.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    exposure: f32,
+    /// Tone curve for PNG/JPEG: aces, reinhard, clamp.
+    #[arg(long, default_value = "aces")]
+    tone: String,
+    /// Draw objects over transparent black instead of the environment.
+    #[arg(long)]
+    no_background: bool,
+    /// Camera-rotation motion blur of the background (Greene §9): the camera panned this
+    /// many degrees (about its up axis) since the previous frame.
+    #[arg(long, allow_hyphen_values = true)]
+    pan_blur: Option<f32>,
+    /// Also write the diagnostic channels as float EXRs beside the image: -st (u, v,
+    /// layer read), -reflect (world reflected vector), -normal, -depth (eye depth, window
+    /// depth, coverage).
+    #[arg(long)]
+    aovs: bool,
+    /// Also write NAME-diag.png: the environment map with the texels the image read marked,
+    /// and the per-vertex texture coordinates and triangle edges drawn in texture space.
+    #[arg(long)]
+    diagnostics: bool,
+    /// Render N frames orbiting the target about +Y (NAME-0000.png …).
+    #[arg(long, default_value_t = 1)]
+    turntable: u32,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct AnalyzeArgs {
+    /// Projection to analyse, `NAME[:key=value…]` (see `convert --from`); repeat for more.
+    /// Default: every projection.
+    #[arg(long = "projection", value_name = "PROJECTION")]
+    projections: Vec<String>,
+    /// The same edge size for every projection (cube face edge, lat-long width, disk
+    /// diameter).
+    #[arg(long, conflicts_with = "texel_budget")]
+    size: Option<u32>,
+    /// The same number of texels, all layers together, for every projection (a fair
+    /// comparison: 1572864 = six 512² cube faces = one 1254² sphere map). Default: 1572864.
+    #[arg(long, value_name = "TEXELS")]
+    texel_budget: Option<u64>,
+    /// Folder to write the report into (created if missing).
+    #[arg(long)]
+    out: String,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: Result<(), CliError> = match cli.command {
@@ -151,6 +288,8 @@ fn main() -> ExitCode {
         Command::Info(a) => commands::info::run(a),
         Command::Compare(a) => commands::compare::run(a),
         Command::Demo(a) => commands::demo::run(a),
+        Command::Analyze(a) => commands::analyze::run(a),
+        Command::Render(a) => commands::render::run(*a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,8 +1,10 @@
 //! One module per subcommand.
+pub mod analyze;
 pub mod compare;
 pub mod convert;
 pub mod demo;
 pub mod info;
+pub mod render;
 
 use crate::error::CliError;
 use crate::spec::{bad, ProjSpec};

@@ -1,0 +1,810 @@
+//! `mirrorball render`: environment-mapped objects, as each indexing mode truly behaves.
+//!
+//! `args → RenderPlan` (every option parsed and checked, the output's folder and format
+//! checked, the scene file read) `→` environment and meshes loaded `→`
+//! `mirrorball_render::render` for each frame `→` PNG/JPEG (exposure, tone curve, sRGB) or
+//! EXR/HDR (linear) `→` diagnostic channels as separate float EXRs beside the image.
+
+use super::InputPlan;
+use crate::error::CliError;
+use crate::progress::with_progress;
+use crate::spec::{bad, parse_dir, ProjSpec};
+use crate::{load, RenderArgs};
+use mirrorball_core::glam::{Mat4, Vec3};
+use mirrorball_core::{resample, EnvMap, Image, ResampleOptions, WorldProjection};
+use mirrorball_io::{Format, Precision, WriteOptions};
+use mirrorball_render::tone::{self, Tone};
+use mirrorball_render::{
+    Attach, Builtin, Camera, Environment, Filter, Indexing, Lens, Material, Mesh, Object, Ramp,
+    Scene, Settings,
+};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+use std::sync::Arc;
+
+/// Where a mesh comes from.
+#[derive(Clone, Debug)]
+enum MeshSource {
+    Builtin(Builtin, u32),
+    File(PathBuf),
+}
+
+/// One object to load.
+#[derive(Clone, Debug)]
+struct ObjectPlan {
+    source: MeshSource,
+    model: Mat4,
+    /// Centre the file's mesh and scale it to unit size before `model`.
+    normalize: bool,
+    material: Material,
+}
+
+/// Everything `render` will do, checked.
+struct RenderPlan {
+    objects: Vec<ObjectPlan>,
+    env_file: Option<String>,
+    input: InputPlan,
+    env_as: Option<(ProjSpec, u32)>,
+    attach: Attach,
+    filter: Filter,
+    intensity: f32,
+    background: bool,
+    camera: Camera,
+    settings: Settings,
+    exposure: f32,
+    tone: Tone,
+    output: PathBuf,
+    format: Format,
+    frames: u32,
+    /// Write the texture-space diagram beside each frame.
+    diagnostics: bool,
+    /// Fisheye lens and full field of view.
+    fisheye: Option<(mirrorball_core::Lens, f64)>,
+    /// Pan since the previous frame, radians (motion blur).
+    pan_blur: Option<f32>,
+    quiet: bool,
+}
+
+fn parse_vec3(option: &str, s: &str) -> Result<Vec3, CliError> {
+    let d = parse_dir(s).map_err(|e| bad(option, e))?;
+    Ok(d.as_vec3())
+}
+
+fn parse_point(option: &str, s: &str) -> Result<Vec3, CliError> {
+    let parts: Vec<f32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad(option, format!("'{s}' is not a point x,y,z")))?;
+    if parts.len() != 3 || parts.iter().any(|v| !v.is_finite()) {
+        return Err(bad(option, format!("'{s}' is not a point x,y,z")));
+    }
+    Ok(Vec3::new(parts[0], parts[1], parts[2]))
+}
+
+fn parse_colour(option: &str, s: &str) -> Result<[f32; 3], CliError> {
+    let v = parse_point(option, s)?;
+    if v.min_element() < 0.0 {
+        return Err(bad(option, format!("'{s}' has a negative channel")));
+    }
+    Ok(v.to_array())
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), CliError> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| bad("--size", format!("'{s}' is not WIDTHxHEIGHT")))?;
+    let p = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=16384).contains(&n))
+            .ok_or_else(|| bad("--size", format!("'{s}': each side must be 1..=16384")))
+    };
+    Ok((p(w)?, p(h)?))
+}
+
+fn parse_material(name: &str, tint: [f32; 3], f0: f32) -> Result<Material, String> {
+    Ok(match name.to_ascii_lowercase().as_str() {
+        "mirror" | "chrome" => Material::Mirror { tint },
+        "fresnel" | "varnish" | "plastic" => Material::Fresnel { f0, base: tint },
+        "cheap-chrome" | "ramp" => Material::CheapChrome {
+            ramp: Ramp::chrome(),
+        },
+        "diffuse" | "matte" => Material::diffuse(tint),
+        _ => {
+            return Err(format!(
+                "unknown material '{name}' (known: mirror, fresnel, cheap-chrome, diffuse)"
+            ))
+        }
+    })
+}
+
+fn parse_object(s: &str, level: Option<u32>) -> Result<MeshSource, CliError> {
+    if let Some(b) = Builtin::from_name(s) {
+        let l = level.unwrap_or(b.default_tessellation());
+        if !(1..=4096).contains(&l) {
+            return Err(bad("--tessellation", format!("{l} is outside 1..=4096")));
+        }
+        return Ok(MeshSource::Builtin(b, l));
+    }
+    let p = PathBuf::from(s);
+    let ext = p
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("glb" | "gltf" | "obj") => Ok(MeshSource::File(p)),
+        _ => Err(bad(
+            "--object",
+            format!("'{s}' is neither a built-in (sphere, torus, cube, quad, teapot) nor a .glb/.gltf/.obj file"),
+        )),
+    }
+}
+
+impl RenderPlan {
+    fn new(a: &RenderArgs) -> Result<RenderPlan, CliError> {
+        let input = InputPlan::new(&a.input_args)?;
+        let indexing = Indexing::from_name(&a.mode).ok_or_else(|| {
+            bad(
+                "--mode",
+                format!(
+                    "unknown mode '{}' (known: 1|texgen, 2|vertex, 3|pixel, 4|cone)",
+                    a.mode
+                ),
+            )
+        })?;
+        let attach = Attach::from_name(&a.attach)
+            .ok_or_else(|| bad("--attach", format!("'{}' is not world or eye", a.attach)))?;
+        let filter = Filter::from_name(&a.filter).ok_or_else(|| {
+            bad(
+                "--filter",
+                format!("'{}' is not nearest or bilinear", a.filter),
+            )
+        })?;
+        let tone = Tone::from_name(&a.tone).ok_or_else(|| {
+            bad(
+                "--tone",
+                format!("'{}' is not aces, reinhard or clamp", a.tone),
+            )
+        })?;
+        let tint = parse_colour("--tint", &a.tint)?;
+        if !(0.0..=1.0).contains(&a.f0) {
+            return Err(bad("--f0", format!("{} is outside [0, 1]", a.f0)));
+        }
+        let material = parse_material(&a.material, tint, a.f0).map_err(|e| bad("--material", e))?;
+        let (w, h) = parse_size(&a.size)?;
+        if !(1..=16).contains(&a.ss) {
+            return Err(bad("--ss", format!("{} is outside 1..=16", a.ss)));
+        }
+        let eye = parse_point("--eye", &a.eye)?;
+        let target = parse_point("--target", &a.target)?;
+        let up = parse_vec3("--up", &a.up)?;
+        let lens = match a.ortho {
+            Some(hh) => Lens::Orthographic { half_height: hh },
+            None => Lens::Perspective { fov_y_deg: a.fov },
+        };
+        let camera = Camera {
+            eye,
+            target,
+            up,
+            lens,
+            near: a.near,
+            far: a.far,
+            width: w,
+            height: h,
+        };
+        camera.validate().map_err(|e| bad("camera", e))?;
+        let source = parse_object(&a.object, a.tessellation)?;
+        let normalize = matches!(source, MeshSource::File(_));
+        let objects = vec![ObjectPlan {
+            source,
+            model: Mat4::IDENTITY,
+            normalize,
+            material,
+        }];
+        let env_as = match &a.env_as {
+            Some(s) => {
+                let spec = ProjSpec::parse(s).map_err(|e| bad("--env-as", e))?;
+                let size = a.env_size.unwrap_or(512);
+                if !(1..=8192).contains(&size) {
+                    return Err(bad("--env-size", format!("{size} is outside 1..=8192")));
+                }
+                Some((spec, size))
+            }
+            None => None,
+        };
+        let output = PathBuf::from(&a.output);
+        let format = Format::from_path(&output).ok_or_else(|| {
+            bad(
+                "--output",
+                format!(
+                    "'{}': the extension must be .png, .jpg, .exr or .hdr",
+                    a.output
+                ),
+            )
+        })?;
+        if matches!(format, Format::Ktx2 | Format::Dds | Format::Webp) {
+            return Err(bad(
+                "--output",
+                format!("'{}': render writes .png, .jpg, .exr or .hdr", a.output),
+            ));
+        }
+        if let Some(parent) = output.parent().filter(|p| !p.as_os_str().is_empty()) {
+            if !parent.is_dir() {
+                return Err(CliError::request(format!(
+                    "--output: the folder '{}' does not exist",
+                    parent.display()
+                )));
+            }
+        }
+        if !(1..=3600).contains(&a.turntable) {
+            return Err(bad(
+                "--turntable",
+                format!("{} is outside 1..=3600", a.turntable),
+            ));
+        }
+        let mut plan = RenderPlan {
+            objects,
+            env_file: a.env.clone(),
+            input,
+            env_as,
+            attach,
+            filter,
+            intensity: 1.0,
+            background: !a.no_background,
+            camera,
+            settings: Settings {
+                indexing,
+                supersample: a.ss,
+                aovs: a.aovs || a.diagnostics,
+                motion_from: None,
+            },
+            exposure: a.exposure,
+            tone,
+            output,
+            format,
+            frames: a.turntable,
+            diagnostics: a.diagnostics,
+            fisheye: match a.fisheye {
+                Some(fov) => {
+                    let lens =
+                        mirrorball_core::Lens::from_name(&a.fisheye_lens).ok_or_else(|| {
+                            bad(
+                                "--fisheye-lens",
+                                format!(
+                                "'{}' is not equidistant, equisolid, stereographic or orthographic",
+                                a.fisheye_lens
+                            ),
+                            )
+                        })?;
+                    if !(fov.is_finite()
+                        && fov > 0.0
+                        && fov.to_radians() / 2.0 <= lens.max_half_fov())
+                    {
+                        return Err(bad(
+                            "--fisheye",
+                            format!(
+                                "a {} lens covers (0°, {:.0}°], not {fov}°",
+                                a.fisheye_lens,
+                                2.0 * lens.max_half_fov().to_degrees()
+                            ),
+                        ));
+                    }
+                    if a.aovs || a.diagnostics {
+                        return Err(CliError::request(
+                            "--fisheye: the diagnostic channels and diagram are made for the cube views, not the fisheye; drop --aovs/--diagnostics",
+                        ));
+                    }
+                    Some((lens, fov))
+                }
+                None => None,
+            },
+            pan_blur: match a.pan_blur {
+                Some(d) if d.is_finite() && d.abs() < 180.0 => Some(d.to_radians()),
+                Some(d) => return Err(bad("--pan-blur", format!("{d}° is outside (−180°, 180°)"))),
+                None => None,
+            },
+            quiet: a.quiet,
+        };
+        if let Some(scene) = &a.scene {
+            apply_scene_file(&mut plan, Path::new(scene))?;
+        }
+        let needs_env =
+            plan.background || plan.objects.iter().any(|o| o.material.uses_environment());
+        if needs_env && plan.env_file.is_none() {
+            return Err(CliError::request(
+                "--env: an environment map is needed (or use --material cheap-chrome or diffuse with --no-background)",
+            ));
+        }
+        Ok(plan)
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Scene files (JSON).
+
+/// A scene file: see `docs/render-scene.md` and `examples/scenes/`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    #[serde(default)]
+    meshes: Vec<MeshEntry>,
+    camera: Option<CameraEntry>,
+    environment: Option<EnvEntry>,
+    /// Default material of meshes that name none.
+    material: Option<MaterialEntry>,
+    /// Indexing mode.
+    indexing: Option<String>,
+    supersample: Option<u32>,
+    background: Option<bool>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MeshEntry {
+    /// A built-in name or a file (relative to the scene file).
+    mesh: String,
+    tessellation: Option<u32>,
+    /// Column-major 4×4 (as glTF stores matrices), or absent for the identity.
+    model: Option<[f32; 16]>,
+    /// Centre and scale a file's mesh to unit size first (default true for files).
+    normalize: Option<bool>,
+    material: Option<MaterialEntry>,
+}
+
+#[derive(Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields)]
+struct MaterialEntry {
+    kind: String,
+    tint: Option<[f32; 3]>,
+    f0: Option<f32>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct CameraEntry {
+    eye: [f32; 3],
+    target: [f32; 3],
+    up: Option<[f32; 3]>,
+    /// Vertical field of view in degrees (perspective).
+    fov: Option<f32>,
+    /// Half height of an orthographic view (makes the camera orthographic).
+    ortho_half_height: Option<f32>,
+    near: Option<f32>,
+    far: Option<f32>,
+    width: Option<u32>,
+    height: Option<u32>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct EnvEntry {
+    /// The map's file (relative to the scene file).
+    file: String,
+    /// Its projection, as `--from` spells it (guessed when absent).
+    projection: Option<String>,
+    /// `world` or `eye`.
+    attach: Option<String>,
+    /// `nearest` or `bilinear` (cone filtering comes with `indexing: "cone"`).
+    filter: Option<String>,
+    intensity: Option<f32>,
+}
+
+fn material_of(e: &MaterialEntry) -> Result<Material, String> {
+    parse_material(&e.kind, e.tint.unwrap_or([1.0; 3]), e.f0.unwrap_or(0.04))
+}
+
+/// Reads a scene file and lets it override the flags' defaults.
+fn apply_scene_file(plan: &mut RenderPlan, path: &Path) -> Result<(), CliError> {
+    let name = path.display();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::input(format!("{name}: cannot read: {e}")))?;
+    let sf: SceneFile =
+        serde_json::from_str(&text).map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let rel = |f: &str| -> String {
+        let p = Path::new(f);
+        if p.is_absolute() {
+            f.to_string()
+        } else {
+            base.join(p).to_string_lossy().into_owned()
+        }
+    };
+    let err = |e: String| CliError::input(format!("{name}: {e}"));
+    let default_material = match &sf.material {
+        Some(m) => material_of(m).map_err(err)?,
+        None => plan
+            .objects
+            .first()
+            .map(|o| o.material.clone())
+            .unwrap_or_else(Material::mirror),
+    };
+    if !sf.meshes.is_empty() {
+        let mut objects = Vec::new();
+        for (i, m) in sf.meshes.iter().enumerate() {
+            let source = match Builtin::from_name(&m.mesh) {
+                Some(_) => parse_object(&m.mesh, m.tessellation),
+                None => parse_object(&rel(&m.mesh), None),
+            }
+            .map_err(|e| CliError::input(format!("{name}: meshes[{i}]: {}", e.message)))?;
+            let model = m
+                .model
+                .map(|c| Mat4::from_cols_array(&c))
+                .unwrap_or(Mat4::IDENTITY);
+            if !model.is_finite() || model.determinant() == 0.0 {
+                return Err(err(format!("meshes[{i}]: the model matrix is singular")));
+            }
+            let material = match &m.material {
+                Some(e) => material_of(e).map_err(|e| err(format!("meshes[{i}]: {e}")))?,
+                None => default_material.clone(),
+            };
+            objects.push(ObjectPlan {
+                normalize: m.normalize.unwrap_or(matches!(source, MeshSource::File(_))),
+                source,
+                model,
+                material,
+            });
+        }
+        plan.objects = objects;
+    } else if sf.material.is_some() {
+        for o in &mut plan.objects {
+            o.material = default_material.clone();
+        }
+    }
+    if let Some(c) = &sf.camera {
+        let lens = match (c.ortho_half_height, c.fov) {
+            (Some(h), _) => Lens::Orthographic { half_height: h },
+            (None, Some(f)) => Lens::Perspective { fov_y_deg: f },
+            (None, None) => plan.camera.lens,
+        };
+        plan.camera = Camera {
+            eye: Vec3::from_array(c.eye),
+            target: Vec3::from_array(c.target),
+            up: c.up.map(Vec3::from_array).unwrap_or(Vec3::Y),
+            lens,
+            near: c.near.unwrap_or(plan.camera.near),
+            far: c.far.unwrap_or(plan.camera.far),
+            width: c.width.unwrap_or(plan.camera.width),
+            height: c.height.unwrap_or(plan.camera.height),
+        };
+        plan.camera
+            .validate()
+            .map_err(|e| err(format!("camera: {e}")))?;
+    }
+    if let Some(e) = &sf.environment {
+        plan.env_file = Some(rel(&e.file));
+        if let Some(p) = &e.projection {
+            plan.input.from =
+                Some(ProjSpec::parse(p).map_err(|x| err(format!("environment.projection: {x}")))?);
+        }
+        if let Some(a) = &e.attach {
+            plan.attach = Attach::from_name(a)
+                .ok_or_else(|| err(format!("environment.attach: '{a}' is not world or eye")))?;
+        }
+        if let Some(f) = &e.filter {
+            plan.filter = match f.to_ascii_lowercase().as_str() {
+                // Trilinear and EWA are the cone mode's business until crates/filter lands.
+                "trilinear" | "ewa" => {
+                    plan.settings.indexing = Indexing::Cone;
+                    Filter::Bilinear
+                }
+                other => Filter::from_name(other).ok_or_else(|| {
+                    err(format!(
+                        "environment.filter: '{f}' is not nearest, bilinear, trilinear or ewa"
+                    ))
+                })?,
+            };
+        }
+        if let Some(i) = e.intensity {
+            if !(i.is_finite() && i >= 0.0) {
+                return Err(err("environment.intensity must be ≥ 0".into()));
+            }
+            plan.intensity = i;
+        }
+    }
+    if let Some(m) = &sf.indexing {
+        plan.settings.indexing =
+            Indexing::from_name(m).ok_or_else(|| err(format!("indexing: unknown mode '{m}'")))?;
+    }
+    if let Some(s) = sf.supersample {
+        if !(1..=16).contains(&s) {
+            return Err(err(format!("supersample {s} is outside 1..=16")));
+        }
+        plan.settings.supersample = s;
+    }
+    if let Some(b) = sf.background {
+        plan.background = b;
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------
+// Work.
+
+fn load_object(o: &ObjectPlan) -> Result<Object, CliError> {
+    let (mesh, fit) = match &o.source {
+        MeshSource::Builtin(b, l) => (b.mesh(*l), Mat4::IDENTITY),
+        MeshSource::File(p) => {
+            let m: Mesh = mirrorball_render::load::load_mesh(p).map_err(CliError::input)?;
+            let fit = if o.normalize {
+                m.normalizing_transform()
+            } else {
+                Mat4::IDENTITY
+            };
+            (m, fit)
+        }
+    };
+    Ok(Object {
+        mesh: Arc::new(mesh),
+        model: o.model * fit,
+        material: o.material.clone(),
+    })
+}
+
+/// `out.png` → `out-{tag}.exr`.
+fn sibling(path: &Path, tag: &str, ext: &str) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "render".into());
+    path.with_file_name(format!("{stem}-{tag}.{ext}"))
+}
+
+fn write(path: &Path, img: &Image, format: Format, plan: &RenderPlan) -> Result<(), CliError> {
+    let img = match format {
+        Format::Png | Format::Jpeg => tone::to_display(img, plan.exposure, plan.tone),
+        _ => {
+            let mut i = img.clone();
+            let k = plan.exposure.exp2();
+            if k != 1.0 {
+                for px in i.data_mut().chunks_exact_mut(4) {
+                    for v in &mut px[..3] {
+                        *v *= k;
+                    }
+                }
+            }
+            i
+        }
+    };
+    let img = if format == Format::Jpeg || format == Format::Hdr {
+        img.with_channels(3)
+    } else {
+        img
+    };
+    mirrorball_io::write_image(path, &img, &WriteOptions::default())?;
+    Ok(())
+}
+
+pub fn run(a: RenderArgs) -> Result<(), CliError> {
+    let plan = RenderPlan::new(&a)?;
+    let environment = match &plan.env_file {
+        Some(f) => {
+            let src = load::load(
+                f,
+                plan.input.from.as_ref(),
+                plan.input.layout,
+                &mirrorball_io::Limits::default(),
+            )?;
+            let mut env = src.env;
+            if !plan.input.keep_invalid {
+                env.sanitize();
+            }
+            if !plan.quiet {
+                eprintln!(
+                    "environment: {} {}x{} ({})",
+                    env.projection().name(),
+                    env.width(),
+                    env.height(),
+                    src.decided
+                );
+            }
+            let env: EnvMap = match &plan.env_as {
+                Some((spec, size)) => {
+                    let p = spec
+                        .build(None)
+                        .map_err(|e| CliError::request(format!("--env-as: {e}")))?;
+                    let (w, h) = p.layer_extent(*size);
+                    if !plan.quiet {
+                        eprintln!("environment converted to {} {w}x{h}", p.name());
+                    }
+                    resample(&env, p, *size, &ResampleOptions::default())
+                }
+                None => env,
+            };
+            Some(Environment {
+                map: Arc::new(env),
+                attach: plan.attach,
+                filter: plan.filter,
+                intensity: plan.intensity,
+            })
+        }
+        None => None,
+    };
+    let objects = plan
+        .objects
+        .iter()
+        .map(load_object)
+        .collect::<Result<Vec<_>, _>>()?;
+    let tris: usize = objects.iter().map(|o| o.mesh.triangles.len()).sum();
+    let scene = Scene {
+        objects,
+        environment,
+        background: plan.background,
+    };
+    let frames = plan.frames;
+    let label = if frames > 1 { "frames" } else { "render" };
+    let started = std::time::Instant::now();
+    let results = with_progress(label, frames as u64, plan.quiet || frames == 1, |counter| {
+        (0..frames)
+            .map(|i| {
+                let angle = std::f32::consts::TAU * i as f32 / frames as f32;
+                let cam = plan.camera.orbited(angle);
+                let settings = Settings {
+                    motion_from: plan.pan_blur.map(|p| cam.panned(p)),
+                    ..plan.settings
+                };
+                let f = match plan.fisheye {
+                    Some((lens, fov)) => mirrorball_render::capture::render_fisheye(
+                        &scene,
+                        cam.eye,
+                        cam.target,
+                        cam.up,
+                        lens,
+                        fov,
+                        cam.width,
+                        (cam.width / 2).max(16),
+                        &settings,
+                    )
+                    .map(|img| mirrorball_render::Frame {
+                        color: with_alpha(&img),
+                        aovs: None,
+                    }),
+                    None => mirrorball_render::render(&scene, &cam, &settings),
+                }
+                .map_err(|e| CliError::request(e.to_string()));
+                counter.fetch_add(1, Ordering::Relaxed);
+                f
+            })
+            .collect::<Vec<_>>()
+    });
+    let secs = started.elapsed().as_secs_f64();
+    let mut anim: Vec<Image> = Vec::new();
+    for (i, f) in results.into_iter().enumerate() {
+        let f = f?;
+        if frames > 1 && plan.format == Format::Png {
+            anim.push(tone::to_display(&f.color, plan.exposure, plan.tone));
+        }
+        let path = if frames > 1 {
+            sibling(&plan.output, &format!("{i:04}"), ext_of(plan.format))
+        } else {
+            plan.output.clone()
+        };
+        write(&path, &f.color, plan.format, &plan)?;
+        if !plan.quiet {
+            eprintln!("wrote {}", path.display());
+        }
+        if plan.diagnostics {
+            let angle = std::f32::consts::TAU * i as f32 / frames as f32;
+            let cam = plan.camera.orbited(angle);
+            let d = mirrorball_render::texture_space_diagram(&scene, &cam, &plan.settings, &f, 512)
+                .map_err(|e| CliError::request(format!("--diagnostics: {e}")))?;
+            let p = sibling(&path, "diag", "png");
+            mirrorball_io::write_image(&p, &d, &WriteOptions::default())?;
+            if !plan.quiet {
+                eprintln!("wrote {}", p.display());
+            }
+        }
+        if let Some(aovs) = f.aovs.as_ref().filter(|_| a.aovs) {
+            let opts = WriteOptions {
+                precision: Some(Precision::Float),
+                ..WriteOptions::default()
+            };
+            for (tag, img) in [
+                ("st", &aovs.st_face),
+                ("reflect", &aovs.reflected),
+                ("normal", &aovs.normal),
+                ("depth", &aovs.depth),
+            ] {
+                let p = sibling(&path, tag, "exr");
+                mirrorball_io::write_image(&p, img, &opts)?;
+                if !plan.quiet {
+                    eprintln!("wrote {}", p.display());
+                }
+            }
+        }
+    }
+    if !anim.is_empty() {
+        let p = sibling(&plan.output, "turntable", "png");
+        write_apng(&p, &anim, 24)?;
+        if !plan.quiet {
+            eprintln!(
+                "wrote {} (animated PNG, {} frames)",
+                p.display(),
+                anim.len()
+            );
+        }
+    }
+    if !plan.quiet {
+        let (w, h) = (plan.camera.width, plan.camera.height);
+        eprintln!(
+            "{frames} frame(s) {w}x{h}, {tris} triangles, mode {}, {}x{} samples per pixel: {:.3} s ({:.1} frames/s)",
+            plan.settings.indexing.name(),
+            plan.settings.supersample,
+            plan.settings.supersample,
+            secs,
+            frames as f64 / secs.max(1e-9)
+        );
+    }
+    Ok(())
+}
+
+fn ext_of(f: Format) -> &'static str {
+    match f {
+        Format::Exr => "exr",
+        Format::Hdr => "hdr",
+        Format::Jpeg => "jpg",
+        _ => "png",
+    }
+}
+
+/// The sRGB encoding of linear `x ∈ [0, 1]`, as 8 bits.
+fn srgb8(x: f32) -> u8 {
+    let x = x.clamp(0.0, 1.0);
+    let s = if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Writes display-ready frames (linear, in `[0, 1]`) as an animated PNG that loops, at
+/// `fps` frames per second; written beside the target and renamed into place.
+fn write_apng(path: &Path, frames: &[Image], fps: u16) -> Result<(), CliError> {
+    let fail = |e: String| CliError::input(format!("{}: {e}", path.display()));
+    let (w, h) = (frames[0].width(), frames[0].height());
+    let tmp = path.with_extension("png.partial");
+    let result = (|| -> Result<(), String> {
+        let file = std::fs::File::create(&tmp).map_err(|e| e.to_string())?;
+        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), w, h);
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        enc.set_animated(frames.len() as u32, 0)
+            .map_err(|e| e.to_string())?;
+        enc.set_frame_delay(1, fps).map_err(|e| e.to_string())?;
+        let mut wr = enc.write_header().map_err(|e| e.to_string())?;
+        for f in frames {
+            let c = f.channels();
+            let bytes: Vec<u8> = f
+                .data()
+                .chunks_exact(c)
+                .flat_map(|p| {
+                    let a = if c == 4 { p[3] } else { 1.0 };
+                    [
+                        srgb8(p[0]),
+                        srgb8(p[1]),
+                        srgb8(p[2]),
+                        (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8,
+                    ]
+                })
+                .collect();
+            wr.write_image_data(&bytes).map_err(|e| e.to_string())?;
+        }
+        wr.finish().map_err(|e| e.to_string())
+    })();
+    match result {
+        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| fail(e.to_string())),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(fail(e))
+        }
+    }
+}
+
+/// An RGB picture as RGBA with alpha 1.
+fn with_alpha(img: &Image) -> Image {
+    img.with_channels(4)
+}

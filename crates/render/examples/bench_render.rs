@@ -1,0 +1,116 @@
+//! Frames per second at 1280×720 for `bench/render_mesa.py bench`: a mirror bunny and a
+//! mirror teapot in a cube map (city.exr as six 256² faces). Prints `name<TAB>fps` lines,
+//! best of `--reps` runs of `--frames` frames.
+
+use glam::{Mat4, Vec3};
+use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
+use mirrorball_render::{
+    load::load_mesh, render, Builtin, Camera, Environment, Indexing, Material, Mesh, Object, Scene,
+    Settings,
+};
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+fn arg(name: &str, default: u32) -> u32 {
+    let a: Vec<String> = std::env::args().collect();
+    a.iter()
+        .position(|x| x == name)
+        .and_then(|i| a.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+fn main() {
+    let frames = arg("--frames", 20);
+    let reps = arg("--reps", 3);
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let loaded = mirrorball_io::read(&root.join("assets/env/city.exr"), &Default::default())
+        .expect("city.exr");
+    let ll = EnvMap::new(ProjectionKind::LatLong.default_projection(), loaded.layers).unwrap();
+    let cube = resample(
+        &ll,
+        ProjectionKind::Cube.default_projection(),
+        std::env::var("FACE")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(256),
+        &ResampleOptions::default(),
+    );
+    let bunny = load_mesh(&root.join("assets/meshes/bunny.obj")).expect("bunny.obj");
+    let fit = bunny.normalizing_transform();
+    let teapot = Builtin::Teapot.mesh(8);
+    let cam = Camera::perspective(Vec3::new(0.8, 0.4, 3.0), Vec3::ZERO, 40.0, 1280, 720);
+    let cases: [(&str, &Mesh, Mat4, Indexing, bool); 5] = [
+        (
+            "mirrorball bunny per-pixel cube, no background",
+            &bunny,
+            fit,
+            Indexing::PerPixel,
+            false,
+        ),
+        (
+            "mirrorball bunny per-pixel cube, with background",
+            &bunny,
+            fit,
+            Indexing::PerPixel,
+            true,
+        ),
+        (
+            "mirrorball bunny mode 4 cones (mip stand-in for EWA), with background",
+            &bunny,
+            fit,
+            Indexing::Cone,
+            true,
+        ),
+        (
+            "mirrorball teapot (level 8) per-pixel cube, no background",
+            &teapot,
+            Mat4::IDENTITY,
+            Indexing::PerPixel,
+            false,
+        ),
+        (
+            "mirrorball teapot (level 8) per-pixel cube, with background",
+            &teapot,
+            Mat4::IDENTITY,
+            Indexing::PerPixel,
+            true,
+        ),
+    ];
+    let only: Option<String> = std::env::args()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .find(|w| w[0] == "--only")
+        .map(|w| w[1].clone());
+    for (name, mesh, model, mode, background) in cases {
+        if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
+            continue;
+        }
+        let scene = Scene {
+            objects: vec![Object {
+                mesh: Arc::new(mesh.clone()),
+                model,
+                material: Material::mirror(),
+            }],
+            environment: Some(Environment::new(cube.clone())),
+            background,
+        };
+        let settings = Settings {
+            indexing: mode,
+            supersample: 1,
+            aovs: false,
+            motion_from: None,
+        };
+        render(&scene, &cam, &settings).unwrap();
+        let mut best = 0.0f64;
+        for _ in 0..reps {
+            let t = Instant::now();
+            for _ in 0..frames {
+                std::hint::black_box(render(&scene, &cam, &settings).unwrap());
+            }
+            best = best.max(frames as f64 / t.elapsed().as_secs_f64());
+        }
+        println!("{name}\t{best:.2}");
+    }
+}

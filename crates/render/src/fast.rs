@@ -1,0 +1,99 @@
+//! `f32` fast paths for the per-pixel lookups of the two most common projections, cube and
+//! lat-long, with the same conventions as `mirrorball-core` (which works in `f64`; tested
+//! against it). Texels whose bilinear footprint crosses a seam are handed to
+//! [`EnvMap::bilinear_at`], which joins faces and wraps longitude.
+
+use glam::{DVec2, DVec3, Vec3};
+use mirrorball_core::{EnvMap, Projection, WorldProjection};
+
+/// `(layer, u, v)` of direction `d` (not necessarily unit length for the cube).
+#[inline]
+pub fn dir_to_uv(map: &EnvMap, d: Vec3) -> Option<(usize, f32, f32)> {
+    match map.projection() {
+        Projection::Cube(_) => {
+            let a = d.abs();
+            // OpenGL 4.6 table 8.19; ties go to x, then y, as CubeFace::select.
+            let (layer, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
+                if d.x >= 0.0 {
+                    (0, -d.z, -d.y, a.x)
+                } else {
+                    (1, d.z, -d.y, a.x)
+                }
+            } else if a.y >= a.z {
+                if d.y >= 0.0 {
+                    (2, d.x, d.z, a.y)
+                } else {
+                    (3, d.x, -d.z, a.y)
+                }
+            } else if d.z >= 0.0 {
+                (4, d.x, -d.y, a.z)
+            } else {
+                (5, -d.x, -d.y, a.z)
+            };
+            if ma <= 0.0 || ma.is_nan() {
+                return None;
+            }
+            let k = 0.5 / ma;
+            Some((layer, sc * k + 0.5, tc * k + 0.5))
+        }
+        Projection::LatLong(_) => {
+            let n = d.normalize_or_zero();
+            if n == Vec3::ZERO {
+                return None;
+            }
+            let u = 0.5 + n.x.atan2(-n.z) * (0.5 / std::f32::consts::PI);
+            let v = 0.5 - n.y.clamp(-1.0, 1.0).asin() * (1.0 / std::f32::consts::PI);
+            Some((0, u, v))
+        }
+        p => p
+            .dir_to_uv(d.as_dvec3().normalize_or_zero())
+            .map(|(l, uv)| (l, uv.x as f32, uv.y as f32)),
+    }
+}
+
+/// Bilinear lookup at `(layer, u, v)`, RGB.
+#[inline]
+pub fn bilinear(map: &EnvMap, layer: usize, u: f32, v: f32) -> [f32; 3] {
+    let img = &map.layers()[layer];
+    let (w, h) = (img.width() as i32, img.height() as i32);
+    let c = img.channels();
+    let x = u * w as f32 - 0.5;
+    let y = v * h as f32 - 0.5;
+    // floor without a libm call (x86-64's baseline has no rounding instruction).
+    let (xi, yi) = (x as i32, y as i32);
+    let x0 = xi - ((xi as f32) > x) as i32;
+    let y0 = yi - ((yi as f32) > y) as i32;
+    let (xf, yf) = (x0 as f32, y0 as f32);
+    if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h {
+        let (fx, fy) = (x - xf, y - yf);
+        let data = img.data();
+        let stride = w as usize * c;
+        let i = y0 as usize * stride + x0 as usize * c;
+        let j = i + stride;
+        let mut out = [0.0f32; 3];
+        for (k, o) in out.iter_mut().enumerate() {
+            let top = data[i + k] + fx * (data[i + c + k] - data[i + k]);
+            let bot = data[j + k] + fx * (data[j + c + k] - data[j + k]);
+            *o = top + fy * (bot - top);
+        }
+        return out;
+    }
+    let mut out = [0.0f32; 3];
+    map.bilinear_at(layer, DVec2::new(u as f64, v as f64), &mut out);
+    out
+}
+
+/// Bilinear lookup in direction `d`; zero where the projection does not cover `d`.
+#[inline]
+pub fn sample(map: &EnvMap, d: Vec3) -> [f32; 3] {
+    match dir_to_uv(map, d) {
+        Some((l, u, v)) => bilinear(map, l, u, v),
+        None => [0.0; 3],
+    }
+}
+
+/// The `f64` reference, for tests: `EnvMap::sample`.
+pub fn sample_reference(map: &EnvMap, d: Vec3) -> [f32; 3] {
+    let s = map.sample(DVec3::new(d.x as f64, d.y as f64, d.z as f64).normalize());
+    [s[0], s[1], s[2]]
+}

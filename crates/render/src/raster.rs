@@ -1,0 +1,365 @@
+//! The rasteriser: clip-space triangles into a visibility buffer, one entry per sample.
+//!
+//! Triangles are clipped against the near plane in homogeneous coordinates (`z + w ≥ 0`,
+//! Sutherland–Hodgman), divided by `w` and mapped to the sample grid (OpenGL's viewport
+//! transform, row 0 at the top). Coverage uses edge functions (half-spaces) evaluated at
+//! sample centres with a top-left fill rule, so a sample on an edge shared by two triangles
+//! is drawn exactly once. Depth is `z_ndc`, linear in screen space, tested with `<` and
+//! limited to `[−1, 1]` (the far plane).
+//!
+//! Attributes are not interpolated here. Each sample stores the triangle it sees and its
+//! **perspective-correct** barycentric coordinates with respect to the *original* (unclipped)
+//! triangle: with screen-space barycentrics `λᵢ` and clip `wᵢ`, the weights
+//! `bᵢ = (λᵢ/wᵢ) / Σⱼ(λⱼ/wⱼ)` are those under which any attribute that is linear on the
+//! triangle in eye space interpolates exactly (the hyperbolic interpolation of OpenGL 4.6
+//! §14.6.1, eq. 14.9). Vertices that clipping creates carry their own barycentric coordinates
+//! in the original triangle, so the result is unchanged by clipping. Shading happens
+//! afterwards, once per visible sample (a deferred, "visibility buffer" design).
+//!
+//! Work is split into horizontal bands of sample rows, rendered in parallel with rayon; each
+//! band walks the triangles binned to it.
+
+use glam::{Vec3, Vec4};
+use rayon::prelude::*;
+
+/// The triangle index of a sample that sees no triangle.
+pub const NO_HIT: u32 = u32::MAX;
+
+/// What one sample sees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Normalised device depth in `[−1, 1]` (1 where nothing was drawn).
+    pub depth: f32,
+    /// Index of the original triangle, or [`NO_HIT`].
+    pub tri: u32,
+    /// Perspective-correct barycentric weight of the triangle's second vertex.
+    pub b1: f32,
+    /// Perspective-correct barycentric weight of the triangle's third vertex.
+    pub b2: f32,
+}
+
+impl Sample {
+    /// Nothing drawn.
+    pub const EMPTY: Sample = Sample {
+        depth: 1.0,
+        tri: NO_HIT,
+        b1: 0.0,
+        b2: 0.0,
+    };
+
+    /// The three weights `(b0, b1, b2)`.
+    #[inline]
+    pub fn weights(&self) -> Vec3 {
+        Vec3::new(1.0 - self.b1 - self.b2, self.b1, self.b2)
+    }
+}
+
+/// A grid of samples, row 0 at the top.
+#[derive(Clone, Debug)]
+pub struct VisBuffer {
+    /// Samples per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// `width × height` samples, row by row.
+    pub samples: Vec<Sample>,
+}
+
+/// A clipped, projected triangle ready to scan.
+#[derive(Clone, Copy, Debug)]
+struct Setup {
+    /// Screen positions in sample units.
+    p: [[f32; 2]; 3],
+    z: [f32; 3],
+    inv_w: [f32; 3],
+    /// Barycentric coordinates of each vertex in the original triangle.
+    ob: [Vec3; 3],
+    area: f32,
+    tri: u32,
+    y0: u32,
+    y1: u32,
+    x0: u32,
+    x1: u32,
+}
+
+/// A clip-space vertex with its barycentric coordinates in the original triangle.
+#[derive(Clone, Copy, Debug)]
+struct ClipVert {
+    c: Vec4,
+    ob: Vec3,
+}
+
+/// Triangles clipped, projected and binned into horizontal bands of sample rows, ready to
+/// be scanned band by band (in parallel, and fused with shading by the renderer).
+#[derive(Clone, Debug)]
+pub struct Binned {
+    setups: Vec<Setup>,
+    bins: Vec<Vec<u32>>,
+    width: u32,
+    height: u32,
+    band: u32,
+}
+
+impl Binned {
+    /// Sets up triangles `tris` over clip-space vertices `clip` for a `width × height`
+    /// sample grid cut into bands of `band` rows.
+    pub fn new(clip: &[Vec4], tris: &[[u32; 3]], width: u32, height: u32, band: u32) -> Binned {
+        let band = band.max(1);
+        let setups: Vec<Setup> = tris
+            .par_iter()
+            .enumerate()
+            .fold(Vec::new, |mut acc, (i, t)| {
+                setup_triangle(clip, *t, i as u32, width, height, &mut acc);
+                acc
+            })
+            .flat_map_iter(|v| v.into_iter())
+            .collect();
+        let bands = height.div_ceil(band) as usize;
+        let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
+        for (i, s) in setups.iter().enumerate() {
+            for bin in &mut bins[(s.y0 / band) as usize..=(s.y1 / band) as usize] {
+                bin.push(i as u32);
+            }
+        }
+        Binned {
+            setups,
+            bins,
+            width,
+            height,
+            band,
+        }
+    }
+
+    /// Number of bands.
+    pub fn bands(&self) -> usize {
+        self.bins.len()
+    }
+
+    /// Rows in each band (the last may have fewer).
+    pub fn band_rows(&self) -> u32 {
+        self.band
+    }
+
+    /// Scans band `b` into `rows` (`width ×` the band's rows, reset to [`Sample::EMPTY`]
+    /// here).
+    pub fn scan_band(&self, b: usize, rows: &mut [Sample]) {
+        rows.fill(Sample::EMPTY);
+        let y_start = b as u32 * self.band;
+        for &si in &self.bins[b] {
+            scan(&self.setups[si as usize], rows, y_start, self.width);
+        }
+    }
+
+    /// Whether band `b` has any triangle.
+    pub fn band_is_empty(&self, b: usize) -> bool {
+        self.bins[b].is_empty()
+    }
+
+    /// Sample rows of the grid.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+}
+
+/// Sample rows per band of [`rasterize`].
+const BAND: u32 = 8;
+
+/// Rasterises triangles `tris` over clip-space vertices `clip` into a `width × height`
+/// sample grid.
+pub fn rasterize(clip: &[Vec4], tris: &[[u32; 3]], width: u32, height: u32) -> VisBuffer {
+    let binned = Binned::new(clip, tris, width, height, BAND);
+    let mut samples = vec![Sample::EMPTY; width as usize * height as usize];
+    samples
+        .par_chunks_mut(width as usize * BAND as usize)
+        .enumerate()
+        .for_each(|(b, rows)| binned.scan_band(b, rows));
+    VisBuffer {
+        width,
+        height,
+        samples,
+    }
+}
+
+/// Clips triangle `t` against the near plane and pushes what is left (a fan of up to two
+/// triangles) as setups.
+fn setup_triangle(
+    clip: &[Vec4],
+    t: [u32; 3],
+    tri: u32,
+    width: u32,
+    height: u32,
+    out: &mut Vec<Setup>,
+) {
+    let v = t.map(|i| clip[i as usize]);
+    if v.iter().any(|c| !c.is_finite()) {
+        return;
+    }
+    // Trivial rejection against each frustum plane.
+    let outside = |f: &dyn Fn(Vec4) -> bool| v.iter().all(|&c| f(c));
+    if outside(&|c| c.x > c.w)
+        || outside(&|c| c.x < -c.w)
+        || outside(&|c| c.y > c.w)
+        || outside(&|c| c.y < -c.w)
+        || outside(&|c| c.z > c.w)
+        || outside(&|c| c.z < -c.w)
+    {
+        return;
+    }
+    let verts = [
+        ClipVert {
+            c: v[0],
+            ob: Vec3::X,
+        },
+        ClipVert {
+            c: v[1],
+            ob: Vec3::Y,
+        },
+        ClipVert {
+            c: v[2],
+            ob: Vec3::Z,
+        },
+    ];
+    let d = |c: Vec4| c.z + c.w; // ≥ 0 inside the near plane
+    let mut poly: Vec<ClipVert> = Vec::with_capacity(4);
+    if verts.iter().all(|p| d(p.c) >= 0.0) {
+        poly.extend_from_slice(&verts);
+    } else {
+        for i in 0..3 {
+            let a = verts[i];
+            let b = verts[(i + 1) % 3];
+            let (da, db) = (d(a.c), d(b.c));
+            if da >= 0.0 {
+                poly.push(a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                let s = da / (da - db);
+                poly.push(ClipVert {
+                    c: a.c + (b.c - a.c) * s,
+                    ob: a.ob + (b.ob - a.ob) * s,
+                });
+            }
+        }
+    }
+    for k in 1..poly.len().saturating_sub(1) {
+        if let Some(s) = project([poly[0], poly[k], poly[k + 1]], tri, width, height) {
+            out.push(s);
+        }
+    }
+}
+
+/// Divides by `w`, maps to the sample grid and prepares the edge functions.
+fn project(v: [ClipVert; 3], tri: u32, width: u32, height: u32) -> Option<Setup> {
+    let (fw, fh) = (width as f32, height as f32);
+    let mut p = [[0.0f32; 2]; 3];
+    let mut z = [0.0f32; 3];
+    let mut inv_w = [0.0f32; 3];
+    for i in 0..3 {
+        let w = v[i].c.w;
+        if w.is_nan() || w <= 0.0 {
+            return None;
+        }
+        let iw = 1.0 / w;
+        p[i] = [
+            (v[i].c.x * iw + 1.0) * 0.5 * fw,
+            (1.0 - v[i].c.y * iw) * 0.5 * fh,
+        ];
+        z[i] = v[i].c.z * iw;
+        inv_w[i] = iw;
+    }
+    let mut ob = [v[0].ob, v[1].ob, v[2].ob];
+    // Signed area in the y-down grid; make it positive (both faces are drawn).
+    let mut area =
+        (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+    if !area.is_finite() || area == 0.0 {
+        return None;
+    }
+    if area < 0.0 {
+        p.swap(1, 2);
+        z.swap(1, 2);
+        inv_w.swap(1, 2);
+        ob.swap(1, 2);
+        area = -area;
+    }
+    let minx = p.iter().map(|q| q[0]).fold(f32::INFINITY, f32::min);
+    let maxx = p.iter().map(|q| q[0]).fold(f32::NEG_INFINITY, f32::max);
+    let miny = p.iter().map(|q| q[1]).fold(f32::INFINITY, f32::min);
+    let maxy = p.iter().map(|q| q[1]).fold(f32::NEG_INFINITY, f32::max);
+    // Samples at x + ½ inside [minx, maxx].
+    let x0 = (minx - 0.5).ceil().max(0.0);
+    let x1 = (maxx - 0.5).floor().min(fw - 1.0);
+    let y0 = (miny - 0.5).ceil().max(0.0);
+    let y1 = (maxy - 0.5).floor().min(fh - 1.0);
+    if x0 > x1 || y0 > y1 {
+        return None;
+    }
+    Some(Setup {
+        p,
+        z,
+        inv_w,
+        ob,
+        area,
+        tri,
+        x0: x0 as u32,
+        x1: x1 as u32,
+        y0: y0 as u32,
+        y1: y1 as u32,
+    })
+}
+
+/// Edge function of `a → b` at `q` in the y-down grid: positive on the inside of a
+/// triangle whose [`project`] made the area positive.
+#[inline(always)]
+fn edge(a: [f32; 2], b: [f32; 2], q: [f32; 2]) -> f32 {
+    (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])
+}
+
+/// Whether a sample exactly on edge `a → b` belongs to the triangle (top-left rule, for
+/// y-down coordinates and positive area).
+#[inline]
+fn top_left(a: [f32; 2], b: [f32; 2]) -> bool {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    // Positive area with y down means the vertices run clockwise on screen: the top edge
+    // runs to the right (dy = 0, dx > 0) and left edges run upwards (dy < 0).
+    (dy == 0.0 && dx > 0.0) || dy < 0.0
+}
+
+/// Scans one triangle over the rows of a band.
+fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
+    let band_rows = rows.len() as u32 / width;
+    let ya = s.y0.max(y_start);
+    let yb = s.y1.min(y_start + band_rows - 1);
+    if ya > yb {
+        return;
+    }
+    let [p0, p1, p2] = s.p;
+    let tl = [top_left(p1, p2), top_left(p2, p0), top_left(p0, p1)];
+    let inv_area = 1.0 / s.area;
+    // Edge functions are evaluated afresh at every sample (not accumulated), so that two
+    // triangles sharing an edge compute bit-identical values there and the fill rule holds.
+    let inside = |e: f32, t: bool| e > 0.0 || (e == 0.0 && t);
+    for y in ya..=yb {
+        let qy = y as f32 + 0.5;
+        let row = &mut rows[((y - y_start) * width) as usize..((y - y_start + 1) * width) as usize];
+        for (x, cell) in (s.x0..=s.x1).zip(&mut row[s.x0 as usize..=s.x1 as usize]) {
+            let q = [x as f32 + 0.5, qy];
+            let (f0, f1, f2) = (edge(p1, p2, q), edge(p2, p0, q), edge(p0, p1, q));
+            if !(inside(f0, tl[0]) && inside(f1, tl[1]) && inside(f2, tl[2])) {
+                continue;
+            }
+            let (l0, l1, l2) = (f0 * inv_area, f1 * inv_area, f2 * inv_area);
+            let z = l0 * s.z[0] + l1 * s.z[1] + l2 * s.z[2];
+            if z >= cell.depth || z.is_nan() || z < -1.0 {
+                continue;
+            }
+            let (q0, q1, q2) = (l0 * s.inv_w[0], l1 * s.inv_w[1], l2 * s.inv_w[2]);
+            let sum = q0 + q1 + q2;
+            let b = (s.ob[0] * q0 + s.ob[1] * q1 + s.ob[2] * q2) / sum;
+            *cell = Sample {
+                depth: z,
+                tri: s.tri,
+                b1: b.y,
+                b2: b.z,
+            };
+        }
+    }
+}

@@ -1,0 +1,8 @@
+//! mirrorball-render integration tests: analytic checks of every indexing mode, the GL
+//! texgen formula, the rasteriser's rules, meshes and loading, and small golden images.
+mod analytic;
+mod capture;
+mod golden;
+mod meshes;
+mod rasterizer;
+mod util;
