@@ -39,6 +39,9 @@ enum Command {
     /// Measure each projection's distortion and error exactly and write a report (HTML with
     /// SVG plots, the plots as SVG files, and the numbers as JSON).
     Analyze(AnalyzeArgs),
+    /// Prefiltered lighting: a Lambert, Phong or GGX mip chain (KTX2/DDS cube, or one
+    /// image per level), spherical-harmonic coefficients (JSON) and a preview sheet (PNG).
+    Prefilter(PrefilterArgs),
 }
 
 /// How to read an input file.
@@ -281,6 +284,88 @@ pub struct AnalyzeArgs {
     quiet: bool,
 }
 
+#[derive(Args, Debug)]
+pub struct PrefilterArgs {
+    /// Input environment map (any projection; `{face}` reads one file per layer).
+    input: String,
+    /// Output: .ktx2 or .dds (a cube map with the whole chain), or .exr/.hdr/.png (one file
+    /// per level: `{level}` in the name, or `_mip0`, `_mip1`, … added).
+    output: String,
+    /// The lobe: lambert (irradiance E/π), phong, or ggx (split-sum prefiltered radiance).
+    #[arg(long)]
+    lobe: String,
+    /// Face edge of level 0 (cubes; width or diameter for other projections). Default: 32
+    /// for lambert; the source's resolution (a power of two, at most 512) otherwise.
+    #[arg(long)]
+    size: Option<u32>,
+    /// Output projection (as --to of convert); KTX2/DDS hold cubes only.
+    #[arg(long, default_value = "cube", value_name = "PROJECTION")]
+    to: String,
+    /// Number of mip levels (default: all, down to 1×1).
+    #[arg(long)]
+    levels: Option<usize>,
+    /// Roughness of each level: linear (r = level/(levels−1)), ue4, filament, or a
+    /// comma-separated list of roughness values, one per level.
+    #[arg(long, default_value = "linear")]
+    mapping: String,
+    /// Phong exponents, one per level (`inf` is a mirror); default: 2/α² − 2 from the
+    /// mapping's roughness.
+    #[arg(long)]
+    exponents: Option<String>,
+    /// Importance samples per texel for the sharpest lobes (wider lobes take more).
+    #[arg(long, default_value_t = 128)]
+    samples: u32,
+    /// Face size of the working cube the source is filtered from (default: the source's
+    /// resolution).
+    #[arg(long)]
+    cube_size: Option<u32>,
+    /// Tame extreme texels first: none, clamp:MAX, soft:MAX, soft:KNEE:MAX (luminance);
+    /// the energy removed is reported.
+    #[arg(long, default_value = "none")]
+    compress: String,
+    /// Window against spherical-harmonic ringing: none, hann[:W], lanczos[:W], auto (the
+    /// weakest Hann window with non-negative irradiance).
+    #[arg(long, default_value = "none")]
+    sh_window: String,
+    /// How lambert maps are computed: exact (the brute-force sum, fast) or sh (nine
+    /// coefficients, windowed by --sh-window).
+    #[arg(long, default_value = "exact")]
+    irradiance: String,
+    /// Where to write the spherical-harmonic JSON (default: beside OUTPUT, .sh.json).
+    #[arg(long)]
+    sh: Option<String>,
+    /// Do not write the spherical-harmonic JSON.
+    #[arg(long)]
+    no_sh: bool,
+    /// Where to write the preview sheet (default: beside OUTPUT, _preview.png).
+    #[arg(long)]
+    preview: Option<String>,
+    /// Do not write the preview sheet.
+    #[arg(long)]
+    no_preview: bool,
+    /// Exposure of the preview sheet in stops (level 0's mean is shown at 18% grey).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    preview_exposure: f32,
+    /// Also write the split-sum BRDF table (A, B in red and green) to this .exr or .png.
+    #[arg(long)]
+    lut: Option<String>,
+    /// Edge of the BRDF table.
+    #[arg(long, default_value_t = 128)]
+    lut_size: u32,
+    /// Layout of flat outputs of multi-layer projections: separate, hcross, vcross,
+    /// hstrip, vstrip.
+    #[arg(long, value_name = "LAYOUT")]
+    layout: Option<String>,
+    /// Texel precision: half (default) or float.
+    #[arg(long)]
+    precision: Option<String>,
+    #[command(flatten)]
+    input_args: InputArgs,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: Result<(), CliError> = match cli.command {
@@ -288,6 +373,7 @@ fn main() -> ExitCode {
         Command::Info(a) => commands::info::run(a),
         Command::Compare(a) => commands::compare::run(a),
         Command::Demo(a) => commands::demo::run(a),
+        Command::Prefilter(a) => commands::prefilter::run(a),
         Command::Analyze(a) => commands::analyze::run(a),
         Command::Render(a) => commands::render::run(*a),
     };

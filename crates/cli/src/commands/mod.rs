@@ -4,6 +4,7 @@ pub mod compare;
 pub mod convert;
 pub mod demo;
 pub mod info;
+pub mod prefilter;
 pub mod render;
 
 use crate::error::CliError;

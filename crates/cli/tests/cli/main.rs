@@ -3,6 +3,7 @@
 mod analyze;
 mod bad_input;
 mod commands;
+mod prefilter;
 mod quality;
 mod render;
 mod util;

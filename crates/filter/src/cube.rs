@@ -1,0 +1,438 @@
+//! The working representation of the prefilterers: an OpenGL cube map with a
+//! solid-angle-weighted box mip pyramid whose faces carry a one-texel border copied from
+//! their neighbours, so that bilinear and trilinear lookups are seamless (as
+//! ARB_seamless_cube_map filters: across an edge from the adjacent face; at a corner, the
+//! missing texel is the mean of the three that meet there) without any branch in the inner
+//! loop. `f32`, four channels (RGB and a spare), in `glam::Vec4` for SIMD.
+
+use crate::mip::{MipChain, MipFilter};
+use glam::{Vec3, Vec4};
+use mirrorball_core::{
+    resample, CubeMap, EnvMap, Image, Projection, ResampleOptions, WorldProjection,
+};
+use rayon::prelude::*;
+
+/// The face OpenGL selects for `d` and `(sc, tc, |ma|)` (OpenGL 4.6 table 8.19), in `f32`,
+/// with the same tie rules as [`mirrorball_core::CubeFace::select`] (x, then y).
+#[inline(always)]
+pub(crate) fn select(d: Vec3) -> (usize, f32, f32, f32) {
+    let a = d.abs();
+    if a.x >= a.y && a.x >= a.z {
+        if d.x >= 0.0 {
+            (0, -d.z, -d.y, a.x)
+        } else {
+            (1, d.z, -d.y, a.x)
+        }
+    } else if a.y >= a.z {
+        if d.y >= 0.0 {
+            (2, d.x, d.z, a.y)
+        } else {
+            (3, d.x, -d.z, a.y)
+        }
+    } else if d.z >= 0.0 {
+        (4, d.x, -d.y, a.z)
+    } else {
+        (5, -d.x, -d.y, a.z)
+    }
+}
+
+/// `log₂ x` for positive normal `x`, to about 2e-4 (exponent plus a quartic in the
+/// mantissa, least-squares fit on `[1, 2)` with `p(1) = 0`). Mip level selection needs no
+/// more.
+#[inline(always)]
+pub(crate) fn fast_log2(x: f32) -> f32 {
+    let bits = x.to_bits();
+    let e = ((bits >> 23) & 0xff) as i32 - 127;
+    let t = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000) - 1.0;
+    let p = t * (1.438_545_4 + t * (-0.678_071_5 + t * (0.323_610_5 - 0.084_273_16 * t)));
+    e as f32 + p
+}
+
+/// Fills one level (six faces of `size²` texels) with a one-texel border,
+/// `stride = size + 2`, into `out` (`6·stride²` texels).
+fn pad_level(faces: &[Image], out: &mut [Vec4]) {
+    let size = faces[0].width() as usize;
+    let stride = size + 2;
+    let proj = CubeMap;
+    let texel = |f: usize, x: i64, y: i64| -> Vec4 {
+        let (l, tx, ty) = if x >= 0 && y >= 0 && x < size as i64 && y < size as i64 {
+            (f, x as u32, y as u32)
+        } else {
+            proj.wrap_texel(f, x, y, size as u32, size as u32)
+        };
+        let t = faces[l].get(tx, ty);
+        Vec4::new(t[0], t[1], t[2], if t.len() > 3 { t[3] } else { 1.0 })
+    };
+    out.par_chunks_mut(stride * stride)
+        .enumerate()
+        .for_each(|(f, face)| {
+            for py in 0..stride {
+                for px in 0..stride {
+                    let (x, y) = (px as i64 - 1, py as i64 - 1);
+                    let outside_x = x < 0 || x >= size as i64;
+                    let outside_y = y < 0 || y >= size as i64;
+                    face[py * stride + px] = if outside_x && outside_y {
+                        // A corner: the mean of the three texels that meet there.
+                        let cx = x.clamp(0, size as i64 - 1);
+                        let cy = y.clamp(0, size as i64 - 1);
+                        (texel(f, cx, cy) + texel(f, x, cy) + texel(f, cx, y)) / 3.0
+                    } else {
+                        texel(f, x, y)
+                    };
+                }
+            }
+        });
+}
+
+/// A cube map with its seamless, solid-angle-weighted box pyramid, for fast lookups: every
+/// level's six bordered faces in one buffer.
+pub(crate) struct SeamlessCube {
+    texels: Vec<Vec4>,
+    /// Per level: face size and bordered stride as `f32`, and where each of its six faces
+    /// starts in `texels`. Within a face, texel indices are computed in `f32`, exact below
+    /// 2²⁴ (faces up to 2048² are made, checked at build).
+    size: Vec<f32>,
+    stride: Vec<f32>,
+    stride_index: Vec<usize>,
+    face_offset: Vec<[usize; 6]>,
+    /// `0.5·log₂(4/size₀²)`: half the log₂ of a level-0 texel's solid angle per `|ma|³`.
+    half_log2_texel0: f32,
+    /// The coarsest level, as a float.
+    last_lod: f32,
+}
+
+impl SeamlessCube {
+    /// From a cube map's mip chain (box filter: energy-exact).
+    pub fn from_chain(chain: &MipChain) -> SeamlessCube {
+        let mut size = Vec::new();
+        let mut stride = Vec::new();
+        let mut face_offset = Vec::new();
+        let mut stride_index = Vec::new();
+        let mut total = 0usize;
+        for l in chain.levels() {
+            let s = l.width() as usize;
+            size.push(s as f32);
+            stride.push((s + 2) as f32);
+            face_offset.push(std::array::from_fn(|f| total + f * (s + 2) * (s + 2)));
+            stride_index.push(s + 2);
+            total += 6 * (s + 2) * (s + 2);
+        }
+        assert!(
+            total < 1 << 24,
+            "working cube too large for f32 texel indices"
+        );
+        let mut texels = vec![Vec4::ZERO; total];
+        let mut rest = texels.as_mut_slice();
+        for l in chain.levels() {
+            let s = l.width() as usize + 2;
+            let (head, tail) = rest.split_at_mut(6 * s * s);
+            pad_level(l.layers(), head);
+            rest = tail;
+        }
+        let s0 = size[0];
+        let last_lod = (size.len() - 1) as f32;
+        SeamlessCube {
+            texels,
+            size,
+            stride,
+            stride_index,
+            face_offset,
+            half_log2_texel0: 0.5 * (4.0 / (s0 * s0)).log2(),
+            last_lod,
+        }
+    }
+
+    /// `½ log₂(4/size₀²)`.
+    #[inline(always)]
+    pub fn half_log2_texel0(&self) -> f32 {
+        self.half_log2_texel0
+    }
+
+    /// The coarsest level index.
+    #[inline(always)]
+    pub fn last_lod(&self) -> f32 {
+        self.last_lod
+    }
+
+    /// Level `l`'s `(size, stride)`.
+    #[inline(always)]
+    pub fn level_params(&self, l: usize) -> (f32, f32) {
+        (self.size[l], self.stride[l])
+    }
+
+    /// Level `l`'s bordered stride, as an index.
+    #[inline(always)]
+    pub fn stride_index(&self, l: usize) -> usize {
+        self.stride_index[l]
+    }
+
+    /// Where face `face` of level `l` starts in the texel buffer.
+    #[inline(always)]
+    pub fn face_offset(&self, l: usize, face: usize) -> usize {
+        self.face_offset[l][face]
+    }
+
+    /// The four texels of a bilinear footprint: `[i, i + 1, i + stride, i + stride + 1]`.
+    #[inline(always)]
+    pub fn quad(&self, i: usize, stride: usize) -> [Vec4; 4] {
+        let d = &self.texels[i..i + stride + 2];
+        [d[0], d[1], d[stride], d[stride + 1]]
+    }
+
+    /// Bilinear lookup at `(u, v)` ∈ `[0, 1]²` of `face` on level `l`; seamless thanks to
+    /// the border.
+    #[inline(always)]
+    pub fn bilinear(&self, l: usize, face: usize, u: f32, v: f32) -> Vec4 {
+        // Bordered texel i + 1 has its centre at u = (i + ½)/size, so the bordered
+        // continuous coordinate is u·size + ½ ∈ [½, size + ½]; clamping below size + ½ keeps
+        // x0 + 1 ≤ size + 1 and lets a truncating conversion act as floor.
+        let (size, stride) = self.level_params(l);
+        let max = size + 0.499_9;
+        let x = (u * size + 0.5).max(0.5).min(max);
+        let y = (v * size + 0.5).max(0.5).min(max);
+        let (x0, y0) = (x as i32, y as i32);
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let st = stride as usize;
+        let i = self.face_offset(l, face) + y0 as usize * st + x0 as usize;
+        let [a, b, c, d] = self.quad(i, st);
+        a.lerp(b, fx).lerp(c.lerp(d, fx), fy)
+    }
+
+    /// Trilinear lookup in direction `d` at the mip level whose texels cover solid angle
+    /// `2^(2·half_log2_omega)` where `d` lands: level 0 texels there cover
+    /// `(2/size₀)²·|ma|³` steradians (the cube's area element `4/(1 + a² + b²)^{3/2}` times
+    /// the texel's `uv` area, and `1 + a² + b² = 1/ma²` for a unit direction).
+    #[inline(always)]
+    pub fn lookup(&self, d: Vec3, half_log2_omega: f32) -> Vec4 {
+        let (face, sc, tc, ma) = select(d);
+        let inv = 0.5 / ma;
+        let (u, v) = (sc * inv + 0.5, tc * inv + 0.5);
+        let lod = half_log2_omega - self.half_log2_texel0 - 1.5 * fast_log2(ma);
+        self.trilinear(face, u, v, lod)
+    }
+
+    /// Trilinear lookup at `(face, u, v)` and fractional level `lod`.
+    #[inline(always)]
+    pub fn trilinear(&self, face: usize, u: f32, v: f32, lod: f32) -> Vec4 {
+        let lod = lod.max(0.0).min(self.last_lod);
+        let l0 = lod as i32 as usize;
+        let f = lod - l0 as f32;
+        let a = self.bilinear(l0, face, u, v);
+        if f <= 0.0 {
+            return a;
+        }
+        let b = self.bilinear((l0 + 1).min(self.size.len() - 1), face, u, v);
+        a.lerp(b, f)
+    }
+}
+
+/// A power-of-two cube at least as fine as `src`, for use as the prefilterers' working map:
+/// `src` itself when it already is one, otherwise an antialiased conversion at about the
+/// source's texel density (rounded up to a power of two, at most `max_size`).
+pub(crate) fn working_cube(src: &EnvMap, size: Option<u32>, max_size: u32) -> EnvMap {
+    let is_cube = src.projection().kind() == mirrorball_core::ProjectionKind::Cube;
+    let want = size.unwrap_or_else(|| {
+        if is_cube {
+            src.width()
+        } else {
+            // Same texels per steradian as the source's mean.
+            let n = src.width() as f64 * src.height() as f64 * src.layers().len() as f64;
+            let per_face =
+                n * (4.0 * std::f64::consts::PI / src.projection().covered_solid_angle()) / 6.0;
+            per_face.sqrt().ceil() as u32
+        }
+    });
+    // f32 texel indices within a face are exact up to 2048² faces (see SeamlessCube).
+    let max_size = max_size.clamp(1, 2048);
+    let p = want.clamp(1, max_size).next_power_of_two();
+    let s = if p > max_size { p / 2 } else { p };
+    if is_cube && src.width() == s {
+        return with_four_channels(src.clone());
+    }
+    let out = resample(
+        src,
+        Projection::Cube(CubeMap),
+        s,
+        &ResampleOptions::default(),
+    );
+    with_four_channels(out)
+}
+
+fn with_four_channels(env: EnvMap) -> EnvMap {
+    if env.channels() == 4 {
+        return env;
+    }
+    let proj = *env.projection();
+    let layers = env.layers().iter().map(|l| l.with_channels(4)).collect();
+    EnvMap::new(proj, layers).expect("same shape")
+}
+
+/// Builds the seamless pyramid of a cube map.
+pub(crate) fn seamless_pyramid(cube: &EnvMap) -> SeamlessCube {
+    SeamlessCube::from_chain(&MipChain::build(cube, MipFilter::Box))
+}
+
+/// Face-local geometry shared by the six faces of a `size²` cube: for texel `(x, y)`,
+/// `a = 2(x + ½)/size − 1`, `b = 2(y + ½)/size − 1`, the unit direction in the face frame
+/// `(a, b, 1)/√(1 + a² + b²)` and the exact solid angle
+/// `F(a₁, b₁) − F(a₀, b₁) − F(a₁, b₀) + F(a₀, b₀)`, `F(a, b) = atan(ab/√(1 + a² + b²))`,
+/// from a table of `F` at the `(size + 1)²` texel corners (odd in each argument, so only
+/// a quadrant is computed).
+pub(crate) struct FaceGeometry {
+    /// `(a/ρ, b/ρ, 1/ρ, Ω)` per texel, row-major, `ρ = √(1 + a² + b²)`.
+    pub texels: Vec<[f32; 4]>,
+}
+
+/// `F(a, b) = atan(ab/√(1 + a² + b²))` at the `(size + 1)²` texel corners of a cube face
+/// (the solid angle of the face rectangle `[0, a]×[0, b]`). `F` is odd in each argument, so
+/// for even sizes only the quadrant `a, b ≥ 0` is computed.
+struct CornerTable {
+    size: usize,
+    half: usize,
+    q: usize,
+    even: bool,
+    table: Vec<f64>,
+}
+
+impl CornerTable {
+    fn new(size: usize) -> CornerTable {
+        let n = size + 1;
+        let half = size / 2;
+        let even = size.is_multiple_of(2);
+        let corner = |i: usize| 2.0 * i as f64 / size as f64 - 1.0;
+        let (q, base) = if even { (n - half, half) } else { (n, 0) };
+        let table = (0..q * q)
+            .into_par_iter()
+            .map(|k| {
+                let (a, b) = (corner(base + k % q), corner(base + k / q));
+                (a * b / (1.0 + a * a + b * b).sqrt()).atan()
+            })
+            .collect();
+        CornerTable {
+            size,
+            half,
+            q,
+            even,
+            table,
+        }
+    }
+
+    /// `F` at corner `(i, j)`.
+    #[inline]
+    fn f(&self, i: usize, j: usize) -> f64 {
+        if self.even {
+            let h = self.half;
+            let (si, ii) = if i >= h { (1.0, i - h) } else { (-1.0, h - i) };
+            let (sj, jj) = if j >= h { (1.0, j - h) } else { (-1.0, h - j) };
+            si * sj * self.table[jj * self.q + ii]
+        } else {
+            self.table[j * self.q + i]
+        }
+    }
+
+    /// The exact solid angle of texel `(x, y)`.
+    #[inline]
+    fn omega(&self, x: usize, y: usize) -> f64 {
+        debug_assert!(x < self.size && y < self.size);
+        self.f(x + 1, y + 1) - self.f(x, y + 1) - self.f(x + 1, y) + self.f(x, y)
+    }
+}
+
+/// Exact solid angles of the texels of one `size²` cube face (the same for all six), row
+/// by row: `F(a₁, b₁) − F(a₀, b₁) − F(a₁, b₀) + F(a₀, b₀)` from [`CornerTable`].
+pub(crate) fn face_solid_angles(size: usize) -> Vec<f64> {
+    let t = CornerTable::new(size);
+    (0..size * size)
+        .into_par_iter()
+        .map(|k| t.omega(k % size, k / size))
+        .collect()
+}
+
+impl FaceGeometry {
+    pub fn new(size: usize) -> FaceGeometry {
+        let t = CornerTable::new(size);
+        let texels = (0..size * size)
+            .into_par_iter()
+            .map(|k| {
+                let (x, y) = (k % size, k / size);
+                let a = 2.0 * (x as f64 + 0.5) / size as f64 - 1.0;
+                let b = 2.0 * (y as f64 + 0.5) / size as f64 - 1.0;
+                let inv = 1.0 / (1.0 + a * a + b * b).sqrt();
+                [
+                    (a * inv) as f32,
+                    (b * inv) as f32,
+                    inv as f32,
+                    t.omega(x, y) as f32,
+                ]
+            })
+            .collect();
+        FaceGeometry { texels }
+    }
+}
+
+/// The world direction of a face-local vector `(x, y, z)` = `(a, b, 1)·s` on `face`: the
+/// same map as [`mirrorball_core::CubeFace::point`], linear in its arguments.
+#[inline(always)]
+pub(crate) fn face_to_world(face: usize, l: Vec3) -> Vec3 {
+    match face {
+        0 => Vec3::new(l.z, -l.y, -l.x),
+        1 => Vec3::new(-l.z, -l.y, l.x),
+        2 => Vec3::new(l.x, l.z, l.y),
+        3 => Vec3::new(l.x, -l.z, -l.y),
+        4 => Vec3::new(l.x, -l.y, l.z),
+        _ => Vec3::new(-l.x, -l.y, -l.z),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn select_matches_core() {
+        for i in 0..2000 {
+            let t = i as f64 * 0.618_033_988_749_895;
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / 2000.0;
+            let r = (1.0 - z * z).sqrt();
+            let a = t * std::f64::consts::TAU;
+            let d = DVec3::new(r * a.cos(), z, r * a.sin());
+            let (f, uv) = CubeMap.dir_to_uv(d).unwrap();
+            let (g, sc, tc, ma) = select(d.as_vec3());
+            assert_eq!(f, g);
+            assert!(((sc / ma * 0.5 + 0.5) as f64 - uv.x).abs() < 1e-5);
+            assert!(((tc / ma * 0.5 + 0.5) as f64 - uv.y).abs() < 1e-5);
+            let w = face_to_world(f, Vec3::new(sc / ma, tc / ma, 1.0) * ma);
+            assert!((w.as_dvec3() - d).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn log2_is_close() {
+        for i in 1..10_000 {
+            let x = i as f32 * 0.013;
+            assert!((fast_log2(x) - x.log2()).abs() < 3e-4);
+        }
+    }
+
+    #[test]
+    fn face_geometry_solid_angles() {
+        for size in [1usize, 2, 5, 8] {
+            let g = FaceGeometry::new(size);
+            let mut total = 0.0;
+            for y in 0..size {
+                for x in 0..size {
+                    let om =
+                        CubeMap.texel_solid_angle(0, x as u32, y as u32, size as u32, size as u32);
+                    let t = g.texels[y * size + x];
+                    assert!(
+                        (t[3] as f64 - om).abs() < 1e-6 * om.max(1e-3),
+                        "{size} {x} {y}"
+                    );
+                    total += t[3] as f64;
+                }
+            }
+            assert!((total - 4.0 * std::f64::consts::PI / 6.0).abs() < 1e-5);
+        }
+    }
+}
