@@ -21,27 +21,10 @@ pub fn angle_between(a: DVec3, b: DVec3) -> f64 {
     a.cross(b).length().atan2(a.dot(b))
 }
 
-/// Signed solid angle of the spherical triangle with vertex directions `a`, `b`, `c`
-/// (positive when `a, b, c` run counter-clockwise seen from outside the sphere).
-pub fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let (la, lb, lc) = (a.length(), b.length(), c.length());
-    let num = a.dot(b.cross(c));
-    let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-    2.0 * num.atan2(den)
-}
-
-/// Unsigned solid angle of a convex spherical polygon given by its vertex directions in
-/// order (edges are great-circle arcs).
-pub fn spherical_polygon_area(v: &[DVec3]) -> f64 {
-    if v.len() < 3 {
-        return 0.0;
-    }
-    let mut s = 0.0;
-    for i in 1..v.len() - 1 {
-        s += triangle_solid_angle(v[0], v[i], v[i + 1]);
-    }
-    s.abs()
-}
+// The spherical-triangle and spherical-polygon areas are core's (Van Oosterom & Strackee).
+pub use mirrorball_core::quadrature::{
+    polygon_solid_angle as spherical_polygon_area, triangle_solid_angle,
+};
 
 /// Solid angle of a rectangular pyramid (a camera frustum) with half-angles `alpha` and
 /// `beta` (radians) at its apex: `4 asin(sin α sin β)`.

@@ -44,7 +44,6 @@ pub mod jacobian;
 pub mod plot;
 pub mod png;
 pub mod profile;
-mod quad;
 pub mod report;
 pub mod texels;
 

@@ -27,8 +27,8 @@
 //!   (Zimmons: `1/(2√2)` for the sphere map); otherwise the projection has none.
 
 use crate::jacobian;
-use crate::quad::gauss_legendre;
 use glam::{DVec2, DVec3};
+use mirrorball_core::quadrature::gauss_legendre;
 use mirrorball_core::{Projection, WorldProjection};
 use rayon::prelude::*;
 use serde::Serialize;
