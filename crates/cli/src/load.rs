@@ -30,6 +30,36 @@ pub struct Source {
     pub decided: String,
 }
 
+impl Source {
+    /// What was read and decided, for the user, after replacing NaN, infinite and negative
+    /// texels by 0 unless `keep_invalid` (with a warning when any were).
+    pub fn prepare(&mut self, input: &str, keep_invalid: bool) -> Vec<String> {
+        let env = &self.env;
+        let layers = if env.layers().len() > 1 {
+            format!(" x{}", env.layers().len())
+        } else {
+            String::new()
+        };
+        let mut lines = vec![format!(
+            "read {input} ({}): {} {}x{}{layers} — {}",
+            self.description,
+            env.projection().name(),
+            env.width(),
+            env.height(),
+            self.decided
+        )];
+        if !keep_invalid {
+            let fixed = self.env.sanitize();
+            if fixed > 0 {
+                lines.push(format!(
+                    "warning: {input}: {fixed} NaN, infinite or negative values set to 0 (--keep-invalid keeps them)"
+                ));
+            }
+        }
+        lines
+    }
+}
+
 /// Reads `input`: one file, or one per layer when the name holds `{face}`.
 pub fn load(
     input: &str,

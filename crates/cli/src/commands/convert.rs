@@ -152,25 +152,8 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
             eprintln!("{s}");
         }
     };
-    say(format!(
-        "read {} ({}): {} {}x{}{} — {}",
-        a.input,
-        src.description,
-        src.env.projection().name(),
-        src.env.width(),
-        src.env.height(),
-        if src.env.layers().len() > 1 {
-            format!(" x{}", src.env.layers().len())
-        } else {
-            String::new()
-        },
-        src.decided
-    ));
-    if !plan.input.keep_invalid {
-        let fixed = src.env.sanitize();
-        if fixed > 0 {
-            say(format!("warning: {}: {fixed} NaN, infinite or negative values set to 0 (--keep-invalid keeps them)", a.input));
-        }
+    for line in src.prepare(&a.input, plan.input.keep_invalid) {
+        say(line);
     }
     let t_read = t0.elapsed();
     let dst = plan.to.build(None).map_err(|e| bad("--to", e))?;
