@@ -72,8 +72,14 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
 
 /// The file for layer `name` of a separate-layout output.
 fn layer_path(out: &str, name: &str) -> PathBuf {
-    if out.contains(FACE) {
-        return PathBuf::from(out.replace(FACE, name));
+    per_part_path(out, FACE, name)
+}
+
+/// `out` with `placeholder` replaced by `part`, or, without the placeholder, `_part` added
+/// before the extension (`sky.exr` → `sky_px.exr`).
+pub fn per_part_path(out: &str, placeholder: &str, part: &str) -> PathBuf {
+    if out.contains(placeholder) {
+        return PathBuf::from(out.replace(placeholder, part));
     }
     let p = Path::new(out);
     let stem = p
@@ -84,7 +90,7 @@ fn layer_path(out: &str, name: &str) -> PathBuf {
         .extension()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    p.with_file_name(format!("{stem}_{name}.{ext}"))
+    p.with_file_name(format!("{stem}_{part}.{ext}"))
 }
 
 /// Writes `env` to `out`; returns the files written.

@@ -16,24 +16,7 @@ use rayon::prelude::*;
 /// with the same tie rules as [`mirrorball_core::CubeFace::select`] (x, then y).
 #[inline(always)]
 pub(crate) fn select(d: Vec3) -> (usize, f32, f32, f32) {
-    let a = d.abs();
-    if a.x >= a.y && a.x >= a.z {
-        if d.x >= 0.0 {
-            (0, -d.z, -d.y, a.x)
-        } else {
-            (1, d.z, -d.y, a.x)
-        }
-    } else if a.y >= a.z {
-        if d.y >= 0.0 {
-            (2, d.x, d.z, a.y)
-        } else {
-            (3, d.x, -d.z, a.y)
-        }
-    } else if d.z >= 0.0 {
-        (4, d.x, -d.y, a.z)
-    } else {
-        (5, -d.x, -d.y, a.z)
-    }
+    mirrorball_core::CubeFace::select_f32(d)
 }
 
 /// `log₂ x` for positive normal `x`, to about 2e-4 (exponent plus a quartic in the

@@ -11,25 +11,8 @@ use mirrorball_core::{EnvMap, Projection, WorldProjection};
 pub fn dir_to_uv(map: &EnvMap, d: Vec3) -> Option<(usize, f32, f32)> {
     match map.projection() {
         Projection::Cube(_) => {
-            let a = d.abs();
             // OpenGL 4.6 table 8.19; ties go to x, then y, as CubeFace::select.
-            let (layer, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
-                if d.x >= 0.0 {
-                    (0, -d.z, -d.y, a.x)
-                } else {
-                    (1, d.z, -d.y, a.x)
-                }
-            } else if a.y >= a.z {
-                if d.y >= 0.0 {
-                    (2, d.x, d.z, a.y)
-                } else {
-                    (3, d.x, -d.z, a.y)
-                }
-            } else if d.z >= 0.0 {
-                (4, d.x, -d.y, a.z)
-            } else {
-                (5, -d.x, -d.y, a.z)
-            };
+            let (layer, sc, tc, ma) = mirrorball_core::CubeFace::select_f32(d);
             if ma <= 0.0 || ma.is_nan() {
                 return None;
             }

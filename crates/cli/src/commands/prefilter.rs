@@ -72,16 +72,7 @@ fn level_path(out: &str, i: usize) -> String {
     if out.contains("{level}") {
         return out.replace("{level}", &i.to_string());
     }
-    let p = Path::new(out);
-    let stem = p
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let ext = p
-        .extension()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    p.with_file_name(format!("{stem}_mip{i}.{ext}"))
+    crate::save::per_part_path(out, "{level}", &format!("mip{i}"))
         .display()
         .to_string()
 }

@@ -69,6 +69,30 @@ impl CubeFace {
         }
     }
 
+    /// [`CubeFace::select`] in `f32` for the fast paths of the filter and render crates:
+    /// `(layer, sc, tc, |ma|)`, with the same ties.
+    #[inline(always)]
+    pub fn select_f32(d: glam::Vec3) -> (usize, f32, f32, f32) {
+        let a = d.abs();
+        if a.x >= a.y && a.x >= a.z {
+            if d.x >= 0.0 {
+                (0, -d.z, -d.y, a.x)
+            } else {
+                (1, d.z, -d.y, a.x)
+            }
+        } else if a.y >= a.z {
+            if d.y >= 0.0 {
+                (2, d.x, d.z, a.y)
+            } else {
+                (3, d.x, -d.z, a.y)
+            }
+        } else if d.z >= 0.0 {
+            (4, d.x, -d.y, a.z)
+        } else {
+            (5, -d.x, -d.y, a.z)
+        }
+    }
+
     /// The point on the unit cube for face coordinates `sc`, `tc` ∈ `[-1, 1]` (the inverse
     /// of the table; also meaningful a little outside the face, which filtering uses).
     #[inline]
