@@ -10,8 +10,12 @@
 //! `ResampleOptions::max_samples`; 1 is plain bilinear). File reading is not timed. Prints one JSON
 //! line: the best times, output texels per second, and the round-trip log-domain PSNR of the
 //! lat-long that came back against the input (`mirrorball_core::metrics::log_psnr`).
+//!
+//! Then the same two conversions through a [`Remap`] planned once (like `cv2.remap`'s
+//! precomputed maps; planning not in the conversion times, reported apart): applied into a
+//! new output each time (`plan_*_s`) and into a reused one (`plan_into_*_s`).
 
-use mirrorball_core::{metrics, resample, EnvMap, ProjectionKind, ResampleOptions};
+use mirrorball_core::{metrics, resample, EnvMap, ProjectionKind, Remap, ResampleOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -90,6 +94,39 @@ fn main() -> ExitCode {
     }
     let back = back.expect("reps > 0");
 
+    // The same conversions, planned once.
+    let t = Instant::now();
+    let fwd_plan = Remap::new(
+        *env.projection(),
+        (env.width(), env.height()),
+        1,
+        cube_proj,
+        face,
+        &opts,
+    );
+    let back_plan = Remap::new(cube_proj, (face, face), 6, ll_proj, width, &opts);
+    let plan_build_s = t.elapsed().as_secs_f64();
+    let best = |f: &mut dyn FnMut()| {
+        let mut b = f64::INFINITY;
+        for _ in 0..reps {
+            let t = Instant::now();
+            f();
+            b = b.min(t.elapsed().as_secs_f64());
+        }
+        b
+    };
+    let mut pc = fwd_plan.apply(&env).expect("plan fits its source");
+    let mut pb = back_plan.apply(&pc).expect("plan fits its source");
+    let plan_forward_s = best(&mut || {
+        std::hint::black_box(fwd_plan.apply(&env).expect("plan fits"));
+    });
+    let plan_back_s = best(&mut || {
+        std::hint::black_box(back_plan.apply(&pc).expect("plan fits"));
+    });
+    let plan_into_forward_s = best(&mut || fwd_plan.apply_into(&env, &mut pc).expect("plan fits"));
+    let plan_into_back_s = best(&mut || back_plan.apply_into(&pc, &mut pb).expect("plan fits"));
+    let plan_psnr = metrics::log_psnr(&env, &pb);
+
     let texels = |m: &EnvMap| m.layers().len() as f64 * m.width() as f64 * m.height() as f64;
     let forward_texels = texels(&cube);
     let back_texels = texels(&back);
@@ -114,6 +151,13 @@ fn main() -> ExitCode {
         "back_texels_per_s": back_texels / back_s,
         // JSON has no infinity: an exact round trip (or a mismatch, None) prints null.
         "roundtrip_log_psnr_db": psnr.filter(|p| p.is_finite()),
+        "plan_build_s": plan_build_s,
+        "plan_bytes": fwd_plan.memory_bytes() + back_plan.memory_bytes(),
+        "plan_forward_s": plan_forward_s,
+        "plan_back_s": plan_back_s,
+        "plan_into_forward_s": plan_into_forward_s,
+        "plan_into_back_s": plan_into_back_s,
+        "plan_roundtrip_log_psnr_db": plan_psnr.filter(|p| p.is_finite()),
     });
     println!("{json}");
     ExitCode::SUCCESS

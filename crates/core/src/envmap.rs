@@ -318,7 +318,7 @@ pub(crate) fn bilinear32<const C: usize>(
 
 /// Bilinear blend of two rows of two `C`-channel texels.
 #[inline(always)]
-fn lerp4<const C: usize>(r0: &[f32], r1: &[f32], fx: f32, fy: f32, out: &mut [f32]) {
+pub(crate) fn lerp4<const C: usize>(r0: &[f32], r1: &[f32], fx: f32, fy: f32, out: &mut [f32]) {
     let out = &mut out[..C];
     for i in 0..C {
         let top = r0[i] + fx * (r0[C + i] - r0[i]);

@@ -21,6 +21,7 @@ mod image;
 pub mod layout;
 pub mod metrics;
 pub mod projection;
+mod remap;
 mod resample;
 
 pub use envmap::{EnvMap, EnvMapError, Stats};
@@ -31,6 +32,7 @@ pub use projection::{
     Frame, LatLong, Lens, Lookup, Mercator, Octahedral, Projection, ProjectionKind, RadialMap,
     SphereMap, UnknownProjection, WorldProjection,
 };
+pub use remap::{Remap, RemapError};
 pub use resample::{resample, resample_to_extent, ResampleOptions, Rotation};
 
 pub use glam;

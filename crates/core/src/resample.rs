@@ -3,8 +3,11 @@
 //! For each output texel the ratio `r` of its solid angle to that of the source texels under
 //! it (from the two projections' exact area elements) decides the filter:
 //!
-//! * `r < 2.25` (the output texel covers about one source texel or less): one bilinear
-//!   lookup at the texel centre, seamless across cube edges, the longitude wrap and poles;
+//! * `r < 4` (the output texel spans less than two source texels each way): one bilinear
+//!   lookup at the texel centre, seamless across cube edges, the longitude wrap and poles.
+//!   Bilinear weights are a tent two texels wide, so up to a 2× linear minification every
+//!   source texel still contributes (the rule by which GPUs stay on mip level 0 until the
+//!   footprint exceeds two texels);
 //! * otherwise the output texel is integrated: an `n×n` grid of points over the texel
 //!   (`n ≈ √r`, at most [`ResampleOptions::max_samples`]), each weighted by its solid angle
 //!   and looked up bilinearly, on a solid-angle-weighted mip level of the source once `r`
@@ -123,17 +126,17 @@ impl Default for ResampleOptions {
     }
 }
 
-/// Below this footprint ratio one bilinear lookup is used.
-const BILINEAR_MAX_RATIO: f64 = 2.25;
+/// Below this footprint ratio (2× linear minification) one bilinear lookup is used.
+const BILINEAR_MAX_RATIO: f64 = 4.0;
 
 /// A source map with its solid-angle-weighted mip pyramid (only as deep as needed).
-struct Pyramid<'a> {
+pub(crate) struct Pyramid<'a> {
     base: &'a [Image],
     levels: Vec<Vec<Image>>,
 }
 
 impl<'a> Pyramid<'a> {
-    fn new(src: &'a EnvMap, depth: usize) -> Pyramid<'a> {
+    pub(crate) fn new(src: &'a EnvMap, depth: usize) -> Pyramid<'a> {
         let mut levels: Vec<Vec<Image>> = Vec::new();
         for _ in 0..depth {
             let prev = levels.last().map(|l| l.as_slice()).unwrap_or(src.layers());
@@ -154,16 +157,12 @@ impl<'a> Pyramid<'a> {
     }
 
     #[inline]
-    fn level(&self, l: usize) -> &[Image] {
+    pub(crate) fn level(&self, l: usize) -> &[Image] {
         if l == 0 || self.levels.is_empty() {
             self.base
         } else {
             &self.levels[(l - 1).min(self.levels.len() - 1)]
         }
-    }
-
-    fn level_count(&self) -> usize {
-        self.levels.len() + 1
     }
 }
 
@@ -230,7 +229,7 @@ fn footprint_ratio(ddens: f64, sdens: f64, area: f64) -> f64 {
 /// footprints that are long and thin on the source rather than large: `cap` points on the
 /// full-resolution source integrate those better than a blurred level would.)
 fn levels_needed(
-    src: &EnvMap,
+    sproj: &Projection,
     dst: &Projection,
     w: u32,
     h: u32,
@@ -238,7 +237,6 @@ fn levels_needed(
     cap: f64,
     rot: &Rotation,
 ) -> usize {
-    let sproj = src.projection();
     let step = (w.max(h) / 64).max(1);
     let mut ratios = Vec::new();
     let mut dirs = vec![None; w as usize];
@@ -268,25 +266,25 @@ fn levels_needed(
 const MAX_POINTS: usize = 256;
 
 /// Per-thread buffers for one output row.
-struct RowScratch {
-    dirs: Vec<Option<(DVec3, f64)>>,
+pub(crate) struct RowScratch {
+    pub(crate) dirs: Vec<Option<(DVec3, f64)>>,
     xs: Vec<f32>,
     ys: Vec<f32>,
     zs: Vec<f32>,
-    look: Vec<Lookup>,
+    pub(crate) look: Vec<Lookup>,
 }
 
 /// Per-thread buffers for one texel's integration points: directions, weights, lookups.
-struct PointScratch {
+pub(crate) struct PointScratch {
     sx: Vec<f32>,
     sy: Vec<f32>,
     sz: Vec<f32>,
-    sw: Vec<f32>,
-    slook: Vec<Lookup>,
+    pub(crate) sw: Vec<f32>,
+    pub(crate) slook: Vec<Lookup>,
 }
 
 impl RowScratch {
-    fn new(w: usize) -> RowScratch {
+    pub(crate) fn new(w: usize) -> RowScratch {
         RowScratch {
             dirs: vec![None; w],
             xs: vec![0.0; w],
@@ -298,7 +296,7 @@ impl RowScratch {
 }
 
 impl PointScratch {
-    fn new() -> PointScratch {
+    pub(crate) fn new() -> PointScratch {
         PointScratch {
             sx: vec![0.0; MAX_POINTS],
             sy: vec![0.0; MAX_POINTS],
@@ -310,35 +308,28 @@ impl PointScratch {
 }
 
 /// Everything one output row needs, shared by all rows.
-struct Job<'a> {
-    dst: Projection,
-    sproj: Projection,
-    pyr: Pyramid<'a>,
+pub(crate) struct Job {
+    pub(crate) dst: Projection,
+    pub(crate) sproj: Projection,
+    /// Mip levels the source needs (1: the source alone).
+    pub(crate) levels: usize,
     rot: Rotation,
     rotate: bool,
     area: f32,
     cap: f64,
     max_n: u32,
-    scale: f32,
-    w: u32,
-    h: u32,
+    pub(crate) scale: f32,
+    pub(crate) w: u32,
+    pub(crate) h: u32,
 }
 
-impl Job<'_> {
-    /// Fills output row `y` of `layer` (`C` channels per texel).
+impl Job {
+    /// Stages 1 and 2 of a row: the output row's directions (per-row work hoisted by the
+    /// projection), turned into the source, and where they land in the source, as one batch.
     #[inline(always)]
-    fn row<const C: usize>(
-        &self,
-        s: &mut RowScratch,
-        ps: &mut PointScratch,
-        layer: usize,
-        y: usize,
-        row: &mut [f32],
-    ) {
+    pub(crate) fn locate(&self, s: &mut RowScratch, layer: usize, y: usize) {
         let (dst, sproj, rot) = (&self.dst, &self.sproj, &self.rot);
-        let (w, h) = (self.w, self.h);
-        // Stage 1: the row's directions (per-row work hoisted by the projection).
-        dst.row_dirs(layer, y as u32, w, h, &mut s.dirs);
+        dst.row_dirs(layer, y as u32, self.w, self.h, &mut s.dirs);
         for (x, t) in s.dirs.iter().enumerate() {
             let d = match t {
                 Some((d, _)) if self.rotate => rot.source_of(*d),
@@ -347,25 +338,49 @@ impl Job<'_> {
             };
             (s.xs[x], s.ys[x], s.zs[x]) = (d.x as f32, d.y as f32, d.z as f32);
         }
-        // Stage 2: where they land in the source, as one batch.
         sproj.lookup_batch(&s.xs, &s.ys, &s.zs, &mut s.look);
+    }
+
+    /// The footprint ratio of an output texel of density `ddens` whose centre landed at
+    /// `lk`, when it is to be integrated; `None` when one bilinear lookup serves.
+    #[inline(always)]
+    pub(crate) fn integration_ratio(&self, ddens: f64, lk: &Lookup) -> Option<f64> {
+        let ratio = if lk.density > 0.0 {
+            ddens as f32 * self.area / lk.density
+        } else {
+            f32::INFINITY
+        };
+        if ratio < BILINEAR_MAX_RATIO as f32 || self.max_n == 1 || ddens == 0.0 {
+            None
+        } else {
+            Some(ratio as f64)
+        }
+    }
+
+    /// Fills output row `y` of `layer` (`C` channels per texel).
+    #[inline(always)]
+    fn row<const C: usize>(
+        &self,
+        pyr: &Pyramid,
+        s: &mut RowScratch,
+        ps: &mut PointScratch,
+        layer: usize,
+        y: usize,
+        row: &mut [f32],
+    ) {
+        self.locate(s, layer, y);
         // Stage 3: filter.
-        let base = self.pyr.level(0);
+        let sproj = &self.sproj;
+        let base = pyr.level(0);
         for (x, (texel, lk)) in s.dirs.iter().zip(&s.look).enumerate() {
             let Some((_, ddens)) = *texel else { continue };
             if lk.layer == u32::MAX {
                 continue;
             }
             let out = &mut row[x * C..(x + 1) * C];
-            let ratio = if lk.density > 0.0 {
-                ddens as f32 * self.area / lk.density
-            } else {
-                f32::INFINITY
-            };
-            if ratio < BILINEAR_MAX_RATIO as f32 || self.max_n == 1 || ddens == 0.0 {
-                bilinear32::<C>(sproj, base, lk.layer as usize, lk.u, lk.v, out);
-            } else {
-                self.integrate::<C>(ps, layer, x, y, ratio as f64, lk, out);
+            match self.integration_ratio(ddens, lk) {
+                None => bilinear32::<C>(sproj, base, lk.layer as usize, lk.u, lk.v, out),
+                Some(ratio) => self.integrate::<C>(pyr, ps, layer, x, y, ratio, lk, out),
             }
             if self.scale != 1.0 {
                 for v in &mut out[..3] {
@@ -375,31 +390,27 @@ impl Job<'_> {
         }
     }
 
-    /// Integrates output texel `(x, y)` whose footprint covers `ratio` source texels: n×n
-    /// points over the texel, weighted by solid angle, on a mip level where each stands for
-    /// about one source texel.
-    #[inline(never)]
-    #[allow(clippy::too_many_arguments)]
-    fn integrate<const C: usize>(
+    /// The integration points of output texel `(x, y)`, whose footprint covers `ratio`
+    /// source texels: an n×n grid over the texel, with their solid-angle weights in `s.sw`
+    /// and their source lookups in `s.slook`, on the returned mip level, where each stands
+    /// for about one source texel. Returns `(level, number of points)`.
+    pub(crate) fn points(
         &self,
         s: &mut PointScratch,
         layer: usize,
         x: usize,
         y: usize,
         ratio: f64,
-        lk: &Lookup,
-        out: &mut [f32],
-    ) {
+    ) -> (usize, usize) {
         let (dst, sproj) = (&self.dst, &self.sproj);
         let (w, h) = (self.w as f64, self.h as f64);
         let level = if ratio > self.cap {
-            (((ratio / self.cap).log2() * 0.5).ceil() as usize).min(self.pyr.level_count() - 1)
+            (((ratio / self.cap).log2() * 0.5).ceil() as usize).min(self.levels - 1)
         } else {
             0
         };
         let r_l = ratio / 4f64.powi(level as i32);
         let n = (r_l.sqrt().round() as u32).clamp(1, self.max_n);
-        let lv = self.pyr.level(level);
         let inv = 1.0 / n as f64;
         let mut m = 0;
         for j in 0..n {
@@ -421,6 +432,26 @@ impl Job<'_> {
             }
         }
         sproj.lookup_batch(&s.sx[..m], &s.sy[..m], &s.sz[..m], &mut s.slook[..m]);
+        (level, m)
+    }
+
+    /// Integrates output texel `(x, y)` over its [`points`](Self::points).
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn integrate<const C: usize>(
+        &self,
+        pyr: &Pyramid,
+        s: &mut PointScratch,
+        layer: usize,
+        x: usize,
+        y: usize,
+        ratio: f64,
+        lk: &Lookup,
+        out: &mut [f32],
+    ) {
+        let sproj = &self.sproj;
+        let (level, m) = self.points(s, layer, x, y, ratio);
+        let lv = pyr.level(level);
         let mut acc = [0.0f32; C];
         let mut tmp = [0.0f32; C];
         let mut wsum = 0.0f32;
@@ -440,13 +471,14 @@ impl Job<'_> {
                 out[k] = acc[k] / wsum;
             }
         } else {
-            bilinear32::<C>(sproj, self.pyr.level(0), lk.layer as usize, lk.u, lk.v, out);
+            bilinear32::<C>(sproj, pyr.level(0), lk.layer as usize, lk.u, lk.v, out);
         }
     }
 
     /// Fills one layer.
     fn layer<const C: usize>(
         &self,
+        pyr: &Pyramid,
         layer: usize,
         img: &mut Image,
         progress: Option<&Arc<AtomicU64>>,
@@ -458,13 +490,59 @@ impl Job<'_> {
             .for_each_init(
                 || (RowScratch::new(w), PointScratch::new()),
                 |(s, ps), (y, row)| {
-                    self.row::<C>(s, ps, layer, y, row);
+                    self.row::<C>(pyr, s, ps, layer, y, row);
                     if let Some(p) = progress {
                         p.fetch_add(1, Ordering::Relaxed);
                     }
                 },
             );
     }
+
+    /// The conversion from a `sw`×`sh` source in `sproj` to `w`×`h` layers of `dst`.
+    pub(crate) fn new(
+        sproj: Projection,
+        (sw, sh): (u32, u32),
+        dst: Projection,
+        (w, h): (u32, u32),
+        opts: &ResampleOptions,
+    ) -> Job {
+        let max_n = opts.max_samples.clamp(1, 16);
+        let cap = (max_n * max_n) as f64;
+        // Output texel area over source texel area, in uv units.
+        let area = (sw as f64 * sh as f64) / (w as f64 * h as f64);
+        let rot = opts.rotation;
+        let depth = if max_n > 1 {
+            levels_needed(&sproj, &dst, w, h, area, cap, &rot)
+        } else {
+            0
+        };
+        Job {
+            dst,
+            sproj,
+            levels: pyramid_levels(sw, sh, depth),
+            rot,
+            rotate: !rot.is_identity(),
+            area: area as f32,
+            cap,
+            max_n,
+            scale: 2f32.powf(opts.exposure),
+            w,
+            h,
+        }
+    }
+}
+
+/// How many levels (the source included) a pyramid `depth` deep over a `w`×`h` source has:
+/// halving stops at 1×1, as [`Pyramid::new`] does.
+pub(crate) fn pyramid_levels(w: u32, h: u32, depth: usize) -> usize {
+    let (mut cw, mut ch, mut n) = (w, h, 1);
+    for _ in 0..depth {
+        if cw == 1 && ch == 1 {
+            break;
+        }
+        (cw, ch, n) = ((cw / 2).max(1), (ch / 2).max(1), n + 1);
+    }
+    n
 }
 
 /// Converts `src` into projection `dst` with layers of `w`×`h` texels.
@@ -475,36 +553,21 @@ pub fn resample_to_extent(
     h: u32,
     opts: &ResampleOptions,
 ) -> EnvMap {
-    let max_n = opts.max_samples.clamp(1, 16);
-    let cap = (max_n * max_n) as f64;
     let c = src.channels();
-    // Output texel area over source texel area, in uv units.
-    let area = (src.width() as f64 * src.height() as f64) / (w as f64 * h as f64);
-    let rot = opts.rotation;
-    let depth = if max_n > 1 {
-        levels_needed(src, &dst, w, h, area, cap, &rot)
-    } else {
-        0
-    };
-    let job = Job {
+    let job = Job::new(
+        *src.projection(),
+        (src.width(), src.height()),
         dst,
-        sproj: *src.projection(),
-        pyr: Pyramid::new(src, depth),
-        rot,
-        rotate: !rot.is_identity(),
-        area: area as f32,
-        cap,
-        max_n,
-        scale: 2f32.powf(opts.exposure),
-        w,
-        h,
-    };
+        (w, h),
+        opts,
+    );
+    let pyr = Pyramid::new(src, job.levels - 1);
     let layers = (0..dst.layer_count())
         .map(|layer| {
             let mut img = Image::new(w, h, c);
             match c {
-                3 => job.layer::<3>(layer, &mut img, opts.progress.as_ref()),
-                _ => job.layer::<4>(layer, &mut img, opts.progress.as_ref()),
+                3 => job.layer::<3>(&pyr, layer, &mut img, opts.progress.as_ref()),
+                _ => job.layer::<4>(&pyr, layer, &mut img, opts.progress.as_ref()),
             }
             img
         })

@@ -207,3 +207,138 @@ fn env_map_refuses_wrong_layer_counts() {
     )
     .is_err());
 }
+
+/// Largest difference between two maps of one shape, relative to the largest value.
+fn max_rel_diff(a: &EnvMap, b: &EnvMap) -> f32 {
+    assert_eq!(
+        (a.layers().len(), a.width(), a.height(), a.channels()),
+        (b.layers().len(), b.width(), b.height(), b.channels())
+    );
+    let (mut d, mut m) = (0.0f32, 0.0f32);
+    for (la, lb) in a.layers().iter().zip(b.layers()) {
+        for (x, y) in la.data().iter().zip(lb.data()) {
+            d = d.max((x - y).abs());
+            m = m.max(x.abs());
+        }
+    }
+    d / m.max(1e-30)
+}
+
+/// A plan made once gives what `resample` gives, for plain bilinear lookups, seams,
+/// integration with and without mip levels, rotation, exposure and four channels.
+#[test]
+fn a_planned_remap_matches_resample() {
+    use mirrorball_core::Remap;
+    let ll = ProjectionKind::LatLong.default_projection();
+    let cube = ProjectionKind::Cube.default_projection();
+    let zone = |d: DVec3| {
+        let t = d.y.clamp(-1.0, 1.0).acos();
+        let v = 0.5 + 0.5 * (200.0 * t * t).cos();
+        [v as f32, (1.0 + d.x) as f32, 0.5, 0.25 + d.z.abs() as f32]
+    };
+    let turned = ResampleOptions {
+        rotation: Rotation::from_euler_deg(30.0, -20.0, 10.0),
+        exposure: 1.5,
+        ..Default::default()
+    };
+    let cases: Vec<(EnvMap, Projection, u32, ResampleOptions)> = vec![
+        // Integrated near the poles, bilinear elsewhere, the longitude wrap.
+        (
+            EnvMap::from_fn(ll, 512, 3, smooth),
+            cube,
+            64,
+            ResampleOptions::default(),
+        ),
+        // Mip levels (a 1024 lat-long onto 16² faces), four channels.
+        (
+            EnvMap::from_fn(ll, 1024, 4, zone),
+            cube,
+            16,
+            ResampleOptions::default(),
+        ),
+        // Growing from a cube: every lookup near a face edge crosses a seam.
+        (
+            EnvMap::from_fn(cube, 32, 3, smooth),
+            ll,
+            256,
+            ResampleOptions::default(),
+        ),
+        // Disk maps, turned and exposed.
+        (
+            EnvMap::from_fn(ProjectionKind::Sphere.default_projection(), 128, 3, smooth),
+            ProjectionKind::EqualAreaOctahedral.default_projection(),
+            96,
+            turned.clone(),
+        ),
+        (
+            EnvMap::from_fn(
+                ProjectionKind::Paraboloid.default_projection(),
+                64,
+                4,
+                smooth,
+            ),
+            ProjectionKind::Fisheye.default_projection(),
+            80,
+            turned,
+        ),
+    ];
+    for (src, dst, size, opts) in &cases {
+        let slow = resample(src, *dst, *size, opts);
+        let plan = Remap::new(
+            *src.projection(),
+            (src.width(), src.height()),
+            src.layers().len(),
+            *dst,
+            *size,
+            opts,
+        );
+        let fast = plan.apply(src).unwrap();
+        let e = max_rel_diff(&fast, &slow);
+        assert!(
+            e < 1e-4,
+            "{:?} → {:?}: plan differs by {e}",
+            src.projection(),
+            dst
+        );
+        // Reusing an output gives the same texels.
+        let mut again = resample(src, *dst, *size, &ResampleOptions::default());
+        plan.apply_into(src, &mut again).unwrap();
+        assert_eq!(max_rel_diff(&again, &fast), 0.0);
+    }
+}
+
+/// A plan refuses maps of another projection or size, and outputs of the wrong shape.
+#[test]
+fn a_planned_remap_refuses_the_wrong_maps() {
+    use mirrorball_core::{Remap, RemapError};
+    let ll = ProjectionKind::LatLong.default_projection();
+    let cube = ProjectionKind::Cube.default_projection();
+    let plan = Remap::new(ll, (64, 32), 1, cube, 16, &ResampleOptions::default());
+    let other_size = EnvMap::from_fn(ll, 128, 3, smooth);
+    assert!(matches!(
+        plan.apply(&other_size),
+        Err(RemapError::Extent { .. })
+    ));
+    let other_proj = EnvMap::from_fn(
+        ProjectionKind::Octahedral.default_projection(),
+        32,
+        3,
+        smooth,
+    );
+    assert!(matches!(
+        plan.apply(&other_proj),
+        Err(RemapError::Projection { .. })
+    ));
+    let src = EnvMap::from_fn(ll, 64, 3, smooth);
+    let mut wrong_out = EnvMap::from_fn(cube, 8, 3, smooth);
+    assert_eq!(
+        plan.apply_into(&src, &mut wrong_out),
+        Err(RemapError::Output)
+    );
+    let mut wrong_channels = EnvMap::from_fn(cube, 16, 4, smooth);
+    assert_eq!(
+        plan.apply_into(&src, &mut wrong_channels),
+        Err(RemapError::Output)
+    );
+    assert!(plan.apply(&src).is_ok());
+}
