@@ -20,6 +20,16 @@ fn main() {
     };
     let cube = ProjectionKind::Cube.default_projection();
     let ll = *src.projection();
+    if std::env::var_os("MB_APPLY_ONLY").is_some() {
+        // For `perf record`: the planned forward conversion into new outputs, 30 times.
+        let fwd = Remap::new(ll, (4096, 2048), 1, cube, 1024, &opts);
+        let t = Instant::now();
+        for _ in 0..30 {
+            std::hint::black_box(fwd.apply(&src).unwrap());
+        }
+        println!("apply: {:.4}s each", t.elapsed().as_secs_f64() / 30.0);
+        return;
+    }
     for _ in 0..3 {
         let t = Instant::now();
         let c = resample(&src, cube, 1024, &opts);

@@ -24,6 +24,27 @@ fn main() {
     if which == "none" {
         return;
     }
+    if which == "remap" {
+        // The planned conversion: compare counts with MB_REPS=0 and MB_REPS=5.
+        let reps: usize = std::env::var("MB_REPS")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(5);
+        let plan = mirrorball_core::Remap::new(
+            *src.projection(),
+            (src.width(), src.height()),
+            1,
+            cube_p,
+            size / 4,
+            &opts,
+        );
+        let mut out = plan.apply(&src).expect("plan fits");
+        for _ in 0..reps {
+            plan.apply_into(&src, &mut out).expect("plan fits");
+        }
+        std::hint::black_box(out);
+        return;
+    }
     if which != "back" {
         for _ in 0..5 {
             std::hint::black_box(resample(&src, cube_p, size / 4, &opts));

@@ -305,6 +305,10 @@ pub(crate) fn bilinear32<const C: usize>(
         let data = img.data();
         let stride = w as usize * C;
         let i00 = y0 as usize * stride + x0 as usize * C;
+        if let Some(q) = lerp_quad::<C>(data, i00, stride, fx, fy) {
+            out[..C].copy_from_slice(&q[..C]);
+            return;
+        }
         if let (Some(r0), Some(r1)) = (
             data.get(i00..i00 + 2 * C),
             data.get(i00 + stride..i00 + stride + 2 * C),
@@ -314,6 +318,55 @@ pub(crate) fn bilinear32<const C: usize>(
         }
     }
     bilinear(proj, layers, layer, DVec2::new(u as f64, v as f64), out);
+}
+
+/// Bilinear blend of the 2×2 texels of `C` channels whose top-left texel starts at float
+/// `i` of `data` (rows `stride` floats apart), as four lanes: the `C` channels, then (for
+/// `C = 3`) a lane to ignore. `None` when a four-float read would pass the end of `data`
+/// (the last texels of an image), where [`lerp4`] serves. Same arithmetic as [`lerp4`],
+/// `a + f·(b − a)`, so results agree to the bit; on x86-64 one SSE2 operation per step
+/// instead of `C`.
+#[inline(always)]
+pub(crate) fn lerp_quad<const C: usize>(
+    data: &[f32],
+    i: usize,
+    stride: usize,
+    fx: f32,
+    fy: f32,
+) -> Option<[f32; 4]> {
+    if i + stride + C + 4 > data.len() {
+        return None;
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is part of x86-64; the four unaligned 4-float reads end at
+        // `i + stride + C + 4 <= data.len()`, checked above.
+        unsafe {
+            let p = data.as_ptr().add(i);
+            let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(C)));
+            let (c, d) = (_mm_loadu_ps(p.add(stride)), _mm_loadu_ps(p.add(stride + C)));
+            let (vx, vy) = (_mm_set1_ps(fx), _mm_set1_ps(fy));
+            let top = _mm_add_ps(a, _mm_mul_ps(vx, _mm_sub_ps(b, a)));
+            let bot = _mm_add_ps(c, _mm_mul_ps(vx, _mm_sub_ps(d, c)));
+            let v = _mm_add_ps(top, _mm_mul_ps(vy, _mm_sub_ps(bot, top)));
+            let mut out = [0.0f32; 4];
+            _mm_storeu_ps(out.as_mut_ptr(), v);
+            Some(out)
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let mut out = [0.0f32; 4];
+        lerp4::<C>(
+            &data[i..i + 2 * C],
+            &data[i + stride..i + stride + 2 * C],
+            fx,
+            fy,
+            &mut out,
+        );
+        Some(out)
+    }
 }
 
 /// Bilinear blend of two rows of two `C`-channel texels.

@@ -35,6 +35,7 @@ const MAX_LAYERS: usize = 8;
 /// One output texel's bilinear lookup: the top-left source texel (layer above
 /// `INDEX_BITS`, texel index below) and the fractions towards `+x` and `+y` in 1/65536.
 #[derive(Clone, Copy, Debug)]
+#[repr(C)]
 struct Texel {
     idx: u32,
     fx: u16,
@@ -336,24 +337,22 @@ impl Remap {
             &self.taps[layer],
             &self.row_starts[layer],
         );
-        gather_row::<C>(&self.texels[layer][y * w..(y + 1) * w], planes, stride, row);
+        let single = self.src_layers == 1;
+        gather_row::<C>(
+            &self.texels[layer][y * w..(y + 1) * w],
+            planes,
+            single,
+            stride,
+            row,
+        );
         let ((g0, t0), (g1, _)) = (starts[y], starts[y + 1]);
         let mut k = t0 as usize;
         for g in &groups[g0 as usize..g1 as usize] {
             let level = pyr.level(g.level as usize);
-            let mut acc = [0.0f32; C];
-            for t in &taps[k..k + g.count as usize] {
-                let img = &level[(t.idx >> INDEX_BITS) as usize];
-                let i = (t.idx & INDEX_MASK) as usize * C;
-                if let Some(v) = img.data().get(i..i + C) {
-                    for c in 0..C {
-                        acc[c] += t.w * v[c];
-                    }
-                }
-            }
+            let group = &taps[k..k + g.count as usize];
             k += g.count as usize;
             if let Some(o) = row.get_mut(g.x as usize * C..(g.x as usize + 1) * C) {
-                o.copy_from_slice(&acc);
+                sum_taps::<C>(group, level, o);
             }
         }
         let scale = self.job.scale;
@@ -373,25 +372,149 @@ impl Remap {
 fn gather_row<const C: usize>(
     entries: &[Texel],
     planes: &[&[f32]; MAX_LAYERS],
+    single: bool,
     stride: usize,
     row: &mut [f32],
 ) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // SAFETY: SSE2 is part of x86-64; `gather_row_sse` checks every read and write.
+        unsafe {
+            if single {
+                gather_row_sse::<C, true>(entries, planes, stride, row)
+            } else {
+                gather_row_sse::<C, false>(entries, planes, stride, row)
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = single;
+        for (x, t) in entries.iter().enumerate() {
+            gather_one::<C>(t, planes, stride, &mut row[x * C..(x + 1) * C]);
+        }
+    }
+}
+
+/// One texel of the bilinear pass, in plain arithmetic (the reference for the SSE2 loop).
+#[inline(always)]
+fn gather_one<const C: usize>(
+    t: &Texel,
+    planes: &[&[f32]; MAX_LAYERS],
+    stride: usize,
+    out: &mut [f32],
+) {
     const Q: f32 = 1.0 / 65536.0;
-    for (t, out) in entries.iter().zip(row.chunks_exact_mut(C)) {
-        if t.idx == NO_TEXEL {
-            out.fill(0.0);
+    if t.idx == NO_TEXEL {
+        out.fill(0.0);
+        return;
+    }
+    let data = planes[(t.idx >> INDEX_BITS) as usize];
+    let i = (t.idx & INDEX_MASK) as usize * C;
+    match (
+        data.get(i..i + 2 * C),
+        data.get(i + stride..i + stride + 2 * C),
+    ) {
+        (Some(r0), Some(r1)) => lerp4::<C>(r0, r1, t.fx as f32 * Q, t.fy as f32 * Q, out),
+        _ => out.fill(0.0),
+    }
+}
+
+/// The bilinear pass with SSE2: each texel's fractions decoded from its packed entry in
+/// one vector, its four source texels blended four channels at a time (`lerp4`'s
+/// arithmetic, so the same bits). `SINGLE`: the source has one layer, so the entry's layer
+/// bits are not decoded.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn gather_row_sse<const C: usize, const SINGLE: bool>(
+    entries: &[Texel],
+    planes: &[&[f32]; MAX_LAYERS],
+    stride: usize,
+    row: &mut [f32],
+) {
+    use std::arch::x86_64::*;
+    let q = _mm_set1_ps(1.0 / 65536.0);
+    let zero = _mm_setzero_si128();
+    let n = row.len();
+    let out = row.as_mut_ptr();
+    for (x, t) in entries.iter().enumerate() {
+        let o = x * C;
+        let data = if SINGLE {
+            planes[0]
+        } else {
+            planes[(t.idx >> INDEX_BITS) as usize & (MAX_LAYERS - 1)]
+        };
+        let i = (t.idx & INDEX_MASK) as usize * C;
+        // An empty entry (NO_TEXEL) fails this test, as do the last texels of a row or an
+        // image, where a four-float read or write would pass the end.
+        if t.idx == NO_TEXEL || i + stride + C + 4 > data.len() || o + 4 > n {
+            gather_one::<C>(t, planes, stride, &mut row[o..o + C]);
             continue;
         }
-        let data = planes[(t.idx >> INDEX_BITS) as usize];
-        let i = (t.idx & INDEX_MASK) as usize * C;
-        if let (Some(r0), Some(r1)) = (
-            data.get(i..i + 2 * C),
-            data.get(i + stride..i + stride + 2 * C),
-        ) {
-            lerp4::<C>(r0, r1, t.fx as f32 * Q, t.fy as f32 * Q, out);
-        } else {
-            out.fill(0.0);
+        // The entry's fractions: bytes 4..8 of the (repr(C)) entry are fx, fy as u16.
+        let e = _mm_loadl_epi64(t as *const Texel as *const __m128i);
+        let f = _mm_mul_ps(
+            _mm_cvtepi32_ps(_mm_unpacklo_epi16(_mm_srli_si128::<4>(e), zero)),
+            q,
+        );
+        let (vx, vy) = (_mm_shuffle_ps::<0x00>(f, f), _mm_shuffle_ps::<0x55>(f, f));
+        let p = data.as_ptr().add(i);
+        let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(C)));
+        let (c, d) = (_mm_loadu_ps(p.add(stride)), _mm_loadu_ps(p.add(stride + C)));
+        let top = _mm_add_ps(a, _mm_mul_ps(vx, _mm_sub_ps(b, a)));
+        let bot = _mm_add_ps(c, _mm_mul_ps(vx, _mm_sub_ps(d, c)));
+        // Four lanes; for C = 3 the fourth lands on the next texel's first channel, which
+        // that texel (or the zero of an empty one) overwrites next.
+        _mm_storeu_ps(
+            out.add(o),
+            _mm_add_ps(top, _mm_mul_ps(vy, _mm_sub_ps(bot, top))),
+        );
+    }
+}
+
+/// The weighted sum of `taps` over the layers of one mip level, into `out`.
+#[inline(always)]
+fn sum_taps<const C: usize>(taps: &[Tap], level: &[Image], out: &mut [f32]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SSE2 (part of x86-64): four channels at once wherever a four-float read fits.
+        // SAFETY: each read is checked against its layer's length first.
+        unsafe {
+            let mut acc = _mm_setzero_ps();
+            let mut tail = [0.0f32; C];
+            for t in taps {
+                let data = level[(t.idx >> INDEX_BITS) as usize].data();
+                let i = (t.idx & INDEX_MASK) as usize * C;
+                if i + 4 <= data.len() {
+                    let v = _mm_loadu_ps(data.as_ptr().add(i));
+                    acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(t.w), v));
+                } else if let Some(v) = data.get(i..i + C) {
+                    for c in 0..C {
+                        tail[c] += t.w * v[c];
+                    }
+                }
+            }
+            let mut lanes = [0.0f32; 4];
+            _mm_storeu_ps(lanes.as_mut_ptr(), acc);
+            for c in 0..C {
+                out[c] = lanes[c] + tail[c];
+            }
         }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let mut acc = [0.0f32; C];
+        for t in taps {
+            let data = level[(t.idx >> INDEX_BITS) as usize].data();
+            let i = (t.idx & INDEX_MASK) as usize * C;
+            if let Some(v) = data.get(i..i + C) {
+                for c in 0..C {
+                    acc[c] += t.w * v[c];
+                }
+            }
+        }
+        out.copy_from_slice(&acc);
     }
 }
 

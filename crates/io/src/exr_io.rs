@@ -60,6 +60,40 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
 
     let layer_count = headers.len();
 
+    // The common case (a layer of exactly R, G, B and maybe A, half or float) straight from
+    // the decompressed blocks; anything else through the crate's generic image reader.
+    let index = headers.iter().position(is_rgb_layer).unwrap_or(0);
+    if let Some(layout) = block_layout(&headers[index]) {
+        let header = headers[index].clone();
+        let image =
+            read_blocks(chunks, index, &header, &layout).map_err(|e| read_error(path, e))?;
+        let declared = header.own_attributes.environment_map.map(|m| match m {
+            EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
+            EnvironmentMap::Cube => ProjectionKind::Cube,
+        });
+        let types: Vec<SampleType> = header.channels.list.iter().map(|c| c.sample_type).collect();
+        let layer_name = header
+            .own_attributes
+            .layer_name
+            .as_ref()
+            .map(|n| n.to_string());
+        let tiled = matches!(header.blocks, exr::meta::BlockDescription::Tiles(_));
+        let description = describe(
+            &types,
+            header.compression,
+            image.channels(),
+            tiled,
+            layer_count,
+            layer_name,
+        );
+        return Ok(Loaded {
+            layers: vec![image],
+            declared,
+            format: Format::Exr,
+            description,
+        });
+    }
+
     let exr_image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -93,21 +127,14 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     if let Some(alpha) = &channels.3 {
         sample_types.push(alpha.sample_type);
     }
-    let mut description = format!(
-        "OpenEXR, {}, {}, {}",
-        sample_type_names(&sample_types),
-        compression_description(compression),
-        if nchannels == 4 { "RGBA" } else { "RGB" }
+    let description = describe(
+        &sample_types,
+        compression,
+        nchannels,
+        tiled,
+        layer_count,
+        layer_name,
     );
-    if tiled {
-        description.push_str(", tiled");
-    }
-    if layer_count > 1 {
-        match layer_name {
-            Some(name) => description.push_str(&format!(", layer \"{name}\" of {layer_count}")),
-            None => description.push_str(&format!(", first RGB layer of {layer_count}")),
-        }
-    }
 
     Ok(Loaded {
         layers: vec![image],
@@ -230,6 +257,115 @@ fn create_texels(size: Vec2<usize>, channels: &exr::image::RgbaChannels) -> Texe
         channels: nchannels,
         data: vec![0.0; size.area() * nchannels],
     }
+}
+
+/// What [`Loaded::description`] says of an EXR layer.
+fn describe(
+    sample_types: &[SampleType],
+    compression: Compression,
+    nchannels: usize,
+    tiled: bool,
+    layer_count: usize,
+    layer_name: Option<String>,
+) -> String {
+    let mut description = format!(
+        "OpenEXR, {}, {}, {}",
+        sample_type_names(sample_types),
+        compression_description(compression),
+        if nchannels == 4 { "RGBA" } else { "RGB" }
+    );
+    if tiled {
+        description.push_str(", tiled");
+    }
+    if layer_count > 1 {
+        match layer_name {
+            Some(name) => description.push_str(&format!(", layer \"{name}\" of {layer_count}")),
+            None => description.push_str(&format!(", first RGB layer of {layer_count}")),
+        }
+    }
+    description
+}
+
+/// For a layer of exactly `R`, `G`, `B` (and `A`), each half or float and fully sampled:
+/// for each channel in the file's order (sorted by name), its index in an interleaved
+/// texel and its sample type. `None` for any other layer.
+fn block_layout(header: &Header) -> Option<Vec<(usize, SampleType)>> {
+    let list = &header.channels.list;
+    let mut layout = Vec::with_capacity(list.len());
+    for c in list.iter() {
+        let index = match c.name.to_string().as_str() {
+            "R" => 0,
+            "G" => 1,
+            "B" => 2,
+            "A" => 3,
+            _ => return None,
+        };
+        if !matches!(c.sample_type, SampleType::F16 | SampleType::F32) || c.sampling != Vec2(1, 1) {
+            return None;
+        }
+        layout.push((index, c.sample_type));
+    }
+    let n = layout.len();
+    let mut seen = [false; 4];
+    for &(i, _) in &layout {
+        seen[i] = true;
+    }
+    let ok = (n == 3 && seen[..3] == [true; 3] && !seen[3]) || (n == 4 && seen == [true; 4]);
+    ok.then_some(layout)
+}
+
+/// Reads layer `index` (laid out as `layout`, see [`block_layout`]) from its decompressed
+/// blocks, decompressed on all cores, each block's lines of per-channel samples
+/// interleaved straight into the texels. Blocks that do not fit the layer are an error,
+/// never a panic.
+fn read_blocks(
+    chunks: exr::block::reader::Reader<BufReader<File>>,
+    index: usize,
+    header: &Header,
+    layout: &[(usize, SampleType)],
+) -> Result<Image, exr::error::Error> {
+    use exr::block::reader::ChunksReader;
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    let n = layout.len();
+    let mut data = vec![0.0f32; w * h * n];
+    let reader = chunks.filter_chunks(false, |_, _, block| {
+        block.layer == index && block.level == Vec2(0, 0)
+    })?;
+    let bad =
+        || exr::error::Error::Invalid("a block lies outside its layer or is too short".into());
+    reader.decompress_parallel(false, |_, block| {
+        let (bx, by) = (
+            block.index.pixel_position.x(),
+            block.index.pixel_position.y(),
+        );
+        let (bw, bh) = (block.index.pixel_size.x(), block.index.pixel_size.y());
+        if bx + bw > w || by + bh > h {
+            return Err(bad());
+        }
+        let bytes = &block.data;
+        let mut off = 0;
+        for y in by..by + bh {
+            let row = &mut data[(y * w + bx) * n..(y * w + bx + bw) * n];
+            for &(c, st) in layout {
+                let size = if st == SampleType::F32 { 4 } else { 2 };
+                let src = bytes.get(off..off + bw * size).ok_or_else(bad)?;
+                off += bw * size;
+                let dst = row.iter_mut().skip(c).step_by(n);
+                if size == 4 {
+                    for (d, s) in dst.zip(src.chunks_exact(4)) {
+                        *d = f32::from_ne_bytes([s[0], s[1], s[2], s[3]]);
+                    }
+                } else {
+                    for (d, s) in dst.zip(src.chunks_exact(2)) {
+                        *d = half::f16::from_bits(u16::from_ne_bytes([s[0], s[1]])).to_f32();
+                    }
+                }
+            }
+        }
+        Ok(())
+    })?;
+    Image::from_vec(w as u32, h as u32, n, data)
+        .ok_or_else(|| exr::error::Error::Invalid("inconsistent layer size".into()))
 }
 
 /// Stores one decoded texel (the crate has already converted a whole line of samples).

@@ -949,3 +949,113 @@ fn ldr_truncated_garbage_and_missing_are_input_errors() {
     std::fs::write(&path, b"RIFF\x10\x00\x00\x00WEBPgarbage garbage").unwrap();
     assert_input_error(&read_err(&path), &path);
 }
+
+/// The block reader (R, G, B, A in half or float) gives what the `exr` crate's own image
+/// reader gives, for scan lines and tiles, half and float, RGB and RGBA, and sizes that are
+/// not multiples of the block size.
+#[test]
+fn exr_block_reader_matches_the_crates_reader() {
+    use exr::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    let value = |x: usize, y: usize, c: usize| {
+        ((x * 7 + y * 13 + c * 5) % 97) as f32 * 0.37 + (y as f32 * 0.01).sin()
+    };
+    let encodings = [
+        ("lines-zip", Encoding::SMALL_LOSSLESS),
+        ("lines-none", Encoding::UNCOMPRESSED),
+        (
+            "tiles-piz",
+            Encoding {
+                compression: Compression::PIZ,
+                blocks: Blocks::Tiles(Vec2(16, 8)),
+                line_order: LineOrder::Increasing,
+            },
+        ),
+    ];
+    for (name, encoding) in encodings {
+        for (half_samples, alpha) in [(false, false), (true, true), (true, false), (false, true)] {
+            let path = dir
+                .path()
+                .join(format!("{name}-{half_samples}-{alpha}.exr"));
+            let size = (37, 21);
+            let h = |v: f32| f16::from_f32(v);
+            let layer_attrs = LayerAttributes::default();
+            match (half_samples, alpha) {
+                (false, false) => {
+                    let ch = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                        (value(x, y, 0), value(x, y, 1), value(x, y, 2))
+                    });
+                    exr::image::Image::from_layer(Layer::new(size, layer_attrs, encoding, ch))
+                        .write()
+                        .to_file(&path)
+                        .unwrap();
+                }
+                (true, true) => {
+                    let ch = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
+                        (
+                            h(value(x, y, 0)),
+                            h(value(x, y, 1)),
+                            h(value(x, y, 2)),
+                            h(value(x, y, 3)),
+                        )
+                    });
+                    exr::image::Image::from_layer(Layer::new(size, layer_attrs, encoding, ch))
+                        .write()
+                        .to_file(&path)
+                        .unwrap();
+                }
+                (true, false) => {
+                    let ch = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                        (h(value(x, y, 0)), h(value(x, y, 1)), h(value(x, y, 2)))
+                    });
+                    exr::image::Image::from_layer(Layer::new(size, layer_attrs, encoding, ch))
+                        .write()
+                        .to_file(&path)
+                        .unwrap();
+                }
+                (false, true) => {
+                    let ch = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
+                        (
+                            value(x, y, 0),
+                            value(x, y, 1),
+                            value(x, y, 2),
+                            value(x, y, 3),
+                        )
+                    });
+                    exr::image::Image::from_layer(Layer::new(size, layer_attrs, encoding, ch))
+                        .write()
+                        .to_file(&path)
+                        .unwrap();
+                }
+            }
+            let (img, _) = read_one(&path);
+            let reference = exr::prelude::read_first_rgba_layer_from_file(
+                &path,
+                |res, _| (res, vec![[0.0f32; 4]; res.area()]),
+                |(res, px): &mut (Vec2<usize>, Vec<[f32; 4]>),
+                 p: Vec2<usize>,
+                 (r, g, b, a): (f32, f32, f32, f32)| {
+                    px[p.y() * res.width() + p.x()] = [r, g, b, a]
+                },
+            )
+            .unwrap();
+            let (res, px) = &reference.layer_data.channel_data.pixels;
+            assert_eq!(
+                (img.width() as usize, img.height() as usize),
+                (res.x(), res.y())
+            );
+            let n = img.channels();
+            assert_eq!(n, if alpha { 4 } else { 3 }, "{name}");
+            for y in 0..res.y() {
+                for x in 0..res.x() {
+                    let got = img.get(x as u32, y as u32);
+                    assert_eq!(
+                        got,
+                        &px[y * res.x() + x][..n],
+                        "{name} {half_samples} {alpha} at {x},{y}"
+                    );
+                }
+            }
+        }
+    }
+}
