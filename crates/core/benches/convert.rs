@@ -5,7 +5,7 @@
 //! scripts run the same conversion on a real HDR beside OpenCV).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
+use mirrorball_core::{resample, EnvMap, ProjectionKind, Remap, ResampleOptions};
 use std::hint::black_box;
 
 fn source() -> EnvMap {
@@ -30,6 +30,27 @@ fn bench(c: &mut Criterion) {
     g.throughput(Throughput::Elements(4096 * 2048));
     g.bench_function("back", |b| {
         b.iter(|| black_box(resample(&faces, latlong, 4096, &opts)))
+    });
+    g.finish();
+
+    // Planned once (like cv2.remap's precomputed maps; planning not timed), applied into a
+    // reused output and into a new one.
+    let fwd = Remap::new(latlong, (4096, 2048), 1, cube, 1024, &opts);
+    let back = Remap::new(cube, (1024, 1024), 6, latlong, 4096, &opts);
+    let mut g = c.benchmark_group("latlong4096_cube1024_planned");
+    g.sample_size(20);
+    g.throughput(Throughput::Elements(6 * 1024 * 1024));
+    let mut out = fwd.apply(&src).expect("plan fits");
+    g.bench_function("forward_into", |b| {
+        b.iter(|| fwd.apply_into(&src, &mut out).expect("plan fits"))
+    });
+    g.bench_function("forward_new", |b| {
+        b.iter(|| black_box(fwd.apply(&src).expect("plan fits")))
+    });
+    g.throughput(Throughput::Elements(4096 * 2048));
+    let mut ll = back.apply(&faces).expect("plan fits");
+    g.bench_function("back_into", |b| {
+        b.iter(|| back.apply_into(&faces, &mut ll).expect("plan fits"))
     });
     g.finish();
 
