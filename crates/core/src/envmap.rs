@@ -409,6 +409,27 @@ fn bilinear_n<const C: usize>(
         }
         return;
     }
+    out.fill(0.0);
+    for (l, tx, ty, wt) in seam_taps(proj, layer, (w as u32, h as u32), (x0, y0), (fx, fy)) {
+        let t = layers[l].get(tx, ty);
+        for i in 0..C {
+            out[i] += wt * t[i];
+        }
+    }
+}
+
+/// The four texels and weights of a bilinear lookup whose top-left texel `(x0, y0)` (with
+/// fractions `(fx, fy)`) may lie outside the `w`×`h` layer `layer`: each corner outside is
+/// moved to where it really is, across a cube edge, around the longitude wrap or over a
+/// pole ([`WorldProjection::wrap_texel`]).
+#[inline]
+pub(crate) fn seam_taps(
+    proj: &Projection,
+    layer: usize,
+    (w, h): (u32, u32),
+    (x0, y0): (i64, i64),
+    (fx, fy): (f32, f32),
+) -> [(usize, u32, u32, f32); 4] {
     let weights = [
         (1.0 - fx) * (1.0 - fy),
         fx * (1.0 - fy),
@@ -416,17 +437,13 @@ fn bilinear_n<const C: usize>(
         fx * fy,
     ];
     let corners = [(x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1)];
-    out.fill(0.0);
-    for k in 0..4 {
+    std::array::from_fn(|k| {
         let (cx, cy) = corners[k];
-        let (l, tx, ty) = if cx >= 0 && cy >= 0 && cx < w && cy < h {
+        let (l, tx, ty) = if cx >= 0 && cy >= 0 && cx < w as i64 && cy < h as i64 {
             (layer, cx as u32, cy as u32)
         } else {
-            proj.wrap_texel(layer, cx, cy, w as u32, h as u32)
+            proj.wrap_texel(layer, cx, cy, w, h)
         };
-        let t = layers[l].get(tx, ty);
-        for i in 0..C {
-            out[i] += weights[k] * t[i];
-        }
-    }
+        (l, tx, ty, weights[k])
+    })
 }

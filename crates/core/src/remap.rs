@@ -17,7 +17,7 @@
 //! Memory: 8 bytes per output texel, plus 16 bytes per tap of the few texels that are
 //! integrated or straddle a seam (a 6×1024² cube from a 4096×2048 lat-long: about 60 MB).
 
-use crate::envmap::lerp4;
+use crate::envmap::{lerp4, seam_taps};
 use crate::projection::{Projection, WorldProjection};
 use crate::resample::{Job, PointScratch, Pyramid, RowScratch};
 use crate::{EnvMap, Image, ResampleOptions};
@@ -661,27 +661,14 @@ fn push_bilinear(
         }
         return;
     }
-    let (wi, hi) = (w as i64, h as i64);
-    let fx_ = lk.u as f64 * w as f64 - 0.5;
-    let fy_ = lk.v as f64 * h as f64 - 0.5;
-    let (x0, y0) = (fx_.floor() as i64, fy_.floor() as i64);
-    let (fx, fy) = ((fx_ - x0 as f64) as f32, (fy_ - y0 as f64) as f32);
-    let weights = [
-        (1.0 - fx) * (1.0 - fy),
-        fx * (1.0 - fy),
-        (1.0 - fx) * fy,
-        fx * fy,
-    ];
-    let corners = [(x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1)];
-    for (k, (cx, cy)) in corners.into_iter().enumerate() {
-        let (l, tx, ty) = if cx >= 0 && cy >= 0 && cx < wi && cy < hi {
-            (layer, cx as u32, cy as u32)
-        } else {
-            proj.wrap_texel(layer, cx, cy, w, h)
-        };
+    let x = lk.u as f64 * w as f64 - 0.5;
+    let y = lk.v as f64 * h as f64 - 0.5;
+    let (x0, y0) = (x.floor() as i64, y.floor() as i64);
+    let f = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
+    for (l, tx, ty, cw) in seam_taps(proj, layer, (w, h), (x0, y0), f) {
         taps.push(Tap {
             idx: ((l as u32) << INDEX_BITS) | (ty * w + tx),
-            w: wt * weights[k],
+            w: wt * cw,
         });
     }
 }
