@@ -618,6 +618,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                 attach: plan.attach,
                 filter: plan.filter,
                 intensity: plan.intensity,
+                cache: Default::default(),
             })
         }
         None => None,
