@@ -46,7 +46,7 @@ pub mod teapot;
 pub mod tone;
 
 pub use camera::{Camera, Lens, Rays};
+pub use lookup::{EnvCache, SpecularLobe};
 pub use mesh::{Builtin, Mesh};
 pub use render::{render, sphere_map_texcoords, texture_space_diagram, Aovs, Frame, RenderError};
-pub use lookup::{EnvCache, SpecularLobe};
 pub use scene::{Attach, Environment, Filter, Indexing, Material, Object, Ramp, Scene, Settings};

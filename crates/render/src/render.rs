@@ -335,10 +335,9 @@ fn prepare<'a>(scene: &'a Scene, cam: &Camera, settings: &Settings) -> Prepared<
         }
         _ => (Vec::new(), Vec::new(), Vec::new()),
     };
-    let filter = scene
-        .environment
-        .as_ref()
-        .map_or(Filter::Bilinear, |e| crate::lookup::effective(e.filter, mode));
+    let filter = scene.environment.as_ref().map_or(Filter::Bilinear, |e| {
+        crate::lookup::effective(e.filter, mode)
+    });
     let sampler = match scene.environment.as_ref() {
         Some(e) if filter.uses_footprint() => Some(e.cache.sampler(&e.map, filter)),
         _ => None,
@@ -348,7 +347,9 @@ fn prepare<'a>(scene: &'a Scene, cam: &Camera, settings: &Settings) -> Prepared<
         .map(|m| crate::shading::MaterialMaps::new(m, scene.environment.as_ref()))
         .collect();
     let texgen_eye = if mode == Indexing::PerVertexTexgen
-        && materials.iter().any(|m| matches!(m, Material::PhongMap { .. }))
+        && materials
+            .iter()
+            .any(|m| matches!(m, Material::PhongMap { .. }))
     {
         crate::shading::eye_sphere_texgen(&pos, &nrm, &view)
     } else {
@@ -438,7 +439,9 @@ impl Prepared<'_> {
         if !uv.is_finite() {
             return None;
         }
-        env.map.projection().uv_to_dir(0, uv.clamp(DVec2::ZERO, DVec2::ONE))
+        env.map
+            .projection()
+            .uv_to_dir(0, uv.clamp(DVec2::ZERO, DVec2::ONE))
     }
 
     /// Reads the environment in direction `d` (already attached); returns the colour and

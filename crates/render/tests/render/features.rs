@@ -55,7 +55,11 @@ fn greene_on_a_constant_environment_is_dc_plus_sc_times_it_in_every_mode() {
         SpecularLobe::Phong { exponent: 20.0 },
         SpecularLobe::Ggx { roughness: 0.4 },
     ] {
-        for kind in [ProjectionKind::LatLong, ProjectionKind::Cube, ProjectionKind::Sphere] {
+        for kind in [
+            ProjectionKind::LatLong,
+            ProjectionKind::Cube,
+            ProjectionKind::Sphere,
+        ] {
             let s = greene_scene(env_of(kind, 64, constant), dc, sc, lobe);
             for mode in Indexing::ALL {
                 let f = draw(&s, &cam, mode, 1, false);
@@ -206,7 +210,10 @@ fn cone_mode_with_ewa_aliases_far_less_than_point_sampling() {
     eprintln!("rms error: point {e_point:.4}, cone+EWA {e_ewa:.4}, cone+trilinear {e_tri:.4}");
     assert!(e_point > 0.2, "the setup does not alias: {e_point}");
     assert!(e_ewa < 0.35 * e_point, "EWA {e_ewa} vs point {e_point}");
-    assert!(e_tri < 0.6 * e_point, "trilinear {e_tri} vs point {e_point}");
+    assert!(
+        e_tri < 0.6 * e_point,
+        "trilinear {e_tri} vs point {e_point}"
+    );
 }
 
 #[test]
@@ -330,5 +337,8 @@ fn phong_map_highlight_sits_where_the_mirror_direction_meets_the_light() {
     let e_fine = rms(&fine.color, &pixel.color);
     eprintln!("phong map, texgen vs per pixel: coarse {e_coarse:.4}, fine {e_fine:.4}");
     assert!(e_fine < 0.02, "fine texgen vs per pixel: {e_fine}");
-    assert!(e_coarse > 3.0 * e_fine, "coarse {e_coarse} vs fine {e_fine}");
+    assert!(
+        e_coarse > 3.0 * e_fine,
+        "coarse {e_coarse} vs fine {e_fine}"
+    );
 }
