@@ -529,7 +529,13 @@ impl Prepared<'_> {
                         let d = lerp3(&self.texgen).as_dvec3().normalize_or_zero();
                         let (c, st) = self.read_dir(d);
                         out.st = st;
-                        c
+                        if self.sampler.is_some() {
+                            let corners = self.corner_reflections(s, fx, fy);
+                            let dirs = corners.map(|c| self.attach(c));
+                            self.cone_read(d, &dirs)
+                        } else {
+                            c
+                        }
                     }
                 },
                 Indexing::Cone => {
