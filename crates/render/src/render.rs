@@ -517,11 +517,7 @@ impl Prepared<'_> {
                         match self.uv_dir(uv) {
                             // A footprint filter: the texgen's direction, with the
                             // footprint of the pixel's reflected corner rays.
-                            Some(d) if self.sampler.is_some() => {
-                                let corners = self.corner_reflections(s, fx, fy);
-                                let dirs = corners.map(|c| self.attach(c));
-                                self.cone_read(d, &dirs)
-                            }
+                            Some(d) if self.sampler.is_some() => self.footprint_read(s, fx, fy, d),
                             _ => self.read_uv(0, uv),
                         }
                     }
@@ -530,9 +526,7 @@ impl Prepared<'_> {
                         let (c, st) = self.read_dir(d);
                         out.st = st;
                         if self.sampler.is_some() {
-                            let corners = self.corner_reflections(s, fx, fy);
-                            let dirs = corners.map(|c| self.attach(c));
-                            self.cone_read(d, &dirs)
+                            self.footprint_read(s, fx, fy, d)
                         } else {
                             c
                         }
@@ -549,12 +543,10 @@ impl Prepared<'_> {
                 _ if self.sampler.is_some() => {
                     // Modes 2 and 3 with a footprint filter: the reflected rays at the
                     // pixel's corners give the footprint.
-                    let corners = self.corner_reflections(s, fx, fy);
                     let d = self.attach(r);
                     let (_, st) = self.read_dir(d);
                     out.st = st;
-                    let dirs = corners.map(|c| self.attach(c));
-                    self.cone_read(d, &dirs)
+                    self.footprint_read(s, fx, fy, d)
                 }
                 _ => {
                     let (c, st) = self.read_dir32(self.attach32(r));
@@ -584,11 +576,31 @@ impl Prepared<'_> {
                 let k = ambient + n.dot(l).max(0.0);
                 colour.map(|c| c * k)
             }
-            Material::Greene { dc, sc, .. } => {
-                let k = self.tri_mat[s.tri as usize] as usize;
-                let crate::shading::MaterialMaps::Greene(maps) = &self.extra[k] else {
-                    return out;
-                };
+            Material::Greene { .. } | Material::PhongMap { .. } => {
+                self.shade_maps(material, s, n, r, &mut out)
+            }
+        };
+        out
+    }
+
+    /// Greene's and the Phong-map materials (out of line: the mirror path stays small).
+    #[inline(never)]
+    fn shade_maps(
+        &self,
+        material: &Material,
+        s: crate::raster::Sample,
+        n: Vec3,
+        r: Vec3,
+        out: &mut Shaded,
+    ) -> [f32; 3] {
+        let t = self.tris[s.tri as usize];
+        let b = s.weights();
+        let [i0, i1, i2] = t.map(|i| i as usize);
+        let lerp3 = |a: &[Vec3]| a[i0] * b.x + a[i1] * b.y + a[i2] * b.z;
+        let mode = self.settings.indexing;
+        let k = self.tri_mat[s.tri as usize] as usize;
+        match (material, &self.extra[k]) {
+            (Material::Greene { dc, sc, .. }, crate::shading::MaterialMaps::Greene(maps)) => {
                 let uv = match (mode, self.texgen_kind) {
                     (Indexing::PerVertexTexgen, Texgen::SphereSt | Texgen::Uv) => {
                         Some(lerp3(&self.texgen))
@@ -606,16 +618,15 @@ impl Prepared<'_> {
                 out.st = st;
                 c.map(|x| x * k)
             }
-            Material::PhongMap {
-                colour,
-                light,
-                ambient,
-                ..
-            } => {
-                let k = self.tri_mat[s.tri as usize] as usize;
-                let crate::shading::MaterialMaps::Phong(map) = &self.extra[k] else {
-                    return out;
-                };
+            (
+                Material::PhongMap {
+                    colour,
+                    light,
+                    ambient,
+                    ..
+                },
+                crate::shading::MaterialMaps::Phong(map),
+            ) => {
                 let st = (mode == Indexing::PerVertexTexgen).then(|| lerp3(&self.texgen_eye));
                 let l = Vec3::from_array(*light).normalize_or_zero();
                 let diffuse = ambient + (self.view_rot * n).dot(l).max(0.0);
@@ -623,8 +634,17 @@ impl Prepared<'_> {
                 out.st = [uv[0], uv[1], 0.0];
                 [0, 1, 2].map(|c| colour[c] * diffuse + h[c])
             }
-        };
-        out
+            _ => [0.0; 3],
+        }
+    }
+
+    /// The environment filtered over the footprint of the reflected rays through the
+    /// corners of sample `s`'s pixel, about the attached direction `d`.
+    #[inline(never)]
+    fn footprint_read(&self, s: crate::raster::Sample, fx: f32, fy: f32, d: DVec3) -> [f32; 3] {
+        let corners = self.corner_reflections(s, fx, fy);
+        let dirs = corners.map(|c| self.attach(c));
+        self.cone_read(d, &dirs)
     }
 
     /// The environment seen along the primary ray of a sample that hits nothing.
