@@ -155,8 +155,8 @@ pub struct DemoArgs {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// A scene file (JSON: meshes with model matrices, camera, environment, material,
-    /// indexing); its values override the flags.
+    /// A scene file (.json or .toml, the same schema: meshes with model matrices, camera,
+    /// environment, material, indexing); its values override the flags.
     scene: Option<String>,
     /// Output image: .png/.jpg (exposure, tone curve, sRGB) or .exr/.hdr (linear).
     #[arg(short, long, default_value = "render.png")]
@@ -186,10 +186,14 @@ pub struct RenderArgs {
     /// What the environment is attached to: world (view-independent) or eye.
     #[arg(long, default_value = "world")]
     attach: String,
-    /// Lookup filter: nearest or bilinear (mode 4 filters cones itself).
+    /// Lookup filter: nearest, bilinear, trilinear or ewa (the last two filter each pixel's
+    /// footprint, objects and background; mode 4 always filters: EWA unless trilinear).
     #[arg(long, default_value = "bilinear")]
     filter: String,
-    /// Material: mirror, fresnel, cheap-chrome, diffuse.
+    /// Material: mirror, fresnel, cheap-chrome, diffuse,
+    /// greene[:dc=R,G,B][:sc=R,G,B][:phong=EXP|:ggx=ROUGHNESS] (Greene's dc·D + sc·S from
+    /// prefiltered maps), phong-map[:exponent=N][:light=X,Y,Z][:specular=R,G,B][:ambient=A]
+    /// (highlights from a sphere map of Phong intensities, light in eye space).
     #[arg(long, default_value = "mirror")]
     material: String,
     /// Tint of a mirror, base colour of fresnel/diffuse: r,g,b.

@@ -35,15 +35,18 @@ pub mod capture;
 pub mod cone;
 pub mod fast;
 pub mod load;
+pub mod lookup;
 pub mod maps;
 pub mod mesh;
 pub mod raster;
 mod render;
 pub mod scene;
+mod shading;
 pub mod teapot;
 pub mod tone;
 
 pub use camera::{Camera, Lens, Rays};
+pub use lookup::{EnvCache, SpecularLobe};
 pub use mesh::{Builtin, Mesh};
 pub use render::{render, sphere_map_texcoords, texture_space_diagram, Aovs, Frame, RenderError};
 pub use scene::{Attach, Environment, Filter, Indexing, Material, Object, Ramp, Scene, Settings};

@@ -9,7 +9,6 @@
 
 use crate::camera::Camera;
 use crate::camera::Rays;
-use crate::cone::Pyramid;
 use crate::raster::{Binned, NO_HIT};
 use crate::scene::{Attach, Filter, Indexing, Material, Scene, Settings};
 use glam::{DVec2, DVec3, Mat3, Mat4, Vec2, Vec3, Vec4};
@@ -88,7 +87,12 @@ struct Prepared<'a> {
     /// Material index per triangle.
     tri_mat: Vec<u32>,
     materials: Vec<Material>,
-    pyramid: Option<Pyramid>,
+    /// Its footprint sampler (trilinear, EWA), from the environment's cache.
+    sampler: Option<std::sync::Arc<mirrorball_filter::Sampler>>,
+    /// Per material: Greene's prefiltered maps, or the Phong-intensity sphere map.
+    extra: Vec<crate::shading::MaterialMaps>,
+    /// Mode 1 with a Phong-map material: per-vertex `GL_SPHERE_MAP` `(s, 1 − t)` in eye space.
+    texgen_eye: Vec<Vec3>,
     rays: Rays,
     /// Rays of the previous frame's camera (motion blur).
     prev_rays: Option<Rays>,
@@ -331,9 +335,25 @@ fn prepare<'a>(scene: &'a Scene, cam: &Camera, settings: &Settings) -> Prepared<
         }
         _ => (Vec::new(), Vec::new(), Vec::new()),
     };
-    let pyramid = match (mode, scene.environment.as_ref()) {
-        (Indexing::Cone, Some(e)) => Some(Pyramid::new(&e.map)),
+    let filter = scene.environment.as_ref().map_or(Filter::Bilinear, |e| {
+        crate::lookup::effective(e.filter, mode)
+    });
+    let sampler = match scene.environment.as_ref() {
+        Some(e) if filter.uses_footprint() => Some(e.cache.sampler(&e.map, filter)),
         _ => None,
+    };
+    let extra: Vec<crate::shading::MaterialMaps> = materials
+        .iter()
+        .map(|m| crate::shading::MaterialMaps::new(m, scene.environment.as_ref()))
+        .collect();
+    let texgen_eye = if mode == Indexing::PerVertexTexgen
+        && materials
+            .iter()
+            .any(|m| matches!(m, Material::PhongMap { .. }))
+    {
+        crate::shading::eye_sphere_texgen(&pos, &nrm, &view)
+    } else {
+        Vec::new()
     };
     let ss = settings.supersample;
     Prepared {
@@ -351,7 +371,9 @@ fn prepare<'a>(scene: &'a Scene, cam: &Camera, settings: &Settings) -> Prepared<
         tris,
         tri_mat,
         materials,
-        pyramid,
+        sampler,
+        extra,
+        texgen_eye,
         rays: cam.rays(),
         prev_rays: settings.motion_from.map(|c| c.rays()),
         sw: cam.width * ss,
@@ -391,7 +413,10 @@ impl Prepared<'_> {
             return [0.0; 3];
         }
         let out = match env.filter {
-            Filter::Bilinear => crate::fast::bilinear(&env.map, layer, u, v),
+            // Footprint filters without a footprint (motion-blur sweeps) read bilinearly.
+            Filter::Bilinear | Filter::Trilinear | Filter::Ewa => {
+                crate::fast::bilinear(&env.map, layer, u, v)
+            }
             Filter::Nearest => {
                 let img = &env.map.layers()[layer];
                 let (w, h) = (img.width(), img.height());
@@ -406,6 +431,17 @@ impl Prepared<'_> {
         } else {
             out.map(|c| c * env.intensity)
         }
+    }
+
+    /// The direction of layer 0's `uv` in the environment (mode 1's texgen coordinates).
+    fn uv_dir(&self, uv: DVec2) -> Option<DVec3> {
+        let env = self.scene.environment.as_ref()?;
+        if !uv.is_finite() {
+            return None;
+        }
+        env.map
+            .projection()
+            .uv_to_dir(0, uv.clamp(DVec2::ZERO, DVec2::ONE))
     }
 
     /// Reads the environment in direction `d` (already attached); returns the colour and
@@ -478,13 +514,22 @@ impl Prepared<'_> {
                         let g = lerp3(&self.texgen);
                         let uv = DVec2::new(g.x as f64, g.y as f64);
                         out.st = [g.x, g.y, 0.0];
-                        self.read_uv(0, uv)
+                        match self.uv_dir(uv) {
+                            // A footprint filter: the texgen's direction, with the
+                            // footprint of the pixel's reflected corner rays.
+                            Some(d) if self.sampler.is_some() => self.footprint_read(s, fx, fy, d),
+                            _ => self.read_uv(0, uv),
+                        }
                     }
                     Texgen::Vector => {
                         let d = lerp3(&self.texgen).as_dvec3().normalize_or_zero();
                         let (c, st) = self.read_dir(d);
                         out.st = st;
-                        c
+                        if self.sampler.is_some() {
+                            self.footprint_read(s, fx, fy, d)
+                        } else {
+                            c
+                        }
                     }
                 },
                 Indexing::Cone => {
@@ -494,6 +539,14 @@ impl Prepared<'_> {
                     out.st = st;
                     let dirs = corners.map(|c| self.attach(c));
                     self.cone_read(d, &dirs)
+                }
+                _ if self.sampler.is_some() => {
+                    // Modes 2 and 3 with a footprint filter: the reflected rays at the
+                    // pixel's corners give the footprint.
+                    let d = self.attach(r);
+                    let (_, st) = self.read_dir(d);
+                    out.st = st;
+                    self.footprint_read(s, fx, fy, d)
                 }
                 _ => {
                     let (c, st) = self.read_dir32(self.attach32(r));
@@ -523,8 +576,75 @@ impl Prepared<'_> {
                 let k = ambient + n.dot(l).max(0.0);
                 colour.map(|c| c * k)
             }
+            Material::Greene { .. } | Material::PhongMap { .. } => {
+                self.shade_maps(material, s, n, r, &mut out)
+            }
         };
         out
+    }
+
+    /// Greene's and the Phong-map materials (out of line: the mirror path stays small).
+    #[inline(never)]
+    fn shade_maps(
+        &self,
+        material: &Material,
+        s: crate::raster::Sample,
+        n: Vec3,
+        r: Vec3,
+        out: &mut Shaded,
+    ) -> [f32; 3] {
+        let t = self.tris[s.tri as usize];
+        let b = s.weights();
+        let [i0, i1, i2] = t.map(|i| i as usize);
+        let lerp3 = |a: &[Vec3]| a[i0] * b.x + a[i1] * b.y + a[i2] * b.z;
+        let mode = self.settings.indexing;
+        let k = self.tri_mat[s.tri as usize] as usize;
+        match (material, &self.extra[k]) {
+            (Material::Greene { dc, sc, .. }, crate::shading::MaterialMaps::Greene(maps)) => {
+                let uv = match (mode, self.texgen_kind) {
+                    (Indexing::PerVertexTexgen, Texgen::SphereSt | Texgen::Uv) => {
+                        Some(lerp3(&self.texgen))
+                    }
+                    _ => None,
+                };
+                let k = self.scene.environment.as_ref().map_or(1.0, |e| e.intensity);
+                let (c, st) = crate::shading::greene(
+                    maps,
+                    [*dc, *sc],
+                    self.attach32(n),
+                    self.attach32(r),
+                    uv,
+                );
+                out.st = st;
+                c.map(|x| x * k)
+            }
+            (
+                Material::PhongMap {
+                    colour,
+                    light,
+                    ambient,
+                    ..
+                },
+                crate::shading::MaterialMaps::Phong(map),
+            ) => {
+                let st = (mode == Indexing::PerVertexTexgen).then(|| lerp3(&self.texgen_eye));
+                let l = Vec3::from_array(*light).normalize_or_zero();
+                let diffuse = ambient + (self.view_rot * n).dot(l).max(0.0);
+                let (h, uv) = crate::shading::phong_highlight(map, self.view_rot * r, st);
+                out.st = [uv[0], uv[1], 0.0];
+                [0, 1, 2].map(|c| colour[c] * diffuse + h[c])
+            }
+            _ => [0.0; 3],
+        }
+    }
+
+    /// The environment filtered over the footprint of the reflected rays through the
+    /// corners of sample `s`'s pixel, about the attached direction `d`.
+    #[inline(never)]
+    fn footprint_read(&self, s: crate::raster::Sample, fx: f32, fy: f32, d: DVec3) -> [f32; 3] {
+        let corners = self.corner_reflections(s, fx, fy);
+        let dirs = corners.map(|c| self.attach(c));
+        self.cone_read(d, &dirs)
     }
 
     /// The environment seen along the primary ray of a sample that hits nothing.
@@ -544,7 +664,7 @@ impl Prepared<'_> {
             return out;
         }
         let d = self.attach(dir);
-        let (c, st) = match (&self.pyramid, self.settings.indexing, &self.prev_rays) {
+        let (c, st) = match (&self.sampler, self.settings.indexing, &self.prev_rays) {
             (_, _, Some(prev)) => {
                 // Greene §9: the path the pixel's ray sweeps between the two frames, sampled
                 // about once per texel along its length (at most 64 samples) and averaged.
@@ -552,7 +672,8 @@ impl Prepared<'_> {
                 let (_, st) = self.read_dir(d);
                 (self.sweep(d0, d), st)
             }
-            (Some(_), Indexing::Cone, None) => {
+            (Some(_), _, None) => {
+                // A footprint filter: the pixel's cone of camera rays.
                 let h = 0.5;
                 let corners = [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(dx, dy)| {
                     let (cx, cy) = self.ndc(fx + dx, fy + dy);
@@ -617,12 +738,14 @@ impl Prepared<'_> {
         })
     }
 
-    /// Filters the environment over the cone bounded by corner directions `dirs` around `d`.
+    /// Filters the environment over the footprint of the corner directions `dirs` around
+    /// `d` with the footprint sampler (trilinear or EWA; see [`crate::lookup`]).
     fn cone_read(&self, d: DVec3, dirs: &[DVec3; 4]) -> [f32; 3] {
-        let (Some(pyr), Some(env)) = (&self.pyramid, self.scene.environment.as_ref()) else {
+        let (Some(sampler), Some(env)) = (&self.sampler, self.scene.environment.as_ref()) else {
             return self.read_dir(d).0;
         };
-        pyr.cone(d, dirs).map(|c| c * env.intensity)
+        let v = sampler.sample(d, &crate::lookup::footprint(dirs));
+        [v[0], v[1], v[2]].map(|c| c * env.intensity)
     }
 }
 

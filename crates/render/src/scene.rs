@@ -1,6 +1,7 @@
 //! What is rendered: objects with materials, the environment and how it is attached and
 //! indexed.
 
+use crate::lookup::{EnvCache, SpecularLobe};
 use crate::mesh::Mesh;
 use glam::Mat4;
 use mirrorball_core::EnvMap;
@@ -96,7 +97,7 @@ impl Attach {
     }
 }
 
-/// Texture filter for per-pixel lookups.
+/// Texture filter for environment lookups.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Filter {
     /// The texel containing the coordinates.
@@ -104,16 +105,40 @@ pub enum Filter {
     /// Bilinear, seamless across the projection's seams.
     #[default]
     Bilinear,
+    /// Two bilinear lookups in `mirrorball_filter`'s solid-angle-weighted mip pyramid, at
+    /// the level of the pixel's footprint (the ray differentials of the reflected ray, or
+    /// of the camera ray on the background), blended.
+    Trilinear,
+    /// Heckbert's elliptical weighted average over the pixel's footprint
+    /// (`mirrorball_filter::sampler`), weighted by exact texel solid angle.
+    Ewa,
 }
 
 impl Filter {
-    /// Parses `nearest` or `bilinear`.
+    /// Parses `nearest`, `bilinear`, `trilinear` (`mip`) or `ewa` (`anisotropic`).
     pub fn from_name(s: &str) -> Option<Filter> {
         match s.to_ascii_lowercase().as_str() {
             "nearest" | "point" => Some(Filter::Nearest),
             "bilinear" | "linear" => Some(Filter::Bilinear),
+            "trilinear" | "mip" | "mipmap" => Some(Filter::Trilinear),
+            "ewa" | "anisotropic" => Some(Filter::Ewa),
             _ => None,
         }
+    }
+
+    /// Canonical name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Filter::Nearest => "nearest",
+            Filter::Bilinear => "bilinear",
+            Filter::Trilinear => "trilinear",
+            Filter::Ewa => "ewa",
+        }
+    }
+
+    /// Whether the filter uses the pixel's footprint (and so a mip pyramid).
+    pub fn uses_footprint(self) -> bool {
+        matches!(self, Filter::Trilinear | Filter::Ewa)
     }
 }
 
@@ -124,10 +149,14 @@ pub struct Environment {
     pub map: Arc<EnvMap>,
     /// World- or eye-attached.
     pub attach: Attach,
-    /// Filter of direct lookups.
+    /// Filter of direct lookups (mode 4 and footprint-filtered backgrounds: see
+    /// [`Filter`]).
     pub filter: Filter,
     /// Scale applied to every value read.
     pub intensity: f32,
+    /// What is derived from `map` once and reused by every render (mip pyramids, Greene's
+    /// prefiltered maps); shared by clones, rebuilt when `map` is replaced.
+    pub cache: EnvCache,
 }
 
 impl Environment {
@@ -138,6 +167,7 @@ impl Environment {
             attach: Attach::World,
             filter: Filter::Bilinear,
             intensity: 1.0,
+            cache: EnvCache::default(),
         }
     }
 }
@@ -209,6 +239,39 @@ pub enum Material {
         /// Ambient term.
         ambient: f32,
     },
+    /// Greene (1986, §7): `dc·D(n) + sc·S(r)`, with `D` the diffuse illumination map
+    /// (Lambert, `E/π`) read at the surface normal and `S` the specular prefiltered map
+    /// (a Phong or GGX lobe) read at the reflected vector of the indexing mode. Both are
+    /// made from the environment by `mirrorball_filter::Prefilterer`, once per environment
+    /// (see [`EnvCache`]), in the environment's own projection, so mode 1 reads `S` at its
+    /// interpolated texture coordinates as the hardware would.
+    Greene {
+        /// Diffuse reflectance.
+        dc: [f32; 3],
+        /// Specular reflectance.
+        sc: [f32; 3],
+        /// The specular lobe.
+        lobe: SpecularLobe,
+    },
+    /// Phong highlights from a sphere map of Phong intensities (Zimmons; see
+    /// [`crate::maps::phong_sphere_map`]): `colour × (ambient + max(0, n·l)) + H(r)`, with
+    /// `H` the eye-attached sphere map of `specular · max(0, r·l)^exponent` indexed by the
+    /// mode's reflected vector in eye space (mode 1: `GL_SPHERE_MAP` texture coordinates per
+    /// vertex, interpolated, with their chords and bow ties). `light` is in eye space
+    /// (towards the light; it moves with the camera, as the map does). No environment is
+    /// read.
+    PhongMap {
+        /// Diffuse colour.
+        colour: [f32; 3],
+        /// Highlight colour.
+        specular: [f32; 3],
+        /// Phong exponent.
+        exponent: f32,
+        /// Eye-space direction towards the light.
+        light: [f32; 3],
+        /// Ambient term.
+        ambient: f32,
+    },
 }
 
 impl Material {
@@ -228,7 +291,10 @@ impl Material {
 
     /// Whether the material reads the environment.
     pub fn uses_environment(&self) -> bool {
-        matches!(self, Material::Mirror { .. } | Material::Fresnel { .. })
+        matches!(
+            self,
+            Material::Mirror { .. } | Material::Fresnel { .. } | Material::Greene { .. }
+        )
     }
 }
 

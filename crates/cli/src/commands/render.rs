@@ -16,7 +16,7 @@ use mirrorball_io::{Format, Precision, WriteOptions};
 use mirrorball_render::tone::{self, Tone};
 use mirrorball_render::{
     Attach, Builtin, Camera, Environment, Filter, Indexing, Lens, Material, Mesh, Object, Ramp,
-    Scene, Settings,
+    Scene, Settings, SpecularLobe,
 };
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -105,20 +105,69 @@ fn parse_size(s: &str) -> Result<(u32, u32), CliError> {
     Ok((p(w)?, p(h)?))
 }
 
-fn parse_material(name: &str, tint: [f32; 3], f0: f32) -> Result<Material, String> {
-    Ok(match name.to_ascii_lowercase().as_str() {
-        "mirror" | "chrome" => Material::Mirror { tint },
-        "fresnel" | "varnish" | "plastic" => Material::Fresnel { f0, base: tint },
-        "cheap-chrome" | "ramp" => Material::CheapChrome {
-            ramp: Ramp::chrome(),
-        },
-        "diffuse" | "matte" => Material::diffuse(tint),
-        _ => {
-            return Err(format!(
-                "unknown material '{name}' (known: mirror, fresnel, cheap-chrome, diffuse)"
-            ))
+/// Parses a `--material` spec, `NAME[:key=value…]` (see [`material_of`] for the keys), with
+/// `--tint` and `--f0` as the defaults of `tint` and `f0`.
+fn parse_material(spec: &str, tint: [f32; 3], f0: f32) -> Result<Material, String> {
+    let mut parts = spec.split(':');
+    let mut e = MaterialEntry {
+        kind: parts.next().unwrap_or_default().trim().to_string(),
+        tint: Some(tint),
+        f0: Some(f0),
+        ..MaterialEntry::default()
+    };
+    let colour = |k: &str, v: &str| -> Result<[f32; 3], String> {
+        let c: Vec<f32> = v
+            .split(',')
+            .map(|x| x.trim().parse::<f32>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| format!("{k}='{v}' is not r,g,b"))?;
+        match c[..] {
+            [r, g, b] => Ok([r, g, b]),
+            [x] => Ok([x; 3]),
+            _ => Err(format!("{k}='{v}' is not r,g,b")),
         }
-    })
+    };
+    let num = |k: &str, v: &str| -> Result<f32, String> {
+        v.trim()
+            .parse::<f32>()
+            .map_err(|_| format!("{k}='{v}' is not a number"))
+    };
+    for kv in parts {
+        let (k, v) = kv
+            .split_once('=')
+            .ok_or_else(|| format!("'{kv}' in '{spec}' is not key=value"))?;
+        match k.trim() {
+            "tint" | "colour" | "color" => e.tint = Some(colour(k, v)?),
+            "f0" => e.f0 = Some(num(k, v)?),
+            "dc" => e.dc = Some(colour(k, v)?),
+            "sc" => e.sc = Some(colour(k, v)?),
+            "specular" => e.specular = Some(colour(k, v)?),
+            "lobe" => e.lobe = Some(v.trim().to_string()),
+            "exponent" | "phong" => {
+                e.exponent = Some(num(k, v)?);
+                if k.trim() == "phong" {
+                    e.lobe = Some("phong".into());
+                }
+            }
+            "roughness" | "ggx" => {
+                e.roughness = Some(num(k, v)?);
+                if k.trim() == "ggx" {
+                    e.lobe = Some("ggx".into());
+                }
+            }
+            "ambient" => e.ambient = Some(num(k, v)?),
+            "light" => {
+                let d = parse_dir(v).map_err(|x| format!("light: {x}"))?;
+                e.light = Some(d.as_vec3().to_array());
+            }
+            other => {
+                return Err(format!(
+                    "unknown key '{other}' in '{spec}' (known: tint, f0, dc, sc, lobe, exponent, roughness, specular, light, ambient)"
+                ))
+            }
+        }
+    }
+    material_of(&e)
 }
 
 fn parse_object(s: &str, level: Option<u32>) -> Result<MeshSource, CliError> {
@@ -160,7 +209,7 @@ impl RenderPlan {
         let filter = Filter::from_name(&a.filter).ok_or_else(|| {
             bad(
                 "--filter",
-                format!("'{}' is not nearest or bilinear", a.filter),
+                format!("'{}' is not nearest, bilinear, trilinear or ewa", a.filter),
             )
         })?;
         let tone = Tone::from_name(&a.tone).ok_or_else(|| {
@@ -354,12 +403,26 @@ struct MeshEntry {
     material: Option<MaterialEntry>,
 }
 
-#[derive(Deserialize, Debug, Clone)]
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 struct MaterialEntry {
     kind: String,
+    /// Mirror tint; base colour of fresnel, diffuse and phong-map.
     tint: Option<[f32; 3]>,
     f0: Option<f32>,
+    /// Greene: diffuse and specular reflectance.
+    dc: Option<[f32; 3]>,
+    sc: Option<[f32; 3]>,
+    /// Greene: `phong` or `ggx`.
+    lobe: Option<String>,
+    /// Phong exponent (Greene's phong lobe, phong-map).
+    exponent: Option<f32>,
+    /// GGX perceptual roughness (Greene's ggx lobe).
+    roughness: Option<f32>,
+    /// phong-map: highlight colour, eye-space light direction, ambient term.
+    specular: Option<[f32; 3]>,
+    light: Option<[f32; 3]>,
+    ambient: Option<f32>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -387,13 +450,126 @@ struct EnvEntry {
     projection: Option<String>,
     /// `world` or `eye`.
     attach: Option<String>,
-    /// `nearest` or `bilinear` (cone filtering comes with `indexing: "cone"`).
+    /// `nearest`, `bilinear`, `trilinear` or `ewa`.
     filter: Option<String>,
     intensity: Option<f32>,
 }
 
+/// The material a scene file's (or a `--material` spec's) entry describes, every value
+/// checked.
 fn material_of(e: &MaterialEntry) -> Result<Material, String> {
-    parse_material(&e.kind, e.tint.unwrap_or([1.0; 3]), e.f0.unwrap_or(0.04))
+    let tint = e.tint.unwrap_or([1.0; 3]);
+    let f0 = e.f0.unwrap_or(0.04);
+    let name = e.kind.to_ascii_lowercase();
+    let colour = |k: &str, c: [f32; 3]| -> Result<[f32; 3], String> {
+        if c.iter().all(|v| v.is_finite() && *v >= 0.0) {
+            Ok(c)
+        } else {
+            Err(format!("{k} {c:?} has a negative or non-finite channel"))
+        }
+    };
+    let tint = colour("tint", tint)?;
+    if !(0.0..=1.0).contains(&f0) {
+        return Err(format!("f0 {f0} is outside [0, 1]"));
+    }
+    let allowed: &[&str] = match name.as_str() {
+        "mirror" | "chrome" | "fresnel" | "varnish" | "plastic" | "cheap-chrome" | "ramp"
+        | "diffuse" | "matte" => &[],
+        "greene" => &["dc", "sc", "lobe", "exponent", "roughness"],
+        "phong-map" | "phongmap" => &["specular", "exponent", "light", "ambient"],
+        _ => {
+            return Err(format!(
+                "unknown material '{}' (known: mirror, fresnel, cheap-chrome, diffuse, greene, phong-map)",
+                e.kind
+            ))
+        }
+    };
+    for (key, set) in [
+        ("dc", e.dc.is_some()),
+        ("sc", e.sc.is_some()),
+        ("lobe", e.lobe.is_some()),
+        ("exponent", e.exponent.is_some()),
+        ("roughness", e.roughness.is_some()),
+        ("specular", e.specular.is_some()),
+        ("light", e.light.is_some()),
+        ("ambient", e.ambient.is_some()),
+    ] {
+        if set && !allowed.contains(&key) {
+            return Err(format!("'{key}' does not apply to material '{}'", e.kind));
+        }
+    }
+    Ok(match name.as_str() {
+        "mirror" | "chrome" => Material::Mirror { tint },
+        "fresnel" | "varnish" | "plastic" => Material::Fresnel { f0, base: tint },
+        "cheap-chrome" | "ramp" => Material::CheapChrome {
+            ramp: Ramp::chrome(),
+        },
+        "diffuse" | "matte" => Material::diffuse(tint),
+        "greene" => {
+            let lobe_name = e.lobe.clone().unwrap_or_else(|| {
+                if e.roughness.is_some() {
+                    "ggx".into()
+                } else {
+                    "phong".into()
+                }
+            });
+            let lobe = match lobe_name.to_ascii_lowercase().as_str() {
+                "phong" => {
+                    if e.roughness.is_some() {
+                        return Err(
+                            "'roughness' is for the ggx lobe; phong takes 'exponent'".into()
+                        );
+                    }
+                    SpecularLobe::Phong {
+                        exponent: e.exponent.unwrap_or(32.0),
+                    }
+                }
+                "ggx" => {
+                    if e.exponent.is_some() {
+                        return Err(
+                            "'exponent' is for the phong lobe; ggx takes 'roughness'".into()
+                        );
+                    }
+                    SpecularLobe::Ggx {
+                        roughness: e.roughness.unwrap_or(0.3),
+                    }
+                }
+                other => return Err(format!("lobe '{other}' is not phong or ggx")),
+            };
+            if !lobe.is_valid() {
+                return Err(format!(
+                    "{lobe:?}: the exponent must be ≥ 0 and the roughness in [0, 1]"
+                ));
+            }
+            Material::Greene {
+                dc: colour("dc", e.dc.unwrap_or([0.2; 3]))?,
+                sc: colour("sc", e.sc.unwrap_or([0.8; 3]))?,
+                lobe,
+            }
+        }
+        _ => {
+            // phong-map
+            let exponent = e.exponent.unwrap_or(32.0);
+            if !(exponent.is_finite() && exponent >= 0.0) {
+                return Err(format!("exponent {exponent} must be ≥ 0"));
+            }
+            let light = e.light.unwrap_or([0.3, 0.5, 1.0]);
+            if !light.iter().all(|v| v.is_finite()) || light == [0.0; 3] {
+                return Err(format!("light {light:?} points nowhere"));
+            }
+            let ambient = e.ambient.unwrap_or(0.1);
+            if !(ambient.is_finite() && ambient >= 0.0) {
+                return Err(format!("ambient {ambient} must be ≥ 0"));
+            }
+            Material::PhongMap {
+                colour: if e.tint.is_some() { tint } else { [0.5; 3] },
+                specular: colour("specular", e.specular.unwrap_or([1.0; 3]))?,
+                exponent,
+                light,
+                ambient,
+            }
+        }
+    })
 }
 
 /// Reads a scene file and lets it override the flags' defaults.
@@ -401,8 +577,17 @@ fn apply_scene_file(plan: &mut RenderPlan, path: &Path) -> Result<(), CliError> 
     let name = path.display();
     let text = std::fs::read_to_string(path)
         .map_err(|e| CliError::input(format!("{name}: cannot read: {e}")))?;
-    let sf: SceneFile =
-        serde_json::from_str(&text).map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    let is_toml = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let sf: SceneFile = if is_toml {
+        toml::from_str(&text)
+            .map_err(|e| CliError::input(format!("{name}: not a valid TOML scene: {e}")))?
+    } else {
+        serde_json::from_str(&text)
+            .map_err(|e| CliError::input(format!("{name}: not a valid JSON scene: {e}")))?
+    };
     let base = path.parent().unwrap_or(Path::new("."));
     let rel = |f: &str| -> String {
         let p = Path::new(f);
@@ -484,18 +669,11 @@ fn apply_scene_file(plan: &mut RenderPlan, path: &Path) -> Result<(), CliError> 
                 .ok_or_else(|| err(format!("environment.attach: '{a}' is not world or eye")))?;
         }
         if let Some(f) = &e.filter {
-            plan.filter = match f.to_ascii_lowercase().as_str() {
-                // Trilinear and EWA are the cone mode's business until crates/filter lands.
-                "trilinear" | "ewa" => {
-                    plan.settings.indexing = Indexing::Cone;
-                    Filter::Bilinear
-                }
-                other => Filter::from_name(other).ok_or_else(|| {
-                    err(format!(
-                        "environment.filter: '{f}' is not nearest, bilinear, trilinear or ewa"
-                    ))
-                })?,
-            };
+            plan.filter = Filter::from_name(f).ok_or_else(|| {
+                err(format!(
+                    "environment.filter: '{f}' is not nearest, bilinear, trilinear or ewa"
+                ))
+            })?;
         }
         if let Some(i) = e.intensity {
             if !(i.is_finite() && i >= 0.0) {
@@ -618,6 +796,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                 attach: plan.attach,
                 filter: plan.filter,
                 intensity: plan.intensity,
+                cache: Default::default(),
             })
         }
         None => None,

@@ -255,7 +255,7 @@ fn scene_file_sets_meshes_camera_and_environment() {
     if let Ok(rd) = std::fs::read_dir(&examples) {
         for e in rd {
             let p = e.unwrap().path();
-            if p.extension().is_some_and(|x| x == "json") {
+            if p.extension().is_some_and(|x| x == "json" || x == "toml") {
                 let o = dir.path().join("ex.png");
                 ok(&[
                     "render",
@@ -312,5 +312,208 @@ fn bad_requests_say_what_is_wrong() {
         let msg = stderr(&r);
         assert!(msg.contains(needle), "{args:?}: {msg}");
     }
+    assert!(!out.exists());
+}
+
+/// A constant lat-long environment of `value`, written as EXR into `dir`.
+fn constant_env(dir: &Path, value: f32) -> std::path::PathBuf {
+    let mut img = mirrorball_core::Image::new(64, 32, 3);
+    for y in 0..32 {
+        for x in 0..64 {
+            img.set(x, y, &[value; 3]);
+        }
+    }
+    let p = dir.join("constant.exr");
+    mirrorball_io::write_image(&p, &img, &Default::default()).unwrap();
+    p
+}
+
+fn exr(p: &Path) -> mirrorball_core::Image {
+    mirrorball_io::read(p, &Default::default()).unwrap().layers[0].clone()
+}
+
+#[test]
+fn render_toml_and_json_scenes_render_identically() {
+    let dir = tempfile::tempdir().unwrap();
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let (a, b) = (dir.path().join("json.exr"), dir.path().join("toml.exr"));
+    for (scene, out) in [("chrome-pair.json", &a), ("chrome-pair.toml", &b)] {
+        let s = examples.join(scene);
+        ok(&[
+            "render",
+            s.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ]);
+    }
+    let (ia, ib) = (exr(&a), exr(&b));
+    assert_eq!((ia.width(), ia.height()), (480, 270));
+    assert_eq!(ia.data(), ib.data(), "the TOML and JSON scenes differ");
+    // And the picture is not empty: both objects and the background are there.
+    assert!(ia.data().iter().any(|&v| v > 0.05));
+}
+
+#[test]
+fn render_bad_toml_scene_names_the_file_and_the_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let bad = dir.path().join("broken-scene.toml");
+    std::fs::write(&bad, "indexing = \"pixel\"\n[camera\neye = [0, 0, 3]\n").unwrap();
+    let r = run(&["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!r.status.success());
+    let msg = stderr(&r);
+    assert!(msg.contains("broken-scene.toml"), "{msg}");
+    assert!(msg.contains("TOML") && msg.contains("line 2"), "{msg}");
+    // A well-formed file with an unknown key names the key.
+    let typo = dir.path().join("typo.toml");
+    std::fs::write(&typo, "indexng = \"pixel\"\n").unwrap();
+    let r = run(&[
+        "render",
+        typo.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let msg = stderr(&r);
+    assert!(!r.status.success());
+    assert!(
+        msg.contains("typo.toml") && msg.contains("indexng"),
+        "{msg}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn render_greene_material_from_the_command_line_and_a_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = constant_env(dir.path(), 0.5);
+    let out = dir.path().join("g.exr");
+    // On a constant environment L, dc·D + sc·S = (dc + sc)·L whatever the lobe and mode.
+    for (spec, mode, filter) in [
+        ("greene:dc=0.2,0.1,0.3:sc=0.6:phong=40", "pixel", "bilinear"),
+        ("greene:dc=0.2,0.1,0.3:sc=0.6:ggx=0.5", "cone", "ewa"),
+        ("greene:dc=0.2,0.1,0.3:sc=0.6", "texgen", "trilinear"),
+    ] {
+        ok(&[
+            "render",
+            "--env",
+            env.to_str().unwrap(),
+            "--from",
+            "latlong",
+            "--material",
+            spec,
+            "--mode",
+            mode,
+            "--filter",
+            filter,
+            "--no-background",
+            "--size",
+            "24x24",
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ]);
+        let img = exr(&out);
+        let mut n = 0;
+        for p in img.data().chunks_exact(4).filter(|p| p[3] > 0.999) {
+            n += 1;
+            for (k, want) in [0.4f32, 0.35, 0.45].into_iter().enumerate() {
+                // Half-float EXR: a little over 1e-3 relative.
+                assert!(
+                    (p[k] - want).abs() < 0.01 * want,
+                    "{spec}: {} vs {want}",
+                    p[k]
+                );
+            }
+        }
+        assert!(n > 100, "{spec}: {n} pixels");
+    }
+    // The same from a JSON scene.
+    let scene = dir.path().join("g.json");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"{{"environment": {{"file": "{}", "projection": "latlong", "filter": "trilinear"}},
+  "material": {{"kind": "greene", "dc": [0.2, 0.1, 0.3], "sc": [0.6, 0.6, 0.6], "lobe": "ggx", "roughness": 0.2}},
+  "camera": {{"eye": [0, 0, 3.5], "target": [0, 0, 0], "fov": 40, "width": 24, "height": 24}},
+  "background": false}}"#,
+            env.display()
+        ),
+    )
+    .unwrap();
+    ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    let img = exr(&out);
+    let p = img.get(12, 12);
+    assert!(
+        (p[0] - 0.4).abs() < 0.004 && (p[1] - 0.35).abs() < 0.0035,
+        "{p:?}"
+    );
+}
+
+#[test]
+fn render_phong_map_material_needs_no_environment_and_puts_the_highlight_at_the_light() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p.exr");
+    ok(&[
+        "render",
+        "--material",
+        "phong-map:exponent=50:light=0,0,1:specular=1,1,1:ambient=0",
+        "--tint",
+        "0.2,0.2,0.2",
+        "--tessellation",
+        "128",
+        "--ss",
+        "1",
+        "--no-background",
+        "--ortho",
+        "1",
+        "--size",
+        "33x33",
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    let img = exr(&out);
+    // The headlight meets the mirror direction at the centre: 0.2·1 + 1.
+    let c = img.get(16, 16)[0];
+    assert!((c - 1.2).abs() < 0.03, "centre {c}");
+    // Halfway to the limb (n·l ≈ 0.87, r·l = 2(n·l)² − 1 = 0.5, 0.5⁵⁰ ≈ 0): diffuse only.
+    let side = img.get(16 + 8, 16)[0];
+    assert!((side - 0.2 * 0.866).abs() < 0.02, "side {side}");
+}
+
+#[test]
+fn render_bad_material_and_filter_specs_say_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let o = out.to_str().unwrap();
+    let env = asset("city.exr");
+    let e = env.to_str().unwrap();
+    for (material, needle) in [
+        ("greene:ggx=2", "roughness"),
+        ("greene:phong=-1", "exponent"),
+        ("greene:lobe=blinn", "blinn"),
+        ("mirror:dc=1", "does not apply"),
+        ("greene:shiny=1", "unknown key"),
+        ("phong-map:light=0,0,0", "light"),
+        ("greene:dc=1,2", "r,g,b"),
+    ] {
+        let r = run(&["render", "--env", e, "--material", material, "-o", o]);
+        assert!(!r.status.success(), "{material}");
+        let msg = stderr(&r);
+        assert!(
+            msg.contains("--material") && msg.contains(needle),
+            "{material}: {msg}"
+        );
+    }
+    let r = run(&["render", "--env", e, "--filter", "cubic", "-o", o]);
+    assert!(!r.status.success());
+    assert!(stderr(&r).contains("trilinear or ewa"));
     assert!(!out.exists());
 }

@@ -2,6 +2,7 @@
 //! texgen formula, the rasteriser's rules, meshes and loading, and small golden images.
 mod analytic;
 mod capture;
+mod features;
 mod golden;
 mod meshes;
 mod rasterizer;

@@ -1,0 +1,210 @@
+//! Environment lookups beyond one bilinear fetch, all through `mirrorball-filter`, and the
+//! per-environment work they need, done once and kept in the [`Environment`]'s [`EnvCache`]:
+//!
+//! * **Footprint filters** ([`Filter::Trilinear`], [`Filter::Ewa`]): a
+//!   [`mirrorball_filter::Sampler`] over the filter crate's solid-angle-weighted mip pyramid.
+//!   A pixel's footprint is the ray differentials of the direction looked up, taken from the
+//!   directions through the pixel's four corners ([`footprint`]): the reflected rays at the
+//!   corners for objects (Greene's pixel cone, [`crate::Indexing::Cone`]), the camera rays
+//!   at the corners for the background.
+//! * **Greene's material** ([`crate::Material::Greene`]): the diffuse illumination map
+//!   (Lambert, `E/π`) and the specular map of each lobe, made by
+//!   [`mirrorball_filter::Prefilterer`] in the environment's own projection.
+//!
+//! The cache is keyed by the environment map's `Arc`: replacing `Environment::map` makes it
+//! start again; clones of the environment share it, so a turntable's frames build nothing.
+//!
+//! [`Environment`]: crate::Environment
+//! [`Filter::Trilinear`]: crate::Filter::Trilinear
+//! [`Filter::Ewa`]: crate::Filter::Ewa
+
+use crate::scene::{Filter, Indexing};
+use glam::DVec3;
+use mirrorball_core::EnvMap;
+use mirrorball_filter::{Footprint, Lobe, PrefilterOptions, Prefilterer, Sampler};
+use std::sync::{Arc, Mutex, Weak};
+
+/// The specular lobe of Greene's material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SpecularLobe {
+    /// Phong, `max(r·l, 0)^exponent` (Greene §7, Miller & Hoffman).
+    Phong {
+        /// The exponent (≥ 0).
+        exponent: f32,
+    },
+    /// GGX in the split-sum form (`n = v = r`), perceptual roughness in `[0, 1]`.
+    Ggx {
+        /// Perceptual roughness; `α = roughness²`.
+        roughness: f32,
+    },
+}
+
+impl SpecularLobe {
+    /// The filter crate's lobe.
+    pub fn lobe(self) -> Lobe {
+        match self {
+            SpecularLobe::Phong { exponent } => Lobe::Phong {
+                exponent: exponent as f64,
+            },
+            SpecularLobe::Ggx { roughness } => Lobe::Ggx {
+                roughness: roughness as f64,
+            },
+        }
+    }
+
+    /// Whether the parameter is in range (exponent ≥ 0, roughness in `[0, 1]`, finite).
+    pub fn is_valid(self) -> bool {
+        match self {
+            SpecularLobe::Phong { exponent } => exponent.is_finite() && exponent >= 0.0,
+            SpecularLobe::Ggx { roughness } => (0.0..=1.0).contains(&roughness),
+        }
+    }
+}
+
+/// Greene's two prefiltered maps for one lobe, in the environment's projection.
+#[derive(Debug)]
+pub struct GreeneMaps {
+    /// `E/π` (Lambert), read at the normal.
+    pub diffuse: Arc<EnvMap>,
+    /// The lobe's prefiltered radiance, read at the reflected vector.
+    pub specular: Arc<EnvMap>,
+}
+
+#[derive(Default)]
+struct Inner {
+    /// The map everything here was made from.
+    key: Weak<EnvMap>,
+    prefilterer: Option<Arc<Prefilterer>>,
+    samplers: Vec<(Filter, Arc<Sampler>)>,
+    diffuse: Option<Arc<EnvMap>>,
+    specular: Vec<(SpecularLobe, Arc<EnvMap>)>,
+    builds: usize,
+}
+
+/// Derived data of an environment map, built on first use and shared by every render of
+/// the environment (see the module docs).
+#[derive(Clone, Default)]
+pub struct EnvCache(Arc<Mutex<Inner>>);
+
+impl std::fmt::Debug for EnvCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("EnvCache")
+    }
+}
+
+impl EnvCache {
+    /// How many pyramids and prefiltered maps have been built so far (for tests: a second
+    /// frame must build nothing).
+    pub fn builds(&self) -> usize {
+        self.lock().builds
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The cache for `map`, emptied first if it was made from another map.
+    fn for_map(&self, map: &Arc<EnvMap>) -> std::sync::MutexGuard<'_, Inner> {
+        let mut g = self.lock();
+        let same = g.key.upgrade().is_some_and(|k| Arc::ptr_eq(&k, map));
+        if !same {
+            let builds = g.builds;
+            *g = Inner {
+                key: Arc::downgrade(map),
+                builds,
+                ..Inner::default()
+            };
+        }
+        g
+    }
+
+    /// The footprint sampler of `map` for `filter` (trilinear or EWA).
+    pub fn sampler(&self, map: &Arc<EnvMap>, filter: Filter) -> Arc<Sampler> {
+        let mut g = self.for_map(map);
+        if let Some((_, s)) = g.samplers.iter().find(|(f, _)| *f == filter) {
+            return s.clone();
+        }
+        let f = match filter {
+            Filter::Trilinear => mirrorball_filter::Filter::Trilinear,
+            Filter::Ewa => mirrorball_filter::Filter::Ewa,
+            Filter::Nearest => mirrorball_filter::Filter::Nearest,
+            Filter::Bilinear => mirrorball_filter::Filter::Bilinear,
+        };
+        let s = Arc::new(Sampler::new(map, f));
+        g.samplers.push((filter, s.clone()));
+        g.builds += 1;
+        s
+    }
+
+    /// Greene's diffuse and specular maps of `map` for `lobe`.
+    pub fn greene(&self, map: &Arc<EnvMap>, lobe: SpecularLobe) -> GreeneMaps {
+        let mut g = self.for_map(map);
+        let pf = match &g.prefilterer {
+            Some(p) => p.clone(),
+            None => {
+                let p = Arc::new(Prefilterer::new(map, PrefilterOptions::default()));
+                g.prefilterer = Some(p.clone());
+                p
+            }
+        };
+        let diffuse = match &g.diffuse {
+            Some(d) => d.clone(),
+            None => {
+                let (w, h) = extent_for(map, Lobe::Lambert.angular_scale() / 8.0);
+                let d = Arc::new(pf.render_extent(&Lobe::Lambert, *map.projection(), w, h));
+                g.diffuse = Some(d.clone());
+                g.builds += 1;
+                d
+            }
+        };
+        let specular = match g.specular.iter().find(|(l, _)| *l == lobe) {
+            Some((_, s)) => s.clone(),
+            None => {
+                let l = lobe.lobe();
+                let (w, h) = extent_for(map, l.angular_scale() / 4.0);
+                let s = Arc::new(pf.render_extent(&l, *map.projection(), w, h));
+                g.specular.push((lobe, s.clone()));
+                g.builds += 1;
+                s
+            }
+        };
+        GreeneMaps { diffuse, specular }
+    }
+}
+
+/// The layer extent, in `map`'s projection, whose texels are about `angle` radians across
+/// (never finer than the map, at most 512 texels along a side, at least 8 on the shorter
+/// side): a prefiltered map needs only resolve its lobe.
+fn extent_for(map: &EnvMap, angle: f64) -> (u32, u32) {
+    let (w, h) = (map.width() as f64, map.height() as f64);
+    let texel = (4.0 * std::f64::consts::PI / (w * h * map.layers().len() as f64)).sqrt();
+    let mut f = (angle / texel).max(1.0);
+    f = f.max(w.max(h) / 512.0);
+    f = f.min(w.min(h) / 8.0).max(1.0);
+    (
+        ((w / f).round() as u32).max(1),
+        ((h / f).round() as u32).max(1),
+    )
+}
+
+/// The filter a mode actually uses: mode 4 always filters its cone (EWA unless trilinear is
+/// asked for); the other modes use the environment's filter.
+pub(crate) fn effective(filter: Filter, mode: Indexing) -> Filter {
+    match (mode, filter) {
+        (Indexing::Cone, Filter::Trilinear) => Filter::Trilinear,
+        (Indexing::Cone, _) => Filter::Ewa,
+        (_, f) => f,
+    }
+}
+
+/// A pixel's footprint from the unit directions through its four corners (pixel order
+/// `(−,−) (+,−) (+,+) (−,+)`): the ray differentials `∂d/∂x`, `∂d/∂y` as the mean of the
+/// two opposite edges (a point where a corner is degenerate).
+pub fn footprint(c: &[DVec3; 4]) -> Footprint {
+    if c.iter().any(|x| !x.is_finite() || x.length_squared() < 0.5) {
+        return Footprint::Point;
+    }
+    let dx = ((c[1] - c[0]) + (c[2] - c[3])) * 0.5;
+    let dy = ((c[3] - c[0]) + (c[2] - c[1])) * 0.5;
+    Footprint::Differentials { dx, dy }
+}
