@@ -66,6 +66,86 @@ pub fn bilinear(map: &EnvMap, layer: usize, u: f32, v: f32) -> [f32; 3] {
     out
 }
 
+/// A cube map's six faces, looked up once per frame instead of per sample: the per-pixel
+/// loop's bilinear lookup without the projection, filter and layer indirections. Gives
+/// exactly what [`dir_to_uv`] then [`bilinear`] give.
+#[derive(Clone, Copy)]
+pub struct CubeFaces<'a> {
+    map: &'a EnvMap,
+    faces: [&'a [f32]; 6],
+    n: i32,
+    c: usize,
+}
+
+impl<'a> CubeFaces<'a> {
+    /// `None` unless `map` is a cube of six equal square faces.
+    pub fn new(map: &'a EnvMap) -> Option<CubeFaces<'a>> {
+        if !matches!(map.projection(), Projection::Cube(_)) {
+            return None;
+        }
+        let l = map.layers();
+        if l.len() != 6 {
+            return None;
+        }
+        let (w, c) = (l[0].width(), l[0].channels());
+        if w < 2
+            || w > 1 << 24
+            || c < 3
+            || l.iter()
+                .any(|i| i.width() != w || i.height() != w || i.channels() != c)
+        {
+            return None;
+        }
+        Some(CubeFaces {
+            map,
+            faces: std::array::from_fn(|k| l[k].data()),
+            n: w as i32,
+            c,
+        })
+    }
+
+    /// Bilinear lookup in direction `d` (any length); zero where `d` has no face.
+    #[inline(always)]
+    pub fn sample(&self, d: Vec3) -> [f32; 3] {
+        let (layer, sc, tc, ma) = mirrorball_core::CubeFace::select_f32(d);
+        if ma <= 0.0 || ma.is_nan() {
+            return [0.0; 3];
+        }
+        let k = 0.5 / ma;
+        let (u, v) = (sc * k + 0.5, tc * k + 0.5);
+        if !(u.is_finite() && v.is_finite()) {
+            return [0.0; 3];
+        }
+        let (n, c) = (self.n, self.c);
+        let x = u * n as f32 - 0.5;
+        let y = v * n as f32 - 0.5;
+        let (xi, yi) = (x as i32, y as i32);
+        let x0 = xi - ((xi as f32) > x) as i32;
+        let y0 = yi - ((yi as f32) > y) as i32;
+        if x0 >= 0 && y0 >= 0 && x0 + 1 < n && y0 + 1 < n {
+            let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+            let stride = n as usize * c;
+            let i = y0 as usize * stride + x0 as usize * c;
+            let data = self.faces[layer];
+            // One bounds check for the whole 2×2 footprint.
+            let q = &data[i..i + stride + c + 3];
+            let mut out = [0.0f32; 3];
+            for (k, o) in out.iter_mut().enumerate() {
+                let (a, b) = (q[k], q[c + k]);
+                let (e, f) = (q[stride + k], q[stride + c + k]);
+                let top = a + fx * (b - a);
+                let bot = e + fx * (f - e);
+                *o = top + fy * (bot - top);
+            }
+            return out;
+        }
+        let mut out = [0.0f32; 3];
+        self.map
+            .bilinear_at(layer, DVec2::new(u as f64, v as f64), &mut out);
+        out
+    }
+}
+
 /// Bilinear lookup in direction `d`; zero where the projection does not cover `d`.
 #[inline]
 pub fn sample(map: &EnvMap, d: Vec3) -> [f32; 3] {

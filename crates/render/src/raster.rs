@@ -220,27 +220,33 @@ fn setup_triangle(
         },
     ];
     let d = |c: Vec4| c.z + c.w; // ≥ 0 inside the near plane
-    let mut poly: Vec<ClipVert> = Vec::with_capacity(4);
+    // At most four vertices survive one plane; kept on the stack (no allocation per
+    // triangle).
+    let mut poly = [verts[0]; 4];
+    let mut len = 0;
     if verts.iter().all(|p| d(p.c) >= 0.0) {
-        poly.extend_from_slice(&verts);
+        poly[..3].copy_from_slice(&verts);
+        len = 3;
     } else {
         for i in 0..3 {
             let a = verts[i];
             let b = verts[(i + 1) % 3];
             let (da, db) = (d(a.c), d(b.c));
             if da >= 0.0 {
-                poly.push(a);
+                poly[len] = a;
+                len += 1;
             }
             if (da >= 0.0) != (db >= 0.0) {
                 let s = da / (da - db);
-                poly.push(ClipVert {
+                poly[len] = ClipVert {
                     c: a.c + (b.c - a.c) * s,
                     ob: a.ob + (b.ob - a.ob) * s,
-                });
+                };
+                len += 1;
             }
         }
     }
-    for k in 1..poly.len().saturating_sub(1) {
+    for k in 1..len.saturating_sub(1) {
         if let Some(s) = project([poly[0], poly[k], poly[k + 1]], tri, width, height) {
             out.push(s);
         }
@@ -340,12 +346,19 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
     for y in ya..=yb {
         let qy = y as f32 + 0.5;
         let row = &mut rows[((y - y_start) * width) as usize..((y - y_start + 1) * width) as usize];
+        // The covered samples of a row are contiguous (the triangle is convex): once past
+        // them, the rest of the row is outside.
+        let mut entered = false;
         for (x, cell) in (s.x0..=s.x1).zip(&mut row[s.x0 as usize..=s.x1 as usize]) {
             let q = [x as f32 + 0.5, qy];
             let (f0, f1, f2) = (edge(p1, p2, q), edge(p2, p0, q), edge(p0, p1, q));
             if !(inside(f0, tl[0]) && inside(f1, tl[1]) && inside(f2, tl[2])) {
+                if entered {
+                    break;
+                }
                 continue;
             }
+            entered = true;
             let (l0, l1, l2) = (f0 * inv_area, f1 * inv_area, f2 * inv_area);
             let z = l0 * s.z[0] + l1 * s.z[1] + l2 * s.z[2];
             if z >= cell.depth || z.is_nan() || z < -1.0 {

@@ -169,6 +169,10 @@ pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame,
                 }
                 vis.resize((p.sw * rows * ss) as usize, crate::raster::Sample::EMPTY);
                 binned.scan_band(b, vis);
+                if ss == 1 && aov.is_none() {
+                    p.shade_band_fast(y0, vis, out);
+                    return None;
+                }
                 for ly in 0..rows {
                     for x in 0..w {
                         let mut acc = [0.0f32; 3];
@@ -433,6 +437,85 @@ impl Prepared<'_> {
             2.0 * sx / self.sw as f32 - 1.0,
             1.0 - 2.0 * sy / self.sh as f32,
         )
+    }
+
+    /// The hot loop for one sample per pixel without diagnostic channels: colour and
+    /// coverage of the band of pixel rows starting at row `y0` (`vis` holds its samples,
+    /// `out` its RGBA pixels, zero on entry). Background rays are stepped along each row,
+    /// and a per-pixel mirror reads a cube map directly; what this loop does not specialise
+    /// goes through [`Prepared::shade`]. Allocates nothing.
+    fn shade_band_fast(&self, y0: u32, vis: &[crate::raster::Sample], out: &mut [f32]) {
+        let w = self.cam.width as usize;
+        let env = self.scene.environment.as_ref();
+        let cube = env
+            .filter(|e| e.filter == Filter::Bilinear)
+            .and_then(|e| crate::fast::CubeFaces::new(&e.map));
+        let intensity = env.map_or(1.0, |e| e.intensity);
+        let eye_attached = env.is_some_and(|e| e.attach == Attach::Eye);
+        // The environment in attached direction `d` (any length): lookup, scale.
+        let lookup = |d: Vec3| -> [f32; 3] {
+            match &cube {
+                Some(cf) if intensity == 1.0 => cf.sample(d),
+                Some(cf) => cf.sample(d).map(|c| c * intensity),
+                None => self.read_dir32(d).0,
+            }
+        };
+        let background = self.scene.background;
+        // The background is a plain lookup along the view ray unless it is blurred or
+        // cone-filtered.
+        let plain_bg = background
+            && self.prev_rays.is_none()
+            && !(self.pyramid.is_some() && self.settings.indexing == Indexing::Cone);
+        let mirror_pp = self.settings.indexing == Indexing::PerPixel;
+        let persp = self.cam.is_perspective();
+        let (eye, forward) = (self.cam.eye, self.forward);
+        for (ly, (vrow, orow)) in vis.chunks_exact(w).zip(out.chunks_exact_mut(w * 4)).enumerate()
+        {
+            let sy = y0 + ly as u32;
+            let fy = sy as f32 + 0.5;
+            for (x, (s, o)) in vrow.iter().zip(orow.chunks_exact_mut(4)).enumerate() {
+                let fx = x as f32 + 0.5;
+                let (c, alpha) = if s.tri == NO_HIT {
+                    if !background {
+                        continue; // transparent black, as `out` already holds
+                    }
+                    if plain_bg {
+                        // Exactly as `background` computes it (a blurred frame of a still
+                        // camera must equal the sharp one bit for bit).
+                        let (x, y) = self.ndc(fx, fy);
+                        (lookup(self.attach32(self.rays.ray(x, y).1)), 1.0)
+                    } else {
+                        (self.background(fx, fy).color, 1.0)
+                    }
+                } else {
+                    let material = &self.materials[self.tri_mat[s.tri as usize] as usize];
+                    match (material, mirror_pp) {
+                        (Material::Mirror { tint }, true) => {
+                            let t = self.tris[s.tri as usize];
+                            let b = s.weights();
+                            let [i0, i1, i2] = t.map(|i| i as usize);
+                            let n = (self.nrm[i0] * b.x + self.nrm[i1] * b.y + self.nrm[i2] * b.z)
+                                .normalize_or_zero();
+                            // The reflection is linear in the view vector, so an unnormalised
+                            // one gives the same direction, and the lookup needs no unit length.
+                            let v = if persp {
+                                self.pos[i0] * b.x + self.pos[i1] * b.y + self.pos[i2] * b.z - eye
+                            } else {
+                                forward
+                            };
+                            let r = v - 2.0 * n.dot(v) * n;
+                            let e = lookup(if eye_attached { self.view_rot * r } else { r });
+                            ([e[0] * tint[0], e[1] * tint[1], e[2] * tint[2]], 1.0)
+                        }
+                        _ => (self.shade(x as u32, sy, *s).color, 1.0),
+                    }
+                };
+                o[0] = c[0];
+                o[1] = c[1];
+                o[2] = c[2];
+                o[3] = alpha;
+            }
+        }
     }
 
     /// Shades one sample.
