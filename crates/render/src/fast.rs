@@ -89,7 +89,7 @@ impl<'a> CubeFaces<'a> {
         }
         let (w, c) = (l[0].width(), l[0].channels());
         if w < 2
-            || w > 1 << 24
+            || w as u64 * w as u64 * c as u64 >= SEAM as u64
             || c < 3
             || l.iter()
                 .any(|i| i.width() != w || i.height() != w || i.channels() != c)
@@ -107,43 +107,117 @@ impl<'a> CubeFaces<'a> {
     /// Bilinear lookup in direction `d` (any length); zero where `d` has no face.
     #[inline(always)]
     pub fn sample(&self, d: Vec3) -> [f32; 3] {
+        self.fetch(&self.locate(d))
+    }
+
+    /// First half of [`CubeFaces::sample`]: where the lookup in direction `d` reads. The
+    /// texels are prefetched, so that a batch of locations has its cache misses in flight
+    /// together before [`CubeFaces::fetch`] reads them.
+    #[inline(always)]
+    pub fn locate(&self, d: Vec3) -> CubeLoc {
         let (layer, sc, tc, ma) = mirrorball_core::CubeFace::select_f32(d);
         if ma <= 0.0 || ma.is_nan() {
-            return [0.0; 3];
+            return CubeLoc::NONE;
         }
         let k = 0.5 / ma;
         let (u, v) = (sc * k + 0.5, tc * k + 0.5);
         if !(u.is_finite() && v.is_finite()) {
-            return [0.0; 3];
+            return CubeLoc::NONE;
         }
-        let (n, c) = (self.n, self.c);
+        let n = self.n;
         let x = u * n as f32 - 0.5;
         let y = v * n as f32 - 0.5;
+        // floor without a libm call (x86-64's baseline has no rounding instruction).
         let (xi, yi) = (x as i32, y as i32);
         let x0 = xi - ((xi as f32) > x) as i32;
         let y0 = yi - ((yi as f32) > y) as i32;
         if x0 >= 0 && y0 >= 0 && x0 + 1 < n && y0 + 1 < n {
-            let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-            let stride = n as usize * c;
-            let i = y0 as usize * stride + x0 as usize * c;
-            let data = self.faces[layer];
-            // One bounds check for the whole 2×2 footprint.
-            let q = &data[i..i + stride + c + 3];
-            let mut out = [0.0f32; 3];
-            for (k, o) in out.iter_mut().enumerate() {
-                let (a, b) = (q[k], q[c + k]);
-                let (e, f) = (q[stride + k], q[stride + c + k]);
-                let top = a + fx * (b - a);
-                let bot = e + fx * (f - e);
-                *o = top + fy * (bot - top);
-            }
+            let stride = n as usize * self.c;
+            let i = y0 as usize * stride + x0 as usize * self.c;
+            prefetch(&self.faces[layer][i..]);
+            prefetch(&self.faces[layer][i + stride..]);
+            return CubeLoc {
+                layer: layer as u32,
+                i: i as u32,
+                a: x - x0 as f32,
+                b: y - y0 as f32,
+            };
+        }
+        // Across a seam: the core's lookup, which joins the faces.
+        CubeLoc {
+            layer: layer as u32,
+            i: SEAM,
+            a: u,
+            b: v,
+        }
+    }
+
+    /// Second half of [`CubeFaces::sample`]: the bilinear read at `l`.
+    #[inline(always)]
+    pub fn fetch(&self, l: &CubeLoc) -> [f32; 3] {
+        let mut out = [0.0f32; 3];
+        if l.layer as usize >= 6 {
             return out;
         }
-        let mut out = [0.0f32; 3];
-        self.map
-            .bilinear_at(layer, DVec2::new(u as f64, v as f64), &mut out);
+        if l.i == SEAM {
+            self.map.bilinear_at(
+                l.layer as usize,
+                DVec2::new(l.a as f64, l.b as f64),
+                &mut out,
+            );
+            return out;
+        }
+        let (c, stride) = (self.c, self.n as usize * self.c);
+        let (fx, fy) = (l.a, l.b);
+        let i = l.i as usize;
+        // One bounds check for the whole 2×2 footprint.
+        let q = &self.faces[l.layer as usize][i..i + stride + c + 3];
+        for (k, o) in out.iter_mut().enumerate() {
+            let (a, b) = (q[k], q[c + k]);
+            let (e, f) = (q[stride + k], q[stride + c + k]);
+            let top = a + fx * (b - a);
+            let bot = e + fx * (f - e);
+            *o = top + fy * (bot - top);
+        }
         out
     }
+}
+
+/// `CubeLoc::i` of a lookup whose footprint crosses a seam.
+const SEAM: u32 = u32::MAX;
+
+/// Where a [`CubeFaces`] lookup reads: the face, and the index of the footprint's top-left
+/// texel with the bilinear weights `(a, b)` (or, across a seam, `(u, v)` in `a, b`).
+#[derive(Clone, Copy, Debug)]
+pub struct CubeLoc {
+    layer: u32,
+    i: u32,
+    a: f32,
+    b: f32,
+}
+
+impl CubeLoc {
+    /// No face: reads as zero.
+    pub const NONE: CubeLoc = CubeLoc {
+        layer: u32::MAX,
+        i: 0,
+        a: 0.0,
+        b: 0.0,
+    };
+}
+
+/// Asks for the cache line holding `s[0]` (a hint; does nothing where unsupported).
+#[inline(always)]
+fn prefetch(s: &[f32]) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch is only a hint and cannot fault; the pointer is in bounds anyway.
+    #[allow(unused_unsafe)]
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(s.as_ptr() as *const i8);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = s;
 }
 
 /// Bilinear lookup in direction `d`; zero where the projection does not cover `d`.

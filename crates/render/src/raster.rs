@@ -220,6 +220,7 @@ fn setup_triangle(
         },
     ];
     let d = |c: Vec4| c.z + c.w; // ≥ 0 inside the near plane
+
     // At most four vertices survive one plane; kept on the stack (no allocation per
     // triangle).
     let mut poly = [verts[0]; 4];

@@ -110,6 +110,9 @@ struct Shaded {
     win_depth: f32,
 }
 
+/// Columns of the square tiles the hot loop walks (a band is as many rows).
+const TILE: usize = 16;
+
 /// Renders `scene` through `cam`.
 pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame, RenderError> {
     cam.validate().map_err(RenderError)?;
@@ -445,21 +448,14 @@ impl Prepared<'_> {
     /// and a per-pixel mirror reads a cube map directly; what this loop does not specialise
     /// goes through [`Prepared::shade`]. Allocates nothing.
     fn shade_band_fast(&self, y0: u32, vis: &[crate::raster::Sample], out: &mut [f32]) {
+        use crate::fast::{CubeFaces, CubeLoc};
         let w = self.cam.width as usize;
         let env = self.scene.environment.as_ref();
         let cube = env
             .filter(|e| e.filter == Filter::Bilinear)
-            .and_then(|e| crate::fast::CubeFaces::new(&e.map));
+            .and_then(|e| CubeFaces::new(&e.map));
         let intensity = env.map_or(1.0, |e| e.intensity);
         let eye_attached = env.is_some_and(|e| e.attach == Attach::Eye);
-        // The environment in attached direction `d` (any length): lookup, scale.
-        let lookup = |d: Vec3| -> [f32; 3] {
-            match &cube {
-                Some(cf) if intensity == 1.0 => cf.sample(d),
-                Some(cf) => cf.sample(d).map(|c| c * intensity),
-                None => self.read_dir32(d).0,
-            }
-        };
         let background = self.scene.background;
         // The background is a plain lookup along the view ray unless it is blurred or
         // cone-filtered.
@@ -469,31 +465,52 @@ impl Prepared<'_> {
         let mirror_pp = self.settings.indexing == Indexing::PerPixel;
         let persp = self.cam.is_perspective();
         let (eye, forward) = (self.cam.eye, self.forward);
-        for (ly, (vrow, orow)) in vis.chunks_exact(w).zip(out.chunks_exact_mut(w * 4)).enumerate()
-        {
-            let sy = y0 + ly as u32;
-            let fy = sy as f32 + 0.5;
-            for (x, (s, o)) in vrow.iter().zip(orow.chunks_exact_mut(4)).enumerate() {
-                let fx = x as f32 + 0.5;
-                let (c, alpha) = if s.tri == NO_HIT {
-                    if !background {
-                        continue; // transparent black, as `out` already holds
+        let rows = vis.len() / w;
+        // What a pixel of a segment needs: nothing (transparent black, as `out` holds), an
+        // environment lookup in `dirs` times `tint`, or a colour already in `tint`.
+        const SKIP: u8 = 0;
+        const LOOKUP: u8 = 1;
+        const DONE: u8 = 2;
+        let mut kind = [SKIP; TILE];
+        let mut dirs = [Vec3::ZERO; TILE];
+        let mut tint = [[1.0f32; 3]; TILE];
+        let mut locs = [CubeLoc::NONE; TILE];
+        // Square tiles of the band, column block by column block: neighbouring pixels read
+        // neighbouring texels. Each row of a tile is shaded in three passes: directions,
+        // then every texel address (prefetched, so the cache misses of a minified mirror
+        // overlap instead of queueing one after the other), then the bilinear reads.
+        for xb in (0..w).step_by(TILE) {
+            let xe = (xb + TILE).min(w);
+            for ly in 0..rows {
+                let sy = y0 + ly as u32;
+                let fy = sy as f32 + 0.5;
+                let vrow = &vis[ly * w + xb..ly * w + xe];
+                let orow = &mut out[(ly * w + xb) * 4..(ly * w + xe) * 4];
+                for (i, s) in vrow.iter().enumerate() {
+                    let x = xb + i;
+                    let fx = x as f32 + 0.5;
+                    kind[i] = LOOKUP;
+                    tint[i] = [1.0; 3];
+                    if s.tri == NO_HIT {
+                        if !background {
+                            kind[i] = SKIP;
+                        } else if plain_bg {
+                            // Exactly as `background` computes it (a blurred frame of a still
+                            // camera must equal the sharp one bit for bit).
+                            let (x, y) = self.ndc(fx, fy);
+                            dirs[i] = self.attach32(self.rays.ray(x, y).1);
+                        } else {
+                            kind[i] = DONE;
+                            tint[i] = self.background(fx, fy).color;
+                        }
+                        continue;
                     }
-                    if plain_bg {
-                        // Exactly as `background` computes it (a blurred frame of a still
-                        // camera must equal the sharp one bit for bit).
-                        let (x, y) = self.ndc(fx, fy);
-                        (lookup(self.attach32(self.rays.ray(x, y).1)), 1.0)
-                    } else {
-                        (self.background(fx, fy).color, 1.0)
-                    }
-                } else {
                     let material = &self.materials[self.tri_mat[s.tri as usize] as usize];
                     match (material, mirror_pp) {
-                        (Material::Mirror { tint }, true) => {
-                            let t = self.tris[s.tri as usize];
+                        (Material::Mirror { tint: t }, true) => {
+                            let tri = self.tris[s.tri as usize];
                             let b = s.weights();
-                            let [i0, i1, i2] = t.map(|i| i as usize);
+                            let [i0, i1, i2] = tri.map(|i| i as usize);
                             let n = (self.nrm[i0] * b.x + self.nrm[i1] * b.y + self.nrm[i2] * b.z)
                                 .normalize_or_zero();
                             // The reflection is linear in the view vector, so an unnormalised
@@ -504,16 +521,42 @@ impl Prepared<'_> {
                                 forward
                             };
                             let r = v - 2.0 * n.dot(v) * n;
-                            let e = lookup(if eye_attached { self.view_rot * r } else { r });
-                            ([e[0] * tint[0], e[1] * tint[1], e[2] * tint[2]], 1.0)
+                            dirs[i] = if eye_attached { self.view_rot * r } else { r };
+                            tint[i] = *t;
                         }
-                        _ => (self.shade(x as u32, sy, *s).color, 1.0),
+                        _ => {
+                            kind[i] = DONE;
+                            tint[i] = self.shade(x as u32, sy, *s).color;
+                        }
                     }
-                };
-                o[0] = c[0];
-                o[1] = c[1];
-                o[2] = c[2];
-                o[3] = alpha;
+                }
+                let n = vrow.len();
+                if let Some(cf) = &cube {
+                    for i in 0..n {
+                        if kind[i] == LOOKUP {
+                            locs[i] = cf.locate(dirs[i]);
+                        }
+                    }
+                }
+                for (i, o) in orow.chunks_exact_mut(4).enumerate() {
+                    let c = match kind[i] {
+                        SKIP => continue,
+                        DONE => tint[i],
+                        _ => {
+                            let e = match &cube {
+                                Some(cf) if intensity == 1.0 => cf.fetch(&locs[i]),
+                                Some(cf) => cf.fetch(&locs[i]).map(|c| c * intensity),
+                                None => self.read_dir32(dirs[i]).0,
+                            };
+                            let t = tint[i];
+                            [e[0] * t[0], e[1] * t[1], e[2] * t[2]]
+                        }
+                    };
+                    o[0] = c[0];
+                    o[1] = c[1];
+                    o[2] = c[2];
+                    o[3] = 1.0;
+                }
             }
         }
     }
