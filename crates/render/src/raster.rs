@@ -344,13 +344,32 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
     // Edge functions are evaluated afresh at every sample (not accumulated), so that two
     // triangles sharing an edge compute bit-identical values there and the fill rule holds.
     let inside = |e: f32, t: bool| e > 0.0 || (e == 0.0 && t);
+    // Each edge a → b whose function grows with x bounds a row's covered span on the
+    // left: inside needs x ≥ a.x + (b.x − a.x)(y − a.y)/(b.y − a.y). The scan starts a
+    // sample before that bound (rounding cannot move it that far) and tests exactly from
+    // there.
+    let lefts: [([f32; 2], [f32; 2]); 3] = [(p1, p2), (p2, p0), (p0, p1)];
     for y in ya..=yb {
         let qy = y as f32 + 0.5;
+        let mut xs = s.x0;
+        for (a, b) in lefts {
+            let dy = b[1] - a[1];
+            if dy < 0.0 {
+                let bound = a[0] + (b[0] - a[0]) * (qy - a[1]) / dy - 1.5;
+                if bound.is_finite() && bound > xs as f32 {
+                    xs = (bound as u32).min(s.x1 + 1);
+                }
+            }
+        }
+        if xs > s.x1 {
+            continue;
+        }
         let row = &mut rows[((y - y_start) * width) as usize..((y - y_start + 1) * width) as usize];
-        // The covered samples of a row are contiguous (the triangle is convex): once past
+        // The covered samples of a row are contiguous (the triangle is convex, and each
+        // edge function is monotonic along the row even in floating point): once past
         // them, the rest of the row is outside.
         let mut entered = false;
-        for (x, cell) in (s.x0..=s.x1).zip(&mut row[s.x0 as usize..=s.x1 as usize]) {
+        for (x, cell) in (xs..=s.x1).zip(&mut row[xs as usize..=s.x1 as usize]) {
             let q = [x as f32 + 0.5, qy];
             let (f0, f1, f2) = (edge(p1, p2, q), edge(p2, p0, q), edge(p0, p1, q));
             if !(inside(f0, tl[0]) && inside(f1, tl[1]) && inside(f2, tl[2])) {
