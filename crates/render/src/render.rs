@@ -475,6 +475,16 @@ impl Prepared<'_> {
         let mut dirs = [Vec3::ZERO; TILE];
         let mut tint = [[1.0f32; 3]; TILE];
         let mut locs = [CubeLoc::NONE; TILE];
+        // Background rays of a segment, as `background` computes them (normalised, then
+        // attached and normalised again: a blurred frame of a still camera must equal the
+        // sharp one bit for bit), but a component array at a time, so the square roots and
+        // divisions vectorise.
+        let batch_bg = match self.rays.perspective_parts() {
+            Some(parts) if plain_bg && !eye_attached => Some(parts),
+            _ => None,
+        };
+        let (sw, sh) = (self.sw as f32, self.sh as f32);
+        let mut bg = [[0.0f32; TILE]; 3];
         // Square tiles of the band, column block by column block: neighbouring pixels read
         // neighbouring texels. Each row of a tile is shaded in three passes: directions,
         // then every texel address (prefetched, so the cache misses of a minified mirror
@@ -486,6 +496,24 @@ impl Prepared<'_> {
                 let fy = sy as f32 + 0.5;
                 let vrow = &vis[ly * w + xb..ly * w + xe];
                 let orow = &mut out[(ly * w + xb) * 4..(ly * w + xe) * 4];
+                if let Some((f, r, u)) = batch_bg {
+                    let yn = 1.0 - 2.0 * fy / sh;
+                    let uy = u * yn;
+                    let [bx, by, bz] = &mut bg;
+                    for (i, ((bx, by), bz)) in bx.iter_mut().zip(by).zip(bz).enumerate() {
+                        let xn = 2.0 * ((xb + i) as f32 + 0.5) / sw - 1.0;
+                        let x = f.x + r.x * xn + uy.x;
+                        let y = f.y + r.y * xn + uy.y;
+                        let z = f.z + r.z * xn + uy.z;
+                        let k = 1.0 / (x * x + y * y + z * z).sqrt();
+                        let (x, y, z) = (x * k, y * k, z * k);
+                        let k = 1.0 / (x * x + y * y + z * z).sqrt();
+                        let ok = k.is_finite() && k > 0.0;
+                        *bx = if ok { x * k } else { 0.0 };
+                        *by = if ok { y * k } else { 0.0 };
+                        *bz = if ok { z * k } else { 0.0 };
+                    }
+                }
                 for (i, s) in vrow.iter().enumerate() {
                     let x = xb + i;
                     let fx = x as f32 + 0.5;
@@ -494,6 +522,8 @@ impl Prepared<'_> {
                     if s.tri == NO_HIT {
                         if !background {
                             kind[i] = SKIP;
+                        } else if batch_bg.is_some() {
+                            dirs[i] = Vec3::new(bg[0][i], bg[1][i], bg[2][i]);
                         } else if plain_bg {
                             // Exactly as `background` computes it (a blurred frame of a still
                             // camera must equal the sharp one bit for bit).
