@@ -167,14 +167,26 @@ impl<'a> CubeFaces<'a> {
             );
             return out;
         }
-        let (c, stride) = (self.c, self.n as usize * self.c);
+        match self.c {
+            3 => self.footprint::<3>(l),
+            _ => self.footprint::<4>(l),
+        }
+    }
+
+    /// The bilinear blend of the 2×2 texels at `l` (inside a face), `C` channels a texel:
+    /// two row slices of constant length, so the reads need no further bounds checks.
+    #[inline(always)]
+    fn footprint<const C: usize>(&self, l: &CubeLoc) -> [f32; 3] {
+        let stride = self.n as usize * C;
         let (fx, fy) = (l.a, l.b);
         let i = l.i as usize;
-        // One bounds check for the whole 2×2 footprint.
-        let q = &self.faces[l.layer as usize][i..i + stride + c + 3];
+        let data = self.faces[l.layer as usize];
+        let r0 = &data[i..i + 2 * C];
+        let r1 = &data[i + stride..i + stride + 2 * C];
+        let mut out = [0.0f32; 3];
         for (k, o) in out.iter_mut().enumerate() {
-            let (a, b) = (q[k], q[c + k]);
-            let (e, f) = (q[stride + k], q[stride + c + k]);
+            let (a, b) = (r0[k], r0[C + k]);
+            let (e, f) = (r1[k], r1[C + k]);
             let top = a + fx * (b - a);
             let bot = e + fx * (f - e);
             *o = top + fy * (bot - top);
