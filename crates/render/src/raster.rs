@@ -19,7 +19,7 @@
 //! Work is split into horizontal bands of sample rows, rendered in parallel with rayon; each
 //! band walks the triangles binned to it.
 
-use glam::{Vec3, Vec4};
+use glam::{BVec4A, Vec3, Vec4};
 use rayon::prelude::*;
 
 /// The triangle index of a sample that sees no triangle.
@@ -313,13 +313,6 @@ fn project(v: [ClipVert; 3], tri: u32, width: u32, height: u32) -> Option<Setup>
     })
 }
 
-/// Edge function of `a → b` at `q` in the y-down grid: positive on the inside of a
-/// triangle whose [`project`] made the area positive.
-#[inline(always)]
-fn edge(a: [f32; 2], b: [f32; 2], q: [f32; 2]) -> f32 {
-    (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])
-}
-
 /// Whether a sample exactly on edge `a → b` belongs to the triangle (top-left rule, for
 /// y-down coordinates and positive area).
 #[inline]
@@ -343,7 +336,8 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
     let inv_area = 1.0 / s.area;
     // Edge functions are evaluated afresh at every sample (not accumulated), so that two
     // triangles sharing an edge compute bit-identical values there and the fill rule holds.
-    let inside = |e: f32, t: bool| e > 0.0 || (e == 0.0 && t);
+    let tl4 = tl.map(BVec4A::splat);
+    let edges = [(p1, p2), (p2, p0), (p0, p1)];
     // Each edge a → b whose function grows with x bounds a row's covered span on the
     // left: inside needs x ≥ a.x + (b.x − a.x)(y − a.y)/(b.y − a.y). The scan starts a
     // sample before that bound (rounding cannot move it that far) and tests exactly from
@@ -365,34 +359,61 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
             continue;
         }
         let row = &mut rows[((y - y_start) * width) as usize..((y - y_start + 1) * width) as usize];
+        // The edge function of a → b at sample centre q, positive inside a triangle whose
+        // [`project`] made the area positive, is (b.x − a.x)(q.y − a.y) − (b.y − a.y)(q.x −
+        // a.x) = c − d·(q.x − a.x), with c constant along the row: each sample (one SIMD
+        // lane of four) forms the same products and differences, whichever its neighbours.
+        let ec = edges.map(|(a, b)| ((b[0] - a[0]) * (qy - a[1]), b[1] - a[1], a[0]));
+        let ev = ec.map(|(c, d, ax)| (Vec4::splat(c), Vec4::splat(d), Vec4::splat(ax)));
         // The covered samples of a row are contiguous (the triangle is convex, and each
         // edge function is monotonic along the row even in floating point): once past
         // them, the rest of the row is outside.
         let mut entered = false;
-        for (x, cell) in (xs..=s.x1).zip(&mut row[xs as usize..=s.x1 as usize]) {
-            let q = [x as f32 + 0.5, qy];
-            let (f0, f1, f2) = (edge(p1, p2, q), edge(p2, p0, q), edge(p0, p1, q));
-            if !(inside(f0, tl[0]) && inside(f1, tl[1]) && inside(f2, tl[2])) {
+        let mut x4 = xs;
+        while x4 <= s.x1 {
+            let qx = Vec4::splat(x4 as f32) + LANES;
+            let mut mask = BVec4A::splat(true);
+            let mut f = [Vec4::ZERO; 3];
+            for k in 0..3 {
+                let (c, d, ax) = ev[k];
+                f[k] = c - d * (qx - ax);
+                mask &= f[k].cmpgt(Vec4::ZERO) | (f[k].cmpeq(Vec4::ZERO) & tl4[k]);
+            }
+            // Lanes past the bounding box do not count.
+            let mut bits = mask.bitmask() & (0xf >> (x4 + 3).saturating_sub(s.x1).min(3));
+            if bits == 0 {
                 if entered {
                     break;
                 }
+                x4 += 4;
                 continue;
             }
             entered = true;
-            let (l0, l1, l2) = (f0 * inv_area, f1 * inv_area, f2 * inv_area);
-            let z = l0 * s.z[0] + l1 * s.z[1] + l2 * s.z[2];
-            if z >= cell.depth || z.is_nan() || z < -1.0 {
-                continue;
+            let [f0, f1, f2] = f.map(|v| v.to_array());
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let cell = &mut row[x4 as usize + lane];
+                let (f0, f1, f2) = (f0[lane], f1[lane], f2[lane]);
+                let (l0, l1, l2) = (f0 * inv_area, f1 * inv_area, f2 * inv_area);
+                let z = l0 * s.z[0] + l1 * s.z[1] + l2 * s.z[2];
+                if z >= cell.depth || z.is_nan() || z < -1.0 {
+                    continue;
+                }
+                let (q0, q1, q2) = (l0 * s.inv_w[0], l1 * s.inv_w[1], l2 * s.inv_w[2]);
+                let sum = q0 + q1 + q2;
+                let b = (s.ob[0] * q0 + s.ob[1] * q1 + s.ob[2] * q2) / sum;
+                *cell = Sample {
+                    depth: z,
+                    tri: s.tri,
+                    b1: b.y,
+                    b2: b.z,
+                };
             }
-            let (q0, q1, q2) = (l0 * s.inv_w[0], l1 * s.inv_w[1], l2 * s.inv_w[2]);
-            let sum = q0 + q1 + q2;
-            let b = (s.ob[0] * q0 + s.ob[1] * q1 + s.ob[2] * q2) / sum;
-            *cell = Sample {
-                depth: z,
-                tri: s.tri,
-                b1: b.y,
-                b2: b.z,
-            };
+            x4 += 4;
         }
     }
 }
+
+/// Offsets of the four samples a SIMD step of [`scan`] tests (sample centres).
+const LANES: Vec4 = Vec4::new(0.5, 1.5, 2.5, 3.5);

@@ -496,6 +496,9 @@ impl Prepared<'_> {
                 let fy = sy as f32 + 0.5;
                 let vrow = &vis[ly * w + xb..ly * w + xe];
                 let orow = &mut out[(ly * w + xb) * 4..(ly * w + xe) * 4];
+                if !background && vrow.iter().all(|s| s.tri == NO_HIT) {
+                    continue; // transparent black, as `out` already holds
+                }
                 if let Some((f, r, u)) = batch_bg {
                     let yn = 1.0 - 2.0 * fy / sh;
                     let uy = u * yn;
@@ -518,8 +521,8 @@ impl Prepared<'_> {
                     let x = xb + i;
                     let fx = x as f32 + 0.5;
                     kind[i] = LOOKUP;
-                    tint[i] = [1.0; 3];
                     if s.tri == NO_HIT {
+                        tint[i] = [1.0; 3];
                         if !background {
                             kind[i] = SKIP;
                         } else if batch_bg.is_some() {
