@@ -372,12 +372,10 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
         let mut x4 = xs;
         while x4 <= s.x1 {
             let qx = Vec4::splat(x4 as f32) + LANES;
+            let f = ev.map(|(c, d, ax)| c - d * (qx - ax));
             let mut mask = BVec4A::splat(true);
-            let mut f = [Vec4::ZERO; 3];
-            for k in 0..3 {
-                let (c, d, ax) = ev[k];
-                f[k] = c - d * (qx - ax);
-                mask &= f[k].cmpgt(Vec4::ZERO) | (f[k].cmpeq(Vec4::ZERO) & tl4[k]);
+            for (fk, t) in f.iter().zip(tl4) {
+                mask &= fk.cmpgt(Vec4::ZERO) | (fk.cmpeq(Vec4::ZERO) & t);
             }
             // Lanes past the bounding box do not count.
             let mut bits = mask.bitmask() & (0xf >> (x4 + 3).saturating_sub(s.x1).min(3));

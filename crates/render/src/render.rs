@@ -444,9 +444,9 @@ impl Prepared<'_> {
 
     /// The hot loop for one sample per pixel without diagnostic channels: colour and
     /// coverage of the band of pixel rows starting at row `y0` (`vis` holds its samples,
-    /// `out` its RGBA pixels, zero on entry). Background rays are stepped along each row,
-    /// and a per-pixel mirror reads a cube map directly; what this loop does not specialise
-    /// goes through [`Prepared::shade`]. Allocates nothing.
+    /// `out` its RGBA pixels, zero on entry). Background rays are computed a tile row at a
+    /// time, and a per-pixel mirror reads a cube map directly; what this loop does not
+    /// specialise goes through [`Prepared::shade`]. Allocates nothing.
     fn shade_band_fast(&self, y0: u32, vis: &[crate::raster::Sample], out: &mut [f32]) {
         use crate::fast::{CubeFaces, CubeLoc};
         let w = self.cam.width as usize;
@@ -565,9 +565,9 @@ impl Prepared<'_> {
                 }
                 let n = vrow.len();
                 if let Some(cf) = &cube {
-                    for i in 0..n {
-                        if kind[i] == LOOKUP {
-                            locs[i] = cf.locate(dirs[i]);
+                    for ((k, d), l) in kind[..n].iter().zip(&dirs[..n]).zip(&mut locs[..n]) {
+                        if *k == LOOKUP {
+                            *l = cf.locate(*d);
                         }
                     }
                 }
