@@ -337,6 +337,7 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
     // Edge functions are evaluated afresh at every sample (not accumulated), so that two
     // triangles sharing an edge compute bit-identical values there and the fill rule holds.
     let tl4 = tl.map(BVec4A::splat);
+    let z4 = s.z.map(Vec4::splat);
     let edges = [(p1, p2), (p2, p0), (p0, p1)];
     // Each edge a → b whose function grows with x bounds a row's covered span on the
     // left: inside needs x ≥ a.x + (b.x − a.x)(y − a.y)/(b.y − a.y). The scan starts a
@@ -387,17 +388,19 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
                 continue;
             }
             entered = true;
-            let [f0, f1, f2] = f.map(|v| v.to_array());
+            // Depth for the four lanes at once (the same operations per lane), tested
+            // against the samples' depths: z < depth and z ≥ −1 (NaN fails both).
+            let l = f.map(|v| v * inv_area);
+            let z = l[0] * z4[0] + l[1] * z4[1] + l[2] * z4[2];
+            let at = |k: usize| row.get(x4 as usize + k).map_or(-2.0, |c| c.depth);
+            let depth = Vec4::new(at(0), at(1), at(2), at(3));
+            bits &= (z.cmplt(depth) & z.cmpge(Vec4::NEG_ONE)).bitmask();
+            let ([l0, l1, l2], z) = (l.map(|v| v.to_array()), z.to_array());
             while bits != 0 {
                 let lane = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
                 let cell = &mut row[x4 as usize + lane];
-                let (f0, f1, f2) = (f0[lane], f1[lane], f2[lane]);
-                let (l0, l1, l2) = (f0 * inv_area, f1 * inv_area, f2 * inv_area);
-                let z = l0 * s.z[0] + l1 * s.z[1] + l2 * s.z[2];
-                if z >= cell.depth || z.is_nan() || z < -1.0 {
-                    continue;
-                }
+                let (l0, l1, l2, z) = (l0[lane], l1[lane], l2[lane], z[lane]);
                 let (q0, q1, q2) = (l0 * s.inv_w[0], l1 * s.inv_w[1], l2 * s.inv_w[2]);
                 let sum = q0 + q1 + q2;
                 let b = (s.ob[0] * q0 + s.ob[1] * q1 + s.ob[2] * q2) / sum;
