@@ -18,7 +18,8 @@ compared, and the script fails unless all agree to within half a texel.
 map: Mesa fixed-function ``GL_REFLECTION_MAP`` texgen and a per-pixel GLSL reflection shader,
 both with no background, and mirrorball's per-pixel cube lookup (with and without the
 environment drawn behind) and mode 4 cones, from ``cargo run --release --example
-bench_render``. Best of ``--reps`` timed runs of ``--frames`` frames each.
+bench_render``. Best of ``--reps`` timed runs of ``--frames`` frames each, over ``--rounds``
+rounds that alternate Mesa and mirrorball (a shared machine's load then reaches both).
 
 Needs: Debian's ``libosmesa6`` (``apt-get install -y libosmesa6``), and from PyPI ``numpy``,
 ``PyOpenGL`` and ``OpenEXR`` (``pip install numpy PyOpenGL OpenEXR``). Run from the repository
@@ -381,29 +382,34 @@ def bench(args):
         return draw
 
     results = {}
-    for name, setup in [("mesa fixed-function GL_REFLECTION_MAP (per-vertex), no background", fixed_function),
-                        ("mesa GLSL per-pixel reflect(), no background", glsl)]:
-        draw = setup()
-        draw()
-        gl.glFinish()
-        best = 0.0
-        for _ in range(args.reps):
-            t0 = time.perf_counter()
-            for _ in range(args.frames):
-                draw()
-            gl.glFinish()
-            best = max(best, args.frames / (time.perf_counter() - t0))
-        results[name] = best
-    gl.glReadPixels(0, 0, 1, 1, gl.GL_RGBA, gl.GL_UNSIGNED_BYTE)
+
+    def keep(name, fps):
+        results[name] = max(results.get(name, 0.0), fps)
+
     ex = ROOT / "target" / "release" / "examples" / "bench_render"
-    out = subprocess.run([str(ex), "--frames", str(args.frames), "--reps", str(args.reps)],
-                         check=True, capture_output=True, text=True).stdout
-    for line in out.splitlines():
-        if "\t" in line:
-            k, v = line.split("\t")
-            results[k] = float(v)
+    # Rounds alternate Mesa and mirrorball, so that a load that comes and goes on a shared
+    # machine reaches both; each case keeps its best.
+    for _ in range(args.rounds):
+        for name, setup in [("mesa fixed-function GL_REFLECTION_MAP (per-vertex), no background", fixed_function),
+                            ("mesa GLSL per-pixel reflect(), no background", glsl)]:
+            draw = setup()
+            draw()
+            gl.glFinish()
+            for _ in range(args.reps):
+                t0 = time.perf_counter()
+                for _ in range(args.frames):
+                    draw()
+                gl.glFinish()
+                keep(name, args.frames / (time.perf_counter() - t0))
+        gl.glReadPixels(0, 0, 1, 1, gl.GL_RGBA, gl.GL_UNSIGNED_BYTE)
+        out = subprocess.run([str(ex), "--frames", str(args.frames), "--reps", str(args.reps)],
+                             check=True, capture_output=True, text=True).stdout
+        for line in out.splitlines():
+            if "\t" in line:
+                k, v = line.split("\t")
+                keep(k, float(v))
     width = max(len(k) for k in results)
-    print(f"{'1280x720, frames per second (best of %d runs of %d frames)' % (args.reps, args.frames)}")
+    print(f"1280x720, frames per second (best of {args.rounds} rounds x {args.reps} runs of {args.frames} frames)")
     for k, v in results.items():
         print(f"  {k:<{width}}  {v:8.1f}")
     if args.json:
@@ -418,6 +424,7 @@ def main():
     ap.add_argument("--size", type=int, default=256, help="image size of the agreement check")
     ap.add_argument("--frames", type=int, default=20)
     ap.add_argument("--reps", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=1, help="bench: alternate Mesa and mirrorball this often")
     ap.add_argument("--json", help="write the numbers here")
     args = ap.parse_args()
     if not args.no_build:

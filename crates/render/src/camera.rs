@@ -246,4 +246,12 @@ impl Rays {
             (self.eye + self.right * x + self.up * y, self.forward)
         }
     }
+
+    /// For a perspective camera, the `(forward, right, up)` that [`Rays::ray`] combines
+    /// into `forward + right·x + up·y` before normalising (for callers that batch rays).
+    #[inline]
+    pub fn perspective_parts(&self) -> Option<(Vec3, Vec3, Vec3)> {
+        self.perspective
+            .then_some((self.forward, self.right, self.up))
+    }
 }

@@ -66,6 +66,172 @@ pub fn bilinear(map: &EnvMap, layer: usize, u: f32, v: f32) -> [f32; 3] {
     out
 }
 
+/// A cube map's six faces, looked up once per frame instead of per sample: the per-pixel
+/// loop's bilinear lookup without the projection, filter and layer indirections. Gives
+/// exactly what [`dir_to_uv`] then [`bilinear`] give.
+#[derive(Clone, Copy)]
+pub struct CubeFaces<'a> {
+    map: &'a EnvMap,
+    faces: [&'a [f32]; 6],
+    n: i32,
+    c: usize,
+}
+
+impl<'a> CubeFaces<'a> {
+    /// `None` unless `map` is a cube of six equal square faces.
+    pub fn new(map: &'a EnvMap) -> Option<CubeFaces<'a>> {
+        if !matches!(map.projection(), Projection::Cube(_)) {
+            return None;
+        }
+        let l = map.layers();
+        if l.len() != 6 {
+            return None;
+        }
+        let (w, c) = (l[0].width(), l[0].channels());
+        if w < 2
+            || w as u64 * w as u64 * c as u64 >= SEAM as u64
+            || c < 3
+            || l.iter()
+                .any(|i| i.width() != w || i.height() != w || i.channels() != c)
+        {
+            return None;
+        }
+        Some(CubeFaces {
+            map,
+            faces: std::array::from_fn(|k| l[k].data()),
+            n: w as i32,
+            c,
+        })
+    }
+
+    /// Bilinear lookup in direction `d` (any length); zero where `d` has no face.
+    #[inline(always)]
+    pub fn sample(&self, d: Vec3) -> [f32; 3] {
+        self.fetch(&self.locate(d))
+    }
+
+    /// First half of [`CubeFaces::sample`]: where the lookup in direction `d` reads. The
+    /// texels are prefetched, so that a batch of locations has its cache misses in flight
+    /// together before [`CubeFaces::fetch`] reads them.
+    #[inline(always)]
+    pub fn locate(&self, d: Vec3) -> CubeLoc {
+        let (layer, sc, tc, ma) = mirrorball_core::CubeFace::select_f32(d);
+        if ma <= 0.0 || ma.is_nan() {
+            return CubeLoc::NONE;
+        }
+        let k = 0.5 / ma;
+        let (u, v) = (sc * k + 0.5, tc * k + 0.5);
+        if !(u.is_finite() && v.is_finite()) {
+            return CubeLoc::NONE;
+        }
+        let n = self.n;
+        let x = u * n as f32 - 0.5;
+        let y = v * n as f32 - 0.5;
+        // floor without a libm call (x86-64's baseline has no rounding instruction).
+        let (xi, yi) = (x as i32, y as i32);
+        let x0 = xi - ((xi as f32) > x) as i32;
+        let y0 = yi - ((yi as f32) > y) as i32;
+        if x0 >= 0 && y0 >= 0 && x0 + 1 < n && y0 + 1 < n {
+            let stride = n as usize * self.c;
+            let i = y0 as usize * stride + x0 as usize * self.c;
+            prefetch(&self.faces[layer][i..]);
+            prefetch(&self.faces[layer][i + stride..]);
+            return CubeLoc {
+                layer: layer as u32,
+                i: i as u32,
+                a: x - x0 as f32,
+                b: y - y0 as f32,
+            };
+        }
+        // Across a seam: the core's lookup, which joins the faces.
+        CubeLoc {
+            layer: layer as u32,
+            i: SEAM,
+            a: u,
+            b: v,
+        }
+    }
+
+    /// Second half of [`CubeFaces::sample`]: the bilinear read at `l`.
+    #[inline(always)]
+    pub fn fetch(&self, l: &CubeLoc) -> [f32; 3] {
+        let mut out = [0.0f32; 3];
+        if l.layer as usize >= 6 {
+            return out;
+        }
+        if l.i == SEAM {
+            self.map.bilinear_at(
+                l.layer as usize,
+                DVec2::new(l.a as f64, l.b as f64),
+                &mut out,
+            );
+            return out;
+        }
+        match self.c {
+            3 => self.footprint::<3>(l),
+            _ => self.footprint::<4>(l),
+        }
+    }
+
+    /// The bilinear blend of the 2×2 texels at `l` (inside a face), `C` channels a texel:
+    /// two row slices of constant length, so the reads need no further bounds checks.
+    #[inline(always)]
+    fn footprint<const C: usize>(&self, l: &CubeLoc) -> [f32; 3] {
+        let stride = self.n as usize * C;
+        let (fx, fy) = (l.a, l.b);
+        let i = l.i as usize;
+        let data = self.faces[l.layer as usize];
+        let r0 = &data[i..i + 2 * C];
+        let r1 = &data[i + stride..i + stride + 2 * C];
+        let mut out = [0.0f32; 3];
+        for (k, o) in out.iter_mut().enumerate() {
+            let (a, b) = (r0[k], r0[C + k]);
+            let (e, f) = (r1[k], r1[C + k]);
+            let top = a + fx * (b - a);
+            let bot = e + fx * (f - e);
+            *o = top + fy * (bot - top);
+        }
+        out
+    }
+}
+
+/// `CubeLoc::i` of a lookup whose footprint crosses a seam.
+const SEAM: u32 = u32::MAX;
+
+/// Where a [`CubeFaces`] lookup reads: the face, and the index of the footprint's top-left
+/// texel with the bilinear weights `(a, b)` (or, across a seam, `(u, v)` in `a, b`).
+#[derive(Clone, Copy, Debug)]
+pub struct CubeLoc {
+    layer: u32,
+    i: u32,
+    a: f32,
+    b: f32,
+}
+
+impl CubeLoc {
+    /// No face: reads as zero.
+    pub const NONE: CubeLoc = CubeLoc {
+        layer: u32::MAX,
+        i: 0,
+        a: 0.0,
+        b: 0.0,
+    };
+}
+
+/// Asks for the cache line holding `s[0]` (a hint; does nothing where unsupported).
+#[inline(always)]
+fn prefetch(s: &[f32]) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch is only a hint and cannot fault; the pointer is in bounds anyway.
+    #[allow(unused_unsafe)]
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(s.as_ptr() as *const i8);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = s;
+}
+
 /// Bilinear lookup in direction `d`; zero where the projection does not cover `d`.
 #[inline]
 pub fn sample(map: &EnvMap, d: Vec3) -> [f32; 3] {

@@ -19,7 +19,7 @@
 //! Work is split into horizontal bands of sample rows, rendered in parallel with rayon; each
 //! band walks the triangles binned to it.
 
-use glam::{Vec3, Vec4};
+use glam::{BVec4A, Vec3, Vec4};
 use rayon::prelude::*;
 
 /// The triangle index of a sample that sees no triangle.
@@ -220,27 +220,34 @@ fn setup_triangle(
         },
     ];
     let d = |c: Vec4| c.z + c.w; // ≥ 0 inside the near plane
-    let mut poly: Vec<ClipVert> = Vec::with_capacity(4);
+
+    // At most four vertices survive one plane; kept on the stack (no allocation per
+    // triangle).
+    let mut poly = [verts[0]; 4];
+    let mut len = 0;
     if verts.iter().all(|p| d(p.c) >= 0.0) {
-        poly.extend_from_slice(&verts);
+        poly[..3].copy_from_slice(&verts);
+        len = 3;
     } else {
         for i in 0..3 {
             let a = verts[i];
             let b = verts[(i + 1) % 3];
             let (da, db) = (d(a.c), d(b.c));
             if da >= 0.0 {
-                poly.push(a);
+                poly[len] = a;
+                len += 1;
             }
             if (da >= 0.0) != (db >= 0.0) {
                 let s = da / (da - db);
-                poly.push(ClipVert {
+                poly[len] = ClipVert {
                     c: a.c + (b.c - a.c) * s,
                     ob: a.ob + (b.ob - a.ob) * s,
-                });
+                };
+                len += 1;
             }
         }
     }
-    for k in 1..poly.len().saturating_sub(1) {
+    for k in 1..len.saturating_sub(1) {
         if let Some(s) = project([poly[0], poly[k], poly[k + 1]], tri, width, height) {
             out.push(s);
         }
@@ -306,13 +313,6 @@ fn project(v: [ClipVert; 3], tri: u32, width: u32, height: u32) -> Option<Setup>
     })
 }
 
-/// Edge function of `a → b` at `q` in the y-down grid: positive on the inside of a
-/// triangle whose [`project`] made the area positive.
-#[inline(always)]
-fn edge(a: [f32; 2], b: [f32; 2], q: [f32; 2]) -> f32 {
-    (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])
-}
-
 /// Whether a sample exactly on edge `a → b` belongs to the triangle (top-left rule, for
 /// y-down coordinates and positive area).
 #[inline]
@@ -336,30 +336,85 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
     let inv_area = 1.0 / s.area;
     // Edge functions are evaluated afresh at every sample (not accumulated), so that two
     // triangles sharing an edge compute bit-identical values there and the fill rule holds.
-    let inside = |e: f32, t: bool| e > 0.0 || (e == 0.0 && t);
+    let tl4 = tl.map(BVec4A::splat);
+    let z4 = s.z.map(Vec4::splat);
+    let edges = [(p1, p2), (p2, p0), (p0, p1)];
+    // Each edge a → b whose function grows with x bounds a row's covered span on the
+    // left: inside needs x ≥ a.x + (b.x − a.x)(y − a.y)/(b.y − a.y). The scan starts a
+    // sample before that bound (rounding cannot move it that far) and tests exactly from
+    // there.
+    let lefts: [([f32; 2], [f32; 2]); 3] = [(p1, p2), (p2, p0), (p0, p1)];
     for y in ya..=yb {
         let qy = y as f32 + 0.5;
+        let mut xs = s.x0;
+        for (a, b) in lefts {
+            let dy = b[1] - a[1];
+            if dy < 0.0 {
+                let bound = a[0] + (b[0] - a[0]) * (qy - a[1]) / dy - 1.5;
+                if bound.is_finite() && bound > xs as f32 {
+                    xs = (bound as u32).min(s.x1 + 1);
+                }
+            }
+        }
+        if xs > s.x1 {
+            continue;
+        }
         let row = &mut rows[((y - y_start) * width) as usize..((y - y_start + 1) * width) as usize];
-        for (x, cell) in (s.x0..=s.x1).zip(&mut row[s.x0 as usize..=s.x1 as usize]) {
-            let q = [x as f32 + 0.5, qy];
-            let (f0, f1, f2) = (edge(p1, p2, q), edge(p2, p0, q), edge(p0, p1, q));
-            if !(inside(f0, tl[0]) && inside(f1, tl[1]) && inside(f2, tl[2])) {
+        // The edge function of a → b at sample centre q, positive inside a triangle whose
+        // [`project`] made the area positive, is (b.x − a.x)(q.y − a.y) − (b.y − a.y)(q.x −
+        // a.x) = c − d·(q.x − a.x), with c constant along the row: each sample (one SIMD
+        // lane of four) forms the same products and differences, whichever its neighbours.
+        let ec = edges.map(|(a, b)| ((b[0] - a[0]) * (qy - a[1]), b[1] - a[1], a[0]));
+        let ev = ec.map(|(c, d, ax)| (Vec4::splat(c), Vec4::splat(d), Vec4::splat(ax)));
+        // The covered samples of a row are contiguous (the triangle is convex, and each
+        // edge function is monotonic along the row even in floating point): once past
+        // them, the rest of the row is outside.
+        let mut entered = false;
+        let mut x4 = xs;
+        while x4 <= s.x1 {
+            let qx = Vec4::splat(x4 as f32) + LANES;
+            let f = ev.map(|(c, d, ax)| c - d * (qx - ax));
+            let mut mask = BVec4A::splat(true);
+            for (fk, t) in f.iter().zip(tl4) {
+                mask &= fk.cmpgt(Vec4::ZERO) | (fk.cmpeq(Vec4::ZERO) & t);
+            }
+            // Lanes past the bounding box do not count.
+            let mut bits = mask.bitmask() & (0xf >> (x4 + 3).saturating_sub(s.x1).min(3));
+            if bits == 0 {
+                if entered {
+                    break;
+                }
+                x4 += 4;
                 continue;
             }
-            let (l0, l1, l2) = (f0 * inv_area, f1 * inv_area, f2 * inv_area);
-            let z = l0 * s.z[0] + l1 * s.z[1] + l2 * s.z[2];
-            if z >= cell.depth || z.is_nan() || z < -1.0 {
-                continue;
+            entered = true;
+            // Depth for the four lanes at once (the same operations per lane), tested
+            // against the samples' depths: z < depth and z ≥ −1 (NaN fails both).
+            let l = f.map(|v| v * inv_area);
+            let z = l[0] * z4[0] + l[1] * z4[1] + l[2] * z4[2];
+            let at = |k: usize| row.get(x4 as usize + k).map_or(-2.0, |c| c.depth);
+            let depth = Vec4::new(at(0), at(1), at(2), at(3));
+            bits &= (z.cmplt(depth) & z.cmpge(Vec4::NEG_ONE)).bitmask();
+            let ([l0, l1, l2], z) = (l.map(|v| v.to_array()), z.to_array());
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let cell = &mut row[x4 as usize + lane];
+                let (l0, l1, l2, z) = (l0[lane], l1[lane], l2[lane], z[lane]);
+                let (q0, q1, q2) = (l0 * s.inv_w[0], l1 * s.inv_w[1], l2 * s.inv_w[2]);
+                let sum = q0 + q1 + q2;
+                let b = (s.ob[0] * q0 + s.ob[1] * q1 + s.ob[2] * q2) / sum;
+                *cell = Sample {
+                    depth: z,
+                    tri: s.tri,
+                    b1: b.y,
+                    b2: b.z,
+                };
             }
-            let (q0, q1, q2) = (l0 * s.inv_w[0], l1 * s.inv_w[1], l2 * s.inv_w[2]);
-            let sum = q0 + q1 + q2;
-            let b = (s.ob[0] * q0 + s.ob[1] * q1 + s.ob[2] * q2) / sum;
-            *cell = Sample {
-                depth: z,
-                tri: s.tri,
-                b1: b.y,
-                b2: b.z,
-            };
+            x4 += 4;
         }
     }
 }
+
+/// Offsets of the four samples a SIMD step of [`scan`] tests (sample centres).
+const LANES: Vec4 = Vec4::new(0.5, 1.5, 2.5, 3.5);

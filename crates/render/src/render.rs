@@ -114,6 +114,9 @@ struct Shaded {
     win_depth: f32,
 }
 
+/// Columns of the square tiles the hot loop walks (a band is as many rows).
+const TILE: usize = 16;
+
 /// Renders `scene` through `cam`.
 pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame, RenderError> {
     cam.validate().map_err(RenderError)?;
@@ -173,6 +176,10 @@ pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame,
                 }
                 vis.resize((p.sw * rows * ss) as usize, crate::raster::Sample::EMPTY);
                 binned.scan_band(b, vis);
+                if ss == 1 && aov.is_none() {
+                    p.shade_band_fast(y0, vis, out);
+                    return None;
+                }
                 for ly in 0..rows {
                     for x in 0..w {
                         let mut acc = [0.0f32; 3];
@@ -469,6 +476,158 @@ impl Prepared<'_> {
             2.0 * sx / self.sw as f32 - 1.0,
             1.0 - 2.0 * sy / self.sh as f32,
         )
+    }
+
+    /// The hot loop for one sample per pixel without diagnostic channels: colour and
+    /// coverage of the band of pixel rows starting at row `y0` (`vis` holds its samples,
+    /// `out` its RGBA pixels, zero on entry). Background rays are computed a tile row at a
+    /// time, and a per-pixel mirror reads a cube map directly; what this loop does not
+    /// specialise goes through [`Prepared::shade`]. Allocates nothing.
+    fn shade_band_fast(&self, y0: u32, vis: &[crate::raster::Sample], out: &mut [f32]) {
+        use crate::fast::{CubeFaces, CubeLoc};
+        let w = self.cam.width as usize;
+        let env = self.scene.environment.as_ref();
+        let cube = env
+            .filter(|e| e.filter == Filter::Bilinear)
+            .and_then(|e| CubeFaces::new(&e.map));
+        let intensity = env.map_or(1.0, |e| e.intensity);
+        let eye_attached = env.is_some_and(|e| e.attach == Attach::Eye);
+        let background = self.scene.background;
+        // The background is a plain lookup along the view ray unless it is blurred or
+        // cone-filtered.
+        let plain_bg = background
+            && self.prev_rays.is_none()
+            && !(self.pyramid.is_some() && self.settings.indexing == Indexing::Cone);
+        let mirror_pp = self.settings.indexing == Indexing::PerPixel;
+        let persp = self.cam.is_perspective();
+        let (eye, forward) = (self.cam.eye, self.forward);
+        let rows = vis.len() / w;
+        // What a pixel of a segment needs: nothing (transparent black, as `out` holds), an
+        // environment lookup in `dirs` times `tint`, or a colour already in `tint`.
+        const SKIP: u8 = 0;
+        const LOOKUP: u8 = 1;
+        const DONE: u8 = 2;
+        let mut kind = [SKIP; TILE];
+        let mut dirs = [Vec3::ZERO; TILE];
+        let mut tint = [[1.0f32; 3]; TILE];
+        let mut locs = [CubeLoc::NONE; TILE];
+        // Background rays of a segment, as `background` computes them (normalised, then
+        // attached and normalised again: a blurred frame of a still camera must equal the
+        // sharp one bit for bit), but a component array at a time, so the square roots and
+        // divisions vectorise.
+        let batch_bg = match self.rays.perspective_parts() {
+            Some(parts) if plain_bg && !eye_attached => Some(parts),
+            _ => None,
+        };
+        let (sw, sh) = (self.sw as f32, self.sh as f32);
+        let mut bg = [[0.0f32; TILE]; 3];
+        // Square tiles of the band, column block by column block: neighbouring pixels read
+        // neighbouring texels. Each row of a tile is shaded in three passes: directions,
+        // then every texel address (prefetched, so the cache misses of a minified mirror
+        // overlap instead of queueing one after the other), then the bilinear reads.
+        for xb in (0..w).step_by(TILE) {
+            let xe = (xb + TILE).min(w);
+            for ly in 0..rows {
+                let sy = y0 + ly as u32;
+                let fy = sy as f32 + 0.5;
+                let vrow = &vis[ly * w + xb..ly * w + xe];
+                let orow = &mut out[(ly * w + xb) * 4..(ly * w + xe) * 4];
+                if !background && vrow.iter().all(|s| s.tri == NO_HIT) {
+                    continue; // transparent black, as `out` already holds
+                }
+                if let Some((f, r, u)) = batch_bg {
+                    let yn = 1.0 - 2.0 * fy / sh;
+                    let uy = u * yn;
+                    let [bx, by, bz] = &mut bg;
+                    for (i, ((bx, by), bz)) in bx.iter_mut().zip(by).zip(bz).enumerate() {
+                        let xn = 2.0 * ((xb + i) as f32 + 0.5) / sw - 1.0;
+                        let x = f.x + r.x * xn + uy.x;
+                        let y = f.y + r.y * xn + uy.y;
+                        let z = f.z + r.z * xn + uy.z;
+                        let k = 1.0 / (x * x + y * y + z * z).sqrt();
+                        let (x, y, z) = (x * k, y * k, z * k);
+                        let k = 1.0 / (x * x + y * y + z * z).sqrt();
+                        let ok = k.is_finite() && k > 0.0;
+                        *bx = if ok { x * k } else { 0.0 };
+                        *by = if ok { y * k } else { 0.0 };
+                        *bz = if ok { z * k } else { 0.0 };
+                    }
+                }
+                for (i, s) in vrow.iter().enumerate() {
+                    let x = xb + i;
+                    let fx = x as f32 + 0.5;
+                    kind[i] = LOOKUP;
+                    if s.tri == NO_HIT {
+                        tint[i] = [1.0; 3];
+                        if !background {
+                            kind[i] = SKIP;
+                        } else if batch_bg.is_some() {
+                            dirs[i] = Vec3::new(bg[0][i], bg[1][i], bg[2][i]);
+                        } else if plain_bg {
+                            // Exactly as `background` computes it (a blurred frame of a still
+                            // camera must equal the sharp one bit for bit).
+                            let (x, y) = self.ndc(fx, fy);
+                            dirs[i] = self.attach32(self.rays.ray(x, y).1);
+                        } else {
+                            kind[i] = DONE;
+                            tint[i] = self.background(fx, fy).color;
+                        }
+                        continue;
+                    }
+                    let material = &self.materials[self.tri_mat[s.tri as usize] as usize];
+                    match (material, mirror_pp) {
+                        (Material::Mirror { tint: t }, true) => {
+                            let tri = self.tris[s.tri as usize];
+                            let b = s.weights();
+                            let [i0, i1, i2] = tri.map(|i| i as usize);
+                            let n = (self.nrm[i0] * b.x + self.nrm[i1] * b.y + self.nrm[i2] * b.z)
+                                .normalize_or_zero();
+                            // The reflection is linear in the view vector, so an unnormalised
+                            // one gives the same direction, and the lookup needs no unit length.
+                            let v = if persp {
+                                self.pos[i0] * b.x + self.pos[i1] * b.y + self.pos[i2] * b.z - eye
+                            } else {
+                                forward
+                            };
+                            let r = v - 2.0 * n.dot(v) * n;
+                            dirs[i] = if eye_attached { self.view_rot * r } else { r };
+                            tint[i] = *t;
+                        }
+                        _ => {
+                            kind[i] = DONE;
+                            tint[i] = self.shade(x as u32, sy, *s).color;
+                        }
+                    }
+                }
+                let n = vrow.len();
+                if let Some(cf) = &cube {
+                    for ((k, d), l) in kind[..n].iter().zip(&dirs[..n]).zip(&mut locs[..n]) {
+                        if *k == LOOKUP {
+                            *l = cf.locate(*d);
+                        }
+                    }
+                }
+                for (i, o) in orow.chunks_exact_mut(4).enumerate() {
+                    let c = match kind[i] {
+                        SKIP => continue,
+                        DONE => tint[i],
+                        _ => {
+                            let e = match &cube {
+                                Some(cf) if intensity == 1.0 => cf.fetch(&locs[i]),
+                                Some(cf) => cf.fetch(&locs[i]).map(|c| c * intensity),
+                                None => self.read_dir32(dirs[i]).0,
+                            };
+                            let t = tint[i];
+                            [e[0] * t[0], e[1] * t[1], e[2] * t[2]]
+                        }
+                    };
+                    o[0] = c[0];
+                    o[1] = c[1];
+                    o[2] = c[2];
+                    o[3] = 1.0;
+                }
+            }
+        }
     }
 
     /// Shades one sample.
