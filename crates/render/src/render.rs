@@ -494,11 +494,11 @@ impl Prepared<'_> {
         let eye_attached = env.is_some_and(|e| e.attach == Attach::Eye);
         let background = self.scene.background;
         // The background is a plain lookup along the view ray unless it is blurred or
-        // cone-filtered.
-        let plain_bg = background
-            && self.prev_rays.is_none()
-            && !(self.pyramid.is_some() && self.settings.indexing == Indexing::Cone);
-        let mirror_pp = self.settings.indexing == Indexing::PerPixel;
+        // filtered over the pixel's footprint (a footprint sampler: trilinear, EWA, mode 4).
+        let plain_bg = background && self.prev_rays.is_none() && self.sampler.is_none();
+        // A per-pixel mirror is one lookup along the reflected ray unless a footprint
+        // sampler filters it over the pixel's corners.
+        let mirror_pp = self.settings.indexing == Indexing::PerPixel && self.sampler.is_none();
         let persp = self.cam.is_perspective();
         let (eye, forward) = (self.cam.eye, self.forward);
         let rows = vis.len() / w;
