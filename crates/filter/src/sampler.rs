@@ -411,44 +411,55 @@ impl Sampler {
             x1 = w as i64 - 1;
         }
         let omega = &self.omega[l];
-        let mut seen: Vec<u64> = Vec::new();
         let mut acc = [0.0f64; 4];
         let mut wsum = 0.0;
-        for ty in y0..=y1 {
-            for tx in x0..=x1 {
-                let inside = tx >= 0 && ty >= 0 && tx < w as i64 && ty < h as i64;
-                let (layer, px, py) = if inside {
-                    (e.layer, tx as u32, ty as u32)
-                } else {
-                    let t = proj.wrap_texel(e.layer, tx, ty, w, h);
-                    // Texels reached twice through a seam count once.
-                    let key = ((t.0 as u64) << 48) | ((t.1 as u64) << 24) | t.2 as u64;
-                    if seen.contains(&key) {
-                        continue;
-                    }
-                    seen.push(key);
-                    t
-                };
-                let om = omega[layer.min(omega.len() - 1)][(py * w + px) as usize];
-                if om <= 0.0 {
-                    continue;
-                }
-                let uv = DVec2::new((px as f64 + 0.5) / w as f64, (py as f64 + 0.5) / h as f64);
-                let Some(dir) = proj.uv_to_dir(layer, uv) else {
-                    continue;
-                };
-                let r2 = q.r2(fp.log(dir));
-                if r2 >= 1.0 {
-                    continue;
-                }
-                let wt = (-2.0 * r2).exp() * om;
-                let t = lv.layers()[layer].get(px, py);
-                for k in 0..c.min(4) {
-                    acc[k] += wt * t[k] as f64;
-                }
-                wsum += wt;
+        let mut add = |layer: usize, px: u32, py: u32| {
+            let om = omega[layer.min(omega.len() - 1)][(py * w + px) as usize];
+            if om <= 0.0 {
+                return;
             }
-        }
+            let uv = DVec2::new((px as f64 + 0.5) / w as f64, (py as f64 + 0.5) / h as f64);
+            let Some(dir) = proj.uv_to_dir(layer, uv) else {
+                return;
+            };
+            let r2 = q.r2(fp.log(dir));
+            if r2 >= 1.0 {
+                return;
+            }
+            let wt = (-2.0 * r2).exp() * om;
+            let t = lv.layers()[layer].get(px, py);
+            for k in 0..c.min(4) {
+                acc[k] += wt * t[k] as f64;
+            }
+            wsum += wt;
+        };
+        // Texels beyond the layer's edge are gathered first and summed once each afterwards:
+        // a large footprint reaches some of them twice through a seam. (A per-thread buffer,
+        // sorted and deduplicated: no allocation per lookup, no quadratic search.)
+        OUTSIDE.with(|cell| {
+            let mut outside = cell.borrow_mut();
+            outside.clear();
+            for ty in y0..=y1 {
+                for tx in x0..=x1 {
+                    if tx >= 0 && ty >= 0 && tx < w as i64 && ty < h as i64 {
+                        add(e.layer, tx as u32, ty as u32);
+                    } else {
+                        let t = proj.wrap_texel(e.layer, tx, ty, w, h);
+                        outside.push(((t.0 as u64) << 48) | ((t.1 as u64) << 24) | t.2 as u64);
+                    }
+                }
+            }
+            outside.sort_unstable();
+            outside.dedup();
+            for &key in outside.iter() {
+                let (layer, px, py) = (
+                    (key >> 48) as usize,
+                    ((key >> 24) & 0xFF_FFFF) as u32,
+                    (key & 0xFF_FFFF) as u32,
+                );
+                add(layer, px, py);
+            }
+        });
         if wsum > 0.0 {
             for v in &mut acc {
                 *v /= wsum;
@@ -463,6 +474,12 @@ impl Sampler {
             out.map(|v| v as f64)
         }
     }
+}
+
+thread_local! {
+    /// Per-thread scratch of [`Sampler::ewa_level`]: the texels a footprint reaches beyond
+    /// its layer's edge, as `layer << 48 | x << 24 | y`.
+    static OUTSIDE: std::cell::RefCell<Vec<u64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// A footprint in the tangent plane at its centre direction `d`: the conjugate
