@@ -405,11 +405,44 @@ impl Sampler {
         let (cx, cy) = (e.uv.x * w as f64 - 0.5, e.uv.y * h as f64 - 0.5);
         let (mut x0, mut x1) = ((cx - ru).ceil() as i64, (cx + ru).floor() as i64);
         let (y0, y1) = ((cy - rv).ceil() as i64, (cy + rv).floor() as i64);
+        let mut whole_rows = false;
         if x1 - x0 + 1 > w as i64 && proj.layer_count() == 1 {
             // Wider than a whole row (near a pole): each column once.
             x0 = 0;
             x1 = w as i64 - 1;
+            whole_rows = true;
         }
+        // Each row visits only the span of the (grown) ellipse, not its whole bounding box:
+        // with `M = [a b]·grow`, a point `p` from the centre is inside when
+        // `|M⁻¹p|² ≤ 1`, i.e. `A·px² + B·px + C ≤ 0` for the row's `py`, plus a texel of
+        // margin each side (a thin diagonal ellipse covers a small part of its box). Only
+        // where the map is smooth inside a layer (cube faces, lat-long): the disk and
+        // octahedral maps fold their parametrisation, and a footprint across a fold reaches
+        // texels far from its linearised ellipse, which the whole box keeps.
+        let smooth = matches!(proj, Projection::Cube(_) | Projection::LatLong(_));
+        let (ga, gb) = (a * grow, b * grow);
+        let det = ga.x * gb.y - ga.y * gb.x;
+        let qa = ga.y * ga.y + gb.y * gb.y;
+        let span = |ty: i64| -> (i64, i64) {
+            if !smooth || whole_rows || det.abs() < 1e-9 || qa < 1e-18 {
+                return (x0, x1);
+            }
+            let py = ty as f64 - cy;
+            let qb = -2.0 * py * (ga.x * ga.y + gb.x * gb.y);
+            let qc = py * py * (ga.x * ga.x + gb.x * gb.x) - det * det;
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc < 0.0 {
+                // The row passes beyond the ellipse: only the margin's texel.
+                let m = (-qb / (2.0 * qa) + cx).round() as i64;
+                return (m.max(x0), m.min(x1));
+            }
+            let r = disc.sqrt();
+            let (lo, hi) = ((-qb - r) / (2.0 * qa) + cx, (-qb + r) / (2.0 * qa) + cx);
+            (
+                ((lo - 1.0).ceil() as i64).max(x0),
+                ((hi + 1.0).floor() as i64).min(x1),
+            )
+        };
         let omega = &self.omega[l];
         let mut acc = [0.0f64; 4];
         let mut wsum = 0.0;
@@ -440,7 +473,8 @@ impl Sampler {
             let mut outside = cell.borrow_mut();
             outside.clear();
             for ty in y0..=y1 {
-                for tx in x0..=x1 {
+                let (sx0, sx1) = span(ty);
+                for tx in sx0..=sx1 {
                     if tx >= 0 && ty >= 0 && tx < w as i64 && ty < h as i64 {
                         add(e.layer, tx as u32, ty as u32);
                     } else {
