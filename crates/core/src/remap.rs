@@ -623,10 +623,10 @@ fn interior(w: u32, h: u32, layer: u32, u: f32, v: f32) -> Option<Texel> {
     let x0 = xi - ((xi as f32) > x) as i32;
     let y0 = yi - ((yi as f32) > y) as i32;
     let fits = x0 >= 0 && y0 >= 0 && x0 + 1 < wi && y0 + 1 < hi;
-    let idx = y0 as u64 * w as u64 + x0 as u64;
     if !fits || w as u64 * h as u64 > INDEX_MASK as u64 + 1 || layer as usize >= MAX_LAYERS {
         return None;
     }
+    let idx = y0 as u64 * w as u64 + x0 as u64;
     let q = |f: f32| ((f * 65536.0).round() as u32).min(65535) as u16;
     Some(Texel {
         idx: (layer << INDEX_BITS) | idx as u32,
