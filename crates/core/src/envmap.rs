@@ -245,6 +245,28 @@ impl EnvMap {
     }
 }
 
+/// Where a bilinear lookup at `(u, v)` in a `w`×`h` layer reads (texel centres at
+/// half-integers): its top-left texel `(x0, y0)`, which may lie outside the layer (`-1` or
+/// `w - 1`, `h - 1` at the edges), and the fractions `(fx, fy)` towards `+x`, `+y`, in
+/// `f32`. `floor` is taken without a libm call (x86-64's baseline has no rounding
+/// instruction). Every `f32` bilinear filter in the workspace starts here, so all agree to
+/// the bit on where they read.
+///
+/// ```
+/// let (x0, y0, fx, fy) = mirrorball_core::bilinear_corner(0.5, 0.0, 4, 2);
+/// assert_eq!((x0, y0), (1, -1)); // between texels 1 and 2; above the first row
+/// assert_eq!((fx, fy), (0.5, 0.5));
+/// ```
+#[inline(always)]
+pub fn bilinear_corner(u: f32, v: f32, w: u32, h: u32) -> (i32, i32, f32, f32) {
+    let x = u * w as f32 - 0.5;
+    let y = v * h as f32 - 0.5;
+    let (xi, yi) = (x as i32, y as i32);
+    let x0 = xi - ((xi as f32) > x) as i32;
+    let y0 = yi - ((yi as f32) > y) as i32;
+    (x0, y0, x - x0 as f32, y - y0 as f32)
+}
+
 /// `floor` as an integer without a libm call.
 #[inline(always)]
 fn floor_i(x: f64) -> i64 {
@@ -294,14 +316,9 @@ pub(crate) fn bilinear32<const C: usize>(
     out: &mut [f32],
 ) {
     let img = &layers[layer];
+    let (x0, y0, fx, fy) = bilinear_corner(u, v, img.width(), img.height());
     let (w, h) = (img.width() as i32, img.height() as i32);
-    let x = u * w as f32 - 0.5;
-    let y = v * h as f32 - 0.5;
-    let (xi, yi) = (x as i32, y as i32);
-    let x0 = xi - ((xi as f32) > x) as i32;
-    let y0 = yi - ((yi as f32) > y) as i32;
     if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h {
-        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
         let data = img.data();
         let stride = w as usize * C;
         let i00 = y0 as usize * stride + x0 as usize * C;

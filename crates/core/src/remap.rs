@@ -617,11 +617,7 @@ fn level_extent(w: u32, h: u32, level: usize) -> (u32, u32) {
 #[inline]
 fn interior(w: u32, h: u32, layer: u32, u: f32, v: f32) -> Option<Texel> {
     let (wi, hi) = (w as i32, h as i32);
-    let x = u * w as f32 - 0.5;
-    let y = v * h as f32 - 0.5;
-    let (xi, yi) = (x as i32, y as i32);
-    let x0 = xi - ((xi as f32) > x) as i32;
-    let y0 = yi - ((yi as f32) > y) as i32;
+    let (x0, y0, fx, fy) = crate::bilinear_corner(u, v, w, h);
     let fits = x0 >= 0 && y0 >= 0 && x0 + 1 < wi && y0 + 1 < hi;
     if !fits || w as u64 * h as u64 > INDEX_MASK as u64 + 1 || layer as usize >= MAX_LAYERS {
         return None;
@@ -630,8 +626,8 @@ fn interior(w: u32, h: u32, layer: u32, u: f32, v: f32) -> Option<Texel> {
     let q = |f: f32| ((f * 65536.0).round() as u32).min(65535) as u16;
     Some(Texel {
         idx: (layer << INDEX_BITS) | idx as u32,
-        fx: q(x - x0 as f32),
-        fy: q(y - y0 as f32),
+        fx: q(fx),
+        fy: q(fy),
     })
 }
 

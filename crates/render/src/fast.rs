@@ -38,17 +38,10 @@ pub fn dir_to_uv(map: &EnvMap, d: Vec3) -> Option<(usize, f32, f32)> {
 #[inline]
 pub fn bilinear(map: &EnvMap, layer: usize, u: f32, v: f32) -> [f32; 3] {
     let img = &map.layers()[layer];
+    let (x0, y0, fx, fy) = mirrorball_core::bilinear_corner(u, v, img.width(), img.height());
     let (w, h) = (img.width() as i32, img.height() as i32);
     let c = img.channels();
-    let x = u * w as f32 - 0.5;
-    let y = v * h as f32 - 0.5;
-    // floor without a libm call (x86-64's baseline has no rounding instruction).
-    let (xi, yi) = (x as i32, y as i32);
-    let x0 = xi - ((xi as f32) > x) as i32;
-    let y0 = yi - ((yi as f32) > y) as i32;
-    let (xf, yf) = (x0 as f32, y0 as f32);
     if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h {
-        let (fx, fy) = (x - xf, y - yf);
         let data = img.data();
         let stride = w as usize * c;
         let i = y0 as usize * stride + x0 as usize * c;
@@ -125,12 +118,7 @@ impl<'a> CubeFaces<'a> {
             return CubeLoc::NONE;
         }
         let n = self.n;
-        let x = u * n as f32 - 0.5;
-        let y = v * n as f32 - 0.5;
-        // floor without a libm call (x86-64's baseline has no rounding instruction).
-        let (xi, yi) = (x as i32, y as i32);
-        let x0 = xi - ((xi as f32) > x) as i32;
-        let y0 = yi - ((yi as f32) > y) as i32;
+        let (x0, y0, a, b) = mirrorball_core::bilinear_corner(u, v, n as u32, n as u32);
         if x0 >= 0 && y0 >= 0 && x0 + 1 < n && y0 + 1 < n {
             let stride = n as usize * self.c;
             let i = y0 as usize * stride + x0 as usize * self.c;
@@ -139,8 +127,8 @@ impl<'a> CubeFaces<'a> {
             return CubeLoc {
                 layer: layer as u32,
                 i: i as u32,
-                a: x - x0 as f32,
-                b: y - y0 as f32,
+                a,
+                b,
             };
         }
         // Across a seam: the core's lookup, which joins the faces.
