@@ -48,5 +48,7 @@ pub mod tone;
 pub use camera::{Camera, Lens, Rays};
 pub use lookup::{EnvCache, SpecularLobe};
 pub use mesh::{Builtin, Mesh};
-pub use render::{render, sphere_map_texcoords, texture_space_diagram, Aovs, Frame, RenderError};
+pub use render::{
+    render, render_into, sphere_map_texcoords, texture_space_diagram, Aovs, Frame, RenderError,
+};
 pub use scene::{Attach, Environment, Filter, Indexing, Material, Object, Ramp, Scene, Settings};

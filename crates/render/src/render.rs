@@ -119,6 +119,24 @@ const TILE: usize = 16;
 
 /// Renders `scene` through `cam`.
 pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame, RenderError> {
+    let mut frame = Frame {
+        color: Image::new(0, 0, 4),
+        aovs: None,
+    };
+    render_into(scene, cam, settings, &mut frame)?;
+    Ok(frame)
+}
+
+/// [`render`] into `frame`, reusing its colour image when it already has the camera's size
+/// (as a GPU renders into the same framebuffer frame after frame: no fresh memory to fault
+/// in and zero for every frame of an animation). Each band of pixel rows is cleared by the
+/// thread that renders it.
+pub fn render_into(
+    scene: &Scene,
+    cam: &Camera,
+    settings: &Settings,
+    frame: &mut Frame,
+) -> Result<(), RenderError> {
     cam.validate().map_err(RenderError)?;
     if let Some(prev) = &settings.motion_from {
         prev.validate()
@@ -154,7 +172,10 @@ pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame,
     // once, in parallel, so the samples stay in cache.
     let band_px = (16 / ss).max(1);
     let binned = Binned::new(&clip, &p.tris, p.sw, p.sh, band_px * ss);
-    let mut color = Image::new(w, h, 4);
+    let color = &mut frame.color;
+    if (color.width(), color.height(), color.channels()) != (w, h, 4) {
+        *color = Image::new(w, h, 4);
+    }
     let centre = ss / 2;
     let inv = 1.0 / (ss * ss) as f32;
     let row_len = w as usize * 4;
@@ -166,6 +187,7 @@ pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame,
         .map_init(
             Vec::new,
             |vis: &mut Vec<crate::raster::Sample>, (b, out)| {
+                out.fill(0.0);
                 let rows = (out.len() / row_len) as u32;
                 let y0 = b as u32 * band_px;
                 let mut aov: Option<[Vec<f32>; 4]> = settings
@@ -242,7 +264,8 @@ pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame,
             depth,
         }
     });
-    Ok(Frame { color, aovs })
+    frame.aovs = aovs;
+    Ok(())
 }
 
 /// Flattens the objects into world space and computes the per-vertex data of modes 1 and 2.

@@ -364,3 +364,44 @@ fn phong_map_highlight_sits_where_the_mirror_direction_meets_the_light() {
         "coarse {e_coarse} vs fine {e_fine}"
     );
 }
+
+/// Rendering into a reused frame gives exactly what a fresh render gives, whatever the frame
+/// held before: a frame full of background, reused for a scene without one, is cleared to
+/// transparent black where nothing is drawn; a frame of another size is replaced.
+#[test]
+fn render_into_a_reused_frame_equals_a_fresh_render() {
+    use mirrorball_render::render_into;
+    let env = env_of(ProjectionKind::Cube, 16, checker);
+    let with_bg = scene_with(
+        mesh::sphere(24),
+        Mat4::IDENTITY,
+        env.clone(),
+        Attach::World,
+        true,
+    );
+    let without = scene_with(mesh::sphere(24), Mat4::IDENTITY, env, Attach::World, false);
+    let cam = Camera::perspective(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 35.0, 40, 30);
+    for ss in [1, 2] {
+        for indexing in [Indexing::PerPixel, Indexing::Cone] {
+            let settings = Settings {
+                indexing,
+                supersample: ss,
+                ..Settings::default()
+            };
+            let mut frame = render(&with_bg, &cam, &settings).unwrap();
+            assert!(frame.color.data().chunks_exact(4).all(|p| p[3] == 1.0));
+            render_into(&without, &cam, &settings, &mut frame).unwrap();
+            let fresh = render(&without, &cam, &settings).unwrap();
+            assert_eq!(
+                frame.color.data(),
+                fresh.color.data(),
+                "ss {ss} {indexing:?}"
+            );
+            assert!(frame.color.data().chunks_exact(4).any(|p| p == [0.0; 4]));
+        }
+    }
+    let small = Camera::perspective(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 35.0, 8, 6);
+    let mut frame = render(&with_bg, &cam, &Settings::default()).unwrap();
+    render_into(&with_bg, &small, &Settings::default(), &mut frame).unwrap();
+    assert_eq!((frame.color.width(), frame.color.height()), (8, 6));
+}
