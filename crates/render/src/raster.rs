@@ -7,9 +7,13 @@
 //! is drawn exactly once. Depth is `z_ndc`, linear in screen space, tested with `<` and
 //! limited to `[−1, 1]` (the far plane).
 //!
-//! Attributes are not interpolated here. Each sample stores the triangle it sees and its
-//! **perspective-correct** barycentric coordinates with respect to the *original* (unclipped)
-//! triangle: with screen-space barycentrics `λᵢ` and clip `wᵢ`, the weights
+//! Attributes are not interpolated here. The scan is a depth pass: each sample keeps only its
+//! depth and the *setup* (clipped, projected triangle) it sees, four samples a SIMD step,
+//! with no per-sample branch. What a visible sample needs afterwards is computed once, from
+//! its setup ([`Binned::sample`]): the original triangle and its **perspective-correct**
+//! barycentric coordinates with respect to the *original* (unclipped) triangle, evaluated
+//! with exactly the operations the scan used, so depth and weights agree to the bit. With
+//! screen-space barycentrics `λᵢ` and clip `wᵢ`, the weights
 //! `bᵢ = (λᵢ/wᵢ) / Σⱼ(λⱼ/wⱼ)` are those under which any attribute that is linear on the
 //! triangle in eye space interpolates exactly (the hyperbolic interpolation of OpenGL 4.6
 //! §14.6.1, eq. 14.9). Vertices that clipping creates carry their own barycentric coordinates
@@ -65,7 +69,8 @@ pub struct VisBuffer {
     pub samples: Vec<Sample>,
 }
 
-/// A clipped, projected triangle ready to scan.
+/// A clipped, projected triangle ready to scan (a *setup*; a triangle that the near plane
+/// cuts gives two).
 #[derive(Clone, Copy, Debug)]
 struct Setup {
     /// Screen positions in sample units.
@@ -140,14 +145,82 @@ impl Binned {
         self.band
     }
 
-    /// Scans band `b` into `rows` (`width ×` the band's rows, reset to [`Sample::EMPTY`]
-    /// here).
-    pub fn scan_band(&self, b: usize, rows: &mut [Sample]) {
-        rows.fill(Sample::EMPTY);
+    /// Scans band `b`: `depth` and `ids` hold its samples row by row (`width ×` the band's
+    /// rows; any longer is ignored) and are reset here to far (1) and [`NO_HIT`]. Each sample
+    /// keeps the nearest depth and the setup seen there, which [`Binned::sample`] resolves.
+    pub fn scan_band(&self, b: usize, depth: &mut [f32], ids: &mut [u32]) {
         let y_start = b as u32 * self.band;
+        let rows = self.band.min(self.height.saturating_sub(y_start));
+        let n = (rows * self.width) as usize;
+        let (depth, ids) = (&mut depth[..n], &mut ids[..n]);
+        depth.fill(1.0);
+        ids.fill(NO_HIT);
         for &si in &self.bins[b] {
-            scan(&self.setups[si as usize], rows, y_start, self.width);
+            scan(
+                &self.setups[si as usize],
+                si,
+                depth,
+                ids,
+                y_start,
+                self.width,
+            );
         }
+    }
+
+    /// What the sample at `(x, y)` of the grid sees, given the setup `id` and `depth` the
+    /// scan left there: the original triangle and its perspective-correct weights, computed
+    /// with exactly the scan's operations.
+    #[inline]
+    pub fn sample(&self, id: u32, depth: f32, x: u32, y: u32) -> Sample {
+        if id == NO_HIT {
+            return Sample::EMPTY;
+        }
+        let s = &self.setups[id as usize];
+        let l = self.edge_values(id, x, y).map(|f| f * (1.0 / s.area));
+        let (q0, q1, q2) = (l[0] * s.inv_w[0], l[1] * s.inv_w[1], l[2] * s.inv_w[2]);
+        let sum = q0 + q1 + q2;
+        let b = (s.ob[0] * q0 + s.ob[1] * q1 + s.ob[2] * q2) / sum;
+        Sample {
+            depth,
+            tri: s.tri,
+            b1: b.y,
+            b2: b.z,
+        }
+    }
+
+    /// The three edge functions of setup `id` at the centre of sample `(x, y)`, as the scan
+    /// computes them: `fₖ` is twice the area of the sub-triangle opposite the setup's corner
+    /// `k`, so `fₖ / area` are the screen-space barycentrics `λₖ` (positive inside).
+    #[inline]
+    pub fn edge_values(&self, id: u32, x: u32, y: u32) -> [f32; 3] {
+        let e = self.edges(id);
+        let (qx, qy) = (x as f32 + 0.5, y as f32 + 0.5);
+        e.map(|[dx, ay, dy, ax]| dx * (qy - ay) - dy * (qx - ax))
+    }
+
+    /// Setup `id`'s edges as `[b.x − a.x, a.y, b.y − a.y, a.x]` for the edge `a → b` opposite
+    /// each corner: the edge function at `q` is `(b.x − a.x)(q.y − a.y) − (b.y − a.y)(q.x −
+    /// a.x)`.
+    #[inline]
+    pub fn edges(&self, id: u32) -> [[f32; 4]; 3] {
+        let [p0, p1, p2] = self.setups[id as usize].p;
+        [(p1, p2), (p2, p0), (p0, p1)].map(|(a, b)| [b[0] - a[0], a[1], b[1] - a[1], a[0]])
+    }
+
+    /// Setup `id`'s original triangle, the barycentric coordinates of its three corners in
+    /// that triangle, and for each corner the factor `1 / (w · area)` that turns an edge
+    /// value of [`Binned::edge_values`] into the corner's perspective weight up to one
+    /// common positive factor per sample: attributes linear on the triangle in eye space
+    /// interpolate as `Σₖ fₖ·scaleₖ·Aₖ / Σₖ fₖ·scaleₖ`.
+    pub fn corners(&self, id: u32) -> (u32, [Vec3; 3], [f32; 3]) {
+        let s = &self.setups[id as usize];
+        let inv_area = 1.0 / s.area;
+        (s.tri, s.ob, s.inv_w.map(|w| w * inv_area))
+    }
+
+    /// Number of setups (ids run from 0).
+    pub fn setup_count(&self) -> usize {
+        self.setups.len()
     }
 
     /// Whether band `b` has any triangle.
@@ -172,7 +245,16 @@ pub fn rasterize(clip: &[Vec4], tris: &[[u32; 3]], width: u32, height: u32) -> V
     samples
         .par_chunks_mut(width as usize * BAND as usize)
         .enumerate()
-        .for_each(|(b, rows)| binned.scan_band(b, rows));
+        .for_each(|(b, rows)| {
+            let mut depth = vec![1.0; rows.len()];
+            let mut ids = vec![NO_HIT; rows.len()];
+            binned.scan_band(b, &mut depth, &mut ids);
+            let y0 = b as u32 * BAND;
+            for (i, cell) in rows.iter_mut().enumerate() {
+                let (x, y) = (i as u32 % width, y0 + i as u32 / width);
+                *cell = binned.sample(ids[i], depth[i], x, y);
+            }
+        });
     VisBuffer {
         width,
         height,
@@ -323,9 +405,10 @@ fn top_left(a: [f32; 2], b: [f32; 2]) -> bool {
     (dy == 0.0 && dx > 0.0) || dy < 0.0
 }
 
-/// Scans one triangle over the rows of a band.
-fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
-    let band_rows = rows.len() as u32 / width;
+/// Scans one setup (number `id`) over the rows of a band: the depth test, four samples a
+/// step.
+fn scan(s: &Setup, id: u32, depth: &mut [f32], ids: &mut [u32], y_start: u32, width: u32) {
+    let band_rows = depth.len() as u32 / width;
     let ya = s.y0.max(y_start);
     let yb = s.y1.min(y_start + band_rows - 1);
     if ya > yb {
@@ -338,16 +421,16 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
     // triangles sharing an edge compute bit-identical values there and the fill rule holds.
     let tl4 = tl.map(BVec4A::splat);
     let z4 = s.z.map(Vec4::splat);
+    let x_end = Vec4::splat(s.x1 as f32 + 1.0);
     let edges = [(p1, p2), (p2, p0), (p0, p1)];
     // Each edge a → b whose function grows with x bounds a row's covered span on the
     // left: inside needs x ≥ a.x + (b.x − a.x)(y − a.y)/(b.y − a.y). The scan starts a
     // sample before that bound (rounding cannot move it that far) and tests exactly from
     // there.
-    let lefts: [([f32; 2], [f32; 2]); 3] = [(p1, p2), (p2, p0), (p0, p1)];
     for y in ya..=yb {
         let qy = y as f32 + 0.5;
         let mut xs = s.x0;
-        for (a, b) in lefts {
+        for (a, b) in edges {
             let dy = b[1] - a[1];
             if dy < 0.0 {
                 let bound = a[0] + (b[0] - a[0]) * (qy - a[1]) / dy - 1.5;
@@ -359,11 +442,14 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
         if xs > s.x1 {
             continue;
         }
-        let row = &mut rows[((y - y_start) * width) as usize..((y - y_start + 1) * width) as usize];
+        let r0 = ((y - y_start) * width) as usize;
+        let drow = &mut depth[r0..r0 + width as usize];
+        let irow = &mut ids[r0..r0 + width as usize];
         // The edge function of a → b at sample centre q, positive inside a triangle whose
         // [`project`] made the area positive, is (b.x − a.x)(q.y − a.y) − (b.y − a.y)(q.x −
         // a.x) = c − d·(q.x − a.x), with c constant along the row: each sample (one SIMD
-        // lane of four) forms the same products and differences, whichever its neighbours.
+        // lane of four) forms the same products and differences, whichever its neighbours,
+        // and [`Binned::edge_values`] the same again.
         let ec = edges.map(|(a, b)| ((b[0] - a[0]) * (qy - a[1]), b[1] - a[1], a[0]));
         let ev = ec.map(|(c, d, ax)| (Vec4::splat(c), Vec4::splat(d), Vec4::splat(ax)));
         // The covered samples of a row are contiguous (the triangle is convex, and each
@@ -379,7 +465,8 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
                 mask &= fk.cmpgt(Vec4::ZERO) | (fk.cmpeq(Vec4::ZERO) & t);
             }
             // Lanes past the bounding box do not count.
-            let mut bits = mask.bitmask() & (0xf >> (x4 + 3).saturating_sub(s.x1).min(3));
+            mask &= qx.cmplt(x_end);
+            let bits = mask.bitmask();
             if bits == 0 {
                 if entered {
                     break;
@@ -388,30 +475,59 @@ fn scan(s: &Setup, rows: &mut [Sample], y_start: u32, width: u32) {
                 continue;
             }
             entered = true;
-            // Depth for the four lanes at once (the same operations per lane), tested
-            // against the samples' depths: z < depth and z ≥ −1 (NaN fails both).
+            // Depth for the four lanes at once (the same operations per lane, and as
+            // [`Binned::sample`]), tested against the samples' depths: z < depth and z ≥ −1
+            // (NaN fails both).
             let l = f.map(|v| v * inv_area);
             let z = l[0] * z4[0] + l[1] * z4[1] + l[2] * z4[2];
-            let at = |k: usize| row.get(x4 as usize + k).map_or(-2.0, |c| c.depth);
-            let depth = Vec4::new(at(0), at(1), at(2), at(3));
-            bits &= (z.cmplt(depth) & z.cmpge(Vec4::NEG_ONE)).bitmask();
-            let ([l0, l1, l2], z) = (l.map(|v| v.to_array()), z.to_array());
-            while bits != 0 {
-                let lane = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let cell = &mut row[x4 as usize + lane];
-                let (l0, l1, l2, z) = (l0[lane], l1[lane], l2[lane], z[lane]);
-                let (q0, q1, q2) = (l0 * s.inv_w[0], l1 * s.inv_w[1], l2 * s.inv_w[2]);
-                let sum = q0 + q1 + q2;
-                let b = (s.ob[0] * q0 + s.ob[1] * q1 + s.ob[2] * q2) / sum;
-                *cell = Sample {
-                    depth: z,
-                    tri: s.tri,
-                    b1: b.y,
-                    b2: b.z,
-                };
+            let x = x4 as usize;
+            if x + 4 <= drow.len() {
+                let old = Vec4::from_slice(&drow[x..x + 4]);
+                let m = mask & z.cmplt(old) & z.cmpge(Vec4::NEG_ONE);
+                let keep = m.bitmask();
+                if keep == 0 {
+                    x4 += 4;
+                    continue;
+                }
+                Vec4::select(m, z, old).write_to_slice(&mut drow[x..x + 4]);
+                blend_ids(&mut irow[x..x + 4], keep, id);
+            } else {
+                let z = z.to_array();
+                for lane in 0..drow.len() - x {
+                    if bits & (1 << lane) != 0 && z[lane] < drow[x + lane] && z[lane] >= -1.0 {
+                        drow[x + lane] = z[lane];
+                        irow[x + lane] = id;
+                    }
+                }
             }
             x4 += 4;
+        }
+    }
+}
+
+/// Sets the lanes of `ids` (four) selected by the low four bits of `keep` to `id`.
+#[inline(always)]
+fn blend_ids(ids: &mut [u32], keep: u32, id: u32) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE2 is part of x86-64's baseline; `ids` holds four u32 (checked by the
+    // slice index below), read and written unaligned.
+    unsafe {
+        use std::arch::x86_64::*;
+        let ids = &mut ids[..4];
+        let p = ids.as_mut_ptr() as *mut __m128i;
+        let bit = _mm_set_epi32(8, 4, 2, 1);
+        let sel = _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(keep as i32), bit), bit);
+        let old = _mm_loadu_si128(p);
+        let new = _mm_or_si128(
+            _mm_and_si128(sel, _mm_set1_epi32(id as i32)),
+            _mm_andnot_si128(sel, old),
+        );
+        _mm_storeu_si128(p, new);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    for (lane, v) in ids[..4].iter_mut().enumerate() {
+        if keep & (1 << lane) != 0 {
+            *v = id;
         }
     }
 }

@@ -11,7 +11,7 @@ use crate::camera::Camera;
 use crate::camera::Rays;
 use crate::raster::{Binned, NO_HIT};
 use crate::scene::{Attach, Filter, Indexing, Material, Scene, Settings};
-use glam::{DVec2, DVec3, Mat3, Mat4, Vec2, Vec3, Vec4};
+use glam::{DVec2, DVec3, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4};
 use mirrorball_core::{Image, Projection, SphereMap, WorldProjection};
 use rayon::prelude::*;
 
@@ -117,6 +117,34 @@ struct Shaded {
 /// Columns of the square tiles the hot loop walks (a band is as many rows).
 const TILE: usize = 16;
 
+/// What the per-pixel mirror needs of one setup (a clipped, projected triangle), prepared
+/// once a frame: the setup's edges and, at its three corners, the normal and the vector from
+/// the eye, each scaled by the corner's `1 / (w · area)` ([`Binned::corners`]). At a sample
+/// with edge values `fₖ`, `n = Σ fₖ·nₖ` and `v = Σ fₖ·vₖ` are the perspective-correct
+/// interpolated normal and eye vector times one common positive factor, and the mirror
+/// direction `v·(n·n) − 2(n·v)·n` is `v − 2(n̂·v)n̂` times another: the cube lookup needs
+/// only the direction, so the division of the weights by their sum, the normalisation and
+/// the square root drop out.
+#[derive(Clone, Copy)]
+struct MirrorSetup {
+    edges: [[f32; 4]; 3],
+    n: [Vec3A; 3],
+    v: [Vec3A; 3],
+    tint: [f32; 3],
+    /// Whether the setup's material is a mirror (else it is shaded in full).
+    mirror: bool,
+}
+
+/// A band's visibility, as the fast loop reads it.
+struct BandVis<'a> {
+    binned: &'a Binned,
+    /// Depth and setup id per sample.
+    depth: &'a [f32],
+    ids: &'a [u32],
+    /// Per setup, when the per-pixel mirror applies.
+    mirrors: Option<&'a [MirrorSetup]>,
+}
+
 /// Renders `scene` through `cam`.
 pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame, RenderError> {
     let mut frame = Frame {
@@ -180,13 +208,17 @@ pub fn render_into(
     let inv = 1.0 / (ss * ss) as f32;
     let row_len = w as usize * 4;
     let fast_empty = !scene.background && !settings.aovs;
+    // The per-pixel mirror's corner attributes, once per setup, when the fast loop applies.
+    let mirrors = (ss == 1 && !settings.aovs)
+        .then(|| p.mirror_setups(&binned))
+        .flatten();
     let aov_bands: Vec<Option<[Vec<f32>; 4]>> = color
         .data_mut()
         .par_chunks_mut(row_len * band_px as usize)
         .enumerate()
         .map_init(
-            Vec::new,
-            |vis: &mut Vec<crate::raster::Sample>, (b, out)| {
+            || (Vec::new(), Vec::new()),
+            |(depth, ids): &mut (Vec<f32>, Vec<u32>), (b, out)| {
                 out.fill(0.0);
                 let rows = (out.len() / row_len) as u32;
                 let y0 = b as u32 * band_px;
@@ -196,10 +228,18 @@ pub fn render_into(
                 if binned.band_is_empty(b) && !scene.background && aov.is_none() {
                     return None; // already transparent black
                 }
-                vis.resize((p.sw * rows * ss) as usize, crate::raster::Sample::EMPTY);
-                binned.scan_band(b, vis);
+                let n = (p.sw * rows * ss) as usize;
+                depth.resize(n, 1.0);
+                ids.resize(n, NO_HIT);
+                binned.scan_band(b, depth, ids);
                 if ss == 1 && aov.is_none() {
-                    p.shade_band_fast(y0, vis, out);
+                    let vis = BandVis {
+                        binned: &binned,
+                        depth,
+                        ids,
+                        mirrors: mirrors.as_deref(),
+                    };
+                    p.shade_band_fast(y0, &vis, out);
                     return None;
                 }
                 for ly in 0..rows {
@@ -210,10 +250,11 @@ pub fn render_into(
                             for i in 0..ss {
                                 let (sx, lsy) = (x * ss + i, ly * ss + j);
                                 let sy = y0 * ss + lsy;
-                                let s = vis[(lsy * p.sw + sx) as usize];
-                                if s.tri == NO_HIT && fast_empty {
+                                let k = (lsy * p.sw + sx) as usize;
+                                if ids[k] == NO_HIT && fast_empty {
                                     continue; // transparent black, nothing to record
                                 }
+                                let s = binned.sample(ids[k], depth[k], sx, sy);
                                 let sh = p.shade(sx, sy, s);
                                 hits += sh.covered as u32;
                                 for (a, c) in acc.iter_mut().zip(sh.color) {
@@ -492,6 +533,50 @@ impl Prepared<'_> {
         }
     }
 
+    /// The per-pixel mirror's [`MirrorSetup`] of every setup of `binned`, or `None` where
+    /// the fast loop does not read it (another mode, or a footprint sampler).
+    fn mirror_setups(&self, binned: &Binned) -> Option<Vec<MirrorSetup>> {
+        if self.settings.indexing != Indexing::PerPixel || self.sampler.is_some() {
+            return None;
+        }
+        let persp = self.cam.is_perspective();
+        let eye = self.cam.eye;
+        Some(
+            (0..binned.setup_count() as u32)
+                .into_par_iter()
+                .map(|id| {
+                    let (tri, ob, scale) = binned.corners(id);
+                    let material = &self.materials[self.tri_mat[tri as usize] as usize];
+                    let [i0, i1, i2] = self.tris[tri as usize].map(|i| i as usize);
+                    let at = |a: &[Vec3], k: usize| {
+                        let b = ob[k];
+                        Vec3A::from(a[i0] * b.x + a[i1] * b.y + a[i2] * b.z) * scale[k]
+                    };
+                    let rel: [Vec3; 3] = [i0, i1, i2].map(|i| self.pos[i] - eye);
+                    let v = |k: usize| {
+                        let b = ob[k];
+                        Vec3A::from(rel[0] * b.x + rel[1] * b.y + rel[2] * b.z) * scale[k]
+                    };
+                    let (mirror, tint) = match material {
+                        Material::Mirror { tint } => (true, *tint),
+                        _ => (false, [0.0; 3]),
+                    };
+                    MirrorSetup {
+                        edges: binned.edges(id),
+                        n: [0, 1, 2].map(|k| at(&self.nrm, k)),
+                        v: if persp {
+                            [0, 1, 2].map(v)
+                        } else {
+                            [Vec3A::ZERO; 3]
+                        },
+                        tint,
+                        mirror,
+                    }
+                })
+                .collect(),
+        )
+    }
+
     /// NDC of the centre of sample `(sx, sy)`.
     #[inline]
     fn ndc(&self, sx: f32, sy: f32) -> (f32, f32) {
@@ -506,7 +591,7 @@ impl Prepared<'_> {
     /// `out` its RGBA pixels, zero on entry). Background rays are computed a tile row at a
     /// time, and a per-pixel mirror reads a cube map directly; what this loop does not
     /// specialise goes through [`Prepared::shade`]. Allocates nothing.
-    fn shade_band_fast(&self, y0: u32, vis: &[crate::raster::Sample], out: &mut [f32]) {
+    fn shade_band_fast(&self, y0: u32, vis: &BandVis, out: &mut [f32]) {
         use crate::fast::{CubeFaces, CubeLoc};
         let w = self.cam.width as usize;
         let env = self.scene.environment.as_ref();
@@ -520,11 +605,10 @@ impl Prepared<'_> {
         // filtered over the pixel's footprint (a footprint sampler: trilinear, EWA, mode 4).
         let plain_bg = background && self.prev_rays.is_none() && self.sampler.is_none();
         // A per-pixel mirror is one lookup along the reflected ray unless a footprint
-        // sampler filters it over the pixel's corners.
-        let mirror_pp = self.settings.indexing == Indexing::PerPixel && self.sampler.is_none();
+        // sampler filters it over the pixel's corners: then `vis.mirrors` holds its setups.
         let persp = self.cam.is_perspective();
-        let (eye, forward) = (self.cam.eye, self.forward);
-        let rows = vis.len() / w;
+        let forward = Vec3A::from(self.forward);
+        let rows = vis.ids.len() / w;
         // What a pixel of a segment needs: nothing (transparent black, as `out` holds), an
         // environment lookup in `dirs` times `tint`, or a colour already in `tint`.
         const SKIP: u8 = 0;
@@ -553,9 +637,9 @@ impl Prepared<'_> {
             for ly in 0..rows {
                 let sy = y0 + ly as u32;
                 let fy = sy as f32 + 0.5;
-                let vrow = &vis[ly * w + xb..ly * w + xe];
+                let vrow = &vis.ids[ly * w + xb..ly * w + xe];
                 let orow = &mut out[(ly * w + xb) * 4..(ly * w + xe) * 4];
-                if !background && vrow.iter().all(|s| s.tri == NO_HIT) {
+                if !background && vrow.iter().all(|&id| id == NO_HIT) {
                     continue; // transparent black, as `out` already holds
                 }
                 if let Some((f, r, u)) = batch_bg {
@@ -576,11 +660,11 @@ impl Prepared<'_> {
                         *bz = if ok { z * k } else { 0.0 };
                     }
                 }
-                for (i, s) in vrow.iter().enumerate() {
+                for (i, &id) in vrow.iter().enumerate() {
                     let x = xb + i;
                     let fx = x as f32 + 0.5;
                     kind[i] = LOOKUP;
-                    if s.tri == NO_HIT {
+                    if id == NO_HIT {
                         tint[i] = [1.0; 3];
                         if !background {
                             kind[i] = SKIP;
@@ -597,28 +681,27 @@ impl Prepared<'_> {
                         }
                         continue;
                     }
-                    let material = &self.materials[self.tri_mat[s.tri as usize] as usize];
-                    match (material, mirror_pp) {
-                        (Material::Mirror { tint: t }, true) => {
-                            let tri = self.tris[s.tri as usize];
-                            let b = s.weights();
-                            let [i0, i1, i2] = tri.map(|i| i as usize);
-                            let n = (self.nrm[i0] * b.x + self.nrm[i1] * b.y + self.nrm[i2] * b.z)
-                                .normalize_or_zero();
-                            // The reflection is linear in the view vector, so an unnormalised
-                            // one gives the same direction, and the lookup needs no unit length.
+                    match vis.mirrors.map(|m| &m[id as usize]) {
+                        Some(m) if m.mirror => {
+                            // Edge values exactly as `Binned::edge_values` computes them.
+                            let f = m
+                                .edges
+                                .map(|[dx, ay, dy, ax]| dx * (fy - ay) - dy * (fx - ax));
+                            let n = m.n[0] * f[0] + m.n[1] * f[1] + m.n[2] * f[2];
                             let v = if persp {
-                                self.pos[i0] * b.x + self.pos[i1] * b.y + self.pos[i2] * b.z - eye
+                                m.v[0] * f[0] + m.v[1] * f[1] + m.v[2] * f[2]
                             } else {
                                 forward
                             };
-                            let r = v - 2.0 * n.dot(v) * n;
+                            let r = Vec3::from(v * n.dot(n) - n * (2.0 * n.dot(v)));
                             dirs[i] = if eye_attached { self.view_rot * r } else { r };
-                            tint[i] = *t;
+                            tint[i] = m.tint;
                         }
                         _ => {
                             kind[i] = DONE;
-                            tint[i] = self.shade(x as u32, sy, *s).color;
+                            let k = ly * w + x;
+                            let s = vis.binned.sample(id, vis.depth[k], x as u32, sy);
+                            tint[i] = self.shade(x as u32, sy, s).color;
                         }
                     }
                 }
