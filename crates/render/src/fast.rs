@@ -65,9 +65,11 @@ pub fn bilinear(map: &EnvMap, layer: usize, u: f32, v: f32) -> [f32; 3] {
 #[derive(Clone, Copy)]
 pub struct CubeFaces<'a> {
     map: &'a EnvMap,
-    faces: [&'a [f32]; 6],
-    n: i32,
-    c: usize,
+    pub(crate) faces: [&'a [f32]; 6],
+    /// Face edge in texels.
+    pub(crate) n: i32,
+    /// Channels a texel.
+    pub(crate) c: usize,
 }
 
 impl<'a> CubeFaces<'a> {
@@ -140,6 +142,158 @@ impl<'a> CubeFaces<'a> {
         }
     }
 
+    /// [`CubeFaces::locate`] of four directions at once, given as component arrays,
+    /// branch-free (SSE2 on x86-64): lane `k` gives exactly what `locate(Vec3::new(x[k],
+    /// y[k], z[k]))` gives, bit for bit (the same operations
+    /// in the same order, face chosen by masks instead of branches).
+    #[inline(always)]
+    pub fn locate4(&self, x: &[f32; 4], y: &[f32; 4], z: &[f32; 4]) -> [CubeLoc; 4] {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of x86-64's baseline; the intrinsics only read and write
+        // local arrays.
+        unsafe {
+            use std::arch::x86_64::*;
+            let sel =
+                |m: __m128, a: __m128, b: __m128| _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b));
+            let (x, y, z) = (
+                _mm_loadu_ps(x.as_ptr()),
+                _mm_loadu_ps(y.as_ptr()),
+                _mm_loadu_ps(z.as_ptr()),
+            );
+            let sign = _mm_set1_ps(-0.0);
+            let (ax, ay, az) = (
+                _mm_andnot_ps(sign, x),
+                _mm_andnot_ps(sign, y),
+                _mm_andnot_ps(sign, z),
+            );
+            let (nx, ny, nz) = (
+                _mm_xor_ps(sign, x),
+                _mm_xor_ps(sign, y),
+                _mm_xor_ps(sign, z),
+            );
+            // CubeFace::select_f32's branches as masks: x major, else y major, else z.
+            let is_x = _mm_and_ps(_mm_cmpge_ps(ax, ay), _mm_cmpge_ps(ax, az));
+            let is_y = _mm_andnot_ps(is_x, _mm_cmpge_ps(ay, az));
+            let zero = _mm_setzero_ps();
+            let (px, py, pz) = (
+                _mm_cmpge_ps(x, zero),
+                _mm_cmpge_ps(y, zero),
+                _mm_cmpge_ps(z, zero),
+            );
+            let sc = sel(is_x, sel(px, nz, z), sel(is_y, x, sel(pz, x, nx)));
+            let tc = sel(is_x, ny, sel(is_y, sel(py, z, nz), ny));
+            let ma = sel(is_x, ax, sel(is_y, ay, az));
+            let pos = sel(is_x, px, sel(is_y, py, pz));
+            // Layer: 0, 2 or 4 by the major axis, plus 1 on its negative side.
+            let layer = _mm_add_epi32(
+                _mm_or_si128(
+                    _mm_and_si128(_mm_castps_si128(is_y), _mm_set1_epi32(2)),
+                    _mm_andnot_si128(_mm_castps_si128(_mm_or_ps(is_x, is_y)), _mm_set1_epi32(4)),
+                ),
+                _mm_andnot_si128(_mm_castps_si128(pos), _mm_set1_epi32(1)),
+            );
+            let valid = _mm_cmpgt_ps(ma, zero); // false for NaN
+            let k = _mm_div_ps(_mm_set1_ps(0.5), ma);
+            let half = _mm_set1_ps(0.5);
+            let u = _mm_add_ps(_mm_mul_ps(sc, k), half);
+            let v = _mm_add_ps(_mm_mul_ps(tc, k), half);
+            let inf = _mm_set1_ps(f32::INFINITY);
+            let finite = _mm_and_ps(
+                _mm_cmplt_ps(_mm_andnot_ps(sign, u), inf),
+                _mm_cmplt_ps(_mm_andnot_ps(sign, v), inf),
+            );
+            let ok = _mm_movemask_ps(_mm_and_ps(valid, finite));
+            // bilinear_corner, four lanes: truncate, then step down where that rounded up.
+            let nf = _mm_set1_ps(self.n as f32);
+            let fxy = |t: __m128| {
+                let c = _mm_sub_ps(_mm_mul_ps(t, nf), half);
+                let ti = _mm_cvttps_epi32(c);
+                let t0 = _mm_add_epi32(ti, _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(ti), c)));
+                (t0, _mm_sub_ps(c, _mm_cvtepi32_ps(t0)))
+            };
+            let (x0, fx) = fxy(u);
+            let (y0, fy) = fxy(v);
+            let lo = _mm_set1_epi32(-1);
+            let hi = _mm_set1_epi32(self.n - 1);
+            let inside = _mm_movemask_ps(_mm_castsi128_ps(_mm_and_si128(
+                _mm_and_si128(_mm_cmpgt_epi32(x0, lo), _mm_cmplt_epi32(x0, hi)),
+                _mm_and_si128(_mm_cmpgt_epi32(y0, lo), _mm_cmplt_epi32(y0, hi)),
+            )));
+            let mut a = [[0i32; 4]; 3];
+            let mut f = [[0f32; 4]; 4];
+            _mm_storeu_si128(a[0].as_mut_ptr() as *mut __m128i, layer);
+            _mm_storeu_si128(a[1].as_mut_ptr() as *mut __m128i, x0);
+            _mm_storeu_si128(a[2].as_mut_ptr() as *mut __m128i, y0);
+            for (o, t) in f.iter_mut().zip([fx, fy, u, v]) {
+                _mm_storeu_ps(o.as_mut_ptr(), t);
+            }
+            let stride = self.n as usize * self.c;
+            std::array::from_fn(|lane| {
+                if ok & (1 << lane) == 0 {
+                    return CubeLoc::NONE;
+                }
+                let layer = a[0][lane] as usize;
+                if inside & (1 << lane) == 0 {
+                    return CubeLoc {
+                        layer: layer as u32,
+                        i: SEAM,
+                        a: f[2][lane],
+                        b: f[3][lane],
+                    };
+                }
+                let i = a[2][lane] as usize * stride + a[1][lane] as usize * self.c;
+                prefetch(&self.faces[layer][i..]);
+                prefetch(&self.faces[layer][i + stride..]);
+                CubeLoc {
+                    layer: layer as u32,
+                    i: i as u32,
+                    a: f[0][lane],
+                    b: f[1][lane],
+                }
+            })
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        std::array::from_fn(|k| self.locate(Vec3::new(x[k], y[k], z[k])))
+    }
+
+    /// [`CubeFaces::fetch`] as `[r, g, b, 1]` times `[t0, t1, t2, 1]` (the tint): inside a
+    /// face, the two rows of the footprint are read as four-lane vectors (SSE2 on x86-64)
+    /// with the scalar read's operations lane by lane, so the colour is the same to the bit.
+    #[inline(always)]
+    pub fn fetch_tinted(&self, l: &CubeLoc, t: [f32; 4]) -> [f32; 4] {
+        #[cfg(target_arch = "x86_64")]
+        if (l.layer as usize) < 6 && l.i != SEAM {
+            let data = self.faces[l.layer as usize];
+            let stride = self.n as usize * self.c;
+            let i = l.i as usize;
+            // The second texel of each row is read as four lanes from its first channel,
+            // which for three channels reaches one float past it: not past the face.
+            if i + stride + self.c + 4 <= data.len() {
+                // SAFETY: SSE2 is baseline; the reads are in bounds (checked just above).
+                unsafe {
+                    use std::arch::x86_64::*;
+                    let p = data.as_ptr().add(i);
+                    let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(self.c)));
+                    let (e, f) = (
+                        _mm_loadu_ps(p.add(stride)),
+                        _mm_loadu_ps(p.add(stride + self.c)),
+                    );
+                    let fx = _mm_set1_ps(l.a);
+                    let fy = _mm_set1_ps(l.b);
+                    let top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
+                    let bot = _mm_add_ps(e, _mm_mul_ps(fx, _mm_sub_ps(f, e)));
+                    let c = _mm_add_ps(top, _mm_mul_ps(fy, _mm_sub_ps(bot, top)));
+                    let mut out = [0.0f32; 4];
+                    _mm_storeu_ps(out.as_mut_ptr(), _mm_mul_ps(c, _mm_loadu_ps(t.as_ptr())));
+                    out[3] = 1.0;
+                    return out;
+                }
+            }
+        }
+        let c = self.fetch(l);
+        [c[0] * t[0], c[1] * t[1], c[2] * t[2], 1.0]
+    }
+
     /// Second half of [`CubeFaces::sample`]: the bilinear read at `l`.
     #[inline(always)]
     pub fn fetch(&self, l: &CubeLoc) -> [f32; 3] {
@@ -184,16 +338,16 @@ impl<'a> CubeFaces<'a> {
 }
 
 /// `CubeLoc::i` of a lookup whose footprint crosses a seam.
-const SEAM: u32 = u32::MAX;
+pub(crate) const SEAM: u32 = u32::MAX;
 
 /// Where a [`CubeFaces`] lookup reads: the face, and the index of the footprint's top-left
 /// texel with the bilinear weights `(a, b)` (or, across a seam, `(u, v)` in `a, b`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CubeLoc {
-    layer: u32,
-    i: u32,
-    a: f32,
-    b: f32,
+    pub(crate) layer: u32,
+    pub(crate) i: u32,
+    pub(crate) a: f32,
+    pub(crate) b: f32,
 }
 
 impl CubeLoc {

@@ -38,6 +38,7 @@ pub mod load;
 pub mod lookup;
 pub mod maps;
 pub mod mesh;
+mod mirror;
 pub mod raster;
 mod render;
 pub mod scene;
@@ -48,6 +49,7 @@ pub mod tone;
 pub use camera::{Camera, Lens, Rays};
 pub use lookup::{EnvCache, SpecularLobe};
 pub use mesh::{Builtin, Mesh};
+pub use mirror::set_portable;
 pub use render::{
     render, render_into, sphere_map_texcoords, texture_space_diagram, Aovs, Frame, RenderError,
 };

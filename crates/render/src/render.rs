@@ -115,25 +115,7 @@ struct Shaded {
 }
 
 /// Columns of the square tiles the hot loop walks (a band is as many rows).
-const TILE: usize = 16;
-
-/// What the per-pixel mirror needs of one setup (a clipped, projected triangle), prepared
-/// once a frame: the setup's edges and, at its three corners, the normal and the vector from
-/// the eye, each scaled by the corner's `1 / (w · area)` ([`Binned::corners`]). At a sample
-/// with edge values `fₖ`, `n = Σ fₖ·nₖ` and `v = Σ fₖ·vₖ` are the perspective-correct
-/// interpolated normal and eye vector times one common positive factor, and the mirror
-/// direction `v·(n·n) − 2(n·v)·n` is `v − 2(n̂·v)n̂` times another: the cube lookup needs
-/// only the direction, so the division of the weights by their sum, the normalisation and
-/// the square root drop out.
-#[derive(Clone, Copy)]
-struct MirrorSetup {
-    edges: [[f32; 4]; 3],
-    n: [Vec3A; 3],
-    v: [Vec3A; 3],
-    tint: [f32; 3],
-    /// Whether the setup's material is a mirror (else it is shaded in full).
-    mirror: bool,
-}
+const TILE: usize = crate::mirror::SPAN;
 
 /// A band's visibility, as the fast loop reads it.
 struct BandVis<'a> {
@@ -142,7 +124,7 @@ struct BandVis<'a> {
     depth: &'a [f32],
     ids: &'a [u32],
     /// Per setup, when the per-pixel mirror applies.
-    mirrors: Option<&'a [MirrorSetup]>,
+    mirrors: Option<&'a [crate::mirror::MirrorSetup]>,
 }
 
 /// Renders `scene` through `cam`.
@@ -219,14 +201,14 @@ pub fn render_into(
         .map_init(
             || (Vec::new(), Vec::new()),
             |(depth, ids): &mut (Vec<f32>, Vec<u32>), (b, out)| {
-                out.fill(0.0);
                 let rows = (out.len() / row_len) as u32;
                 let y0 = b as u32 * band_px;
                 let mut aov: Option<[Vec<f32>; 4]> = settings
                     .aovs
                     .then(|| std::array::from_fn(|_| vec![0.0f32; (w * rows * 3) as usize]));
                 if binned.band_is_empty(b) && !scene.background && aov.is_none() {
-                    return None; // already transparent black
+                    out.fill(0.0); // transparent black
+                    return None;
                 }
                 let n = (p.sw * rows * ss) as usize;
                 depth.resize(n, 1.0);
@@ -533,9 +515,9 @@ impl Prepared<'_> {
         }
     }
 
-    /// The per-pixel mirror's [`MirrorSetup`] of every setup of `binned`, or `None` where
+    /// The per-pixel mirror's [`MirrorSetup`](crate::mirror::MirrorSetup) of every setup of `binned`, or `None` where
     /// the fast loop does not read it (another mode, or a footprint sampler).
-    fn mirror_setups(&self, binned: &Binned) -> Option<Vec<MirrorSetup>> {
+    fn mirror_setups(&self, binned: &Binned) -> Option<Vec<crate::mirror::MirrorSetup>> {
         if self.settings.indexing != Indexing::PerPixel || self.sampler.is_some() {
             return None;
         }
@@ -561,7 +543,7 @@ impl Prepared<'_> {
                         Material::Mirror { tint } => (true, *tint),
                         _ => (false, [0.0; 3]),
                     };
-                    MirrorSetup {
+                    crate::mirror::MirrorSetup {
                         edges: binned.edges(id),
                         n: [0, 1, 2].map(|k| at(&self.nrm, k)),
                         v: if persp {
@@ -588,7 +570,7 @@ impl Prepared<'_> {
 
     /// The hot loop for one sample per pixel without diagnostic channels: colour and
     /// coverage of the band of pixel rows starting at row `y0` (`vis` holds its samples,
-    /// `out` its RGBA pixels, zero on entry). Background rays are computed a tile row at a
+    /// `out` its RGBA pixels, every one written here). Background rays are computed a tile row at a
     /// time, and a per-pixel mirror reads a cube map directly; what this loop does not
     /// specialise goes through [`Prepared::shade`]. Allocates nothing.
     fn shade_band_fast(&self, y0: u32, vis: &BandVis, out: &mut [f32]) {
@@ -606,8 +588,11 @@ impl Prepared<'_> {
         let plain_bg = background && self.prev_rays.is_none() && self.sampler.is_none();
         // A per-pixel mirror is one lookup along the reflected ray unless a footprint
         // sampler filters it over the pixel's corners: then `vis.mirrors` holds its setups.
-        let persp = self.cam.is_perspective();
-        let forward = Vec3A::from(self.forward);
+        let view = crate::mirror::MirrorView {
+            persp: self.cam.is_perspective(),
+            forward: Vec3A::from(self.forward),
+            rot: eye_attached.then_some(self.view_rot),
+        };
         let rows = vis.ids.len() / w;
         // What a pixel of a segment needs: nothing (transparent black, as `out` holds), an
         // environment lookup in `dirs` times `tint`, or a colour already in `tint`.
@@ -615,7 +600,8 @@ impl Prepared<'_> {
         const LOOKUP: u8 = 1;
         const DONE: u8 = 2;
         let mut kind = [SKIP; TILE];
-        let mut dirs = [Vec3::ZERO; TILE];
+        // Directions, a component array at a time.
+        let mut dirs = [[0.0f32; TILE]; 3];
         let mut tint = [[1.0f32; 3]; TILE];
         let mut locs = [CubeLoc::NONE; TILE];
         // Background rays of a segment, as `background` computes them (normalised, then
@@ -640,7 +626,28 @@ impl Prepared<'_> {
                 let vrow = &vis.ids[ly * w + xb..ly * w + xe];
                 let orow = &mut out[(ly * w + xb) * 4..(ly * w + xe) * 4];
                 if !background && vrow.iter().all(|&id| id == NO_HIT) {
-                    continue; // transparent black, as `out` already holds
+                    orow.fill(0.0); // transparent black
+                    continue;
+                }
+                // A mirror-only row without background, eight pixels a step where it can.
+                if let (Some(m), Some(cf), false, true) =
+                    (vis.mirrors, &cube, background, intensity == 1.0)
+                {
+                    if let Some(mut left) =
+                        crate::mirror::mirror_row(vrow, xb, fy, m, &view, cf, orow)
+                    {
+                        while left != 0 {
+                            let i = left.trailing_zeros() as usize;
+                            left &= left - 1;
+                            let x = xb + i;
+                            let s = vis
+                                .binned
+                                .sample(vrow[i], vis.depth[ly * w + x], x as u32, sy);
+                            let c = self.shade(x as u32, sy, s).color;
+                            orow[i * 4..i * 4 + 4].copy_from_slice(&[c[0], c[1], c[2], 1.0]);
+                        }
+                        continue;
+                    }
                 }
                 if let Some((f, r, u)) = batch_bg {
                     let yn = 1.0 - 2.0 * fy / sh;
@@ -660,6 +667,8 @@ impl Prepared<'_> {
                         *bz = if ok { z * k } else { 0.0 };
                     }
                 }
+                // Pixels whose setup is a mirror: their directions come after this loop.
+                let mut mirror_lanes = 0u32;
                 for (i, &id) in vrow.iter().enumerate() {
                     let x = xb + i;
                     let fx = x as f32 + 0.5;
@@ -669,12 +678,15 @@ impl Prepared<'_> {
                         if !background {
                             kind[i] = SKIP;
                         } else if batch_bg.is_some() {
-                            dirs[i] = Vec3::new(bg[0][i], bg[1][i], bg[2][i]);
+                            for (d, b) in dirs.iter_mut().zip(&bg) {
+                                d[i] = b[i];
+                            }
                         } else if plain_bg {
                             // Exactly as `background` computes it (a blurred frame of a still
                             // camera must equal the sharp one bit for bit).
                             let (x, y) = self.ndc(fx, fy);
-                            dirs[i] = self.attach32(self.rays.ray(x, y).1);
+                            let r = self.attach32(self.rays.ray(x, y).1);
+                            (dirs[0][i], dirs[1][i], dirs[2][i]) = (r.x, r.y, r.z);
                         } else {
                             kind[i] = DONE;
                             tint[i] = self.background(fx, fy).color;
@@ -683,18 +695,7 @@ impl Prepared<'_> {
                     }
                     match vis.mirrors.map(|m| &m[id as usize]) {
                         Some(m) if m.mirror => {
-                            // Edge values exactly as `Binned::edge_values` computes them.
-                            let f = m
-                                .edges
-                                .map(|[dx, ay, dy, ax]| dx * (fy - ay) - dy * (fx - ax));
-                            let n = m.n[0] * f[0] + m.n[1] * f[1] + m.n[2] * f[2];
-                            let v = if persp {
-                                m.v[0] * f[0] + m.v[1] * f[1] + m.v[2] * f[2]
-                            } else {
-                                forward
-                            };
-                            let r = Vec3::from(v * n.dot(n) - n * (2.0 * n.dot(v)));
-                            dirs[i] = if eye_attached { self.view_rot * r } else { r };
+                            mirror_lanes |= 1 << i;
                             tint[i] = m.tint;
                         }
                         _ => {
@@ -705,32 +706,50 @@ impl Prepared<'_> {
                         }
                     }
                 }
+                if let (Some(m), true) = (vis.mirrors, mirror_lanes != 0) {
+                    crate::mirror::mirror_dirs(vrow, mirror_lanes, xb, fy, m, &view, &mut dirs);
+                }
                 let n = vrow.len();
+                let dir = |i: usize| Vec3::new(dirs[0][i], dirs[1][i], dirs[2][i]);
                 if let Some(cf) = &cube {
-                    for ((k, d), l) in kind[..n].iter().zip(&dirs[..n]).zip(&mut locs[..n]) {
-                        if *k == LOOKUP {
-                            *l = cf.locate(*d);
+                    // Four at a time where a lane needs it (a lane that does not is located
+                    // and ignored).
+                    let mut i = 0;
+                    while i + 4 <= n {
+                        if kind[i..i + 4].contains(&LOOKUP) {
+                            let d =
+                                |c: usize| -> &[f32; 4] { dirs[c][i..i + 4].try_into().unwrap() };
+                            locs[i..i + 4].copy_from_slice(&cf.locate4(d(0), d(1), d(2)));
+                        }
+                        i += 4;
+                    }
+                    for i in i..n {
+                        if kind[i] == LOOKUP {
+                            locs[i] = cf.locate(dir(i));
                         }
                     }
                 }
                 for (i, o) in orow.chunks_exact_mut(4).enumerate() {
                     let c = match kind[i] {
-                        SKIP => continue,
-                        DONE => tint[i],
+                        SKIP => [0.0; 4],
+                        DONE => [tint[i][0], tint[i][1], tint[i][2], 1.0],
                         _ => {
-                            let e = match &cube {
-                                Some(cf) if intensity == 1.0 => cf.fetch(&locs[i]),
-                                Some(cf) => cf.fetch(&locs[i]).map(|c| c * intensity),
-                                None => self.read_dir32(dirs[i]).0,
-                            };
                             let t = tint[i];
-                            [e[0] * t[0], e[1] * t[1], e[2] * t[2]]
+                            match &cube {
+                                Some(cf) if intensity == 1.0 => {
+                                    cf.fetch_tinted(&locs[i], [t[0], t[1], t[2], 1.0])
+                                }
+                                _ => {
+                                    let e = match &cube {
+                                        Some(cf) => cf.fetch(&locs[i]).map(|c| c * intensity),
+                                        None => self.read_dir32(dir(i)).0,
+                                    };
+                                    [e[0] * t[0], e[1] * t[1], e[2] * t[2], 1.0]
+                                }
+                            }
                         }
                     };
-                    o[0] = c[0];
-                    o[1] = c[1];
-                    o[2] = c[2];
-                    o[3] = 1.0;
+                    o.copy_from_slice(&c);
                 }
             }
         }
