@@ -33,6 +33,7 @@
 pub mod camera;
 pub mod capture;
 pub mod cone;
+mod cpu;
 pub mod fast;
 pub mod load;
 pub mod lookup;
@@ -47,9 +48,9 @@ pub mod teapot;
 pub mod tone;
 
 pub use camera::{Camera, Lens, Rays};
+pub use cpu::set_portable;
 pub use lookup::{EnvCache, SpecularLobe};
 pub use mesh::{Builtin, Mesh};
-pub use mirror::set_portable;
 pub use render::{
     render, render_into, sphere_map_texcoords, texture_space_diagram, Aovs, Frame, RenderError,
 };

@@ -79,7 +79,7 @@ pub(crate) fn mirror_dirs(
 ) {
     debug_assert!(ids.len() <= SPAN);
     #[cfg(target_arch = "x86_64")]
-    if avx2() {
+    if crate::cpu::avx2() {
         // SAFETY: the processor has AVX2 (checked just above).
         unsafe { mirror_dirs_avx2(ids, lanes, x0, fy, setups, view, dirs) };
         return;
@@ -105,24 +105,6 @@ pub(crate) fn mirror_dirs_portable(
             dirs[2][i] = r.z;
         }
     }
-}
-
-/// Whether the AVX2 path runs: the processor has AVX2 and [`set_portable`] has not turned
-/// it off.
-#[cfg(target_arch = "x86_64")]
-#[inline]
-fn avx2() -> bool {
-    !PORTABLE.load(std::sync::atomic::Ordering::Relaxed) && std::is_x86_feature_detected!("avx2")
-}
-
-static PORTABLE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// Makes the renderer's vectorised paths that depend on the processor (AVX2) step aside for
-/// the portable ones (`true`), or use them again where the processor has them (`false`,
-/// the default). The pictures are the same to the bit either way; tests and benchmarks
-/// use this to show it and to measure the difference.
-pub fn set_portable(portable: bool) {
-    PORTABLE.store(portable, std::sync::atomic::Ordering::Relaxed);
 }
 
 /// [`mirror_dirs`] eight pixels a step. Pixels of one setup share its attributes, so each
@@ -234,7 +216,7 @@ unsafe fn mirror_dirs_avx2(
 /// pixel's bilinear read ([`CubeFaces::fetch_tinted`](crate::fast::CubeFaces::fetch_tinted))
 /// written to `out` (four floats a pixel). Pixels that see nothing are written transparent black. Returns
 /// the lanes whose setup is not a mirror, left for the caller to shade; `None` where the
-/// processor lacks AVX2 (or [`set_portable`] said so), having done nothing.
+/// processor lacks AVX2 (or [`set_portable`](crate::set_portable) said so), having done nothing.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mirror_row(
     ids: &[u32],
@@ -246,7 +228,7 @@ pub(crate) fn mirror_row(
     out: &mut [f32],
 ) -> Option<u32> {
     #[cfg(target_arch = "x86_64")]
-    if avx2() {
+    if crate::cpu::avx2() {
         // SAFETY: the processor has AVX2 (checked just above).
         return Some(unsafe { mirror_row_avx2(ids, x0, fy, setups, view, cf, out) });
     }
