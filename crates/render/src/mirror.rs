@@ -107,10 +107,7 @@ pub(crate) fn mirror_dirs_portable(
     }
 }
 
-/// [`mirror_dirs`] eight pixels a step. Pixels of one setup share its attributes, so each
-/// step runs once per distinct setup among its eight pixels, with the setup's values
-/// broadcast and its pixels blended in; every lane does [`mirror_dir`]'s operations in its
-/// order (no fused multiply-add), so the bits are the same.
+/// [`mirror_dirs`] eight pixels a step ([`v8::reflect`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn mirror_dirs_avx2(
@@ -124,9 +121,6 @@ unsafe fn mirror_dirs_avx2(
 ) {
     use std::arch::x86_64::*;
     let n = ids.len().min(SPAN);
-    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-    let fyv = _mm256_set1_ps(fy);
-    let two = _mm256_set1_ps(2.0);
     let mut g = 0;
     while g < n {
         let glanes = (lanes >> g) & 0xff;
@@ -137,74 +131,12 @@ unsafe fn mirror_dirs_avx2(
         let cnt = (n - g).min(8);
         let mut idb = [crate::raster::NO_HIT; 8];
         idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
-        let idv = _mm256_loadu_si256(idb.as_ptr() as *const __m256i);
-        let fx = _mm256_add_ps(
-            _mm256_set1_ps((x0 + g) as f32),
-            _mm256_setr_ps(0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5),
-        );
-        let mut r = [_mm256_setzero_ps(); 3];
-        let mut todo = glanes;
-        while todo != 0 {
-            let id = idb[todo.trailing_zeros() as usize];
-            let same = _mm256_castsi256_ps(_mm256_cmpeq_epi32(idv, _mm256_set1_epi32(id as i32)));
-            todo &= !(_mm256_movemask_ps(same) as u32);
-            let m = &setups[id as usize];
-            let b = _mm256_set1_ps;
-            let f = m.edges.map(|[dx, ay, dy, ax]| {
-                _mm256_sub_ps(
-                    _mm256_mul_ps(b(dx), _mm256_sub_ps(fyv, b(ay))),
-                    _mm256_mul_ps(b(dy), _mm256_sub_ps(fx, b(ax))),
-                )
-            });
-            let interp = |a: &[Vec3A; 3], c: usize| {
-                _mm256_add_ps(
-                    _mm256_add_ps(
-                        _mm256_mul_ps(b(a[0][c]), f[0]),
-                        _mm256_mul_ps(b(a[1][c]), f[1]),
-                    ),
-                    _mm256_mul_ps(b(a[2][c]), f[2]),
-                )
-            };
-            let nv = [0, 1, 2].map(|c| interp(&m.n, c));
-            let vv = if view.persp {
-                [0, 1, 2].map(|c| interp(&m.v, c))
-            } else {
-                [0, 1, 2].map(|c| b(view.forward[c]))
-            };
-            let dot = |a: &[__m256; 3], c: &[__m256; 3]| {
-                _mm256_add_ps(
-                    _mm256_add_ps(_mm256_mul_ps(a[0], c[0]), _mm256_mul_ps(a[1], c[1])),
-                    _mm256_mul_ps(a[2], c[2]),
-                )
-            };
-            let nn = dot(&nv, &nv);
-            let t = _mm256_mul_ps(dot(&nv, &vv), two);
-            for c in 0..3 {
-                let rc = _mm256_sub_ps(_mm256_mul_ps(vv[c], nn), _mm256_mul_ps(nv[c], t));
-                r[c] = _mm256_blendv_ps(r[c], rc, same);
-            }
-        }
-        if let Some(rot) = view.rot {
-            let b = _mm256_set1_ps;
-            let col = [rot.x_axis, rot.y_axis, rot.z_axis];
-            r = [0, 1, 2].map(|c| {
-                _mm256_add_ps(
-                    _mm256_add_ps(
-                        _mm256_mul_ps(b(col[0][c]), r[0]),
-                        _mm256_mul_ps(b(col[1][c]), r[1]),
-                    ),
-                    _mm256_mul_ps(b(col[2][c]), r[2]),
-                )
-            });
-        }
-        let keep = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-            _mm256_and_si256(_mm256_set1_epi32(glanes as i32), bits),
-            bits,
-        ));
-        for (d, rc) in dirs.iter_mut().zip(r) {
+        let ev = v8::reflect(&idb, glanes, x0 + g, fy, setups, view);
+        let keep = v8::lane_mask(glanes);
+        for c in 0..3 {
             // g + 8 ≤ SPAN: the eight entries are in the array whatever `cnt` is.
-            let p = d[g..g + 8].as_mut_ptr();
-            _mm256_storeu_ps(p, _mm256_blendv_ps(_mm256_loadu_ps(p), rc, keep));
+            let p = dirs[c][g..g + 8].as_mut_ptr();
+            _mm256_storeu_ps(p, _mm256_blendv_ps(_mm256_loadu_ps(p), ev.r[c], keep));
         }
         g += 8;
     }
@@ -238,7 +170,6 @@ pub(crate) fn mirror_row(
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
 unsafe fn mirror_row_avx2(
     ids: &[u32],
     x0: usize,
@@ -250,16 +181,7 @@ unsafe fn mirror_row_avx2(
 ) -> u32 {
     use crate::fast::{CubeLoc, SEAM};
     use crate::raster::NO_HIT;
-    use std::arch::x86_64::*;
     let n = ids.len().min(SPAN);
-    let b = |v: f32| _mm256_set1_ps(v);
-    let fyv = b(fy);
-    let two = b(2.0);
-    let zero = _mm256_setzero_ps();
-    let half = b(0.5);
-    let sign = b(-0.0);
-    let nf = b(cf.n as f32);
-    let stride = cf.n as usize * cf.c;
     let mut left = 0u32;
     let mut g = 0;
     while g < n {
@@ -267,86 +189,299 @@ unsafe fn mirror_row_avx2(
         let mut idb = [NO_HIT; 8];
         idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
         let orow = &mut out[g * 4..(g + cnt) * 4];
-        let idv = _mm256_loadu_si256(idb.as_ptr() as *const __m256i);
-        let none = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
-            idv,
-            _mm256_set1_epi32(NO_HIT as i32),
-        ))) as u32;
-        let mut todo = !none & ((1u32 << cnt) - 1);
-        if todo == 0 {
+        let none = idb
+            .iter()
+            .enumerate()
+            .fold(0u32, |m, (i, &id)| m | ((id == NO_HIT) as u32) << i);
+        let hit = !none & ((1u32 << cnt) - 1);
+        if hit == 0 {
             orow.fill(0.0);
             g += 8;
             continue;
         }
+        let ev = v8::reflect(&idb, hit, x0 + g, fy, setups, view);
+        left |= ev.left << g;
+        let at = v8::locate(&ev.r, cf);
+        let tint = v8::lanes(&ev.tint);
+        let stride = cf.n as usize * cf.c;
+        for (lane, o) in orow.chunks_exact_mut(4).enumerate() {
+            let bit = 1 << lane;
+            if ev.mirror & bit == 0 {
+                if none & bit != 0 {
+                    o.fill(0.0);
+                }
+                continue; // not a mirror: the caller's
+            }
+            let t = [tint[0][lane], tint[1][lane], tint[2][lane], 1.0];
+            if at.ok & at.inside & bit != 0 {
+                let data = cf.faces[at.layer[lane] as usize];
+                let i = at.index[lane] as usize;
+                // As CubeFaces::fetch_tinted: the second texel of a row is read as four
+                // lanes from its first channel (one float past it for three channels).
+                if i + stride + cf.c + 4 <= data.len() {
+                    v8::bilinear_into(&data[i..], stride, cf.c, at.fx[lane], at.fy[lane], &t, o);
+                    continue;
+                }
+            }
+            let loc = if at.ok & bit == 0 {
+                CubeLoc::NONE
+            } else if at.inside & bit == 0 {
+                CubeLoc {
+                    layer: at.layer[lane] as u32,
+                    i: SEAM,
+                    a: at.u[lane],
+                    b: at.v[lane],
+                }
+            } else {
+                CubeLoc {
+                    layer: at.layer[lane] as u32,
+                    i: at.index[lane] as u32,
+                    a: at.fx[lane],
+                    b: at.fy[lane],
+                }
+            };
+            o.copy_from_slice(&cf.fetch_tinted(&loc, t));
+        }
+        g += 8;
+    }
+    left
+}
+
+/// Eight-lane building blocks (AVX2), each lane doing the scalar code's operations in its
+/// order (no fused multiply-add), so that every result is the scalar result to the bit.
+/// Functions rather than closures, so that they inherit the caller's target feature and
+/// inline.
+#[cfg(target_arch = "x86_64")]
+mod v8 {
+    use super::{MirrorSetup, MirrorView};
+    use crate::fast::CubeFaces;
+    use glam::Vec3A;
+    use std::arch::x86_64::*;
+
+    /// Reflected directions and tints of eight pixels.
+    pub struct Reflected {
+        pub r: [__m256; 3],
+        pub tint: [__m256; 3],
+        /// Lanes whose setup is a mirror (directions and tints set).
+        pub mirror: u32,
+        /// Lanes whose setup is not a mirror.
+        pub left: u32,
+    }
+
+    /// Where eight cube lookups read, as `CubeFaces::locate` computes it.
+    pub struct Located {
+        pub ok: u32,
+        pub inside: u32,
+        pub layer: [i32; 8],
+        pub index: [i32; 8],
+        pub fx: [f32; 8],
+        pub fy: [f32; 8],
+        pub u: [f32; 8],
+        pub v: [f32; 8],
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn splat(v: f32) -> __m256 {
+        _mm256_set1_ps(v)
+    }
+
+    /// `(a + b) + c` of the products `aₖ·fₖ` for component `c` of three corners.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn interp(a: &[Vec3A; 3], c: usize, f: &[__m256; 3]) -> __m256 {
+        _mm256_add_ps(
+            _mm256_add_ps(
+                _mm256_mul_ps(splat(a[0][c]), f[0]),
+                _mm256_mul_ps(splat(a[1][c]), f[1]),
+            ),
+            _mm256_mul_ps(splat(a[2][c]), f[2]),
+        )
+    }
+
+    /// `(x·x' + y·y') + z·z'`, as glam's `Vec3A::dot`.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn dot(a: &[__m256; 3], b: &[__m256; 3]) -> __m256 {
+        _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(a[0], b[0]), _mm256_mul_ps(a[1], b[1])),
+            _mm256_mul_ps(a[2], b[2]),
+        )
+    }
+
+    /// `m ? a : b`, lane by lane.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn sel(m: __m256, a: __m256, b: __m256) -> __m256 {
+        _mm256_blendv_ps(b, a, m)
+    }
+
+    /// All-ones in the lanes whose bit is set in `bits`.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub fn lane_mask(bits: u32) -> __m256 {
+        let b = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+            _mm256_and_si256(_mm256_set1_epi32(bits as i32), b),
+            b,
+        ))
+    }
+
+    /// The lanes of three vectors.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub fn lanes(v: &[__m256; 3]) -> [[f32; 8]; 3] {
+        let mut a = [[0.0f32; 8]; 3];
+        for (a, v) in a.iter_mut().zip(v) {
+            // SAFETY: `a` holds eight floats.
+            unsafe { _mm256_storeu_ps(a.as_mut_ptr(), *v) };
+        }
+        a
+    }
+
+    /// `CubeFaces::fetch_tinted` inside a face: the bilinear blend of the texels at `p[0]`,
+    /// `p[c]` and a row below (`stride` floats), weights `fx`, `fy`, times `t`, alpha 1,
+    /// into `o`. `p` must hold `stride + c + 4` floats.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub fn bilinear_into(
+        p: &[f32],
+        stride: usize,
+        c: usize,
+        fx: f32,
+        fy: f32,
+        t: &[f32; 4],
+        o: &mut [f32],
+    ) {
+        assert!(p.len() >= stride + c + 4 && o.len() >= 4);
+        // SAFETY: the reads stay within `p` and the write within `o` (asserted above).
+        unsafe {
+            let q = p.as_ptr();
+            let (a, b) = (_mm_loadu_ps(q), _mm_loadu_ps(q.add(c)));
+            let (e, f) = (_mm_loadu_ps(q.add(stride)), _mm_loadu_ps(q.add(stride + c)));
+            let fx = _mm_set1_ps(fx);
+            let top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
+            let bot = _mm_add_ps(e, _mm_mul_ps(fx, _mm_sub_ps(f, e)));
+            let v = _mm_add_ps(top, _mm_mul_ps(_mm_set1_ps(fy), _mm_sub_ps(bot, top)));
+            let v = _mm_mul_ps(v, _mm_loadu_ps(t.as_ptr()));
+            _mm_storeu_ps(o.as_mut_ptr(), _mm_blend_ps::<0b1000>(v, _mm_set1_ps(1.0)));
+        }
+    }
+
+    /// `mirror_dir` of the pixels at columns `x0 ..` of `idb` whose bit is set in `lanes`,
+    /// once per distinct setup among them (its values broadcast, its pixels blended in).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub fn reflect(
+        idb: &[u32; 8],
+        lanes: u32,
+        x0: usize,
+        fy: f32,
+        setups: &[MirrorSetup],
+        view: &MirrorView,
+    ) -> Reflected {
+        // SAFETY: `idb` holds eight u32, read unaligned.
+        let idv = unsafe { _mm256_loadu_si256(idb.as_ptr() as *const __m256i) };
         let fx = _mm256_add_ps(
-            b((x0 + g) as f32),
+            splat(x0 as f32),
             _mm256_setr_ps(0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5),
         );
-        // Reflected directions and tints, one pass per distinct setup of the eight.
-        let mut r = [zero; 3];
-        let mut tint = [zero; 3];
-        let mut mirror = 0u32;
+        let fyv = splat(fy);
+        let zero = _mm256_setzero_ps();
+        let mut out = Reflected {
+            r: [zero; 3],
+            tint: [zero; 3],
+            mirror: 0,
+            left: 0,
+        };
+        let mut todo = lanes;
         while todo != 0 {
             let id = idb[todo.trailing_zeros() as usize];
             let same = _mm256_castsi256_ps(_mm256_cmpeq_epi32(idv, _mm256_set1_epi32(id as i32)));
-            let lanes = _mm256_movemask_ps(same) as u32;
-            todo &= !lanes;
+            let bits = _mm256_movemask_ps(same) as u32 & lanes;
+            todo &= !bits;
             let m = &setups[id as usize];
             if !m.mirror {
-                left |= lanes << g;
+                out.left |= bits;
                 continue;
             }
-            mirror |= lanes;
-            let f = m.edges.map(|[dx, ay, dy, ax]| {
-                _mm256_sub_ps(
-                    _mm256_mul_ps(b(dx), _mm256_sub_ps(fyv, b(ay))),
-                    _mm256_mul_ps(b(dy), _mm256_sub_ps(fx, b(ax))),
-                )
-            });
-            let interp = |a: &[Vec3A; 3], c: usize| {
-                _mm256_add_ps(
-                    _mm256_add_ps(
-                        _mm256_mul_ps(b(a[0][c]), f[0]),
-                        _mm256_mul_ps(b(a[1][c]), f[1]),
-                    ),
-                    _mm256_mul_ps(b(a[2][c]), f[2]),
-                )
+            out.mirror |= bits;
+            let e = &m.edges;
+            let edge = |k: usize| {
+                let [dx, ay, dy, ax] = e[k];
+                (dx, ay, dy, ax)
             };
-            let nv = [0, 1, 2].map(|c| interp(&m.n, c));
-            let vv = if view.persp {
-                [0, 1, 2].map(|c| interp(&m.v, c))
+            let mut f = [zero; 3];
+            for (k, fk) in f.iter_mut().enumerate() {
+                let (dx, ay, dy, ax) = edge(k);
+                *fk = _mm256_sub_ps(
+                    _mm256_mul_ps(splat(dx), _mm256_sub_ps(fyv, splat(ay))),
+                    _mm256_mul_ps(splat(dy), _mm256_sub_ps(fx, splat(ax))),
+                );
+            }
+            let n = [
+                interp(&m.n, 0, &f),
+                interp(&m.n, 1, &f),
+                interp(&m.n, 2, &f),
+            ];
+            let v = if view.persp {
+                [
+                    interp(&m.v, 0, &f),
+                    interp(&m.v, 1, &f),
+                    interp(&m.v, 2, &f),
+                ]
             } else {
-                [0, 1, 2].map(|c| b(view.forward[c]))
+                [
+                    splat(view.forward.x),
+                    splat(view.forward.y),
+                    splat(view.forward.z),
+                ]
             };
-            let dot = |a: &[__m256; 3], c: &[__m256; 3]| {
-                _mm256_add_ps(
-                    _mm256_add_ps(_mm256_mul_ps(a[0], c[0]), _mm256_mul_ps(a[1], c[1])),
-                    _mm256_mul_ps(a[2], c[2]),
-                )
-            };
-            let nn = dot(&nv, &nv);
-            let t = _mm256_mul_ps(dot(&nv, &vv), two);
+            let nn = dot(&n, &n);
+            let t = _mm256_mul_ps(dot(&n, &v), splat(2.0));
             for c in 0..3 {
-                let rc = _mm256_sub_ps(_mm256_mul_ps(vv[c], nn), _mm256_mul_ps(nv[c], t));
-                r[c] = _mm256_blendv_ps(r[c], rc, same);
-                tint[c] = _mm256_blendv_ps(tint[c], b(m.tint[c]), same);
+                let rc = _mm256_sub_ps(_mm256_mul_ps(v[c], nn), _mm256_mul_ps(n[c], t));
+                out.r[c] = sel(same, rc, out.r[c]);
+                out.tint[c] = sel(same, splat(m.tint[c]), out.tint[c]);
             }
         }
         if let Some(rot) = view.rot {
             let col = [rot.x_axis, rot.y_axis, rot.z_axis];
-            r = [0, 1, 2].map(|c| {
-                _mm256_add_ps(
+            let r = out.r;
+            for c in 0..3 {
+                out.r[c] = _mm256_add_ps(
                     _mm256_add_ps(
-                        _mm256_mul_ps(b(col[0][c]), r[0]),
-                        _mm256_mul_ps(b(col[1][c]), r[1]),
+                        _mm256_mul_ps(splat(col[0][c]), r[0]),
+                        _mm256_mul_ps(splat(col[1][c]), r[1]),
                     ),
-                    _mm256_mul_ps(b(col[2][c]), r[2]),
-                )
-            });
+                    _mm256_mul_ps(splat(col[2][c]), r[2]),
+                );
+            }
         }
-        // CubeFace::select_f32 and CubeFaces::locate, eight lanes (as CubeFaces::locate4).
-        let sel = |m: __m256, a: __m256, c: __m256| _mm256_blendv_ps(c, a, m);
-        let [x, y, z] = r;
+        out
+    }
+
+    /// `bilinear_corner` of one coordinate: the texel below (truncate, then step down
+    /// where that rounded up) and the fraction.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn corner(t: __m256, n: __m256) -> (__m256i, __m256) {
+        let c = _mm256_sub_ps(_mm256_mul_ps(t, n), splat(0.5));
+        let ti = _mm256_cvttps_epi32(c);
+        let up = _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_cvtepi32_ps(ti), c);
+        let t0 = _mm256_add_epi32(ti, _mm256_castps_si256(up));
+        (t0, _mm256_sub_ps(c, _mm256_cvtepi32_ps(t0)))
+    }
+
+    /// `CubeFace::select_f32` and `CubeFaces::locate` of eight directions, the face chosen
+    /// by masks (as `CubeFaces::locate4`).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub fn locate(r: &[__m256; 3], cf: &CubeFaces) -> Located {
+        let [x, y, z] = *r;
+        let sign = splat(-0.0);
+        let zero = _mm256_setzero_ps();
+        let half = splat(0.5);
         let (ax, ay, az) = (
             _mm256_andnot_ps(sign, x),
             _mm256_andnot_ps(sign, y),
@@ -362,11 +497,9 @@ unsafe fn mirror_row_avx2(
             _mm256_cmp_ps::<_CMP_GE_OQ>(ax, az),
         );
         let is_y = _mm256_andnot_ps(is_x, _mm256_cmp_ps::<_CMP_GE_OQ>(ay, az));
-        let (px, py, pz) = (
-            _mm256_cmp_ps::<_CMP_GE_OQ>(x, zero),
-            _mm256_cmp_ps::<_CMP_GE_OQ>(y, zero),
-            _mm256_cmp_ps::<_CMP_GE_OQ>(z, zero),
-        );
+        let px = _mm256_cmp_ps::<_CMP_GE_OQ>(x, zero);
+        let py = _mm256_cmp_ps::<_CMP_GE_OQ>(y, zero);
+        let pz = _mm256_cmp_ps::<_CMP_GE_OQ>(z, zero);
         let sc = sel(is_x, sel(px, nz, z), sel(is_y, x, sel(pz, x, nx)));
         let tc = sel(is_x, ny, sel(is_y, sel(py, z, nz), ny));
         let ma = sel(is_x, ax, sel(is_y, ay, az));
@@ -385,72 +518,44 @@ unsafe fn mirror_row_avx2(
         let k = _mm256_div_ps(half, ma);
         let u = _mm256_add_ps(_mm256_mul_ps(sc, k), half);
         let v = _mm256_add_ps(_mm256_mul_ps(tc, k), half);
-        let inf = b(f32::INFINITY);
+        let inf = splat(f32::INFINITY);
         let finite = _mm256_and_ps(
             _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, u), inf),
             _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, v), inf),
         );
-        let ok = _mm256_movemask_ps(_mm256_and_ps(valid, finite)) as u32;
-        let corner = |t: __m256| {
-            let c = _mm256_sub_ps(_mm256_mul_ps(t, nf), half);
-            let ti = _mm256_cvttps_epi32(c);
-            let t0 = _mm256_add_epi32(
-                ti,
-                _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_cvtepi32_ps(ti), c)),
-            );
-            (t0, _mm256_sub_ps(c, _mm256_cvtepi32_ps(t0)))
-        };
-        let (x0i, fxs) = corner(u);
-        let (y0i, fys) = corner(v);
+        let nf = splat(cf.n as f32);
+        let (x0, fx) = corner(u, nf);
+        let (y0, fy) = corner(v, nf);
         let lo = _mm256_set1_epi32(-1);
         let hi = _mm256_set1_epi32(cf.n - 1);
-        let inside = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(
-            _mm256_and_si256(_mm256_cmpgt_epi32(x0i, lo), _mm256_cmpgt_epi32(hi, x0i)),
-            _mm256_and_si256(_mm256_cmpgt_epi32(y0i, lo), _mm256_cmpgt_epi32(hi, y0i)),
-        ))) as u32;
-        let index = _mm256_add_epi32(
-            _mm256_mullo_epi32(y0i, _mm256_set1_epi32(stride as i32)),
-            _mm256_mullo_epi32(x0i, _mm256_set1_epi32(cf.c as i32)),
+        let inside = _mm256_and_si256(
+            _mm256_and_si256(_mm256_cmpgt_epi32(x0, lo), _mm256_cmpgt_epi32(hi, x0)),
+            _mm256_and_si256(_mm256_cmpgt_epi32(y0, lo), _mm256_cmpgt_epi32(hi, y0)),
         );
-        let mut li = [[0i32; 8]; 2];
-        let mut lf = [[0f32; 8]; 7];
-        _mm256_storeu_si256(li[0].as_mut_ptr() as *mut __m256i, layer);
-        _mm256_storeu_si256(li[1].as_mut_ptr() as *mut __m256i, index);
-        for (o, t) in lf
-            .iter_mut()
-            .zip([fxs, fys, u, v, tint[0], tint[1], tint[2]])
-        {
-            _mm256_storeu_ps(o.as_mut_ptr(), t);
+        let stride = cf.n * cf.c as i32;
+        let index = _mm256_add_epi32(
+            _mm256_mullo_epi32(y0, _mm256_set1_epi32(stride)),
+            _mm256_mullo_epi32(x0, _mm256_set1_epi32(cf.c as i32)),
+        );
+        let mut out = Located {
+            ok: _mm256_movemask_ps(_mm256_and_ps(valid, finite)) as u32,
+            inside: _mm256_movemask_ps(_mm256_castsi256_ps(inside)) as u32,
+            layer: [0; 8],
+            index: [0; 8],
+            fx: [0.0; 8],
+            fy: [0.0; 8],
+            u: [0.0; 8],
+            v: [0.0; 8],
+        };
+        // SAFETY: each destination holds eight lanes.
+        unsafe {
+            _mm256_storeu_si256(out.layer.as_mut_ptr() as *mut __m256i, layer);
+            _mm256_storeu_si256(out.index.as_mut_ptr() as *mut __m256i, index);
+            _mm256_storeu_ps(out.fx.as_mut_ptr(), fx);
+            _mm256_storeu_ps(out.fy.as_mut_ptr(), fy);
+            _mm256_storeu_ps(out.u.as_mut_ptr(), u);
+            _mm256_storeu_ps(out.v.as_mut_ptr(), v);
         }
-        for (lane, o) in orow.chunks_exact_mut(4).enumerate() {
-            let bit = 1 << lane;
-            if mirror & bit == 0 {
-                if none & bit != 0 {
-                    o.fill(0.0);
-                }
-                continue; // not a mirror: the caller's
-            }
-            let loc = if ok & bit == 0 {
-                CubeLoc::NONE
-            } else if inside & bit == 0 {
-                CubeLoc {
-                    layer: li[0][lane] as u32,
-                    i: SEAM,
-                    a: lf[2][lane],
-                    b: lf[3][lane],
-                }
-            } else {
-                CubeLoc {
-                    layer: li[0][lane] as u32,
-                    i: li[1][lane] as u32,
-                    a: lf[0][lane],
-                    b: lf[1][lane],
-                }
-            };
-            let t = [lf[4][lane], lf[5][lane], lf[6][lane], 1.0];
-            o.copy_from_slice(&cf.fetch_tinted(&loc, t));
-        }
-        g += 8;
+        out
     }
-    left
 }

@@ -533,16 +533,23 @@ unsafe fn scan_avx2(
     if ya > yb {
         return;
     }
-    let b = |v: f32| _mm256_set1_ps(v);
     let [p0, p1, p2] = s.p;
     let edges = [(p1, p2), (p2, p0), (p0, p1)];
-    let tl = edges.map(|(a, c)| _mm256_castsi256_ps(_mm256_set1_epi32(-(top_left(a, c) as i32))));
-    let inv_area = b(1.0 / s.area);
-    let z4 = s.z.map(b);
-    let x_end = b(s.x1 as f32 + 1.0);
+    let mut tl = [_mm256_setzero_ps(); 3];
+    for (t, (a, c)) in tl.iter_mut().zip(edges) {
+        *t = _mm256_castsi256_ps(_mm256_set1_epi32(-(top_left(a, c) as i32)));
+    }
+    let inv_area = _mm256_set1_ps(1.0 / s.area);
+    let z4 = [
+        _mm256_set1_ps(s.z[0]),
+        _mm256_set1_ps(s.z[1]),
+        _mm256_set1_ps(s.z[2]),
+    ];
+    let x_end = _mm256_set1_ps(s.x1 as f32 + 1.0);
     let lanes = _mm256_setr_ps(0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5);
     let zero = _mm256_setzero_ps();
     let idv = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
+    let neg_one = _mm256_set1_ps(-1.0);
     for y in ya..=yb {
         let qy = y as f32 + 0.5;
         let mut xs = s.x0;
@@ -561,17 +568,26 @@ unsafe fn scan_avx2(
         let r0 = ((y - y_start) * width) as usize;
         let drow = &mut depth[r0..r0 + width as usize];
         let irow = &mut ids[r0..r0 + width as usize];
-        let ev = edges.map(|(a, c)| (b((c[0] - a[0]) * (qy - a[1])), b(c[1] - a[1]), b(a[0])));
+        let mut ev = [(zero, zero, zero); 3];
+        for (e, (a, c)) in ev.iter_mut().zip(edges) {
+            *e = (
+                _mm256_set1_ps((c[0] - a[0]) * (qy - a[1])),
+                _mm256_set1_ps(c[1] - a[1]),
+                _mm256_set1_ps(a[0]),
+            );
+        }
         let mut entered = false;
         let mut x8 = xs;
         while x8 <= s.x1 {
-            let qx = _mm256_add_ps(b(x8 as f32), lanes);
-            let f = ev.map(|(c, d, ax)| _mm256_sub_ps(c, _mm256_mul_ps(d, _mm256_sub_ps(qx, ax))));
+            let qx = _mm256_add_ps(_mm256_set1_ps(x8 as f32), lanes);
+            let mut f = [zero; 3];
             let mut mask = _mm256_cmp_ps::<_CMP_LT_OQ>(qx, x_end);
-            for (fk, t) in f.iter().zip(tl) {
+            for k in 0..3 {
+                let (c, d, ax) = ev[k];
+                f[k] = _mm256_sub_ps(c, _mm256_mul_ps(d, _mm256_sub_ps(qx, ax)));
                 let inside = _mm256_or_ps(
-                    _mm256_cmp_ps::<_CMP_GT_OQ>(*fk, zero),
-                    _mm256_and_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(*fk, zero), t),
+                    _mm256_cmp_ps::<_CMP_GT_OQ>(f[k], zero),
+                    _mm256_and_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(f[k], zero), tl[k]),
                 );
                 mask = _mm256_and_ps(mask, inside);
             }
@@ -583,10 +599,12 @@ unsafe fn scan_avx2(
                 continue;
             }
             entered = true;
-            let l = f.map(|v| _mm256_mul_ps(v, inv_area));
             let z = _mm256_add_ps(
-                _mm256_add_ps(_mm256_mul_ps(l[0], z4[0]), _mm256_mul_ps(l[1], z4[1])),
-                _mm256_mul_ps(l[2], z4[2]),
+                _mm256_add_ps(
+                    _mm256_mul_ps(_mm256_mul_ps(f[0], inv_area), z4[0]),
+                    _mm256_mul_ps(_mm256_mul_ps(f[1], inv_area), z4[1]),
+                ),
+                _mm256_mul_ps(_mm256_mul_ps(f[2], inv_area), z4[2]),
             );
             let x = x8 as usize;
             if x + 8 <= drow.len() {
@@ -597,7 +615,7 @@ unsafe fn scan_avx2(
                     mask,
                     _mm256_and_ps(
                         _mm256_cmp_ps::<_CMP_LT_OQ>(z, old),
-                        _mm256_cmp_ps::<_CMP_GE_OQ>(z, b(-1.0)),
+                        _mm256_cmp_ps::<_CMP_GE_OQ>(z, neg_one),
                     ),
                 );
                 if _mm256_movemask_ps(m) != 0 {
