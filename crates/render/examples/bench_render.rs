@@ -1,7 +1,8 @@
 //! Frames per second at 1280×720 for `bench/render_mesa.py bench`: a mirror bunny and a
 //! mirror teapot in a cube map (city.exr as six 256² faces). Prints `name<TAB>fps` lines,
 //! best of `--reps` runs of `--frames` frames, each rendered into one reused frame (as Mesa
-//! renders into its framebuffer).
+//! renders into its framebuffer). `--only TEXT` keeps the cases whose name has it;
+//! `--portable` turns the AVX2 paths off.
 
 use glam::{Mat4, Vec3};
 use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
@@ -23,6 +24,10 @@ fn arg(name: &str, default: u32) -> u32 {
 }
 
 fn main() {
+    // `--portable`: without the AVX2 paths (the same pictures), to measure what they give.
+    if std::env::args().any(|a| a == "--portable") {
+        mirrorball_render::set_portable(true);
+    }
     let frames = arg("--frames", 20);
     let reps = arg("--reps", 3);
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");

@@ -133,10 +133,10 @@ unsafe fn mirror_dirs_avx2(
         idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
         let ev = v8::reflect(&idb, glanes, x0 + g, fy, setups, view);
         let keep = v8::lane_mask(glanes);
-        for c in 0..3 {
+        for (d, r) in dirs.iter_mut().zip(ev.r) {
             // g + 8 ≤ SPAN: the eight entries are in the array whatever `cnt` is.
-            let p = dirs[c][g..g + 8].as_mut_ptr();
-            _mm256_storeu_ps(p, _mm256_blendv_ps(_mm256_loadu_ps(p), ev.r[c], keep));
+            let p = d[g..g + 8].as_mut_ptr();
+            _mm256_storeu_ps(p, _mm256_blendv_ps(_mm256_loadu_ps(p), r, keep));
         }
         g += 8;
     }
@@ -448,8 +448,8 @@ mod v8 {
         if let Some(rot) = view.rot {
             let col = [rot.x_axis, rot.y_axis, rot.z_axis];
             let r = out.r;
-            for c in 0..3 {
-                out.r[c] = _mm256_add_ps(
+            for (c, rc) in out.r.iter_mut().enumerate() {
+                *rc = _mm256_add_ps(
                     _mm256_add_ps(
                         _mm256_mul_ps(splat(col[0][c]), r[0]),
                         _mm256_mul_ps(splat(col[1][c]), r[1]),
