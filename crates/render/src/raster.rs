@@ -432,22 +432,9 @@ fn scan(s: &Setup, id: u32, depth: &mut [f32], ids: &mut [u32], y_start: u32, wi
     let z4 = s.z.map(Vec4::splat);
     let x_end = Vec4::splat(s.x1 as f32 + 1.0);
     let edges = [(p1, p2), (p2, p0), (p0, p1)];
-    // Each edge a → b whose function grows with x bounds a row's covered span on the
-    // left: inside needs x ≥ a.x + (b.x − a.x)(y − a.y)/(b.y − a.y). The scan starts a
-    // sample before that bound (rounding cannot move it that far) and tests exactly from
-    // there.
     for y in ya..=yb {
         let qy = y as f32 + 0.5;
-        let mut xs = s.x0;
-        for (a, b) in edges {
-            let dy = b[1] - a[1];
-            if dy < 0.0 {
-                let bound = a[0] + (b[0] - a[0]) * (qy - a[1]) / dy - 1.5;
-                if bound.is_finite() && bound > xs as f32 {
-                    xs = (bound as u32).min(s.x1 + 1);
-                }
-            }
-        }
+        let xs = row_start(s, &edges, qy);
         if xs > s.x1 {
             continue;
         }
@@ -514,6 +501,26 @@ fn scan(s: &Setup, id: u32, depth: &mut [f32], ids: &mut [u32], y_start: u32, wi
     }
 }
 
+/// Where the scan of sample row `qy` (its centre) starts: each edge a → b whose function
+/// grows with x bounds the row's covered span on the left (inside needs x ≥ a.x + (b.x −
+/// a.x)(y − a.y)/(b.y − a.y)); the scan starts a sample before the rightmost such bound
+/// (rounding cannot move it that far) and tests exactly from there. Past `s.x1` where the
+/// row is empty.
+#[inline(always)]
+fn row_start(s: &Setup, edges: &[([f32; 2], [f32; 2]); 3], qy: f32) -> u32 {
+    let mut xs = s.x0;
+    for &(a, b) in edges {
+        let dy = b[1] - a[1];
+        if dy < 0.0 {
+            let bound = a[0] + (b[0] - a[0]) * (qy - a[1]) / dy - 1.5;
+            if bound.is_finite() && bound > xs as f32 {
+                xs = (bound as u32).min(s.x1 + 1);
+            }
+        }
+    }
+    xs
+}
+
 /// [`scan`] eight samples a step (AVX2): each lane does the same operations in the same
 /// order, so depths, ids and the fill rule come out the same to the bit.
 #[cfg(target_arch = "x86_64")]
@@ -552,16 +559,7 @@ unsafe fn scan_avx2(
     let neg_one = _mm256_set1_ps(-1.0);
     for y in ya..=yb {
         let qy = y as f32 + 0.5;
-        let mut xs = s.x0;
-        for (a, c) in edges {
-            let dy = c[1] - a[1];
-            if dy < 0.0 {
-                let bound = a[0] + (c[0] - a[0]) * (qy - a[1]) / dy - 1.5;
-                if bound.is_finite() && bound > xs as f32 {
-                    xs = (bound as u32).min(s.x1 + 1);
-                }
-            }
-        }
+        let xs = row_start(s, &edges, qy);
         if xs > s.x1 {
             continue;
         }
