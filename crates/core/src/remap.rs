@@ -420,6 +420,10 @@ fn gather_one<const C: usize>(
     }
 }
 
+/// Entries ahead of the current one whose source texels [`gather_row_sse`] prefetches.
+#[cfg(target_arch = "x86_64")]
+const AHEAD: usize = 24;
+
 /// The bilinear pass with SSE2: each texel's fractions decoded from its packed entry in
 /// one vector, its four source texels blended four channels at a time (`lerp4`'s
 /// arithmetic, so the same bits). `SINGLE`: the source has one layer, so the entry's layer
@@ -438,6 +442,21 @@ unsafe fn gather_row_sse<const C: usize, const SINGLE: bool>(
     let n = row.len();
     let out = row.as_mut_ptr();
     for (x, t) in entries.iter().enumerate() {
+        // The source texels of the entry a few ahead, asked for now (a hint: the lookups
+        // of an output row wander over source rows, which the hardware does not foresee).
+        if let Some(a) = entries.get(x + AHEAD) {
+            let data = if SINGLE {
+                planes[0]
+            } else {
+                planes[(a.idx >> INDEX_BITS) as usize & (MAX_LAYERS - 1)]
+            };
+            let i = (a.idx & INDEX_MASK) as usize * C;
+            if a.idx != NO_TEXEL && i + stride < data.len() {
+                let p = data.as_ptr().add(i) as *const i8;
+                _mm_prefetch::<_MM_HINT_T0>(p);
+                _mm_prefetch::<_MM_HINT_T0>(p.add(stride * 4));
+            }
+        }
         let o = x * C;
         let data = if SINGLE {
             planes[0]
