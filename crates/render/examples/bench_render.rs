@@ -47,12 +47,19 @@ fn main() {
     let fit = bunny.normalizing_transform();
     let teapot = Builtin::Teapot.mesh(8);
     let cam = Camera::perspective(Vec3::new(0.8, 0.4, 3.0), Vec3::ZERO, 40.0, 1280, 720);
-    let cases: [(&str, &Mesh, Mat4, Indexing, bool); 5] = [
+    let cases: [(&str, &Mesh, Mat4, Indexing, bool); 6] = [
         (
             "mirrorball bunny per-pixel cube, no background",
             &bunny,
             fit,
             Indexing::PerPixel,
+            false,
+        ),
+        (
+            "mirrorball bunny per-vertex reflection (mode 2) cube, no background",
+            &bunny,
+            fit,
+            Indexing::PerVertexReflection,
             false,
         ),
         (

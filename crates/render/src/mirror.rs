@@ -38,6 +38,9 @@ pub(crate) struct MirrorView {
     pub forward: Vec3A,
     /// World → eye rotation, for an environment attached to the eye.
     pub rot: Option<Mat3>,
+    /// Mode 2: the setups' `v` hold the corners' reflected vectors, interpolated as they
+    /// are (`r = Σ fₖ·vₖ`, the perspective-correct interpolation up to a positive factor).
+    pub per_vertex: bool,
 }
 
 /// The reflected direction (any positive length) at the pixel centre `(fx, fy)` of setup
@@ -49,12 +52,16 @@ pub(crate) fn mirror_dir(m: &MirrorSetup, fx: f32, fy: f32, view: &MirrorView) -
         .edges
         .map(|[dx, ay, dy, ax]| dx * (fy - ay) - dy * (fx - ax));
     let n = m.n[0] * f[0] + m.n[1] * f[1] + m.n[2] * f[2];
-    let v = if view.persp {
+    let v = if view.persp || view.per_vertex {
         m.v[0] * f[0] + m.v[1] * f[1] + m.v[2] * f[2]
     } else {
         view.forward
     };
-    let r = Vec3::from(v * n.dot(n) - n * (2.0 * n.dot(v)));
+    let r = if view.per_vertex {
+        Vec3::from(v)
+    } else {
+        Vec3::from(v * n.dot(n) - n * (2.0 * n.dot(v)))
+    };
     match view.rot {
         Some(rot) => rot * r,
         None => r,
@@ -424,7 +431,7 @@ mod v8 {
                 interp(&m.n, 1, &f),
                 interp(&m.n, 2, &f),
             ];
-            let v = if view.persp {
+            let v = if view.persp || view.per_vertex {
                 [
                     interp(&m.v, 0, &f),
                     interp(&m.v, 1, &f),
@@ -440,7 +447,11 @@ mod v8 {
             let nn = dot(&n, &n);
             let t = _mm256_mul_ps(dot(&n, &v), splat(2.0));
             for c in 0..3 {
-                let rc = _mm256_sub_ps(_mm256_mul_ps(v[c], nn), _mm256_mul_ps(n[c], t));
+                let rc = if view.per_vertex {
+                    v[c]
+                } else {
+                    _mm256_sub_ps(_mm256_mul_ps(v[c], nn), _mm256_mul_ps(n[c], t))
+                };
                 out.r[c] = sel(same, rc, out.r[c]);
                 out.tint[c] = sel(same, splat(m.tint[c]), out.tint[c]);
             }

@@ -518,7 +518,9 @@ impl Prepared<'_> {
     /// The per-pixel mirror's [`MirrorSetup`](crate::mirror::MirrorSetup) of every setup of `binned`, or `None` where
     /// the fast loop does not read it (another mode, or a footprint sampler).
     fn mirror_setups(&self, binned: &Binned) -> Option<Vec<crate::mirror::MirrorSetup>> {
-        if self.settings.indexing != Indexing::PerPixel || self.sampler.is_some() {
+        // Mode 2 interpolates the per-vertex reflected vectors the same way (in `v`).
+        let per_vertex = self.settings.indexing == Indexing::PerVertexReflection;
+        if !(self.settings.indexing == Indexing::PerPixel || per_vertex) || self.sampler.is_some() {
             return None;
         }
         let persp = self.cam.is_perspective();
@@ -546,7 +548,9 @@ impl Prepared<'_> {
                     crate::mirror::MirrorSetup {
                         edges: binned.edges(id),
                         n: [0, 1, 2].map(|k| at(&self.nrm, k)),
-                        v: if persp {
+                        v: if per_vertex {
+                            [0, 1, 2].map(|k| at(&self.r_vert, k))
+                        } else if persp {
                             [0, 1, 2].map(v)
                         } else {
                             [Vec3A::ZERO; 3]
@@ -592,6 +596,7 @@ impl Prepared<'_> {
             persp: self.cam.is_perspective(),
             forward: Vec3A::from(self.forward),
             rot: eye_attached.then_some(self.view_rot),
+            per_vertex: self.settings.indexing == Indexing::PerVertexReflection,
         };
         let rows = vis.ids.len() / w;
         // What a pixel of a segment needs: nothing (transparent black, as `out` holds), an

@@ -408,7 +408,7 @@ fn render_into_a_reused_frame_equals_a_fresh_render() {
 
 #[test]
 fn the_vectorised_mirror_gives_the_portable_pictures_to_the_bit() {
-    // The per-pixel mirror's AVX2 rows (where the processor has them) against the portable
+    // The per-pixel (and mode 2) mirror's AVX2 rows (where the processor has them) against the portable
     // path, on scenes that reach every branch: two objects (a tinted mirror teapot and a
     // Fresnel torus, which the fast rows hand back), perspective and orthographic cameras,
     // an environment attached to the world or the eye, three and four channels, seams and
@@ -446,48 +446,50 @@ fn the_vectorised_mirror_gives_the_portable_pictures_to_the_bit() {
                 Camera::perspective(Vec3::new(0.3, 0.8, 3.5), Vec3::ZERO, 45.0, 61, 37),
                 Camera::orthographic(Vec3::new(0.3, 0.8, 3.5), Vec3::ZERO, 3.0, 61, 37),
             ] {
-                let settings = Settings {
-                    indexing: Indexing::PerPixel,
-                    ..Settings::default()
-                };
-                set_portable(true);
-                let portable = render(&scene, &cam, &settings).unwrap();
-                set_portable(false);
-                let fast = render(&scene, &cam, &settings).unwrap();
-                assert_eq!(
-                    portable
+                for indexing in [Indexing::PerPixel, Indexing::PerVertexReflection] {
+                    let settings = Settings {
+                        indexing,
+                        ..Settings::default()
+                    };
+                    set_portable(true);
+                    let portable = render(&scene, &cam, &settings).unwrap();
+                    set_portable(false);
+                    let fast = render(&scene, &cam, &settings).unwrap();
+                    assert_eq!(
+                        portable
+                            .color
+                            .data()
+                            .iter()
+                            .map(|v| v.to_bits())
+                            .collect::<Vec<_>>(),
+                        fast.color
+                            .data()
+                            .iter()
+                            .map(|v| v.to_bits())
+                            .collect::<Vec<_>>(),
+                        "{channels} channels, {attach:?}"
+                    );
+                    let full = render(
+                        &scene,
+                        &cam,
+                        &Settings {
+                            aovs: true,
+                            ..settings
+                        },
+                    )
+                    .unwrap();
+                    let worst = fast
                         .color
                         .data()
                         .iter()
-                        .map(|v| v.to_bits())
-                        .collect::<Vec<_>>(),
-                    fast.color
-                        .data()
-                        .iter()
-                        .map(|v| v.to_bits())
-                        .collect::<Vec<_>>(),
-                    "{channels} channels, {attach:?}"
-                );
-                let full = render(
-                    &scene,
-                    &cam,
-                    &Settings {
-                        aovs: true,
-                        ..settings
-                    },
-                )
-                .unwrap();
-                let worst = fast
-                    .color
-                    .data()
-                    .iter()
-                    .zip(full.color.data())
-                    .map(|(a, b)| (a - b).abs())
-                    .fold(0.0f32, f32::max);
-                assert!(worst < 1e-3, "{channels} channels, {attach:?}: {worst}");
-                runs += 1;
+                        .zip(full.color.data())
+                        .map(|(a, b)| (a - b).abs())
+                        .fold(0.0f32, f32::max);
+                    assert!(worst < 1e-3, "{channels} channels, {attach:?}: {worst}");
+                    runs += 1;
+                }
             }
         }
     }
-    assert_eq!(runs, 8);
+    assert_eq!(runs, 16);
 }
