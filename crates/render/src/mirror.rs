@@ -196,10 +196,7 @@ unsafe fn mirror_row_avx2(
         let mut idb = [NO_HIT; 8];
         idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
         let orow = &mut out[g * 4..(g + cnt) * 4];
-        let none = idb
-            .iter()
-            .enumerate()
-            .fold(0u32, |m, (i, &id)| m | ((id == NO_HIT) as u32) << i);
+        let none = v8::equal_lanes(&idb, NO_HIT);
         let hit = !none & ((1u32 << cnt) - 1);
         if hit == 0 {
             orow.fill(0.0);
@@ -332,6 +329,16 @@ mod v8 {
             _mm256_and_si256(_mm256_set1_epi32(bits as i32), b),
             b,
         ))
+    }
+
+    /// The lanes of `ids` equal to `id`, as bits.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub fn equal_lanes(ids: &[u32; 8], id: u32) -> u32 {
+        // SAFETY: `ids` holds eight u32, read unaligned.
+        let v = unsafe { _mm256_loadu_si256(ids.as_ptr() as *const __m256i) };
+        let eq = _mm256_cmpeq_epi32(v, _mm256_set1_epi32(id as i32));
+        _mm256_movemask_ps(_mm256_castsi256_ps(eq)) as u32
     }
 
     /// The lanes of three vectors.
