@@ -433,11 +433,6 @@ mod v8 {
                     _mm256_mul_ps(splat(dy), _mm256_sub_ps(fx, splat(ax))),
                 );
             }
-            let n = [
-                interp(&m.n, 0, &f),
-                interp(&m.n, 1, &f),
-                interp(&m.n, 2, &f),
-            ];
             let v = if view.persp || view.per_vertex {
                 [
                     interp(&m.v, 0, &f),
@@ -451,14 +446,23 @@ mod v8 {
                     splat(view.forward.z),
                 ]
             };
-            let nn = dot(&n, &n);
-            let t = _mm256_mul_ps(dot(&n, &v), splat(2.0));
-            for c in 0..3 {
-                let rc = if view.per_vertex {
-                    v[c]
-                } else {
-                    _mm256_sub_ps(_mm256_mul_ps(v[c], nn), _mm256_mul_ps(n[c], t))
-                };
+            let r = if view.per_vertex {
+                v // mode 2: the interpolated reflected vector itself
+            } else {
+                let n = [
+                    interp(&m.n, 0, &f),
+                    interp(&m.n, 1, &f),
+                    interp(&m.n, 2, &f),
+                ];
+                let nn = dot(&n, &n);
+                let t = _mm256_mul_ps(dot(&n, &v), splat(2.0));
+                let mut r = [zero; 3];
+                for ((rc, vc), nc) in r.iter_mut().zip(v).zip(n) {
+                    *rc = _mm256_sub_ps(_mm256_mul_ps(vc, nn), _mm256_mul_ps(nc, t));
+                }
+                r
+            };
+            for (c, rc) in r.into_iter().enumerate() {
                 out.r[c] = sel(same, rc, out.r[c]);
                 out.tint[c] = sel(same, splat(m.tint[c]), out.tint[c]);
             }
