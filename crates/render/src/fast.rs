@@ -269,25 +269,9 @@ impl<'a> CubeFaces<'a> {
             // The second texel of each row is read as four lanes from its first channel,
             // which for three channels reaches one float past it: not past the face.
             if i + stride + self.c + 4 <= data.len() {
-                // SAFETY: SSE2 is baseline; the reads are in bounds (checked just above).
-                unsafe {
-                    use std::arch::x86_64::*;
-                    let p = data.as_ptr().add(i);
-                    let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(self.c)));
-                    let (e, f) = (
-                        _mm_loadu_ps(p.add(stride)),
-                        _mm_loadu_ps(p.add(stride + self.c)),
-                    );
-                    let fx = _mm_set1_ps(l.a);
-                    let fy = _mm_set1_ps(l.b);
-                    let top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
-                    let bot = _mm_add_ps(e, _mm_mul_ps(fx, _mm_sub_ps(f, e)));
-                    let c = _mm_add_ps(top, _mm_mul_ps(fy, _mm_sub_ps(bot, top)));
-                    let mut out = [0.0f32; 4];
-                    _mm_storeu_ps(out.as_mut_ptr(), _mm_mul_ps(c, _mm_loadu_ps(t.as_ptr())));
-                    out[3] = 1.0;
-                    return out;
-                }
+                let mut out = [0.0f32; 4];
+                bilinear_tinted(&data[i..], stride, self.c, l.a, l.b, &t, &mut out);
+                return out;
             }
         }
         let c = self.fetch(l);
@@ -335,6 +319,40 @@ impl<'a> CubeFaces<'a> {
         }
         out
     }
+}
+
+/// The bilinear blend inside a face, four lanes (SSE2): the texels at `p[0]`, `p[c]` and a
+/// row below (`stride` floats), weights `fx`, `fy` (`CubeFaces::footprint`'s arithmetic, lane
+/// by lane, so the same bits), times the tint `t`, alpha 1, into `o[..4]`. For three
+/// channels the second texel is read as four lanes, one float past it, so `p` must hold
+/// `stride + c + 4` floats (asserted). The one copy of this blend: [`CubeFaces::fetch_tinted`]
+/// and the renderer's AVX2 mirror rows both call it.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn bilinear_tinted(
+    p: &[f32],
+    stride: usize,
+    c: usize,
+    fx: f32,
+    fy: f32,
+    t: &[f32; 4],
+    o: &mut [f32],
+) {
+    assert!(p.len() >= stride + c + 4 && o.len() >= 4);
+    // SAFETY: SSE2 is part of x86-64's baseline; the reads stay within `p` and the write
+    // within `o` (asserted above).
+    unsafe {
+        use std::arch::x86_64::*;
+        let q = p.as_ptr();
+        let (a, b) = (_mm_loadu_ps(q), _mm_loadu_ps(q.add(c)));
+        let (e, f) = (_mm_loadu_ps(q.add(stride)), _mm_loadu_ps(q.add(stride + c)));
+        let fx = _mm_set1_ps(fx);
+        let top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
+        let bot = _mm_add_ps(e, _mm_mul_ps(fx, _mm_sub_ps(f, e)));
+        let v = _mm_add_ps(top, _mm_mul_ps(_mm_set1_ps(fy), _mm_sub_ps(bot, top)));
+        _mm_storeu_ps(o.as_mut_ptr(), _mm_mul_ps(v, _mm_loadu_ps(t.as_ptr())));
+    }
+    o[3] = 1.0;
 }
 
 /// `CubeLoc::i` of a lookup whose footprint crosses a seam.

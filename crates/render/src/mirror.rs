@@ -223,7 +223,15 @@ unsafe fn mirror_row_avx2(
                 // As CubeFaces::fetch_tinted: the second texel of a row is read as four
                 // lanes from its first channel (one float past it for three channels).
                 if i + stride + cf.c + 4 <= data.len() {
-                    v8::bilinear_into(&data[i..], stride, cf.c, at.fx[lane], at.fy[lane], &t, o);
+                    crate::fast::bilinear_tinted(
+                        &data[i..],
+                        stride,
+                        cf.c,
+                        at.fx[lane],
+                        at.fy[lane],
+                        &t,
+                        o,
+                    );
                     continue;
                 }
             }
@@ -351,35 +359,6 @@ mod v8 {
             unsafe { _mm256_storeu_ps(a.as_mut_ptr(), *v) };
         }
         a
-    }
-
-    /// `CubeFaces::fetch_tinted` inside a face: the bilinear blend of the texels at `p[0]`,
-    /// `p[c]` and a row below (`stride` floats), weights `fx`, `fy`, times `t`, alpha 1,
-    /// into `o`. `p` must hold `stride + c + 4` floats.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub fn bilinear_into(
-        p: &[f32],
-        stride: usize,
-        c: usize,
-        fx: f32,
-        fy: f32,
-        t: &[f32; 4],
-        o: &mut [f32],
-    ) {
-        assert!(p.len() >= stride + c + 4 && o.len() >= 4);
-        // SAFETY: the reads stay within `p` and the write within `o` (asserted above).
-        unsafe {
-            let q = p.as_ptr();
-            let (a, b) = (_mm_loadu_ps(q), _mm_loadu_ps(q.add(c)));
-            let (e, f) = (_mm_loadu_ps(q.add(stride)), _mm_loadu_ps(q.add(stride + c)));
-            let fx = _mm_set1_ps(fx);
-            let top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
-            let bot = _mm_add_ps(e, _mm_mul_ps(fx, _mm_sub_ps(f, e)));
-            let v = _mm_add_ps(top, _mm_mul_ps(_mm_set1_ps(fy), _mm_sub_ps(bot, top)));
-            let v = _mm_mul_ps(v, _mm_loadu_ps(t.as_ptr()));
-            _mm_storeu_ps(o.as_mut_ptr(), _mm_blend_ps::<0b1000>(v, _mm_set1_ps(1.0)));
-        }
     }
 
     /// `mirror_dir` of the pixels at columns `x0 ..` of `idb` whose bit is set in `lanes`,
