@@ -332,6 +332,15 @@ def bench(args):
     gl.glEnable(gl.GL_DEPTH_TEST)
     n_idx = tris.size
 
+    def culled(setup, on):
+        # GL_CULL_FACE leaves out back faces, as mirrorball does by itself for a closed
+        # mesh (the bunny is watertight): Mesa with and without it, so both are on record.
+        def go():
+            draw = setup()
+            (gl.glEnable if on else gl.glDisable)(gl.GL_CULL_FACE)
+            return draw
+        return go
+
     def fixed_function():
         g.matrices(proj, view)
         gl.glUseProgram(0)
@@ -390,8 +399,12 @@ def bench(args):
     # Rounds alternate Mesa and mirrorball, so that a load that comes and goes on a shared
     # machine reaches both; each case keeps its best.
     for _ in range(args.rounds):
-        for name, setup in [("mesa fixed-function GL_REFLECTION_MAP (per-vertex), no background", fixed_function),
-                            ("mesa GLSL per-pixel reflect(), no background", glsl)]:
+        for name, setup in [
+                ("mesa fixed-function GL_REFLECTION_MAP (per-vertex), no background", culled(fixed_function, False)),
+                ("mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, no background",
+                 culled(fixed_function, True)),
+                ("mesa GLSL per-pixel reflect(), no background", culled(glsl, False)),
+                ("mesa GLSL per-pixel reflect(), GL_CULL_FACE, no background", culled(glsl, True))]:
             draw = setup()
             draw()
             gl.glFinish()
@@ -412,6 +425,21 @@ def bench(args):
     print(f"1280x720, frames per second (best of {args.rounds} rounds x {args.reps} runs of {args.frames} frames)")
     for k, v in results.items():
         print(f"  {k:<{width}}  {v:8.1f}")
+    print("mirrorball / Mesa, frames per second (> 1: mirrorball is faster)")
+    pairs = [("mirrorball bunny per-pixel cube, no background", "mesa GLSL per-pixel reflect(), no background"),
+             ("mirrorball bunny per-pixel cube, no background",
+              "mesa GLSL per-pixel reflect(), GL_CULL_FACE, no background"),
+             ("mirrorball bunny per-pixel cube, no background",
+              "mesa fixed-function GL_REFLECTION_MAP (per-vertex), no background"),
+             ("mirrorball bunny per-pixel cube, no background",
+              "mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, no background"),
+             ("mirrorball bunny per-vertex reflection (mode 2) cube, no background",
+              "mesa fixed-function GL_REFLECTION_MAP (per-vertex), no background"),
+             ("mirrorball bunny per-vertex reflection (mode 2) cube, no background",
+              "mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, no background")]
+    for a, b in pairs:
+        if a in results and b in results:
+            print(f"  {a}\n    / {b}: {results[a] / results[b]:.2f}x")
     if args.json:
         Path(args.json).write_text(json.dumps({"renderer": g.renderer(), "fps": results}, indent=2))
     return 0

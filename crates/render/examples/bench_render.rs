@@ -47,7 +47,7 @@ fn main() {
     let fit = bunny.normalizing_transform();
     let teapot = Builtin::Teapot.mesh(8);
     let cam = Camera::perspective(Vec3::new(0.8, 0.4, 3.0), Vec3::ZERO, 40.0, 1280, 720);
-    let cases: [(&str, &Mesh, Mat4, Indexing, bool); 6] = [
+    let cases: [(&str, &Mesh, Mat4, Indexing, bool); 7] = [
         (
             "mirrorball bunny per-pixel cube, no background",
             &bunny,
@@ -60,6 +60,13 @@ fn main() {
             &bunny,
             fit,
             Indexing::PerVertexReflection,
+            false,
+        ),
+        (
+            "mirrorball bunny per-pixel cube, every face drawn, no background",
+            &bunny,
+            fit,
+            Indexing::PerPixel,
             false,
         ),
         (
@@ -114,6 +121,9 @@ fn main() {
             supersample: 1,
             aovs: false,
             motion_from: None,
+            // The bunny is watertight: its back faces are left out, except in the case that
+            // measures what that gives.
+            cull_hidden_faces: !name.contains("every face drawn"),
         };
         // Frames render into one reused frame, as Mesa into its framebuffer.
         let mut frame = render(&scene, &cam, &settings).unwrap();

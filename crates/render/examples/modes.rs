@@ -69,6 +69,7 @@ fn main() {
                     supersample: 3,
                     aovs: false,
                     motion_from: None,
+                    cull_hidden_faces: true,
                 },
             )
             .expect("render");

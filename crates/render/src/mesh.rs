@@ -21,9 +21,183 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     /// Triangles, counter-clockwise seen from the side the normals point to.
     pub triangles: Vec<[u32; 3]>,
+    /// [`Mesh::is_closed_outward`], remembered with a fingerprint of the mesh it was
+    /// worked out for (the fields are public, so the mesh may have changed since).
+    pub(crate) solid: SolidCache,
+}
+
+/// The last answer of [`Mesh::is_closed_outward`] and the fingerprint of the positions and
+/// triangles it answered for.
+#[derive(Default)]
+pub(crate) struct SolidCache(std::sync::Mutex<Option<(u64, bool)>>);
+
+impl SolidCache {
+    fn get(&self) -> Option<(u64, bool)> {
+        *self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+    fn set(&self, v: (u64, bool)) {
+        *self.0.lock().unwrap_or_else(|e| e.into_inner()) = Some(v);
+    }
+}
+
+impl Clone for SolidCache {
+    fn clone(&self) -> Self {
+        SolidCache(std::sync::Mutex::new(self.get()))
+    }
+}
+
+impl std::fmt::Debug for SolidCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("SolidCache")
+    }
+}
+
+/// A cache is no part of what a mesh is.
+impl PartialEq for SolidCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl Mesh {
+    /// A mesh of these vertices (positions, unit normals, texture coordinates or none) and
+    /// triangles, counter-clockwise seen from the side the normals point to.
+    pub fn new(
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        uvs: Vec<Vec2>,
+        triangles: Vec<[u32; 3]>,
+    ) -> Mesh {
+        Mesh {
+            positions,
+            normals,
+            uvs,
+            triangles,
+            solid: SolidCache::default(),
+        }
+    }
+
+    /// Whether the mesh is the boundary of solids, facing out: every directed edge `a → b`
+    /// of a triangle is matched by exactly one `b → a` of another (closed, consistently
+    /// oriented, two triangles at every edge) and every connected piece encloses a positive
+    /// signed volume `Σ p₀·(p₁ × p₂)/6` (its counter-clockwise sides face out).
+    ///
+    /// Seen from outside such a solid, a ray enters it before it can leave it, so the first
+    /// triangle it meets faces the viewer: back faces are hidden, and the renderer skips
+    /// them (exactly, for a solid whose inside has a winding number ≥ 0 everywhere, which
+    /// a surface that does not pass through itself inside out always has). The answer is
+    /// remembered until the positions or triangles change.
+    ///
+    /// ```
+    /// use mirrorball_render::mesh;
+    /// assert!(mesh::sphere(16).is_closed_outward());
+    /// assert!(!mesh::quad(2).is_closed_outward()); // an open sheet
+    /// ```
+    pub fn is_closed_outward(&self) -> bool {
+        let key = self.fingerprint();
+        if let Some((k, v)) = self.solid.get() {
+            if k == key {
+                return v;
+            }
+        }
+        let v = self.work_out_closed_outward();
+        self.solid.set((key, v));
+        v
+    }
+
+    /// A hash of the positions and triangles (what [`Mesh::is_closed_outward`] depends on).
+    fn fingerprint(&self) -> u64 {
+        // FxHash-style: rotate, xor, multiply; a word at a time.
+        const K: u64 = 0x517c_c1b7_2722_0a95;
+        let mix = |h: u64, w: u64| (h.rotate_left(5) ^ w).wrapping_mul(K);
+        let mut h = mix(self.positions.len() as u64, self.triangles.len() as u64);
+        for p in &self.positions {
+            h = mix(h, (p.x.to_bits() as u64) << 32 | p.y.to_bits() as u64);
+            h = mix(h, p.z.to_bits() as u64);
+        }
+        for t in &self.triangles {
+            h = mix(h, (t[0] as u64) << 32 | t[1] as u64);
+            h = mix(h, t[2] as u64);
+        }
+        h
+    }
+
+    fn work_out_closed_outward(&self) -> bool {
+        let n = self.positions.len();
+        if self
+            .triangles
+            .iter()
+            .any(|t| t.iter().any(|&i| i as usize >= n))
+        {
+            return false;
+        }
+        // Vertices at the same point are one (a sphere's seam and poles, an OBJ's vertices
+        // split by normal or texture coordinate); `+ 0.0` makes −0 and +0 the same key.
+        let mut first = std::collections::HashMap::with_capacity(n);
+        let weld: Vec<u32> = self
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let key = (*p + Vec3::ZERO).to_array().map(f32::to_bits);
+                *first.entry(key).or_insert(i as u32)
+            })
+            .collect();
+        // Triangles with two corners at one point cover nothing (and their edges pair up
+        // among themselves): left out.
+        let tris: Vec<[u32; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| t.map(|i| weld[i as usize]))
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
+            .collect();
+        if tris.is_empty() {
+            return false;
+        }
+        // Every directed edge once, and its reverse once.
+        let mut edges: Vec<u64> = tris
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .map(|(a, b)| (a as u64) << 32 | b as u64)
+            .collect();
+        edges.sort_unstable();
+        if edges.windows(2).any(|w| w[0] == w[1]) {
+            return false;
+        }
+        if !edges
+            .iter()
+            .all(|&e| edges.binary_search(&e.rotate_right(32)).is_ok())
+        {
+            return false;
+        }
+        // Connected pieces (union-find over the triangles' vertices), each with its signed
+        // volume.
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn root(parent: &mut [u32], mut i: u32) -> u32 {
+            while parent[i as usize] != i {
+                let up = parent[parent[i as usize] as usize];
+                parent[i as usize] = up;
+                i = up;
+            }
+            i
+        }
+        for t in &tris {
+            let r0 = root(&mut parent, t[0]);
+            for &i in &t[1..] {
+                let r = root(&mut parent, i);
+                parent[r as usize] = r0;
+            }
+        }
+        // Per piece (indexed by its root): signed volume ×6, and whether it has triangles.
+        let mut volume = vec![(0.0f64, false); n];
+        for t in &tris {
+            let [a, b, c] = t.map(|i| self.positions[i as usize].as_dvec3());
+            let v = &mut volume[root(&mut parent, t[0]) as usize];
+            *v = (v.0 + a.dot(b.cross(c)), true);
+        }
+        volume.iter().all(|&(v, has)| !has || v > 0.0)
+    }
+
     /// Number of vertices.
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
@@ -81,6 +255,7 @@ impl Mesh {
                 .collect(),
             uvs: self.uvs.clone(),
             triangles: self.triangles.clone(),
+            solid: SolidCache::default(),
         }
     }
 
@@ -124,7 +299,9 @@ impl Mesh {
 }
 
 /// A UV sphere of radius 1: `segments` around (longitude) and `segments / 2` rings (at
-/// least 3 and 2). Its texture coordinates are longitude and latitude.
+/// least 3 and 2). Its texture coordinates are longitude and latitude. The seam's two
+/// columns of vertices, and each pole's, sit at exactly the same points, so the mesh is
+/// closed ([`Mesh::is_closed_outward`]).
 pub fn sphere(segments: u32) -> Mesh {
     let nu = segments.max(3);
     let nv = (segments / 2).max(2);
@@ -132,10 +309,15 @@ pub fn sphere(segments: u32) -> Mesh {
     for j in 0..=nv {
         let v = j as f32 / nv as f32;
         let phi = std::f32::consts::PI * v; // from +Y down
+        let (sp, cp) = match j {
+            0 => (0.0, 1.0),
+            _ if j == nv => (0.0, -1.0),
+            _ => phi.sin_cos(),
+        };
         for i in 0..=nu {
             let u = i as f32 / nu as f32;
-            let lam = std::f32::consts::TAU * u;
-            let p = Vec3::new(phi.sin() * lam.sin(), phi.cos(), phi.sin() * lam.cos());
+            let lam = std::f32::consts::TAU * (i % nu) as f32 / nu as f32;
+            let p = Vec3::new(sp * lam.sin(), cp, sp * lam.cos());
             m.positions.push(p);
             m.normals.push(p);
             m.uvs.push(Vec2::new(u, v));
@@ -158,17 +340,18 @@ pub fn sphere(segments: u32) -> Mesh {
 }
 
 /// A torus about the Y axis with ring radius `major` and tube radius `minor`, `segments`
-/// around the ring and `segments / 2` around the tube.
+/// around the ring and `segments / 2` around the tube. Its seams' vertices coincide
+/// exactly, so the mesh is closed ([`Mesh::is_closed_outward`]).
 pub fn torus(major: f32, minor: f32, segments: u32) -> Mesh {
     let nu = segments.max(3);
     let nv = (segments / 2).max(3);
     let mut m = Mesh::default();
     for j in 0..=nv {
         let v = j as f32 / nv as f32;
-        let b = std::f32::consts::TAU * v;
+        let b = std::f32::consts::TAU * (j % nv) as f32 / nv as f32;
         for i in 0..=nu {
             let u = i as f32 / nu as f32;
-            let a = std::f32::consts::TAU * u;
+            let a = std::f32::consts::TAU * (i % nu) as f32 / nu as f32;
             let ring = Vec3::new(a.sin(), 0.0, a.cos());
             let n = ring * b.cos() + Vec3::Y * b.sin();
             m.positions.push(ring * major + n * minor);
@@ -216,7 +399,8 @@ pub fn quad(segments: u32) -> Mesh {
 }
 
 /// A cube of edge 2 centred on the origin, each face a [`quad`] of `segments²` cells with
-/// its own (flat) normals.
+/// its own (flat) normals. Vertices of neighbouring faces along an edge sit at exactly the
+/// same points, so the mesh is closed ([`Mesh::is_closed_outward`]).
 pub fn cube(segments: u32) -> Mesh {
     let face = quad(segments).transformed(Mat4::from_translation(Vec3::Z));
     let rots = [
@@ -230,6 +414,12 @@ pub fn cube(segments: u32) -> Mesh {
     let mut m = Mesh::default();
     for r in rots {
         m.append(&face.transformed(r));
+    }
+    // The rotations leave rounding (cos 90° is not 0 in f32): back onto the grid of
+    // coordinates −1 + 2k/segments.
+    let n = segments.max(1) as f32;
+    for p in &mut m.positions {
+        *p = ((*p + 1.0) * (n / 2.0)).round() * (2.0 / n) - 1.0;
     }
     m
 }

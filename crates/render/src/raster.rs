@@ -87,6 +87,41 @@ struct Setup {
     x1: u32,
 }
 
+/// A band's depth and setup id per sample, reused band after band by one thread
+/// ([`Binned::scan_band`] fills it).
+#[derive(Clone, Debug, Default)]
+pub struct BandBuffer {
+    depth: Vec<f32>,
+    ids: Vec<u32>,
+    /// Columns the last scan may have written (everything else is far and [`NO_HIT`]).
+    dirty: std::ops::Range<usize>,
+}
+
+impl BandBuffer {
+    /// Depth per sample (`z_ndc`; 1 where nothing was hit), row by row.
+    pub fn depth(&self) -> &[f32] {
+        &self.depth
+    }
+
+    /// Setup id per sample ([`NO_HIT`] where nothing was hit), row by row.
+    pub fn ids(&self) -> &[u32] {
+        &self.ids
+    }
+}
+
+/// Which triangles the rasteriser leaves out, by their winding on screen (in OpenGL's window
+/// coordinates, y up), as `glCullFace` does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cull {
+    /// Every triangle is drawn.
+    None,
+    /// Triangles running clockwise on screen are left out (back faces of a mesh whose
+    /// triangles run counter-clockwise seen from outside).
+    Clockwise,
+    /// Triangles running counter-clockwise on screen are left out.
+    CounterClockwise,
+}
+
 /// A clip-space vertex with its barycentric coordinates in the original triangle.
 #[derive(Clone, Copy, Debug)]
 struct ClipVert {
@@ -107,14 +142,23 @@ pub struct Binned {
 
 impl Binned {
     /// Sets up triangles `tris` over clip-space vertices `clip` for a `width × height`
-    /// sample grid cut into bands of `band` rows.
-    pub fn new(clip: &[Vec4], tris: &[[u32; 3]], width: u32, height: u32, band: u32) -> Binned {
+    /// sample grid cut into bands of `band` rows, leaving out triangle `i` where its winding
+    /// on screen is the one `cull(i)` names.
+    pub fn new(
+        clip: &[Vec4],
+        tris: &[[u32; 3]],
+        width: u32,
+        height: u32,
+        band: u32,
+        cull: impl Fn(u32) -> Cull + Sync,
+    ) -> Binned {
         let band = band.max(1);
         let setups: Vec<Setup> = tris
             .par_iter()
             .enumerate()
             .fold(Vec::new, |mut acc, (i, t)| {
-                setup_triangle(clip, *t, i as u32, width, height, &mut acc);
+                let i = i as u32;
+                setup_triangle(clip, *t, i, width, height, cull(i), &mut acc);
                 acc
             })
             .flat_map_iter(|v| v.into_iter())
@@ -145,16 +189,47 @@ impl Binned {
         self.band
     }
 
-    /// Scans band `b`: `depth` and `ids` hold its samples row by row (`width ×` the band's
-    /// rows; any longer is ignored) and are reset here to far (1) and [`NO_HIT`]. Each sample
-    /// keeps the nearest depth and the setup seen there, which [`Binned::sample`] resolves.
-    pub fn scan_band(&self, b: usize, depth: &mut [f32], ids: &mut [u32]) {
+    /// Scans band `b` into `buf` (its samples row by row, `width ×` the band's rows): each
+    /// sample keeps the nearest depth and the setup seen there, which [`Binned::sample`]
+    /// resolves, or far (1) and [`NO_HIT`]. Returns the columns `c0..c1` outside which the
+    /// band has no hit; only those, and the ones the buffer's previous band may have
+    /// written, are reset first (an object covering a quarter of the frame's width leaves
+    /// three quarters of each band untouched).
+    pub fn scan_band(&self, b: usize, buf: &mut BandBuffer) -> std::ops::Range<usize> {
         let y_start = b as u32 * self.band;
         let rows = self.band.min(self.height.saturating_sub(y_start));
-        let n = (rows * self.width) as usize;
-        let (depth, ids) = (&mut depth[..n], &mut ids[..n]);
-        depth.fill(1.0);
-        ids.fill(NO_HIT);
+        let w = self.width as usize;
+        let n = rows as usize * w;
+        if buf.depth.len() != n {
+            buf.depth.clear();
+            buf.depth.resize(n, 1.0);
+            buf.ids.clear();
+            buf.ids.resize(n, NO_HIT);
+            buf.dirty = 0..0;
+        }
+        let cols = self.bins[b]
+            .iter()
+            .map(|&si| &self.setups[si as usize])
+            .fold(None, |r: Option<(u32, u32)>, s| {
+                Some(r.map_or((s.x0, s.x1), |(a, b)| (a.min(s.x0), b.max(s.x1))))
+            })
+            .map_or(0..0, |(a, b)| a as usize..b as usize + 1);
+        // Reset what the last scan may have written and what this one will read: their
+        // hull where they overlap, else each.
+        let (d, c) = (buf.dirty.clone(), cols.clone());
+        let spans = if d.is_empty() || c.is_empty() || (d.start <= c.end && c.start <= d.end) {
+            [d.start.min(c.start)..d.end.max(c.end), 0..0]
+        } else {
+            [d, c]
+        };
+        for span in spans.into_iter().filter(|r| !r.is_empty()) {
+            for r in 0..rows as usize {
+                buf.depth[r * w + span.start..r * w + span.end].fill(1.0);
+                buf.ids[r * w + span.start..r * w + span.end].fill(NO_HIT);
+            }
+        }
+        buf.dirty = cols.clone();
+        let (depth, ids) = (&mut buf.depth[..], &mut buf.ids[..]);
         #[cfg(target_arch = "x86_64")]
         if crate::cpu::avx2() {
             for &si in &self.bins[b] {
@@ -162,7 +237,7 @@ impl Binned {
                 // SAFETY: the processor has AVX2 (checked just above).
                 unsafe { scan_avx2(s, si, depth, ids, y_start, self.width) };
             }
-            return;
+            return cols;
         }
         for &si in &self.bins[b] {
             scan(
@@ -174,6 +249,7 @@ impl Binned {
                 self.width,
             );
         }
+        cols
     }
 
     /// What the sample at `(x, y)` of the grid sees, given the setup `id` and `depth` the
@@ -249,19 +325,18 @@ const BAND: u32 = 8;
 /// Rasterises triangles `tris` over clip-space vertices `clip` into a `width × height`
 /// sample grid.
 pub fn rasterize(clip: &[Vec4], tris: &[[u32; 3]], width: u32, height: u32) -> VisBuffer {
-    let binned = Binned::new(clip, tris, width, height, BAND);
+    let binned = Binned::new(clip, tris, width, height, BAND, |_| Cull::None);
     let mut samples = vec![Sample::EMPTY; width as usize * height as usize];
     samples
         .par_chunks_mut(width as usize * BAND as usize)
         .enumerate()
         .for_each(|(b, rows)| {
-            let mut depth = vec![1.0; rows.len()];
-            let mut ids = vec![NO_HIT; rows.len()];
-            binned.scan_band(b, &mut depth, &mut ids);
+            let mut buf = BandBuffer::default();
+            binned.scan_band(b, &mut buf);
             let y0 = b as u32 * BAND;
             for (i, cell) in rows.iter_mut().enumerate() {
                 let (x, y) = (i as u32 % width, y0 + i as u32 / width);
-                *cell = binned.sample(ids[i], depth[i], x, y);
+                *cell = binned.sample(buf.ids[i], buf.depth[i], x, y);
             }
         });
     VisBuffer {
@@ -279,6 +354,7 @@ fn setup_triangle(
     tri: u32,
     width: u32,
     height: u32,
+    cull: Cull,
     out: &mut Vec<Setup>,
 ) {
     let v = t.map(|i| clip[i as usize]);
@@ -339,14 +415,14 @@ fn setup_triangle(
         }
     }
     for k in 1..len.saturating_sub(1) {
-        if let Some(s) = project([poly[0], poly[k], poly[k + 1]], tri, width, height) {
+        if let Some(s) = project([poly[0], poly[k], poly[k + 1]], tri, width, height, cull) {
             out.push(s);
         }
     }
 }
 
 /// Divides by `w`, maps to the sample grid and prepares the edge functions.
-fn project(v: [ClipVert; 3], tri: u32, width: u32, height: u32) -> Option<Setup> {
+fn project(v: [ClipVert; 3], tri: u32, width: u32, height: u32, cull: Cull) -> Option<Setup> {
     let (fw, fh) = (width as f32, height as f32);
     let mut p = [[0.0f32; 2]; 3];
     let mut z = [0.0f32; 3];
@@ -370,6 +446,12 @@ fn project(v: [ClipVert; 3], tri: u32, width: u32, height: u32) -> Option<Setup>
         (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
     if !area.is_finite() || area == 0.0 {
         return None;
+    }
+    // Counter-clockwise in OpenGL's y-up window coordinates is a negative area here.
+    match cull {
+        Cull::CounterClockwise if area < 0.0 => return None,
+        Cull::Clockwise if area > 0.0 => return None,
+        _ => {}
     }
     if area < 0.0 {
         p.swap(1, 2);

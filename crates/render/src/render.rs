@@ -9,7 +9,7 @@
 
 use crate::camera::Camera;
 use crate::camera::Rays;
-use crate::raster::{Binned, NO_HIT};
+use crate::raster::{Binned, Cull, NO_HIT};
 use crate::scene::{Attach, Filter, Indexing, Material, Scene, Settings};
 use glam::{DVec2, DVec3, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4};
 use mirrorball_core::{Image, Projection, SphereMap, WorldProjection};
@@ -123,6 +123,8 @@ struct BandVis<'a> {
     /// Depth and setup id per sample.
     depth: &'a [f32],
     ids: &'a [u32],
+    /// The columns outside which the band has no hit.
+    cols: std::ops::Range<usize>,
     /// Per setup, when the per-pixel mirror applies.
     mirrors: Option<&'a [crate::mirror::MirrorSetup]>,
 }
@@ -181,7 +183,33 @@ pub fn render_into(
     // Bands of pixel rows: each is rasterised into a small visibility buffer and shaded at
     // once, in parallel, so the samples stay in cache.
     let band_px = (16 / ss).max(1);
-    let binned = Binned::new(&clip, &p.tris, p.sw, p.sh, band_px * ss);
+    // Back faces of a closed solid facing out that lies wholly beyond the near plane: hidden
+    // by its front faces (a ray from the near plane starts outside the solid, so it enters
+    // before it can leave). With a model matrix of positive determinant its outside runs
+    // counter-clockwise on screen, as OpenGL's default front face.
+    let mut culls = Vec::with_capacity(scene.objects.len());
+    let mut base = 0;
+    for o in &scene.objects {
+        let n = o.mesh.positions.len();
+        let beyond_near = clip[base..base + n]
+            .iter()
+            .all(|c| c.w > 0.0 && c.z + c.w > 0.0);
+        culls.push(
+            if settings.cull_hidden_faces && beyond_near && o.mesh.is_closed_outward() {
+                if o.model.determinant() > 0.0 {
+                    Cull::Clockwise
+                } else {
+                    Cull::CounterClockwise
+                }
+            } else {
+                Cull::None
+            },
+        );
+        base += n;
+    }
+    let binned = Binned::new(&clip, &p.tris, p.sw, p.sh, band_px * ss, |t| {
+        culls[p.tri_mat[t as usize] as usize]
+    });
     let color = &mut frame.color;
     if (color.width(), color.height(), color.channels()) != (w, h, 4) {
         *color = Image::new(w, h, 4);
@@ -199,8 +227,8 @@ pub fn render_into(
         .par_chunks_mut(row_len * band_px as usize)
         .enumerate()
         .map_init(
-            || (Vec::new(), Vec::new()),
-            |(depth, ids): &mut (Vec<f32>, Vec<u32>), (b, out)| {
+            crate::raster::BandBuffer::default,
+            |buf: &mut crate::raster::BandBuffer, (b, out)| {
                 let rows = (out.len() / row_len) as u32;
                 let y0 = b as u32 * band_px;
                 let mut aov: Option<[Vec<f32>; 4]> = settings
@@ -210,15 +238,14 @@ pub fn render_into(
                     out.fill(0.0); // transparent black
                     return None;
                 }
-                let n = (p.sw * rows * ss) as usize;
-                depth.resize(n, 1.0);
-                ids.resize(n, NO_HIT);
-                binned.scan_band(b, depth, ids);
+                let cols = binned.scan_band(b, buf);
+                let (depth, ids) = (buf.depth(), buf.ids());
                 if ss == 1 && aov.is_none() {
                     let vis = BandVis {
                         binned: &binned,
                         depth,
                         ids,
+                        cols,
                         mirrors: mirrors.as_deref(),
                     };
                     p.shade_band_fast(y0, &vis, out);
@@ -630,7 +657,8 @@ impl Prepared<'_> {
                 let fy = sy as f32 + 0.5;
                 let vrow = &vis.ids[ly * w + xb..ly * w + xe];
                 let orow = &mut out[(ly * w + xb) * 4..(ly * w + xe) * 4];
-                if !background && vrow.iter().all(|&id| id == NO_HIT) {
+                let beside = xe <= vis.cols.start || vis.cols.end <= xb;
+                if !background && (beside || vrow.iter().all(|&id| id == NO_HIT)) {
                     orow.fill(0.0); // transparent black
                     continue;
                 }

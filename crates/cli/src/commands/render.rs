@@ -309,6 +309,7 @@ impl RenderPlan {
                 supersample: a.ss,
                 aovs: a.aovs || a.diagnostics,
                 motion_from: None,
+                cull_hidden_faces: true,
             },
             exposure: a.exposure,
             tone,

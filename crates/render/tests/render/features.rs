@@ -493,3 +493,89 @@ fn the_vectorised_mirror_gives_the_portable_pictures_to_the_bit() {
     }
     assert_eq!(runs, 16);
 }
+
+#[test]
+fn leaving_out_hidden_back_faces_changes_no_picture() {
+    // Closed solids (a bunny, a sphere, a torus, a mirrored cube) in front of and behind
+    // each other, in every indexing mode, through perspective and orthographic cameras,
+    // and with the camera so close that the near plane cuts the sphere (no culling there,
+    // and the inside shows): the same picture with and without culling, to the bit.
+    use mirrorball_render::{load::load_mesh, Object};
+    use std::sync::Arc;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let bunny = load_mesh(&root.join("assets/meshes/bunny.obj")).unwrap();
+    let fit = bunny.normalizing_transform();
+    let env = env_of(ProjectionKind::Cube, 16, checker);
+    let mut scene = scene_with(bunny, fit, env, Attach::World, true);
+    let extra = [
+        (
+            mesh::sphere(20),
+            Mat4::from_translation(Vec3::new(0.9, 0.2, -0.6)) * Mat4::from_scale(Vec3::splat(0.5)),
+        ),
+        (
+            mesh::torus(0.6, 0.2, 24),
+            Mat4::from_translation(Vec3::new(-0.7, 0.5, 0.6)) * Mat4::from_rotation_x(0.7),
+        ),
+        // Mirrored: a negative determinant turns which winding faces the viewer.
+        (
+            mesh::cube(2),
+            Mat4::from_translation(Vec3::new(0.2, -0.8, 0.5))
+                * Mat4::from_scale(Vec3::new(-0.3, 0.3, 0.3)),
+        ),
+    ];
+    for (m, model) in extra {
+        scene.objects.push(Object {
+            mesh: Arc::new(m),
+            model,
+            material: Material::Fresnel {
+                f0: 0.04,
+                base: [0.2, 0.3, 0.4],
+            },
+        });
+    }
+    let mut runs = 0;
+    for cam in [
+        Camera::perspective(Vec3::new(0.3, 0.8, 3.5), Vec3::ZERO, 45.0, 61, 37),
+        Camera::perspective(Vec3::new(-2.0, -1.0, -2.5), Vec3::ZERO, 60.0, 53, 41),
+        Camera::orthographic(Vec3::new(0.3, 0.8, 3.5), Vec3::ZERO, 1.5, 61, 37),
+        // Inside the near plane's reach of the sphere.
+        Camera::perspective(
+            Vec3::new(0.9, 0.2, -0.12),
+            Vec3::new(0.9, 0.2, -0.6),
+            70.0,
+            40,
+            30,
+        ),
+    ] {
+        for indexing in [
+            Indexing::PerVertexTexgen,
+            Indexing::PerVertexReflection,
+            Indexing::PerPixel,
+            Indexing::Cone,
+        ] {
+            let with = |cull: bool| {
+                render(
+                    &scene,
+                    &cam,
+                    &Settings {
+                        indexing,
+                        aovs: true,
+                        cull_hidden_faces: cull,
+                        ..Settings::default()
+                    },
+                )
+                .unwrap()
+            };
+            let (culled, all) = (with(true), with(false));
+            let bits = |i: &Image| i.data().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(
+                bits(&culled.color),
+                bits(&all.color),
+                "{indexing:?}, camera at {}",
+                cam.eye
+            );
+            runs += 1;
+        }
+    }
+    assert_eq!(runs, 16);
+}

@@ -128,3 +128,54 @@ fn refuses_draco_and_unknown_files_with_a_reason() {
     let e = load_mesh(Path::new("/nonexistent/x.obj")).unwrap_err();
     assert!(e.contains("x.obj"), "{e}");
 }
+
+#[test]
+fn closed_outward_meshes_are_recognised_and_open_or_inverted_ones_are_not() {
+    // Closed solids facing out (seams and poles welded by position).
+    assert!(mesh::sphere(16).is_closed_outward());
+    assert!(mesh::torus(1.0, 0.3, 12).is_closed_outward());
+    assert!(mesh::cube(3).is_closed_outward());
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let bunny = load_mesh(&root.join("assets/meshes/bunny.obj")).unwrap();
+    assert!(bunny.is_closed_outward(), "the bundled bunny is watertight");
+    // Open: a sheet; a sphere with one triangle taken out.
+    assert!(!mesh::quad(2).is_closed_outward());
+    let mut holed = mesh::sphere(16);
+    holed.triangles.remove(40);
+    assert!(!holed.is_closed_outward());
+    // Inconsistent: one triangle turned over.
+    let mut flipped = mesh::sphere(16);
+    flipped.triangles[40].swap(1, 2);
+    assert!(!flipped.is_closed_outward());
+    // Inside out: every triangle turned over, or the mesh mirrored.
+    let mut inverted = mesh::sphere(16);
+    for t in &mut inverted.triangles {
+        t.swap(1, 2);
+    }
+    assert!(!inverted.is_closed_outward());
+    assert!(!mesh::sphere(16)
+        .transformed(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)))
+        .is_closed_outward());
+    // Two pieces, one inside out: not culled.
+    let mut two = mesh::sphere(8);
+    let other = inverted.transformed(Mat4::from_translation(Vec3::X * 3.0));
+    two.append(&other);
+    assert!(!two.is_closed_outward());
+    let mut two_out = mesh::sphere(8);
+    two_out.append(&mesh::sphere(8).transformed(Mat4::from_translation(Vec3::X * 3.0)));
+    assert!(two_out.is_closed_outward());
+    // Non-manifold: an edge shared by four triangles (the same closed surface twice).
+    let mut doubled = mesh::sphere(8);
+    doubled.append(&mesh::sphere(8));
+    assert!(!doubled.is_closed_outward());
+    // The answer follows changes to the (public) fields.
+    let mut m = mesh::sphere(8);
+    assert!(m.is_closed_outward());
+    m.triangles.pop();
+    assert!(!m.is_closed_outward());
+    // Empty, and out-of-range indices: not closed, no panic.
+    assert!(!mirrorball_render::Mesh::default().is_closed_outward());
+    let mut bad = mesh::sphere(4);
+    bad.triangles[0][0] = 1_000_000;
+    assert!(!bad.is_closed_outward());
+}

@@ -81,3 +81,82 @@ fn near_clipping_keeps_perspective_correct_weights() {
     }
     assert!(n > 20);
 }
+
+#[test]
+fn culling_leaves_out_the_winding_it_names_as_gl_cull_face_does() {
+    use mirrorball_render::raster::{Binned, Cull};
+    // In NDC (y up), (−½,−½) → (½,−½) → (0,½) runs counter-clockwise: OpenGL's front face.
+    let clip = vec![
+        Vec4::new(-0.5, -0.5, 0.0, 1.0),
+        Vec4::new(0.5, -0.5, 0.0, 1.0),
+        Vec4::new(0.0, 0.5, 0.0, 1.0),
+    ];
+    let ccw = [[0u32, 1, 2]];
+    let cw = [[0u32, 2, 1]];
+    let count =
+        |tris: &[[u32; 3]], cull: Cull| Binned::new(&clip, tris, 16, 16, 4, |_| cull).setup_count();
+    assert_eq!(count(&ccw, Cull::None), 1);
+    assert_eq!(count(&cw, Cull::None), 1);
+    assert_eq!(count(&ccw, Cull::Clockwise), 1);
+    assert_eq!(count(&cw, Cull::Clockwise), 0);
+    assert_eq!(count(&ccw, Cull::CounterClockwise), 0);
+    assert_eq!(count(&cw, Cull::CounterClockwise), 1);
+}
+
+#[test]
+fn a_band_buffer_reused_band_after_band_sees_what_a_fresh_one_sees() {
+    // Triangles scattered so that neighbouring bands cover disjoint, overlapping and no
+    // columns: a buffer reused in any order of bands (as a rendering thread takes them)
+    // must hold exactly what a fresh buffer holds, band by band.
+    use mirrorball_render::raster::{BandBuffer, Binned, Cull};
+    let (w, h, band) = (96u32, 64u32, 8u32);
+    let mut clip = Vec::new();
+    let mut tris = Vec::new();
+    let mut seed = 7u32;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32
+    };
+    for _ in 0..12 {
+        let (cx, cy, r) = (rnd() * 2.0 - 1.0, rnd() * 2.0 - 1.0, 0.05 + 0.3 * rnd());
+        let z = rnd() * 0.8 - 0.4;
+        let base = clip.len() as u32;
+        for k in 0..3 {
+            let a = k as f32 * 2.1 + rnd();
+            clip.push(Vec4::new(cx + r * a.cos(), cy + r * a.sin(), z, 1.0));
+        }
+        tris.push([base, base + 1, base + 2]);
+    }
+    let binned = Binned::new(&clip, &tris, w, h, band, |_| Cull::None);
+    let bands = h.div_ceil(band) as usize;
+    let mut reused = BandBuffer::default();
+    let mut hits = 0;
+    for b in (0..bands).chain((0..bands).rev()).chain([3, 0, 5, 5, 1]) {
+        let cols = binned.scan_band(b, &mut reused);
+        let mut fresh = BandBuffer::default();
+        let fresh_cols = binned.scan_band(b, &mut fresh);
+        assert_eq!(cols, fresh_cols);
+        assert_eq!(reused.ids(), fresh.ids(), "band {b}");
+        assert_eq!(
+            reused
+                .depth()
+                .iter()
+                .map(|d| d.to_bits())
+                .collect::<Vec<_>>(),
+            fresh
+                .depth()
+                .iter()
+                .map(|d| d.to_bits())
+                .collect::<Vec<_>>()
+        );
+        // Outside the columns it names, the band has no hit.
+        for (i, &id) in fresh.ids().iter().enumerate() {
+            let x = i % w as usize;
+            if id != NO_HIT {
+                hits += 1;
+                assert!(cols.contains(&x));
+            }
+        }
+    }
+    assert!(hits > 100);
+}

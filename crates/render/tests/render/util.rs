@@ -58,6 +58,7 @@ pub fn draw(scene: &Scene, cam: &Camera, mode: Indexing, ss: u32, aovs: bool) ->
             supersample: ss,
             aovs,
             motion_from: None,
+            cull_hidden_faces: true,
         },
     )
     .expect("renders")
