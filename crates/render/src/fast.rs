@@ -339,20 +339,38 @@ pub(crate) fn bilinear_tinted(
     o: &mut [f32],
 ) {
     assert!(p.len() >= stride + c + 4 && o.len() >= 4);
-    // SAFETY: SSE2 is part of x86-64's baseline; the reads stay within `p` and the write
-    // within `o` (asserted above).
+    // SAFETY: the reads stay within `p` and the write within `o` (asserted above).
+    unsafe { bilinear_tinted_unchecked(p.as_ptr(), stride, c, fx, fy, t, o.as_mut_ptr()) }
+}
+
+/// [`bilinear_tinted`] on raw pointers, for callers that have established the bounds for
+/// eight lanes at once.
+///
+/// # Safety
+/// `p` must be valid for reads of `stride + c + 4` floats and `o` for writes of four.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn bilinear_tinted_unchecked(
+    p: *const f32,
+    stride: usize,
+    c: usize,
+    fx: f32,
+    fy: f32,
+    t: &[f32; 4],
+    o: *mut f32,
+) {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE2 is part of x86-64's baseline; the caller vouches for the pointers.
     unsafe {
-        use std::arch::x86_64::*;
-        let q = p.as_ptr();
-        let (a, b) = (_mm_loadu_ps(q), _mm_loadu_ps(q.add(c)));
-        let (e, f) = (_mm_loadu_ps(q.add(stride)), _mm_loadu_ps(q.add(stride + c)));
+        let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(c)));
+        let (e, f) = (_mm_loadu_ps(p.add(stride)), _mm_loadu_ps(p.add(stride + c)));
         let fx = _mm_set1_ps(fx);
         let top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
         let bot = _mm_add_ps(e, _mm_mul_ps(fx, _mm_sub_ps(f, e)));
         let v = _mm_add_ps(top, _mm_mul_ps(_mm_set1_ps(fy), _mm_sub_ps(bot, top)));
-        _mm_storeu_ps(o.as_mut_ptr(), _mm_mul_ps(v, _mm_loadu_ps(t.as_ptr())));
+        _mm_storeu_ps(o, _mm_mul_ps(v, _mm_loadu_ps(t.as_ptr())));
+        *o.add(3) = 1.0;
     }
-    o[3] = 1.0;
 }
 
 /// `CubeLoc::i` of a lookup whose footprint crosses a seam.

@@ -206,17 +206,42 @@ unsafe fn mirror_row_avx2(
         let ev = v8::reflect(&idb, hit, x0 + g, fy, setups, view);
         left |= ev.left << g;
         let at = v8::locate(&ev.r, cf);
-        let tint = v8::lanes(&ev.tint);
+        let tint = v8::pixels(&ev.tint);
         let stride = cf.n as usize * cf.c;
+        // Mirror lanes whose four texels lie inside one face and within reach of four-lane
+        // reads: straight to the blend, no further test.
+        let direct = ev.mirror & at.ok & at.inside & at.reach & ((1u32 << cnt) - 1);
+        let mut m = direct;
+        while m != 0 {
+            let lane = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let data = cf.faces[at.layer[lane] as usize];
+            // SAFETY: `reach` says `index + stride + c + 4 ≤ data.len()`; lane < cnt, so the
+            // pixel's four floats are in `orow`.
+            unsafe {
+                crate::fast::bilinear_tinted_unchecked(
+                    data.as_ptr().add(at.index[lane] as usize),
+                    stride,
+                    cf.c,
+                    at.fx[lane],
+                    at.fy[lane],
+                    &tint[lane],
+                    orow.as_mut_ptr().add(4 * lane),
+                );
+            }
+        }
         for (lane, o) in orow.chunks_exact_mut(4).enumerate() {
             let bit = 1 << lane;
+            if direct & bit != 0 {
+                continue;
+            }
             if ev.mirror & bit == 0 {
                 if none & bit != 0 {
                     o.fill(0.0);
                 }
                 continue; // not a mirror: the caller's
             }
-            let t = [tint[0][lane], tint[1][lane], tint[2][lane], 1.0];
+            let t = tint[lane];
             if at.ok & at.inside & bit != 0 {
                 let data = cf.faces[at.layer[lane] as usize];
                 let i = at.index[lane] as usize;
@@ -284,6 +309,9 @@ mod v8 {
     pub struct Located {
         pub ok: u32,
         pub inside: u32,
+        /// Lanes whose `index + stride + c + 4` is within a face (four-lane reads of the
+        /// second texel of the lower row stay inside).
+        pub reach: u32,
         pub layer: [i32; 8],
         pub index: [i32; 8],
         pub fx: [f32; 8],
@@ -349,16 +377,31 @@ mod v8 {
         _mm256_movemask_ps(_mm256_castsi256_ps(eq)) as u32
     }
 
-    /// The lanes of three vectors.
+    /// Eight `(r, g, b, 1)` of three vectors of lanes `r`, `g`, `b`.
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub fn lanes(v: &[__m256; 3]) -> [[f32; 8]; 3] {
-        let mut a = [[0.0f32; 8]; 3];
-        for (a, v) in a.iter_mut().zip(v) {
-            // SAFETY: `a` holds eight floats.
-            unsafe { _mm256_storeu_ps(a.as_mut_ptr(), *v) };
+    pub fn pixels(v: &[__m256; 3]) -> [[f32; 4]; 8] {
+        let one = splat(1.0);
+        let (rg_lo, rg_hi) = (
+            _mm256_unpacklo_ps(v[0], v[1]),
+            _mm256_unpackhi_ps(v[0], v[1]),
+        );
+        let (ba_lo, ba_hi) = (_mm256_unpacklo_ps(v[2], one), _mm256_unpackhi_ps(v[2], one));
+        // Pixels 0|4, 1|5, 2|6, 3|7, then their halves put in order.
+        let p04 = _mm256_shuffle_ps::<0x44>(rg_lo, ba_lo);
+        let p15 = _mm256_shuffle_ps::<0xEE>(rg_lo, ba_lo);
+        let p26 = _mm256_shuffle_ps::<0x44>(rg_hi, ba_hi);
+        let p37 = _mm256_shuffle_ps::<0xEE>(rg_hi, ba_hi);
+        let mut out = [[0.0f32; 4]; 8];
+        let o = out.as_mut_ptr() as *mut f32;
+        // SAFETY: `out` holds 32 floats.
+        unsafe {
+            _mm256_storeu_ps(o, _mm256_permute2f128_ps::<0x20>(p04, p15));
+            _mm256_storeu_ps(o.add(8), _mm256_permute2f128_ps::<0x20>(p26, p37));
+            _mm256_storeu_ps(o.add(16), _mm256_permute2f128_ps::<0x31>(p04, p15));
+            _mm256_storeu_ps(o.add(24), _mm256_permute2f128_ps::<0x31>(p26, p37));
         }
-        a
+        out
     }
 
     /// `mirror_dir` of the pixels at columns `x0 ..` of `idb` whose bit is set in `lanes`,
@@ -541,6 +584,10 @@ mod v8 {
         let mut out = Located {
             ok: _mm256_movemask_ps(_mm256_and_ps(valid, finite)) as u32,
             inside: _mm256_movemask_ps(_mm256_castsi256_ps(inside)) as u32,
+            reach: _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(
+                _mm256_set1_epi32(cf.n * stride - stride - cf.c as i32 - 3),
+                index,
+            ))) as u32,
             layer: [0; 8],
             index: [0; 8],
             fx: [0.0; 8],
