@@ -230,11 +230,12 @@ unsafe fn mirror_row_avx2(
                 );
             }
         }
-        for (lane, o) in orow.chunks_exact_mut(4).enumerate() {
+        let mut rest = ((1u32 << cnt) - 1) & !direct;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
             let bit = 1 << lane;
-            if direct & bit != 0 {
-                continue;
-            }
+            let o = &mut orow[4 * lane..4 * lane + 4];
             if ev.mirror & bit == 0 {
                 if none & bit != 0 {
                     o.fill(0.0);
