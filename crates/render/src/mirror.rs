@@ -16,18 +16,58 @@
 
 use glam::{Mat3, Vec3, Vec3A};
 
-/// What the per-pixel mirror needs of one setup, prepared once a frame: the setup's edges
-/// (`[b.x − a.x, a.y, b.y − a.y, a.x]` for the edge `a → b` opposite each corner, as
-/// `Binned::edges` gives them) and, at its three corners, the normal and the vector from
-/// the eye, each scaled by the corner's `1 / (w · area)` (see the module documentation).
+/// What the per-pixel mirror needs of one setup, prepared once a frame: `n = Σ fₖ·nₖ` and
+/// `v = Σ fₖ·vₖ` (see the module documentation) as planes over the sample grid. The edge
+/// values `fₖ` are linear in `(x, y)`, so each sum is `a(o) + (x − oₓ)·∂a/∂x + (y − o_y)·∂a/∂y`
+/// about an origin `o` at a corner of the setup (near every sample, so the terms stay small
+/// and nothing cancels): two products a component where the sums took six.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct MirrorSetup {
-    pub edges: [[f32; 4]; 3],
+    /// The planes' origin `o` in the sample grid.
+    pub origin: [f32; 2],
+    /// `n` at `o`, and its change per unit of `x` and of `y`.
     pub n: [Vec3A; 3],
+    /// `v` likewise (mode 2: the interpolated reflected vector).
     pub v: [Vec3A; 3],
     pub tint: [f32; 3],
     /// Whether the setup's material is a mirror (else it is shaded in full).
     pub mirror: bool,
+}
+
+impl MirrorSetup {
+    /// The planes of corner attributes `n`, `v` (each already scaled by the corner's
+    /// `1 / (w · area)`) over a setup with `edges` (`[b.x − a.x, a.y, b.y − a.y, a.x]` for
+    /// the edge `a → b` opposite each corner, as `Binned::edges` gives them, whose value is
+    /// `fₖ(x, y) = (b.x − a.x)(y − a.y) − (b.y − a.y)(x − a.x)`), worked out in `f64`.
+    pub fn new(
+        edges: [[f32; 4]; 3],
+        n: [Vec3A; 3],
+        v: [Vec3A; 3],
+        tint: [f32; 3],
+        mirror: bool,
+    ) -> MirrorSetup {
+        // The origin: the start of edge 0, a corner of the setup.
+        let (ox, oy) = (edges[0][3] as f64, edges[0][1] as f64);
+        let plane = |a: &[Vec3A; 3]| {
+            let mut at = glam::DVec3::ZERO;
+            let (mut ddx, mut ddy) = (glam::DVec3::ZERO, glam::DVec3::ZERO);
+            for (ak, &[dx, ay, dy, ax]) in a.iter().zip(&edges) {
+                let ak = ak.as_dvec3();
+                let (dx, ay, dy, ax) = (dx as f64, ay as f64, dy as f64, ax as f64);
+                at += ak * (dx * (oy - ay) - dy * (ox - ax));
+                ddx -= ak * dy;
+                ddy += ak * dx;
+            }
+            [at, ddx, ddy].map(|d| Vec3A::from(d.as_vec3()))
+        };
+        MirrorSetup {
+            origin: [ox as f32, oy as f32],
+            n: plane(&n),
+            v: plane(&v),
+            tint,
+            mirror,
+        }
+    }
 }
 
 /// What all pixels of a frame share.
@@ -47,13 +87,11 @@ pub(crate) struct MirrorView {
 /// `m`: the reference for [`mirror_dirs`], which gives the same bits.
 #[inline(always)]
 pub(crate) fn mirror_dir(m: &MirrorSetup, fx: f32, fy: f32, view: &MirrorView) -> Vec3 {
-    // Edge values exactly as `Binned::edge_values` computes them.
-    let f = m
-        .edges
-        .map(|[dx, ay, dy, ax]| dx * (fy - ay) - dy * (fx - ax));
-    let n = m.n[0] * f[0] + m.n[1] * f[1] + m.n[2] * f[2];
+    // The planes: the row's part first, then the column's (as `v8::reflect`).
+    let (dx, dy) = (fx - m.origin[0], fy - m.origin[1]);
+    let n = (m.n[0] + m.n[2] * dy) + m.n[1] * dx;
     let v = if view.persp || view.per_vertex {
-        m.v[0] * f[0] + m.v[1] * f[1] + m.v[2] * f[2]
+        (m.v[0] + m.v[2] * dy) + m.v[1] * dx
     } else {
         view.forward
     };
@@ -327,19 +365,6 @@ mod v8 {
         _mm256_set1_ps(v)
     }
 
-    /// `(a + b) + c` of the products `aₖ·fₖ` for component `c` of three corners.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn interp(a: &[Vec3A; 3], c: usize, f: &[__m256; 3]) -> __m256 {
-        _mm256_add_ps(
-            _mm256_add_ps(
-                _mm256_mul_ps(splat(a[0][c]), f[0]),
-                _mm256_mul_ps(splat(a[1][c]), f[1]),
-            ),
-            _mm256_mul_ps(splat(a[2][c]), f[2]),
-        )
-    }
-
     /// `(x·x' + y·y') + z·z'`, as glam's `Vec3A::dot`.
     #[inline]
     #[target_feature(enable = "avx2")]
@@ -423,7 +448,6 @@ mod v8 {
             splat(x0 as f32),
             _mm256_setr_ps(0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5),
         );
-        let fyv = splat(fy);
         let zero = _mm256_setzero_ps();
         let mut out = Reflected {
             r: [zero; 3],
@@ -443,25 +467,16 @@ mod v8 {
                 continue;
             }
             out.mirror |= bits;
-            let e = &m.edges;
-            let edge = |k: usize| {
-                let [dx, ay, dy, ax] = e[k];
-                (dx, ay, dy, ax)
+            // The planes as `mirror_dir` evaluates them: the row's part once (as a Vec3A),
+            // then eight columns.
+            let dy = fy - m.origin[1];
+            let dx = _mm256_sub_ps(fx, splat(m.origin[0]));
+            let plane = |a: &[Vec3A; 3]| {
+                let row = a[0] + a[2] * dy;
+                [0, 1, 2].map(|c| _mm256_add_ps(splat(row[c]), _mm256_mul_ps(splat(a[1][c]), dx)))
             };
-            let mut f = [zero; 3];
-            for (k, fk) in f.iter_mut().enumerate() {
-                let (dx, ay, dy, ax) = edge(k);
-                *fk = _mm256_sub_ps(
-                    _mm256_mul_ps(splat(dx), _mm256_sub_ps(fyv, splat(ay))),
-                    _mm256_mul_ps(splat(dy), _mm256_sub_ps(fx, splat(ax))),
-                );
-            }
             let v = if view.persp || view.per_vertex {
-                [
-                    interp(&m.v, 0, &f),
-                    interp(&m.v, 1, &f),
-                    interp(&m.v, 2, &f),
-                ]
+                plane(&m.v)
             } else {
                 [
                     splat(view.forward.x),
@@ -472,11 +487,7 @@ mod v8 {
             let r = if view.per_vertex {
                 v // mode 2: the interpolated reflected vector itself
             } else {
-                let n = [
-                    interp(&m.n, 0, &f),
-                    interp(&m.n, 1, &f),
-                    interp(&m.n, 2, &f),
-                ];
+                let n = plane(&m.n);
                 let nn = dot(&n, &n);
                 let t = _mm256_mul_ps(dot(&n, &v), splat(2.0));
                 let mut r = [zero; 3];

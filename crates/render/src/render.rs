@@ -572,10 +572,10 @@ impl Prepared<'_> {
                         Material::Mirror { tint } => (true, *tint),
                         _ => (false, [0.0; 3]),
                     };
-                    crate::mirror::MirrorSetup {
-                        edges: binned.edges(id),
-                        n: [0, 1, 2].map(|k| at(&self.nrm, k)),
-                        v: if per_vertex {
+                    crate::mirror::MirrorSetup::new(
+                        binned.edges(id),
+                        [0, 1, 2].map(|k| at(&self.nrm, k)),
+                        if per_vertex {
                             [0, 1, 2].map(|k| at(&self.r_vert, k))
                         } else if persp {
                             [0, 1, 2].map(v)
@@ -584,7 +584,7 @@ impl Prepared<'_> {
                         },
                         tint,
                         mirror,
-                    }
+                    )
                 })
                 .collect(),
         )
