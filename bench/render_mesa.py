@@ -127,17 +127,27 @@ class GL:
         self.buf = np.zeros((h, w, 4), np.uint8)
         if not osmesa.OSMesaMakeCurrent(self.ctx, self.buf, gl.GL_UNSIGNED_BYTE, w, h):
             raise RuntimeError("OSMesaMakeCurrent failed")
-        self.fbo = gl.glGenFramebuffers(1)
-        gl.glBindFramebuffer(gl.GL_FRAMEBUFFER, self.fbo)
-        rb = gl.glGenRenderbuffers(2)
-        gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, rb[0])
-        gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RGBA32F if float_target else gl.GL_RGBA8, w, h)
-        gl.glFramebufferRenderbuffer(gl.GL_FRAMEBUFFER, gl.GL_COLOR_ATTACHMENT0, gl.GL_RENDERBUFFER, rb[0])
-        gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, rb[1])
-        gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_DEPTH_COMPONENT24, w, h)
-        gl.glFramebufferRenderbuffer(gl.GL_FRAMEBUFFER, gl.GL_DEPTH_ATTACHMENT, gl.GL_RENDERBUFFER, rb[1])
-        assert gl.glCheckFramebufferStatus(gl.GL_FRAMEBUFFER) == gl.GL_FRAMEBUFFER_COMPLETE
-        gl.glViewport(0, 0, w, h)
+        # Framebuffers of 8-bit RGBA and of float RGBA (what mirrorball renders into), made
+        # on first use; `float_target` picks the one bound now.
+        self.fbos = {}
+        self.target(float_target)
+
+    def target(self, float_target):
+        if float_target not in self.fbos:
+            fbo = gl.glGenFramebuffers(1)
+            gl.glBindFramebuffer(gl.GL_FRAMEBUFFER, fbo)
+            rb = gl.glGenRenderbuffers(2)
+            gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, rb[0])
+            gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RGBA32F if float_target else gl.GL_RGBA8,
+                                     self.w, self.h)
+            gl.glFramebufferRenderbuffer(gl.GL_FRAMEBUFFER, gl.GL_COLOR_ATTACHMENT0, gl.GL_RENDERBUFFER, rb[0])
+            gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, rb[1])
+            gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_DEPTH_COMPONENT24, self.w, self.h)
+            gl.glFramebufferRenderbuffer(gl.GL_FRAMEBUFFER, gl.GL_DEPTH_ATTACHMENT, gl.GL_RENDERBUFFER, rb[1])
+            assert gl.glCheckFramebufferStatus(gl.GL_FRAMEBUFFER) == gl.GL_FRAMEBUFFER_COMPLETE
+            self.fbos[float_target] = fbo
+        gl.glBindFramebuffer(gl.GL_FRAMEBUFFER, self.fbos[float_target])
+        gl.glViewport(0, 0, self.w, self.h)
 
     def renderer(self):
         return gl.glGetString(gl.GL_RENDERER).decode() + ", " + gl.glGetString(gl.GL_VERSION).decode()
@@ -332,10 +342,12 @@ def bench(args):
     gl.glEnable(gl.GL_DEPTH_TEST)
     n_idx = tris.size
 
-    def culled(setup, on):
+    def culled(setup, on, float_target=False):
         # GL_CULL_FACE leaves out back faces, as mirrorball does by itself for a closed
         # mesh (the bunny is watertight): Mesa with and without it, so both are on record.
+        # `float_target`: into float RGBA, the linear colour mirrorball renders (else 8-bit).
         def go():
+            g.target(float_target)
             draw = setup()
             (gl.glEnable if on else gl.glDisable)(gl.GL_CULL_FACE)
             return draw
@@ -404,7 +416,11 @@ def bench(args):
                 ("mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, no background",
                  culled(fixed_function, True)),
                 ("mesa GLSL per-pixel reflect(), no background", culled(glsl, False)),
-                ("mesa GLSL per-pixel reflect(), GL_CULL_FACE, no background", culled(glsl, True))]:
+                ("mesa GLSL per-pixel reflect(), GL_CULL_FACE, no background", culled(glsl, True)),
+                ("mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, float RGBA, no background",
+                 culled(fixed_function, True, True)),
+                ("mesa GLSL per-pixel reflect(), GL_CULL_FACE, float RGBA, no background",
+                 culled(glsl, True, True))]:
             draw = setup()
             draw()
             gl.glFinish()
@@ -436,7 +452,13 @@ def bench(args):
              ("mirrorball bunny per-vertex reflection (mode 2) cube, no background",
               "mesa fixed-function GL_REFLECTION_MAP (per-vertex), no background"),
              ("mirrorball bunny per-vertex reflection (mode 2) cube, no background",
-              "mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, no background")]
+              "mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, no background"),
+             ("mirrorball bunny per-pixel cube, no background",
+              "mesa GLSL per-pixel reflect(), GL_CULL_FACE, float RGBA, no background"),
+             ("mirrorball bunny per-pixel cube, no background",
+              "mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, float RGBA, no background"),
+             ("mirrorball bunny per-vertex reflection (mode 2) cube, no background",
+              "mesa fixed-function GL_REFLECTION_MAP (per-vertex), GL_CULL_FACE, float RGBA, no background")]
     for a, b in pairs:
         if a in results and b in results:
             print(f"  {a}\n    / {b}: {results[a] / results[b]:.2f}x")
