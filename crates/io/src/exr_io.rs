@@ -218,10 +218,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Erro
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
         let exr_image = exr::image::Image::from_layer(layer);
         atomic_write(path, |out| {
-            exr_image
-                .write()
-                .to_buffered(out)
-                .map_err(|e| write_error(path, e))
+            write_layer(out, exr_image.write(), image, half).map_err(|e| write_error(path, e))
         })
     } else {
         let texels = SpecificChannels {
@@ -234,12 +231,96 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Erro
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
         let exr_image = exr::image::Image::from_layer(layer);
         atomic_write(path, |out| {
-            exr_image
-                .write()
-                .to_buffered(out)
-                .map_err(|e| write_error(path, e))
+            write_layer(out, exr_image.write(), image, half).map_err(|e| write_error(path, e))
         })
     }
+}
+
+/// Writes a one-layer image: ZIP and ZIPS blocks compressed here with libdeflate on all
+/// cores ([`crate::exr_zip`]), each block's samples taken straight from `image` (half
+/// samples clamped as `fit` in [`write`] does); the `exr` crate writes everything else.
+fn write_layer<'i, L, F>(
+    out: &mut std::io::BufWriter<File>,
+    writer: exr::image::write::WriteImageWithOptions<'i, L, F>,
+    image: &Image,
+    half: bool,
+) -> exr::error::UnitResult
+where
+    L: exr::image::write::layers::WritableLayers<'i>,
+    F: FnMut(f64),
+{
+    use exr::block::chunk::{Chunk, CompressedBlock, CompressedScanLineBlock};
+    use rayon::prelude::*;
+    let headers = writer.infer_meta_data();
+    let header = &headers[0];
+    if !matches!(header.compression, Compression::ZIP1 | Compression::ZIP16)
+        || !matches!(header.blocks, exr::meta::BlockDescription::ScanLines)
+    {
+        return writer.to_buffered(out);
+    }
+    let header = header.clone();
+    let (w, c) = (image.width() as usize, image.channels());
+    // Each channel of the file (in its order, by name) as an index into a texel.
+    let sources: Vec<usize> = header
+        .channels
+        .list
+        .iter()
+        .map(|ch| match ch.name.to_string().as_str() {
+            "R" => 0,
+            "G" => 1,
+            "B" => 2,
+            _ => 3,
+        })
+        .collect();
+    let data = image.data();
+    let y0 = header.own_attributes.layer_position.y();
+    exr::block::write(out, headers, true, |meta, chunks| {
+        use exr::block::writer::ChunksWriter;
+        let blocks: Vec<(usize, exr::block::BlockIndex)> =
+            meta.enumerate_ordered_header_block_indices().collect();
+        // A batch of blocks compressed in parallel, then written in order.
+        for batch in blocks.chunks(32) {
+            let packed: Vec<Chunk> = batch
+                .par_iter()
+                .map_init(
+                    || (crate::exr_zip::Zip::new(), Vec::new(), Vec::new()),
+                    |(zip, raw, scratch), (_, block)| {
+                        let (by, bh) = (block.pixel_position.y(), block.pixel_size.y());
+                        raw.clear();
+                        for y in by..by + bh {
+                            let row = &data[y * w * c..(y + 1) * w * c];
+                            for &k in &sources {
+                                let samples = row.iter().skip(k).step_by(c);
+                                if half {
+                                    for &v in samples {
+                                        let v = half::f16::from_f32(v.clamp(-HALF_MAX, HALF_MAX));
+                                        raw.extend_from_slice(&v.to_le_bytes());
+                                    }
+                                } else {
+                                    for &v in samples {
+                                        raw.extend_from_slice(&v.to_le_bytes());
+                                    }
+                                }
+                            }
+                        }
+                        let mut packed = Vec::new();
+                        crate::exr_zip::compress(raw, scratch, zip, &mut packed);
+                        Chunk {
+                            layer_index: 0,
+                            compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
+                                y_coordinate: y0 + by as i32,
+                                compressed_pixels_le: packed,
+                            }),
+                        }
+                    },
+                )
+                .collect();
+            for ((index, _), chunk) in batch.iter().zip(packed) {
+                chunks.write_chunk(*index, chunk)?;
+            }
+        }
+        Ok(())
+    })
 }
 
 /// The decoded texels of one layer, interleaved RGB or RGBA, top row first.
@@ -327,12 +408,15 @@ fn read_blocks(
     use exr::block::reader::ChunksReader;
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
     let n = layout.len();
-    let mut data = vec![0.0f32; w * h * n];
     let reader = chunks.filter_chunks(false, |_, _, block| {
         block.layer == index && block.level == Vec2(0, 0)
     })?;
-    let bad =
-        || exr::error::Error::Invalid("a block lies outside its layer or is too short".into());
+    if matches!(header.compression, Compression::ZIP1 | Compression::ZIP16)
+        && matches!(header.blocks, exr::meta::BlockDescription::ScanLines)
+    {
+        return read_zip_scanlines(reader, header, layout);
+    }
+    let mut data = vec![0.0f32; w * h * n];
     reader.decompress_parallel(false, |_, block| {
         let (bx, by) = (
             block.index.pixel_position.x(),
@@ -340,30 +424,172 @@ fn read_blocks(
         );
         let (bw, bh) = (block.index.pixel_size.x(), block.index.pixel_size.y());
         if bx + bw > w || by + bh > h {
-            return Err(bad());
+            return Err(outside());
         }
-        let bytes = &block.data;
-        let mut off = 0;
-        for y in by..by + bh {
-            let row = &mut data[(y * w + bx) * n..(y * w + bx + bw) * n];
-            for &(c, st) in layout {
-                let size = if st == SampleType::F32 { 4 } else { 2 };
-                let src = bytes.get(off..off + bw * size).ok_or_else(bad)?;
-                off += bw * size;
-                let dst = row.iter_mut().skip(c).step_by(n);
-                if size == 4 {
+        scatter(
+            &block.data,
+            &mut data[(by * w) * n..((by + bh - 1) * w + bx + bw) * n],
+            w,
+            bx,
+            bw,
+            bh,
+            layout,
+            true,
+        )
+    })?;
+    Image::from_vec(w as u32, h as u32, n, data)
+        .ok_or_else(|| exr::error::Error::Invalid("inconsistent layer size".into()))
+}
+
+fn outside() -> exr::error::Error {
+    exr::error::Error::Invalid("a block lies outside its layer or is too short".into())
+}
+
+/// Interleaves the samples of a block's lines (`bh` lines of `bw` texels from column `bx`;
+/// each line its channels in the file's order, as `layout` gives them) into `rows`, the
+/// layer's texels from the block's first line on (`w` texels a row). `native`: the samples
+/// are in this machine's byte order (the `exr` crate converts them), else little-endian.
+#[allow(clippy::too_many_arguments)]
+fn scatter(
+    bytes: &[u8],
+    rows: &mut [f32],
+    w: usize,
+    bx: usize,
+    bw: usize,
+    bh: usize,
+    layout: &[(usize, SampleType)],
+    native: bool,
+) -> Result<(), exr::error::Error> {
+    let n = layout.len();
+    let mut off = 0;
+    for y in 0..bh {
+        let row = rows
+            .get_mut((y * w + bx) * n..(y * w + bx + bw) * n)
+            .ok_or_else(outside)?;
+        for &(c, st) in layout {
+            let size = if st == SampleType::F32 { 4 } else { 2 };
+            let src = bytes.get(off..off + bw * size).ok_or_else(outside)?;
+            off += bw * size;
+            let dst = row.iter_mut().skip(c).step_by(n);
+            match (size, native) {
+                (4, true) => {
                     for (d, s) in dst.zip(src.chunks_exact(4)) {
                         *d = f32::from_ne_bytes([s[0], s[1], s[2], s[3]]);
                     }
-                } else {
+                }
+                (4, false) => {
+                    for (d, s) in dst.zip(src.chunks_exact(4)) {
+                        *d = f32::from_le_bytes([s[0], s[1], s[2], s[3]]);
+                    }
+                }
+                (_, true) => {
                     for (d, s) in dst.zip(src.chunks_exact(2)) {
                         *d = half::f16::from_bits(u16::from_ne_bytes([s[0], s[1]])).to_f32();
                     }
                 }
+                (_, false) => {
+                    for (d, s) in dst.zip(src.chunks_exact(2)) {
+                        *d = half::f16::from_bits(u16::from_le_bytes([s[0], s[1]])).to_f32();
+                    }
+                }
             }
         }
-        Ok(())
-    })?;
+    }
+    Ok(())
+}
+
+/// [`read_blocks`] for ZIP and ZIPS scan lines: each compressed block, as soon as it has
+/// been read (in file order), is inflated with libdeflate ([`crate::exr_zip`]) and
+/// interleaved into its rows on another core while the next is read. Each block must sit
+/// at its place in the layer exactly once.
+fn read_zip_scanlines(
+    reader: impl Iterator<Item = exr::error::Result<exr::block::chunk::Chunk>> + Send,
+    header: &Header,
+    layout: &[(usize, SampleType)],
+) -> Result<Image, exr::error::Error> {
+    use exr::block::chunk::CompressedBlock;
+    use std::cell::RefCell;
+    use std::sync::Mutex;
+    /// A thread's inflater with its two buffers (inflated stream, raw lines).
+    type Scratch = (crate::exr_zip::Zip, Vec<u8>, Vec<u8>);
+    thread_local! {
+        static SCRATCH: RefCell<Option<Scratch>> = const { RefCell::new(None) };
+    }
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    let n = layout.len();
+    let lines = header.compression.scan_lines_per_block();
+    let line_bytes: usize = w * layout
+        .iter()
+        .map(|&(_, st)| if st == SampleType::F32 { 4 } else { 2 })
+        .sum::<usize>();
+    let top = header.own_attributes.layer_position.y() as i64;
+    let mut data = vec![0.0f32; w * h * n];
+    let mut rows: Vec<Option<&mut [f32]>> = data.chunks_mut(w * n * lines).map(Some).collect();
+    let failed: Mutex<Option<exr::error::Error>> = Mutex::new(None);
+    let fail = |e: exr::error::Error| {
+        let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
+        f.get_or_insert(e);
+    };
+    rayon::scope(|scope| {
+        for chunk in reader {
+            let block = match chunk.map(|c| c.compressed_block) {
+                Ok(CompressedBlock::ScanLine(b)) => b,
+                Ok(_) => {
+                    return fail(exr::error::Error::Invalid(
+                        "a scan-line file holds a block that is not scan lines".into(),
+                    ))
+                }
+                Err(e) => return fail(e),
+            };
+            let dy = block.y_coordinate as i64 - top;
+            let k = usize::try_from(dy / lines as i64)
+                .ok()
+                .filter(|_| dy >= 0 && dy % lines as i64 == 0);
+            let Some(slot) = k.and_then(|k| rows.get_mut(k)) else {
+                return fail(outside());
+            };
+            let Some(out) = slot.take() else {
+                return fail(exr::error::Error::Invalid(
+                    format!("two blocks claim the lines from {}", block.y_coordinate).into(),
+                ));
+            };
+            let fail = &fail;
+            scope.spawn(move |_| {
+                let bh = out.len() / (w * n);
+                let done = SCRATCH.with(|s| {
+                    let mut s = s.borrow_mut();
+                    let (zip, scratch, raw) = s.get_or_insert_with(|| {
+                        (crate::exr_zip::Zip::new(), Vec::new(), Vec::new())
+                    });
+                    crate::exr_zip::decompress(
+                        &block.compressed_pixels_le,
+                        bh * line_bytes,
+                        scratch,
+                        zip,
+                        raw,
+                    )
+                    .map_err(|e| exr::error::Error::Invalid(e.into()))?;
+                    scatter(raw, out, w, 0, w, bh, layout, false)
+                });
+                if let Err(e) = done {
+                    fail(e);
+                }
+            });
+        }
+    });
+    if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e);
+    }
+    if let Some(k) = rows.iter().position(Option::is_some) {
+        return Err(exr::error::Error::Invalid(
+            format!(
+                "the block of lines from {} is missing (a truncated file?)",
+                top + (k * lines) as i64
+            )
+            .into(),
+        ));
+    }
+    drop(rows);
     Image::from_vec(w as u32, h as u32, n, data)
         .ok_or_else(|| exr::error::Error::Invalid("inconsistent layer size".into()))
 }

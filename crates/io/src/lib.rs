@@ -11,6 +11,7 @@ mod atomic;
 mod dds_io;
 mod error;
 mod exr_io;
+mod exr_zip;
 mod hdr_io;
 mod ktx2_io;
 mod ldr_io;

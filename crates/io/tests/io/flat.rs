@@ -1059,3 +1059,138 @@ fn exr_block_reader_matches_the_crates_reader() {
         }
     }
 }
+
+#[test]
+fn exr_zip_blocks_agree_with_the_exr_crate_both_ways() {
+    // mirrorball compresses and inflates ZIP/ZIPS blocks itself (libdeflate); the `exr`
+    // crate does both its own way (miniz, zune-inflate). Each reads what the other wrote,
+    // texel for texel: half and float, RGB and RGBA, a partial last block, NaN, ±∞,
+    // negatives and values past the largest half.
+    use exr::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    for c in [3usize, 4] {
+        // Smooth (so that the blocks really are deflated, not stored raw), with specials.
+        let mut img = mirrorball_core::Image::new(37, 45, c);
+        for y in 0..45 {
+            for x in 0..37 {
+                let t = (x + 2 * y) as f32;
+                img.set(x, y, &[t * 0.25, 1.0 + y as f32, 100.0 - t, 0.5]);
+            }
+        }
+        img.set(1, 0, &[f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.5]);
+        img.set(2, 7, &[-3.5, 1e6, -0.0, 1.0]);
+        for comp in [ExrCompression::Zip, ExrCompression::Zips] {
+            for precision in [Precision::Half, Precision::Float] {
+                let tag = format!("{c}-{comp:?}-{precision:?}");
+                // Ours → the exr crate's reader.
+                let ours = dir.path().join(format!("ours-{tag}.exr"));
+                let o = WriteOptions {
+                    exr_compression: comp,
+                    precision: Some(precision),
+                    ..WriteOptions::default()
+                };
+                write_image(&ours, &img, &o).unwrap();
+                let raw_bytes = 37 * 45 * c * if precision == Precision::Half { 2 } else { 4 };
+                let file_bytes = std::fs::metadata(&ours).unwrap().len() as usize;
+                assert!(
+                    file_bytes < raw_bytes / 2,
+                    "{tag}: {file_bytes} bytes, deflated"
+                );
+                let theirs_read = read()
+                    .no_deep_data()
+                    .largest_resolution_level()
+                    .all_channels()
+                    .all_layers()
+                    .all_attributes()
+                    .from_file(&ours)
+                    .unwrap();
+                let layer = &theirs_read.layer_data[0];
+                assert_eq!(
+                    layer.encoding.compression,
+                    match comp {
+                        ExrCompression::Zip => Compression::ZIP16,
+                        _ => Compression::ZIP1,
+                    }
+                );
+                let (back, _) = read_one(&ours);
+                for ch in &layer.channel_data.list {
+                    let k = match ch.name.to_string().as_str() {
+                        "R" => 0,
+                        "G" => 1,
+                        "B" => 2,
+                        _ => 3,
+                    };
+                    let values: Vec<f32> = ch.sample_data.values_as_f32().collect();
+                    assert_eq!(values.len(), 37 * 45);
+                    for (i, v) in values.iter().enumerate() {
+                        // What was written, as half where half was asked for (clamped to
+                        // the largest half, as mirrorball writes it).
+                        let a = img.data()[i * c + k];
+                        let want = if precision == Precision::Half {
+                            half(a.clamp(-65504.0, 65504.0))
+                        } else {
+                            a
+                        };
+                        let ours_v = back.data()[i * c + k];
+                        for got in [*v, ours_v] {
+                            assert!(
+                                got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+                                "{tag} channel {k} sample {i}: wrote {want}, exr crate reads {v}, \
+                                 mirrorball {ours_v}"
+                            );
+                        }
+                    }
+                }
+                // The exr crate's writer → ours.
+                let theirs = dir.path().join(format!("theirs-{tag}.exr"));
+                let st = if precision == Precision::Half {
+                    SampleType::F16
+                } else {
+                    SampleType::F32
+                };
+                let desc = |n: &str| ChannelDescription::named(n, st);
+                let w = img.width() as usize;
+                let data = back.data().to_vec();
+                let texel = move |p: Vec2<usize>, k: usize| data[(p.y() * w + p.x()) * c + k];
+                let enc = Encoding {
+                    compression: match comp {
+                        ExrCompression::Zip => Compression::ZIP16,
+                        _ => Compression::ZIP1,
+                    },
+                    ..Encoding::default()
+                };
+                let size = (img.width() as usize, img.height() as usize);
+                if c == 4 {
+                    let px = SpecificChannels {
+                        channels: (desc("R"), desc("G"), desc("B"), desc("A")),
+                        pixels: move |p: Vec2<usize>| {
+                            (texel(p, 0), texel(p, 1), texel(p, 2), texel(p, 3))
+                        },
+                    };
+                    let layer = Layer::new(size, LayerAttributes::default(), enc, px);
+                    exr::image::Image::from_layer(layer)
+                        .write()
+                        .to_file(&theirs)
+                        .unwrap();
+                } else {
+                    let px = SpecificChannels {
+                        channels: (desc("R"), desc("G"), desc("B")),
+                        pixels: move |p: Vec2<usize>| (texel(p, 0), texel(p, 1), texel(p, 2)),
+                    };
+                    let layer = Layer::new(size, LayerAttributes::default(), enc, px);
+                    exr::image::Image::from_layer(layer)
+                        .write()
+                        .to_file(&theirs)
+                        .unwrap();
+                }
+                let (again, _) = read_one(&theirs);
+                for (i, (a, b)) in back.data().iter().zip(again.data()).enumerate() {
+                    assert!(
+                        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                        "{tag} sample {i}: {a} written by the exr crate, read back as {b}"
+                    );
+                }
+            }
+        }
+    }
+}
