@@ -137,7 +137,7 @@ pub fn load(
     }
     check_shape(input, &proj, w, h, layout)?;
     let env = layout
-        .unpack(&image, proj)
+        .unpack_owned(image, proj)
         .map_err(|e| CliError::input(format!("{input}: {e}")))?;
     Ok(Source {
         env,

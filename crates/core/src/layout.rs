@@ -149,6 +149,16 @@ impl Layout {
         Some(out)
     }
 
+    /// [`Layout::unpack`], taking the picture: a one-layer map (or a separate layout) keeps
+    /// its texels where they are instead of copying them (100 MB for a 4096×2048 float
+    /// lat-long).
+    pub fn unpack_owned(self, image: Image, projection: Projection) -> Result<EnvMap, String> {
+        if self == Layout::Separate {
+            return EnvMap::new(projection, vec![image]).map_err(|e| e.to_string());
+        }
+        self.unpack(&image, projection)
+    }
+
     /// Cuts a picture laid out this way into the layers of `projection`.
     pub fn unpack(self, image: &Image, projection: Projection) -> Result<EnvMap, String> {
         let n = projection.layer_count();

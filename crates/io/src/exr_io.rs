@@ -236,9 +236,10 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Erro
     }
 }
 
-/// Writes a one-layer image: ZIP and ZIPS blocks compressed here with libdeflate on all
-/// cores ([`crate::exr_zip`]), each block's samples taken straight from `image` (half
-/// samples clamped as `fit` in [`write`] does); the `exr` crate writes everything else.
+/// Writes a one-layer image: uncompressed, ZIP and ZIPS blocks made here on all cores (ZIP
+/// compressed with libdeflate, [`crate::exr_zip`]), each block's samples taken straight
+/// from `image` (half samples clamped as `fit` in [`write`] does); the `exr` crate writes
+/// the header and offset table, and blocks of other compressions.
 fn write_layer<'i, L, F>(
     out: &mut std::io::BufWriter<File>,
     writer: exr::image::write::WriteImageWithOptions<'i, L, F>,
@@ -253,7 +254,8 @@ where
     use rayon::prelude::*;
     let headers = writer.infer_meta_data();
     let header = &headers[0];
-    if !matches!(header.compression, Compression::ZIP1 | Compression::ZIP16)
+    let zip = matches!(header.compression, Compression::ZIP1 | Compression::ZIP16);
+    if !(zip || header.compression == Compression::Uncompressed)
         || !matches!(header.blocks, exr::meta::BlockDescription::ScanLines)
     {
         return writer.to_buffered(out);
@@ -274,6 +276,7 @@ where
         .collect();
     let data = image.data();
     let y0 = header.own_attributes.layer_position.y();
+    let zip_blocks = zip;
     exr::block::write(out, headers, true, |meta, chunks| {
         use exr::block::writer::ChunksWriter;
         let blocks: Vec<(usize, exr::block::BlockIndex)> =
@@ -303,8 +306,13 @@ where
                                 }
                             }
                         }
-                        let mut packed = Vec::new();
-                        crate::exr_zip::compress(raw, scratch, zip, &mut packed);
+                        let packed = if zip_blocks {
+                            let mut packed = Vec::new();
+                            crate::exr_zip::compress(raw, scratch, zip, &mut packed);
+                            packed
+                        } else {
+                            raw.clone()
+                        };
                         Chunk {
                             layer_index: 0,
                             compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {

@@ -129,3 +129,25 @@ fn guesses_follow_the_aspect_ratio_and_declarations() {
     );
     assert!(d.reason.contains("declares"));
 }
+
+#[test]
+fn unpacking_an_owned_picture_gives_what_unpacking_a_borrowed_one_gives() {
+    use mirrorball_core::{EnvMap, Layout, ProjectionKind};
+    let cube = EnvMap::from_fn(ProjectionKind::Cube.default_projection(), 8, 3, |d| {
+        [d.x as f32, d.y as f32, d.z as f32, 1.0]
+    });
+    let ll = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 16, 3, |d| {
+        [d.x as f32, 0.5, d.z as f32, 1.0]
+    });
+    for (env, layout) in [
+        (&cube, Layout::HorizontalCross),
+        (&cube, Layout::VerticalStrip),
+        (&ll, Layout::Separate),
+    ] {
+        let img = layout.pack(env).expect("packs");
+        let borrowed = layout.unpack(&img, *env.projection()).unwrap();
+        let owned = layout.unpack_owned(img, *env.projection()).unwrap();
+        assert_eq!(owned, borrowed);
+        assert_eq!(&owned, env);
+    }
+}
