@@ -218,7 +218,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Erro
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
         let exr_image = exr::image::Image::from_layer(layer);
         atomic_write(path, |out| {
-            write_layer(out, exr_image.write(), image, half).map_err(|e| write_error(path, e))
+            write_layer(out, exr_image.write(), image).map_err(|e| write_error(path, e))
         })
     } else {
         let texels = SpecificChannels {
@@ -231,7 +231,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Erro
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
         let exr_image = exr::image::Image::from_layer(layer);
         atomic_write(path, |out| {
-            write_layer(out, exr_image.write(), image, half).map_err(|e| write_error(path, e))
+            write_layer(out, exr_image.write(), image).map_err(|e| write_error(path, e))
         })
     }
 }
@@ -244,7 +244,6 @@ fn write_layer<'i, L, F>(
     out: &mut std::io::BufWriter<File>,
     writer: exr::image::write::WriteImageWithOptions<'i, L, F>,
     image: &Image,
-    half: bool,
 ) -> exr::error::UnitResult
 where
     L: exr::image::write::layers::WritableLayers<'i>,
@@ -255,28 +254,19 @@ where
     let headers = writer.infer_meta_data();
     let header = &headers[0];
     let zip = matches!(header.compression, Compression::ZIP1 | Compression::ZIP16);
-    if !(zip || header.compression == Compression::Uncompressed)
-        || !matches!(header.blocks, exr::meta::BlockDescription::ScanLines)
-    {
-        return writer.to_buffered(out);
-    }
-    let header = header.clone();
+    // Each channel of the file, in its order, as an index into a texel and a sample type.
+    let layout = match block_layout(header) {
+        Some(l)
+            if (zip || header.compression == Compression::Uncompressed)
+                && matches!(header.blocks, exr::meta::BlockDescription::ScanLines) =>
+        {
+            l
+        }
+        _ => return writer.to_buffered(out),
+    };
     let (w, c) = (image.width() as usize, image.channels());
-    // Each channel of the file (in its order, by name) as an index into a texel.
-    let sources: Vec<usize> = header
-        .channels
-        .list
-        .iter()
-        .map(|ch| match ch.name.to_string().as_str() {
-            "R" => 0,
-            "G" => 1,
-            "B" => 2,
-            _ => 3,
-        })
-        .collect();
     let data = image.data();
     let y0 = header.own_attributes.layer_position.y();
-    let zip_blocks = zip;
     exr::block::write(out, headers, true, |meta, chunks| {
         use exr::block::writer::ChunksWriter;
         let blocks: Vec<(usize, exr::block::BlockIndex)> =
@@ -287,14 +277,14 @@ where
                 .par_iter()
                 .map_init(
                     || (crate::exr_zip::Zip::new(), Vec::new(), Vec::new()),
-                    |(zip, raw, scratch), (_, block)| {
+                    |(deflater, raw, scratch), (_, block)| {
                         let (by, bh) = (block.pixel_position.y(), block.pixel_size.y());
                         raw.clear();
                         for y in by..by + bh {
                             let row = &data[y * w * c..(y + 1) * w * c];
-                            for &k in &sources {
+                            for &(k, st) in &layout {
                                 let samples = row.iter().skip(k).step_by(c);
-                                if half {
+                                if st == SampleType::F16 {
                                     for &v in samples {
                                         let v = half::f16::from_f32(v.clamp(-HALF_MAX, HALF_MAX));
                                         raw.extend_from_slice(&v.to_le_bytes());
@@ -306,12 +296,12 @@ where
                                 }
                             }
                         }
-                        let packed = if zip_blocks {
+                        let packed = if zip {
                             let mut packed = Vec::new();
-                            crate::exr_zip::compress(raw, scratch, zip, &mut packed);
+                            crate::exr_zip::compress(raw, scratch, deflater, &mut packed);
                             packed
                         } else {
-                            raw.clone()
+                            std::mem::take(raw)
                         };
                         Chunk {
                             layer_index: 0,
@@ -449,6 +439,15 @@ fn read_blocks(
         .ok_or_else(|| exr::error::Error::Invalid("inconsistent layer size".into()))
 }
 
+/// Bytes a sample of a [`block_layout`] channel takes: float or half.
+fn sample_bytes(st: SampleType) -> usize {
+    if st == SampleType::F32 {
+        4
+    } else {
+        2
+    }
+}
+
 fn outside() -> exr::error::Error {
     exr::error::Error::Invalid("a block lies outside its layer or is too short".into())
 }
@@ -475,7 +474,7 @@ fn scatter(
             .get_mut((y * w + bx) * n..(y * w + bx + bw) * n)
             .ok_or_else(outside)?;
         for &(c, st) in layout {
-            let size = if st == SampleType::F32 { 4 } else { 2 };
+            let size = sample_bytes(st);
             let src = bytes.get(off..off + bw * size).ok_or_else(outside)?;
             off += bw * size;
             let dst = row.iter_mut().skip(c).step_by(n);
@@ -528,7 +527,7 @@ fn read_zip_scanlines(
     let lines = header.compression.scan_lines_per_block();
     let line_bytes: usize = w * layout
         .iter()
-        .map(|&(_, st)| if st == SampleType::F32 { 4 } else { 2 })
+        .map(|&(_, st)| sample_bytes(st))
         .sum::<usize>();
     let top = header.own_attributes.layer_position.y() as i64;
     let mut data = vec![0.0f32; w * h * n];

@@ -326,7 +326,7 @@ impl<'a> CubeFaces<'a> {
 /// by lane, so the same bits), times the tint `t`, alpha 1, into `o[..4]`. For three
 /// channels the second texel is read as four lanes, one float past it, so `p` must hold
 /// `stride + c + 4` floats (asserted). The one copy of this blend: [`CubeFaces::fetch_tinted`]
-/// and the renderer's AVX2 mirror rows both call it.
+/// calls it, and the renderer's AVX2 mirror rows its unchecked form.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) fn bilinear_tinted(

@@ -280,25 +280,9 @@ unsafe fn mirror_row_avx2(
                 }
                 continue; // not a mirror: the caller's
             }
+            // A mirror lane not blended above: no face, across a seam, or too near a face's
+            // end for four-lane reads; `fetch_tinted` sorts out which.
             let t = tint[lane];
-            if at.ok & at.inside & bit != 0 {
-                let data = cf.faces[at.layer[lane] as usize];
-                let i = at.index[lane] as usize;
-                // As CubeFaces::fetch_tinted: the second texel of a row is read as four
-                // lanes from its first channel (one float past it for three channels).
-                if i + stride + cf.c + 4 <= data.len() {
-                    crate::fast::bilinear_tinted(
-                        &data[i..],
-                        stride,
-                        cf.c,
-                        at.fx[lane],
-                        at.fy[lane],
-                        &t,
-                        o,
-                    );
-                    continue;
-                }
-            }
             let loc = if at.ok & bit == 0 {
                 CubeLoc::NONE
             } else if at.inside & bit == 0 {
