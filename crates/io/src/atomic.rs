@@ -6,8 +6,14 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 /// Calls `write` with a buffered writer on a temporary file in `path`'s directory, flushes
-/// and syncs it, and renames it over `path`. On any error the temporary file is removed and
-/// `path` is left as it was.
+/// it, and renames it over `path`. On any error the temporary file is removed and `path` is
+/// left as it was: no reader ever sees a half-written output.
+///
+/// The file is not synced to disk (`fsync`) before the rename, as `cp`, OpenEXR and image
+/// editors do not: a sync waits for the disk (10–15 ms a file here, a third of writing six
+/// cube faces) and guards only against the machine losing power, which is the file
+/// system's business (ext4, for one, flushes a file renamed over another before the
+/// rename is committed).
 pub fn atomic_write<F>(path: &Path, write: F) -> Result<(), Error>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<(), Error>,
@@ -21,7 +27,6 @@ where
         let file = w
             .into_inner()
             .map_err(|e| Error::io(path, e.into_error()))?;
-        file.sync_all().map_err(|e| Error::io(path, e))?;
         drop(file);
         std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
     })();

@@ -21,6 +21,8 @@ use mirrorball_core::{Image, ProjectionKind};
 use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 /// Largest finite half-float: values beyond it are clamped when writing half, so that a
 /// bright sun does not turn into infinity.
@@ -37,8 +39,17 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
 }
 
 fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> {
-    // Headers only: nothing sized by the file is allocated yet.
-    let chunks = exr::block::read(BufReader::new(file), false).map_err(|e| read_error(path, e))?;
+    // Headers only: nothing sized by the file is allocated yet. `Counted` remembers where
+    // they end, which is where the offset table starts.
+    let header_end = Arc::new(AtomicU64::new(0));
+    let chunks = exr::block::read(
+        Counted {
+            inner: BufReader::new(&file),
+            taken: header_end.clone(),
+        },
+        false,
+    )
+    .map_err(|e| read_error(path, e))?;
     let headers = chunks.headers();
 
     let Some(header) = headers.iter().find(|h| is_rgb_layer(h)) else {
@@ -65,8 +76,13 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     let index = headers.iter().position(is_rgb_layer).unwrap_or(0);
     if let Some(layout) = block_layout(&headers[index]) {
         let header = headers[index].clone();
-        let image =
-            read_blocks(chunks, index, &header, &layout).map_err(|e| read_error(path, e))?;
+        let image = if layer_count == 1 && is_zip_scanlines(&header) {
+            drop(chunks);
+            read_zip_file(&file, header_end.load(Ordering::Relaxed), &header, &layout)
+        } else {
+            read_blocks(chunks, index, &header, &layout)
+        }
+        .map_err(|e| read_error(path, e))?;
         let declared = header.own_attributes.environment_map.map(|m| match m {
             EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
             EnvironmentMap::Cube => ProjectionKind::Cube,
@@ -271,37 +287,33 @@ where
         use exr::block::writer::ChunksWriter;
         let blocks: Vec<(usize, exr::block::BlockIndex)> =
             meta.enumerate_ordered_header_block_indices().collect();
+        let line_bytes: usize = w * layout
+            .iter()
+            .map(|&(_, st)| sample_bytes(st))
+            .sum::<usize>();
         // A batch of blocks compressed in parallel, then written in order.
         for batch in blocks.chunks(32) {
             let packed: Vec<Chunk> = batch
                 .par_iter()
                 .map_init(
-                    || (crate::exr_zip::Zip::new(), Vec::new(), Vec::new()),
-                    |(deflater, raw, scratch), (_, block)| {
+                    || {
+                        let lanes = (Vec::new(), Vec::new());
+                        (crate::exr_zip::Zip::new(), Vec::new(), Vec::new(), lanes)
+                    },
+                    |(deflater, raw, scratch, lanes), (_, block)| {
                         let (by, bh) = (block.pixel_position.y(), block.pixel_size.y());
-                        raw.clear();
-                        for y in by..by + bh {
-                            let row = &data[y * w * c..(y + 1) * w * c];
-                            for &(k, st) in &layout {
-                                let samples = row.iter().skip(k).step_by(c);
-                                if st == SampleType::F16 {
-                                    for &v in samples {
-                                        let v = half::f16::from_f32(v.clamp(-HALF_MAX, HALF_MAX));
-                                        raw.extend_from_slice(&v.to_le_bytes());
-                                    }
-                                } else {
-                                    for &v in samples {
-                                        raw.extend_from_slice(&v.to_le_bytes());
-                                    }
-                                }
-                            }
-                        }
+                        // ZIP fills a buffer it keeps; uncompressed lines are the block.
+                        let mut fresh = Vec::new();
+                        let buf = if zip { &mut *raw } else { &mut fresh };
+                        buf.resize(bh * line_bytes, 0);
+                        let rows = &data[by * w * c..(by + bh) * w * c];
+                        pack_lines(rows, w, c, &layout, buf, lanes);
                         let packed = if zip {
                             let mut packed = Vec::new();
                             crate::exr_zip::compress(raw, scratch, deflater, &mut packed);
                             packed
                         } else {
-                            std::mem::take(raw)
+                            fresh
                         };
                         Chunk {
                             layer_index: 0,
@@ -319,6 +331,47 @@ where
         }
         Ok(())
     })
+}
+
+/// Lays out `rows` (interleaved texels, `w` a row, `c` channels) as a scan-line block's raw
+/// little-endian bytes in `out` (exactly the block's size): each line its channels one after
+/// another, in the file's order and sample types (`layout`, see [`block_layout`]). Half
+/// samples are clamped to the finite range (NaN stays NaN) and converted a line at a time
+/// (F16C where the processor has it). `lanes` are buffers kept between calls.
+fn pack_lines(
+    rows: &[f32],
+    w: usize,
+    c: usize,
+    layout: &[(usize, SampleType)],
+    out: &mut [u8],
+    (lane, halves): &mut (Vec<f32>, Vec<half::f16>),
+) {
+    use half::slice::HalfFloatSliceExt;
+    lane.resize(w, 0.0);
+    halves.resize(w, half::f16::ZERO);
+    let mut at = 0;
+    for row in rows.chunks_exact(w * c) {
+        for &(k, st) in layout {
+            for (d, px) in lane.iter_mut().zip(row.chunks_exact(c)) {
+                *d = px[k];
+            }
+            if st == SampleType::F16 {
+                for v in lane.iter_mut() {
+                    *v = v.clamp(-HALF_MAX, HALF_MAX);
+                }
+                halves.convert_from_f32_slice(lane);
+                for (d, h) in out[at..at + 2 * w].chunks_exact_mut(2).zip(halves.iter()) {
+                    d.copy_from_slice(&h.to_le_bytes());
+                }
+                at += 2 * w;
+            } else {
+                for (d, v) in out[at..at + 4 * w].chunks_exact_mut(4).zip(lane.iter()) {
+                    d.copy_from_slice(&v.to_le_bytes());
+                }
+                at += 4 * w;
+            }
+        }
+    }
 }
 
 /// The decoded texels of one layer, interleaved RGB or RGBA, top row first.
@@ -397,8 +450,8 @@ fn block_layout(header: &Header) -> Option<Vec<(usize, SampleType)>> {
 /// blocks, decompressed on all cores, each block's lines of per-channel samples
 /// interleaved straight into the texels. Blocks that do not fit the layer are an error,
 /// never a panic.
-fn read_blocks(
-    chunks: exr::block::reader::Reader<BufReader<File>>,
+fn read_blocks<R: std::io::Read + std::io::Seek + Send>(
+    chunks: exr::block::reader::Reader<R>,
     index: usize,
     header: &Header,
     layout: &[(usize, SampleType)],
@@ -409,11 +462,6 @@ fn read_blocks(
     let reader = chunks.filter_chunks(false, |_, _, block| {
         block.layer == index && block.level == Vec2(0, 0)
     })?;
-    if matches!(header.compression, Compression::ZIP1 | Compression::ZIP16)
-        && matches!(header.blocks, exr::meta::BlockDescription::ScanLines)
-    {
-        return read_zip_scanlines(reader, header, layout);
-    }
     let mut data = vec![0.0f32; w * h * n];
     reader.decompress_parallel(false, |_, block| {
         let (bx, by) = (
@@ -505,23 +553,60 @@ fn scatter(
     Ok(())
 }
 
-/// [`read_blocks`] for ZIP and ZIPS scan lines: each compressed block, as soon as it has
-/// been read (in file order), is inflated with libdeflate ([`crate::exr_zip`]) and
-/// interleaved into its rows on another core while the next is read. Each block must sit
-/// at its place in the layer exactly once.
-fn read_zip_scanlines(
-    reader: impl Iterator<Item = exr::error::Result<exr::block::chunk::Chunk>> + Send,
+/// Whether a layer is ZIP or ZIPS compressed scan lines, which [`read_zip_file`] reads.
+fn is_zip_scanlines(header: &Header) -> bool {
+    matches!(header.compression, Compression::ZIP1 | Compression::ZIP16)
+        && matches!(header.blocks, exr::meta::BlockDescription::ScanLines)
+}
+
+/// A reader that keeps count of the bytes taken from it (in `taken`), so that after the
+/// `exr` crate has read the headers through it, the count is where the offset table starts.
+/// (The crate's own reader hides its position; it reads the headers' closing null byte and
+/// nothing after it.)
+struct Counted<R> {
+    inner: R,
+    taken: Arc<AtomicU64>,
+}
+
+impl<R: std::io::Read> std::io::Read for Counted<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.taken.fetch_add(n as u64, Ordering::Relaxed);
+        Ok(n)
+    }
+}
+
+impl<R: std::io::Seek> std::io::Seek for Counted<R> {
+    fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
+        let at = self.inner.seek(to)?;
+        self.taken.store(at, Ordering::Relaxed);
+        Ok(at)
+    }
+}
+
+/// Reads a single-part file of ZIP or ZIPS scan lines (layer `header`, laid out as `layout`)
+/// whose offset table starts at byte `table_at`: the blocks are read, inflated with
+/// libdeflate ([`crate::exr_zip`]) and interleaved into their rows on all cores at once,
+/// each core reading its blocks with positioned reads into buffers it keeps, so nothing is
+/// read twice, nothing is allocated per block and no core waits for a reader. Every block
+/// must sit at its place in the layer exactly once; blocks past the end of the file, or
+/// larger than their lines, are errors, never a panic or an allocation.
+fn read_zip_file(
+    file: &File,
+    table_at: u64,
     header: &Header,
     layout: &[(usize, SampleType)],
 ) -> Result<Image, exr::error::Error> {
-    use exr::block::chunk::CompressedBlock;
+    use rayon::prelude::*;
     use std::cell::RefCell;
     use std::sync::Mutex;
-    /// A thread's inflater with its two buffers (inflated stream, raw lines).
-    type Scratch = (crate::exr_zip::Zip, Vec<u8>, Vec<u8>);
+    /// A thread's inflater with its buffers (compressed block, inflated stream, raw lines).
+    type Scratch = (crate::exr_zip::Zip, Vec<u8>, Vec<u8>, Vec<u8>);
     thread_local! {
         static SCRATCH: RefCell<Option<Scratch>> = const { RefCell::new(None) };
     }
+    let truncated = || exr::error::Error::Invalid("missing bytes: the file is truncated".into());
+    let file_len = file.metadata()?.len();
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
     let n = layout.len();
     let lines = header.compression.scan_lines_per_block();
@@ -530,64 +615,85 @@ fn read_zip_scanlines(
         .map(|&(_, st)| sample_bytes(st))
         .sum::<usize>();
     let top = header.own_attributes.layer_position.y() as i64;
-    let mut data = vec![0.0f32; w * h * n];
-    let mut rows: Vec<Option<&mut [f32]>> = data.chunks_mut(w * n * lines).map(Some).collect();
-    let failed: Mutex<Option<exr::error::Error>> = Mutex::new(None);
-    let fail = |e: exr::error::Error| {
-        let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
-        f.get_or_insert(e);
-    };
-    rayon::scope(|scope| {
-        for chunk in reader {
-            let block = match chunk.map(|c| c.compressed_block) {
-                Ok(CompressedBlock::ScanLine(b)) => b,
-                Ok(_) => {
-                    return fail(exr::error::Error::Invalid(
-                        "a scan-line file holds a block that is not scan lines".into(),
-                    ))
-                }
-                Err(e) => return fail(e),
-            };
-            let dy = block.y_coordinate as i64 - top;
-            let k = usize::try_from(dy / lines as i64)
-                .ok()
-                .filter(|_| dy >= 0 && dy % lines as i64 == 0);
-            let Some(slot) = k.and_then(|k| rows.get_mut(k)) else {
-                return fail(outside());
-            };
-            let Some(out) = slot.take() else {
-                return fail(exr::error::Error::Invalid(
-                    format!("two blocks claim the lines from {}", block.y_coordinate).into(),
-                ));
-            };
-            let fail = &fail;
-            scope.spawn(move |_| {
-                let bh = out.len() / (w * n);
-                let done = SCRATCH.with(|s| {
-                    let mut s = s.borrow_mut();
-                    let (zip, scratch, raw) = s.get_or_insert_with(|| {
-                        (crate::exr_zip::Zip::new(), Vec::new(), Vec::new())
-                    });
-                    crate::exr_zip::decompress(
-                        &block.compressed_pixels_le,
-                        bh * line_bytes,
-                        scratch,
-                        zip,
-                        raw,
-                    )
-                    .map_err(|e| exr::error::Error::Invalid(e.into()))?;
-                    scatter(raw, out, w, 0, w, bh, layout, false)
-                });
-                if let Err(e) = done {
-                    fail(e);
-                }
-            });
-        }
-    });
-    if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        return Err(e);
+    // The offset table: one u64 a block (the count follows from the header's size, which
+    // the caller has checked against the limits).
+    let count = h.div_ceil(lines);
+    let table_len = count as u64 * 8;
+    if table_at
+        .checked_add(table_len)
+        .is_none_or(|end| end > file_len)
+    {
+        return Err(truncated());
     }
-    if let Some(k) = rows.iter().position(Option::is_some) {
+    let mut table = vec![0u8; count * 8];
+    read_at(file, &mut table, table_at)?;
+    // Zeroed texels in huge pages where the system has them (see `Image::new`): a 4096×2048
+    // float source would otherwise take ~25,000 page faults as the blocks land.
+    let mut image = Image::new(w as u32, h as u32, n);
+    let rows: Vec<Mutex<Option<&mut [f32]>>> = image
+        .data_mut()
+        .chunks_mut(w * n * lines)
+        .map(|r| Mutex::new(Some(r)))
+        .collect();
+    table.par_chunks_exact(8).try_for_each(|entry| {
+        let at = u64::from_le_bytes(entry.try_into().expect("8 bytes"));
+        let mut head = [0u8; 8];
+        if at.checked_add(8).is_none_or(|end| end > file_len) {
+            return Err(truncated());
+        }
+        read_at(file, &mut head, at)?;
+        let y = i32::from_le_bytes(head[..4].try_into().expect("4 bytes")) as i64;
+        let size = i32::from_le_bytes(head[4..].try_into().expect("4 bytes"));
+        let dy = y - top;
+        let k = usize::try_from(dy / lines as i64)
+            .ok()
+            .filter(|_| dy >= 0 && dy % lines as i64 == 0);
+        let slot = k.and_then(|k| rows.get(k)).ok_or_else(outside)?;
+        let out = slot
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .take()
+            .ok_or_else(|| {
+                exr::error::Error::Invalid(format!("two blocks claim the lines from {y}").into())
+            })?;
+        let bh = out.len() / (w * n);
+        let expected = bh * line_bytes;
+        // A ZIP block is never larger than its raw lines (the writer stores those instead).
+        let size = usize::try_from(size)
+            .ok()
+            .filter(|&s| s <= expected)
+            .ok_or_else(|| {
+                exr::error::Error::Invalid(
+                    format!("the block of lines from {y} declares an impossible size").into(),
+                )
+            })?;
+        if (at + 8)
+            .checked_add(size as u64)
+            .is_none_or(|end| end > file_len)
+        {
+            return Err(truncated());
+        }
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let (zip, block, inflated, raw) = s.get_or_insert_with(|| {
+                (
+                    crate::exr_zip::Zip::new(),
+                    Vec::new(),
+                    Vec::new(),
+                    Vec::new(),
+                )
+            });
+            block.resize(size, 0);
+            read_at(file, block, at + 8)?;
+            crate::exr_zip::decompress(block, expected, inflated, zip, raw)
+                .map_err(|e| exr::error::Error::Invalid(e.into()))?;
+            scatter(raw, out, w, 0, w, bh, layout, false)
+        })
+    })?;
+    if let Some(k) = rows
+        .iter()
+        .position(|r| r.lock().unwrap_or_else(|p| p.into_inner()).is_some())
+    {
         return Err(exr::error::Error::Invalid(
             format!(
                 "the block of lines from {} is missing (a truncated file?)",
@@ -597,8 +703,26 @@ fn read_zip_scanlines(
         ));
     }
     drop(rows);
-    Image::from_vec(w as u32, h as u32, n, data)
-        .ok_or_else(|| exr::error::Error::Invalid("inconsistent layer size".into()))
+    Ok(image)
+}
+
+/// Fills `buf` from byte `at` of `file`, without moving (or needing) a shared cursor, so
+/// that several threads can read one file at once.
+#[cfg(unix)]
+fn read_at(file: &File, buf: &mut [u8], at: u64) -> std::io::Result<()> {
+    std::os::unix::fs::FileExt::read_exact_at(file, buf, at)
+}
+
+#[cfg(windows)]
+fn read_at(file: &File, mut buf: &mut [u8], mut at: u64) -> std::io::Result<()> {
+    use std::os::windows::fs::FileExt;
+    while !buf.is_empty() {
+        match file.seek_read(buf, at)? {
+            0 => return Err(std::io::ErrorKind::UnexpectedEof.into()),
+            n => (buf, at) = (&mut buf[n..], at + n as u64),
+        }
+    }
+    Ok(())
 }
 
 /// Stores one decoded texel (the crate has already converted a whole line of samples).

@@ -25,7 +25,7 @@ const LEVEL: i32 = 4;
 /// where deflating would not make it smaller.
 pub(crate) fn compress(raw: &[u8], scratch: &mut Vec<u8>, comp: &mut Zip, out: &mut Vec<u8>) {
     let n = raw.len();
-    scratch.clear();
+    // Every byte is overwritten below: resizing a reused buffer writes nothing.
     scratch.resize(n, 0);
     let half = n.div_ceil(2);
     // Even offsets first, then odd ones.
@@ -49,7 +49,6 @@ pub(crate) fn compress(raw: &[u8], scratch: &mut Vec<u8>, comp: &mut Zip, out: &
         *v = cur.wrapping_sub(prev).wrapping_add(128);
         prev = cur;
     }
-    out.clear();
     out.resize(comp.compressor.zlib_compress_bound(n), 0);
     match comp.compressor.zlib_compress(scratch, out) {
         Ok(len) if len < n => out.truncate(len),
@@ -71,12 +70,12 @@ pub(crate) fn decompress(
     dec: &mut Zip,
     out: &mut Vec<u8>,
 ) -> Result<(), String> {
-    out.clear();
     if block.len() == expected {
+        out.clear();
         out.extend_from_slice(block);
         return Ok(());
     }
-    scratch.clear();
+    // Both buffers are overwritten whole below: resizing a reused one writes nothing.
     scratch.resize(expected, 0);
     let got = dec
         .decompressor

@@ -531,6 +531,93 @@ fn exr_truncated_garbage_and_missing_are_input_errors() {
     }
 }
 
+/// A ZIP EXR whose offset table or blocks were tampered with: each fault is an input error
+/// that names the file and says what is wrong, never a panic, and a file whose blocks are
+/// all in place still reads (the positioned reads of the ZIP path).
+#[test]
+fn exr_zip_blocks_out_of_place_are_input_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let img = hdr_image(40, 50, 3); // 4 blocks of 16 lines (the last one 2 lines)
+    let path = dir.path().join("ok.exr");
+    let opts = WriteOptions {
+        precision: Some(Precision::Float),
+        exr_compression: ExrCompression::Zip,
+        ..WriteOptions::default()
+    };
+    write_image(&path, &img, &opts).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let u64_at = |b: &[u8], p: usize| u64::from_le_bytes(b[p..p + 8].try_into().unwrap());
+    // The offset table: 4 entries, the first pointing just past the table.
+    let table = (0..bytes.len() - 32)
+        .find(|&p| u64_at(&bytes, p) == p as u64 + 32)
+        .expect("offset table");
+    let offsets: Vec<usize> = (0..4)
+        .map(|i| u64_at(&bytes, table + 8 * i) as usize)
+        .collect();
+    assert_eq!(read_one(&path).0.data(), img.data());
+
+    let cases: [(&str, &str, Box<dyn Fn(&mut Vec<u8>)>); 6] = [
+        (
+            "same.exr",
+            "two blocks claim",
+            Box::new(|b| {
+                let first = b[table..table + 8].to_vec();
+                b[table + 8..table + 16].copy_from_slice(&first);
+            }),
+        ),
+        (
+            "past.exr",
+            "truncated",
+            Box::new(|b| {
+                b[table + 16..table + 24].copy_from_slice(&(1u64 << 40).to_le_bytes());
+            }),
+        ),
+        (
+            "size.exr",
+            "impossible size",
+            Box::new(|b| {
+                let at = offsets[1] + 4;
+                b[at..at + 4].copy_from_slice(&(40 * 16 * 12 + 1i32).to_le_bytes());
+            }),
+        ),
+        (
+            "negative.exr",
+            "impossible size",
+            Box::new(|b| {
+                let at = offsets[2] + 4;
+                b[at..at + 4].copy_from_slice(&(-5i32).to_le_bytes());
+            }),
+        ),
+        (
+            "line.exr",
+            "outside",
+            Box::new(|b| {
+                let at = offsets[3];
+                b[at..at + 4].copy_from_slice(&7i32.to_le_bytes());
+            }),
+        ),
+        (
+            "inflate.exr",
+            "inflate",
+            Box::new(|b| {
+                let at = offsets[0] + 8;
+                for v in &mut b[at..at + 64] {
+                    *v = !*v;
+                }
+            }),
+        ),
+    ];
+    for (name, says, tamper) in cases {
+        let mut b = bytes.clone();
+        tamper(&mut b);
+        let path = dir.path().join(name);
+        std::fs::write(&path, &b).unwrap();
+        let e = read_err(&path);
+        assert_input_error(&e, &path);
+        assert!(e.problem().contains(says), "{name}: {e}");
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Radiance HDR.
 
