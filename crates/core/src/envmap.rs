@@ -237,22 +237,53 @@ impl EnvMap {
             .map(|img| {
                 img.data_mut()
                     .par_chunks_mut(c * 16384)
-                    .map(|block| {
-                        // One flat pass (alpha, every fourth value of RGBA, is kept by a
-                        // lane mask): a loop over each texel's three colours would not
-                        // vectorise. A block holds fewer than 2³² values.
-                        let mut n = 0u32;
-                        for (i, v) in block.iter_mut().enumerate() {
-                            let ok = (*v >= 0.0 && *v < f32::INFINITY) || (c == 4 && i % 4 == 3);
-                            n += u32::from(!ok);
-                            *v = if ok { *v } else { 0.0 };
-                        }
-                        u64::from(n)
-                    })
+                    .map(|block| u64::from(sanitize_block(block, c == 4)))
                     .sum::<u64>()
             })
             .sum()
     }
+}
+
+/// [`EnvMap::sanitize`] of one block of texels (`rgba`: four channels, the fourth alpha,
+/// which is left alone; the block a whole number of texels), four values a step with SSE2
+/// masks on x86-64 (a per-texel loop over three colours does not vectorise and ran ten
+/// times slower). Returns how many values it changed.
+fn sanitize_block(block: &mut [f32], rgba: bool) -> u32 {
+    // `x ≥ 0` is false for NaN, `x < ∞` for +∞.
+    let scalar = |run: &mut [f32], n: &mut u32| {
+        for (i, v) in run.iter_mut().enumerate() {
+            let x = *v;
+            let ok = (x >= 0.0 && x < f32::INFINITY) || (rgba && i % 4 == 3);
+            *n += u32::from(!ok);
+            *v = if ok { x } else { 0.0 };
+        }
+    };
+    let mut n = 0u32;
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        let mut quads = block.chunks_exact_mut(4);
+        // SAFETY: SSE2 is part of x86-64; each access is to the four floats of `quad`.
+        unsafe {
+            let (zero, inf) = (_mm_setzero_ps(), _mm_set1_ps(f32::INFINITY));
+            // RGBA: the fourth lane (alpha) always passes.
+            let keep = _mm_castsi128_ps(_mm_set_epi32(-(rgba as i32), 0, 0, 0));
+            for quad in &mut quads {
+                let v = _mm_loadu_ps(quad.as_ptr());
+                let ok = _mm_or_ps(
+                    _mm_and_ps(_mm_cmpge_ps(v, zero), _mm_cmplt_ps(v, inf)),
+                    keep,
+                );
+                _mm_storeu_ps(quad.as_mut_ptr(), _mm_and_ps(v, ok));
+                n += (_mm_movemask_ps(ok) ^ 0xF).count_ones();
+            }
+        }
+        // Only RGB blocks leave a remainder, and it holds no alpha.
+        scalar(quads.into_remainder(), &mut n);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    scalar(block, &mut n);
+    n
 }
 
 /// Where a bilinear lookup at `(u, v)` in a `w`×`h` layer reads (texel centres at

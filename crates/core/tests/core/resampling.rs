@@ -345,49 +345,51 @@ fn a_planned_remap_refuses_the_wrong_maps() {
 
 #[test]
 fn sanitize_zeroes_nan_infinite_and_negative_colour_and_counts_them() {
-    // Two layers, RGBA, larger than one parallel block; alpha is left as it is.
-    let proj = mirrorball_core::ProjectionKind::Cube.default_projection();
-    let mut layers: Vec<mirrorball_core::Image> = (0..6)
-        .map(|_| mirrorball_core::Image::new(160, 160, 4))
-        .collect();
-    let specials = [
-        f32::NAN,
-        f32::INFINITY,
-        f32::NEG_INFINITY,
-        -1.0,
-        -f32::MIN_POSITIVE,
-        -0.0,
-        0.0,
-        f32::MIN_POSITIVE / 2.0,
-        f32::MAX,
-        1.5,
-    ];
-    let mut expect_bad = 0;
-    for (l, img) in layers.iter_mut().enumerate() {
-        for (i, v) in img.data_mut().iter_mut().enumerate() {
-            *v = specials[(i * 7 + l) % specials.len()];
-            let (alpha, bad) = (i % 4 == 3, !(*v >= 0.0 && v.is_finite()));
-            if !alpha && bad {
-                expect_bad += 1;
+    // Six layers, RGB and RGBA, larger than one parallel block; alpha is left as it is.
+    for c in [3, 4] {
+        let proj = mirrorball_core::ProjectionKind::Cube.default_projection();
+        let mut layers: Vec<mirrorball_core::Image> = (0..6)
+            .map(|_| mirrorball_core::Image::new(161, 161, c))
+            .collect();
+        let specials = [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -1.0,
+            -f32::MIN_POSITIVE,
+            -0.0,
+            0.0,
+            f32::MIN_POSITIVE / 2.0,
+            f32::MAX,
+            1.5,
+        ];
+        let mut expect_bad = 0;
+        for (l, img) in layers.iter_mut().enumerate() {
+            for (i, v) in img.data_mut().iter_mut().enumerate() {
+                *v = specials[(i * 7 + l) % specials.len()];
+                let (alpha, bad) = (c == 4 && i % 4 == 3, !(*v >= 0.0 && v.is_finite()));
+                if !alpha && bad {
+                    expect_bad += 1;
+                }
             }
         }
-    }
-    let mut env = mirrorball_core::EnvMap::new(proj, layers.clone()).unwrap();
-    assert_eq!(env.sanitize(), expect_bad);
-    for (before, after) in layers.iter().zip(env.layers()) {
-        for (i, (&b, &a)) in before.data().iter().zip(after.data()).enumerate() {
-            if i % 4 == 3 {
-                assert_eq!(b.to_bits(), a.to_bits(), "alpha kept");
-            } else if b >= 0.0 && b.is_finite() {
-                assert_eq!(
-                    b.to_bits(),
-                    a.to_bits(),
-                    "valid colour kept (even −0 and subnormals)"
-                );
-            } else {
-                assert_eq!(a.to_bits(), 0, "{b} becomes +0");
+        let mut env = mirrorball_core::EnvMap::new(proj, layers.clone()).unwrap();
+        assert_eq!(env.sanitize(), expect_bad);
+        for (before, after) in layers.iter().zip(env.layers()) {
+            for (i, (&b, &a)) in before.data().iter().zip(after.data()).enumerate() {
+                if c == 4 && i % 4 == 3 {
+                    assert_eq!(b.to_bits(), a.to_bits(), "alpha kept");
+                } else if b >= 0.0 && b.is_finite() {
+                    assert_eq!(
+                        b.to_bits(),
+                        a.to_bits(),
+                        "valid colour kept (even −0 and subnormals)"
+                    );
+                } else {
+                    assert_eq!(a.to_bits(), 0, "{b} becomes +0");
+                }
             }
         }
+        assert_eq!(env.sanitize(), 0, "nothing left to fix");
     }
-    assert_eq!(env.sanitize(), 0, "nothing left to fix");
 }
