@@ -70,6 +70,31 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
     Ok(format)
 }
 
+/// The layout `out` gets for a map of `layers` layers.
+fn output_layout(out: &str, layers: usize, opts: &SaveOptions) -> Layout {
+    match opts.layout {
+        Some(l) => l,
+        None if out.contains(FACE) => Layout::Separate,
+        None => default_layout(layers),
+    }
+}
+
+/// The file of each layer, in layer order, when `out` (checked by [`check`]) takes a map of
+/// `layers` layers as one file a layer (`{face}` in the name, or `--layout separate`);
+/// `None` when it takes the whole map in one file.
+pub fn layer_files(out: &str, layers: usize, opts: &SaveOptions) -> Option<Vec<PathBuf>> {
+    let format = Format::from_path(Path::new(out))?;
+    (!format.is_cube_container()
+        && layers > 1
+        && output_layout(out, layers, opts) == Layout::Separate)
+        .then(|| {
+            layer_names(layers)
+                .iter()
+                .map(|nm| layer_path(out, nm))
+                .collect()
+        })
+}
+
 /// The file for layer `name` of a separate-layout output.
 fn layer_path(out: &str, name: &str) -> PathBuf {
     per_part_path(out, FACE, name)
@@ -114,14 +139,8 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
         return Ok(vec![path.to_path_buf()]);
     }
     let n = env.layers().len();
-    let layout = match opts.layout {
-        Some(l) => l,
-        None if out.contains(FACE) => Layout::Separate,
-        None => default_layout(n),
-    };
-    if layout == Layout::Separate && n > 1 {
-        let names = layer_names(n);
-        let paths: Vec<PathBuf> = names.iter().map(|nm| layer_path(out, nm)).collect();
+    let layout = output_layout(out, n, opts);
+    if let Some(paths) = layer_files(out, n, opts) {
         paths
             .par_iter()
             .zip(env.layers().par_iter())

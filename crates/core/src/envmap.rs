@@ -253,7 +253,7 @@ fn sanitize_block(block: &mut [f32], rgba: bool) -> u32 {
     let scalar = |run: &mut [f32], n: &mut u32| {
         for (i, v) in run.iter_mut().enumerate() {
             let x = *v;
-            let ok = (x >= 0.0 && x < f32::INFINITY) || (rgba && i % 4 == 3);
+            let ok = (0.0..f32::INFINITY).contains(&x) || (rgba && i % 4 == 3);
             *n += u32::from(!ok);
             *v = if ok { x } else { 0.0 };
         }

@@ -33,7 +33,7 @@ pub use projection::{
     SphereMap, UnknownProjection, WorldProjection,
 };
 pub use remap::{Remap, RemapError};
-pub use resample::{resample, resample_to_extent, ResampleOptions, Rotation};
+pub use resample::{resample, resample_to_extent, ResampleOptions, Resampler, Rotation};
 
 pub use glam;
 pub use projection::quadrature;

@@ -18,7 +18,7 @@
 use crate::envmap::bilinear32;
 use crate::projection::{Lookup, Projection, WorldProjection};
 use crate::{EnvMap, Image};
-use glam::{DMat3, DVec2, DVec3};
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -276,6 +276,8 @@ pub(crate) struct RowScratch {
 
 /// Per-thread buffers for one texel's integration points: directions, weights, lookups.
 pub(crate) struct PointScratch {
+    /// One row of a texel's points (at most 16).
+    row: Vec<Option<(DVec3, f64)>>,
     sx: Vec<f32>,
     sy: Vec<f32>,
     sz: Vec<f32>,
@@ -298,6 +300,7 @@ impl RowScratch {
 impl PointScratch {
     pub(crate) fn new() -> PointScratch {
         PointScratch {
+            row: vec![None; 16],
             sx: vec![0.0; MAX_POINTS],
             sy: vec![0.0; MAX_POINTS],
             sz: vec![0.0; MAX_POINTS],
@@ -403,7 +406,6 @@ impl Job {
         ratio: f64,
     ) -> (usize, usize) {
         let (dst, sproj) = (&self.dst, &self.sproj);
-        let (w, h) = (self.w as f64, self.h as f64);
         let level = if ratio > self.cap {
             (((ratio / self.cap).log2() * 0.5).ceil() as usize).min(self.levels - 1)
         } else {
@@ -411,23 +413,30 @@ impl Job {
         };
         let r_l = ratio / 4f64.powi(level as i32);
         let n = (r_l.sqrt().round() as u32).clamp(1, self.max_n);
-        let inv = 1.0 / n as f64;
+        // The points are the texel centres of a grid n times finer: row j of them is a span
+        // of n texels of fine row n·y + j (one call a row, per-row work hoisted).
         let mut m = 0;
         for j in 0..n {
-            let v = (y as f64 + (j as f64 + 0.5) * inv) / h;
-            for i in 0..n {
-                let u = (x as f64 + (i as f64 + 0.5) * inv) / w;
-                let p = DVec2::new(u, v);
-                let wt = dst.density(layer, p) as f32;
-                let Some(d) = dst.uv_to_dir(layer, p).filter(|_| wt > 0.0) else {
+            let row = &mut s.row[..n as usize];
+            dst.span_dirs(
+                layer,
+                y as u32 * n + j,
+                self.w * n,
+                self.h * n,
+                x as u32 * n,
+                row,
+            );
+            for &(d, wt) in row.iter().flatten() {
+                if wt <= 0.0 {
                     continue;
-                };
+                }
                 let d = if self.rotate {
                     self.rot.source_of(d)
                 } else {
                     d
                 };
-                (s.sx[m], s.sy[m], s.sz[m], s.sw[m]) = (d.x as f32, d.y as f32, d.z as f32, wt);
+                (s.sx[m], s.sy[m], s.sz[m], s.sw[m]) =
+                    (d.x as f32, d.y as f32, d.z as f32, wt as f32);
                 m += 1;
             }
         }
@@ -553,24 +562,81 @@ pub fn resample_to_extent(
     h: u32,
     opts: &ResampleOptions,
 ) -> EnvMap {
-    let c = src.channels();
-    let job = Job::new(
-        *src.projection(),
-        (src.width(), src.height()),
-        dst,
-        (w, h),
-        opts,
-    );
-    let pyr = Pyramid::new(src, job.levels - 1);
-    let layers = (0..dst.layer_count())
-        .map(|layer| {
-            let mut img = Image::new(w, h, c);
-            match c {
-                3 => job.layer::<3>(&pyr, layer, &mut img, opts.progress.as_ref()),
-                _ => job.layer::<4>(&pyr, layer, &mut img, opts.progress.as_ref()),
-            }
-            img
-        })
-        .collect();
+    let r = Resampler::new(src, dst, w, h, opts);
+    let layers = (0..dst.layer_count()).map(|layer| r.layer(layer)).collect();
     EnvMap::new(dst, layers).expect("layers built to the projection's shape")
+}
+
+/// A conversion planned once (filters chosen, source pyramid built as deep as needed) whose
+/// output layers are made one at a time, each on all cores: a caller can write one cube
+/// face to its file while the next is made, and need not hold them all.
+/// [`resample_to_extent`] is `Resampler::new` and then every [`layer`](Resampler::layer).
+///
+/// ```
+/// use mirrorball_core::{EnvMap, ProjectionKind, Resampler, ResampleOptions};
+/// let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 64, 3, |d| {
+///     [d.y as f32 + 1.0, 1.0, 1.0, 1.0]
+/// });
+/// let cube = ProjectionKind::Cube.default_projection();
+/// let r = Resampler::new(&src, cube, 16, 16, &ResampleOptions::default());
+/// let top = r.layer(2); // +Y
+/// assert!(top.get(8, 8)[0] > 1.9);
+/// ```
+pub struct Resampler<'a> {
+    job: Job,
+    pyramid: Pyramid<'a>,
+    channels: usize,
+    progress: Option<Arc<AtomicU64>>,
+}
+
+impl<'a> Resampler<'a> {
+    /// Plans the conversion of `src` into `dst` with layers of `w`×`h` texels.
+    pub fn new(
+        src: &'a EnvMap,
+        dst: Projection,
+        w: u32,
+        h: u32,
+        opts: &ResampleOptions,
+    ) -> Resampler<'a> {
+        let job = Job::new(
+            *src.projection(),
+            (src.width(), src.height()),
+            dst,
+            (w, h),
+            opts,
+        );
+        let pyramid = Pyramid::new(src, job.levels - 1);
+        Resampler {
+            job,
+            pyramid,
+            channels: src.channels(),
+            progress: opts.progress.clone(),
+        }
+    }
+
+    /// The output projection.
+    pub fn projection(&self) -> &Projection {
+        &self.job.dst
+    }
+
+    /// Makes output layer `layer` (`0 .. projection().layer_count()`), `w`×`h` texels with
+    /// the source's channel count.
+    pub fn layer(&self, layer: usize) -> Image {
+        assert!(
+            layer < self.job.dst.layer_count(),
+            "layer {layer} of a {}-layer projection",
+            self.job.dst.layer_count()
+        );
+        let mut img = Image::new(self.job.w, self.job.h, self.channels);
+        let progress = self.progress.as_ref();
+        match self.channels {
+            3 => self
+                .job
+                .layer::<3>(&self.pyramid, layer, &mut img, progress),
+            _ => self
+                .job
+                .layer::<4>(&self.pyramid, layer, &mut img, progress),
+        }
+        img
+    }
 }

@@ -6,9 +6,11 @@ use crate::progress::with_progress;
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
-use mirrorball_core::{resample, Layout, ResampleOptions, Rotation, WorldProjection};
+use mirrorball_core::{
+    resample, Image, Layout, ResampleOptions, Resampler, Rotation, WorldProjection,
+};
 use mirrorball_io::{ExrCompression, Format, Precision, WriteOptions};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Everything `convert` will do, checked before any work starts.
@@ -163,17 +165,46 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     let (w, h) = dst.layer_extent(size);
     let rows = h as u64 * dst.layer_count() as u64;
     let t1 = Instant::now();
-    let out = with_progress("converting", rows, a.quiet, |counter| {
-        plan.resample.progress = Some(counter);
-        resample(&src.env, dst, size, &plan.resample)
-    });
-    let t_conv = t1.elapsed();
-    drop(src);
-    let t2 = Instant::now();
-    let files = save::save(&out, &a.output, &plan.save)?;
+    let (files, t_conv, t_write) = match save::layer_files(&a.output, dst.layer_count(), &plan.save)
+    {
+        // One file a layer: each is written while the next is converted.
+        Some(paths) => {
+            let written = with_progress("converting", rows, a.quiet, |counter| {
+                plan.resample.progress = Some(counter);
+                let r = Resampler::new(&src.env, dst, w, h, &plan.resample);
+                write_while_converting(&r, &paths, &plan.save.write)
+            })?;
+            drop(src);
+            (written, t1.elapsed(), None)
+        }
+        None => {
+            let out = with_progress("converting", rows, a.quiet, |counter| {
+                plan.resample.progress = Some(counter);
+                resample(&src.env, dst, size, &plan.resample)
+            });
+            let t_conv = t1.elapsed();
+            drop(src);
+            let t2 = Instant::now();
+            let files = save::save(&out, &a.output, &plan.save)?;
+            (files, t_conv, Some(t2.elapsed()))
+        }
+    };
     let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+    let timing = match t_write {
+        Some(t) => format!(
+            "read {:.2}s, convert {:.2}s, write {:.2}s",
+            t_read.as_secs_f64(),
+            t_conv.as_secs_f64(),
+            t.as_secs_f64()
+        ),
+        None => format!(
+            "read {:.2}s, convert and write {:.2}s",
+            t_read.as_secs_f64(),
+            t_conv.as_secs_f64()
+        ),
+    };
     say(format!(
-        "wrote {}: {} {}x{}{} (read {:.2}s, convert {:.2}s, write {:.2}s)",
+        "wrote {}: {} {}x{}{} ({timing})",
         names.join(", "),
         dst.name(),
         w,
@@ -183,9 +214,43 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
         } else {
             String::new()
         },
-        t_read.as_secs_f64(),
-        t_conv.as_secs_f64(),
-        t2.elapsed().as_secs_f64()
     ));
     Ok(())
+}
+
+/// Converts the layers of `r` one after another and writes layer `i` to `paths[i]` on
+/// another thread meanwhile: the file's encoding and the kernel's share of writing it
+/// (replacing an existing file makes ext4 start writing the new one out at the rename)
+/// overlap the next layer's conversion. Stops at the first failed write.
+fn write_while_converting(
+    r: &Resampler,
+    paths: &[PathBuf],
+    opts: &WriteOptions,
+) -> Result<Vec<PathBuf>, CliError> {
+    std::thread::scope(|scope| {
+        // One layer waits while one is written: at most three in memory.
+        let (tx, rx) = std::sync::mpsc::sync_channel::<(&PathBuf, Image)>(1);
+        let writer = scope.spawn(move || -> Result<(), CliError> {
+            // Its own threads: on the global pool, the file's blocks would queue behind
+            // the conversion's rows, and writing would wait for conversion to finish.
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(rayon::current_num_threads())
+                .build()
+                .map_err(|e| CliError::input(format!("cannot start writer threads: {e}")))?;
+            for (path, img) in rx {
+                pool.install(|| mirrorball_io::write_image(path, &img, opts))?;
+            }
+            Ok(())
+        });
+        for (layer, path) in paths.iter().enumerate() {
+            if tx.send((path, r.layer(layer))).is_err() {
+                break; // the writer stopped on an error, which join reports
+            }
+        }
+        drop(tx);
+        writer
+            .join()
+            .unwrap_or_else(|e| std::panic::resume_unwind(e))
+    })?;
+    Ok(paths.to_vec())
 }

@@ -204,3 +204,27 @@ fn nan_inf_and_negative_texels_are_reported_and_fixed() {
     let o = run(&["info", conv.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("0 NaN, 0 infinite, 0 negative"));
 }
+
+/// A face that cannot be written (a folder stands where its file would go) stops a
+/// conversion to one file a face with a message naming it, and leaves no temporary files.
+#[test]
+fn an_unwritable_face_is_named_and_leaves_no_temporary_files() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("face_py.exr")).unwrap();
+    let pattern = dir.path().join("face_{face}.exr");
+    let e = fails(
+        &[
+            "convert",
+            asset("studio.exr").to_str().unwrap(),
+            pattern.to_str().unwrap(),
+            "--to",
+            "cube",
+            "--size",
+            "16",
+        ],
+        &["face_py.exr"],
+    );
+    assert!(!e.contains("face_px.exr:"), "{e}");
+    let left = files(dir.path());
+    assert!(left.iter().all(|n| !n.contains(".tmp")), "{left:?}");
+}

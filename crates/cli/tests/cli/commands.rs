@@ -111,6 +111,41 @@ fn separate_faces_out_and_in() {
     for f in ["px", "nx", "py", "ny", "pz", "nz"] {
         assert!(dir.path().join(format!("face_{f}.exr")).exists());
     }
+    // Each face is written while the next is converted: every file holds its own face, to
+    // the bit, as the library makes it, with no temporary file left over.
+    let exact = dir.path().join("exact_{face}.exr");
+    let exact = exact.to_str().unwrap();
+    ok(&[
+        "convert",
+        asset("studio.exr").to_str().unwrap(),
+        exact,
+        "--to",
+        "cube",
+        "--size",
+        "24",
+        "--precision",
+        "float",
+    ]);
+    let mut src = read_env(&asset("studio.exr"), ProjectionKind::LatLong);
+    src.sanitize();
+    let cube = ProjectionKind::Cube.default_projection();
+    let want = resample(&src, cube, 24, &ResampleOptions::default());
+    for (f, layer) in ["px", "nx", "py", "ny", "pz", "nz"]
+        .iter()
+        .zip(want.layers())
+    {
+        let got = mirrorball_io::read(
+            std::path::Path::new(&exact.replace("{face}", f)),
+            &Default::default(),
+        )
+        .unwrap();
+        assert_eq!(got.layers[0].data(), layer.data(), "face {f}");
+    }
+    assert!(
+        files(dir.path()).iter().all(|n| !n.contains(".tmp")),
+        "{:?}",
+        files(dir.path())
+    );
     let cross = dir.path().join("cross.exr");
     ok(&[
         "convert",

@@ -220,14 +220,22 @@ impl WorldProjection for CubeMap {
             };
         }
     }
-    fn row_dirs(&self, layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
+    fn span_dirs(
+        &self,
+        layer: usize,
+        y: u32,
+        w: u32,
+        h: u32,
+        x0: u32,
+        out: &mut [Option<(DVec3, f64)>],
+    ) {
         let Some(face) = CubeFace::from_index(layer) else {
             return;
         };
         let tc = 2.0 * (y as f64 + 0.5) / h as f64 - 1.0;
         let step = 2.0 / w as f64;
-        for (x, o) in out.iter_mut().enumerate().take(w as usize) {
-            let sc = (x as f64 + 0.5) * step - 1.0;
+        for (i, o) in out.iter_mut().enumerate() {
+            let sc = ((x0 as usize + i) as f64 + 0.5) * step - 1.0;
             let inv = 1.0 / (1.0 + sc * sc + tc * tc).sqrt();
             // density 4/(1 + a² + b²)^{3/2}
             *o = Some((face.point(sc, tc) * inv, 4.0 * inv * inv * inv));

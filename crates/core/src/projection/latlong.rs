@@ -105,15 +105,23 @@ impl WorldProjection for LatLong {
             };
         }
     }
-    fn row_dirs(&self, _layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
+    fn span_dirs(
+        &self,
+        _layer: usize,
+        y: u32,
+        w: u32,
+        h: u32,
+        x0: u32,
+        out: &mut [Option<(DVec3, f64)>],
+    ) {
         // Latitude is fixed along a row; longitude advances by a fixed step, so its sine and
         // cosine follow by the angle-addition recurrence (drift < 1e-12 over 65536 steps).
         let (sp, cp) = (PI * (0.5 - (y as f64 + 0.5) / h as f64)).sin_cos();
         let dens = 2.0 * PI * PI * cp;
         let step = TAU / w as f64;
         let (sd, cd) = step.sin_cos();
-        let (mut s, mut c) = lon_of_u(0.5 / w as f64).sin_cos();
-        for o in out.iter_mut().take(w as usize) {
+        let (mut s, mut c) = lon_of_u((x0 as f64 + 0.5) / w as f64).sin_cos();
+        for o in out.iter_mut() {
             *o = Some((DVec3::new(s * cp, sp, -c * cp), dens));
             (s, c) = (s * cd + c * sd, c * cd - s * sd);
         }

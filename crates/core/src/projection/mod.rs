@@ -81,11 +81,31 @@ pub trait WorldProjection {
 
     /// The centre directions of texel row `y` of a `w`×`h` layer, with the density there:
     /// `out[x] = Some((dir, density))`, where texels outside the covered domain take the
-    /// direction of the nearest covered point and density 0. Projections override it to hoist
-    /// per-row work out of the per-texel loop.
+    /// direction of the nearest covered point and density 0. (The row's first `w` texels;
+    /// see [`span_dirs`](WorldProjection::span_dirs).)
+    #[inline]
     fn row_dirs(&self, layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
+        let n = out.len().min(w as usize);
+        self.span_dirs(layer, y, w, h, 0, &mut out[..n]);
+    }
+
+    /// [`row_dirs`](WorldProjection::row_dirs) for the texels `x0 .. x0 + out.len()` of the
+    /// row only: `out[i]` is texel `x0 + i`. On a grid `n` times finer (`n·w`×`n·h`), the
+    /// span of `n` texels from `n·x` in row `n·y + j` gives row `j` of an `n`×`n` grid of
+    /// points spread evenly over texel `(x, y)`, which is how the resampler integrates.
+    /// Projections override it to hoist per-row work out of the per-texel loop.
+    fn span_dirs(
+        &self,
+        layer: usize,
+        y: u32,
+        w: u32,
+        h: u32,
+        x0: u32,
+        out: &mut [Option<(DVec3, f64)>],
+    ) {
         let v = (y as f64 + 0.5) / h as f64;
-        for (x, o) in out.iter_mut().enumerate().take(w as usize) {
+        for (i, o) in out.iter_mut().enumerate() {
+            let x = x0 as usize + i;
             let uv0 = DVec2::new((x as f64 + 0.5) / w as f64, v);
             let uv = self.nearest_covered(layer, uv0);
             *o = self.uv_to_dir(layer, uv).map(|d| {
@@ -386,8 +406,16 @@ impl WorldProjection for Projection {
     fn density_of_dir(&self, dir: DVec3) -> f64 {
         delegate!(self, p => p.density_of_dir(dir))
     }
-    fn row_dirs(&self, layer: usize, y: u32, w: u32, h: u32, out: &mut [Option<(DVec3, f64)>]) {
-        delegate!(self, p => p.row_dirs(layer, y, w, h, out))
+    fn span_dirs(
+        &self,
+        layer: usize,
+        y: u32,
+        w: u32,
+        h: u32,
+        x0: u32,
+        out: &mut [Option<(DVec3, f64)>],
+    ) {
+        delegate!(self, p => p.span_dirs(layer, y, w, h, x0, out))
     }
     fn lookup_batch(&self, xs: &[f32], ys: &[f32], zs: &[f32], out: &mut [Lookup]) {
         delegate!(self, p => p.lookup_batch(xs, ys, zs, out))

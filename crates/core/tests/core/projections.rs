@@ -428,3 +428,52 @@ fn batch_lookups_agree_with_the_f64_methods() {
         assert!(checked > 1000, "{}", p.name());
     }
 }
+
+/// `span_dirs` (and `row_dirs`, which the resampler's texel loop uses, with their per-row
+/// shortcuts such as the lat-long longitude recurrence) agree with `uv_to_dir` and
+/// `density` at the texel centres, for spans starting anywhere in a row: the integration
+/// points of a texel are such spans on a finer grid.
+#[test]
+fn span_dirs_agree_with_uv_to_dir_and_density_at_texel_centres() {
+    for p in all_projections() {
+        let (w, h) = p.layer_extent(36);
+        for layer in 0..p.layer_count() {
+            let mut row = vec![None; w as usize];
+            for y in [0, 1, h / 3, h / 2, h - 1] {
+                p.row_dirs(layer, y, w, h, &mut row);
+                for (x0, n) in [(0, w), (1, 3), (w / 2 - 2, 4), (w - 2, 2), (w - 1, 1)] {
+                    let mut span = vec![None; n as usize];
+                    p.span_dirs(layer, y, w, h, x0, &mut span);
+                    for (i, got) in span.iter().enumerate() {
+                        let x = x0 + i as u32;
+                        let uv =
+                            DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                        let (d, dens) = got.expect("a direction for every texel");
+                        let (rd, rdens) = row[x as usize].expect("a direction for every texel");
+                        assert!(
+                            angle(d, rd) < 1e-9 && (dens - rdens).abs() <= 1e-9 * rdens.abs(),
+                            "{} layer {layer} ({x}, {y}): span and row differ",
+                            p.name()
+                        );
+                        let wd = p.density(layer, uv);
+                        if wd == 0.0 {
+                            assert_eq!(dens, 0.0, "{} ({x}, {y}) lies outside", p.name());
+                            continue;
+                        }
+                        let want = p.uv_to_dir(layer, uv).expect("covered");
+                        assert!(
+                            angle(d, want) < 1e-9,
+                            "{} layer {layer} ({x}, {y})",
+                            p.name()
+                        );
+                        assert!(
+                            (dens - wd).abs() <= 1e-9 * wd,
+                            "{} ({x}, {y}): {dens} vs {wd}",
+                            p.name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
