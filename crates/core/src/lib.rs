@@ -28,9 +28,9 @@ pub use envmap::{bilinear_corner, EnvMap, EnvMapError, Stats};
 pub use image::Image;
 pub use layout::{guess, Guess, Layout};
 pub use projection::{
-    AngularMap, ContinuousCube, CubeFace, CubeMap, DualParaboloid, EqualAreaOctahedral, Fisheye,
-    Frame, LatLong, Lens, Lookup, Mercator, Octahedral, Projection, ProjectionKind, RadialMap,
-    SphereMap, UnknownProjection, WorldProjection,
+    AngularMap, ContinuousCube, CubeFace, CubeMap, DirRun, DualParaboloid, EqualAreaOctahedral,
+    Fisheye, Frame, LatLong, Lens, Lookup, Mercator, Octahedral, Projection, ProjectionKind,
+    RadialMap, SphereMap, UnknownProjection, WorldProjection,
 };
 pub use remap::{Remap, RemapError};
 pub use resample::{resample, resample_to_extent, ResampleOptions, Resampler, Rotation};

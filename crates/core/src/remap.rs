@@ -586,9 +586,8 @@ fn plan_row(
         groups: Vec::new(),
         taps: Vec::new(),
     };
-    for (x, (texel, lk)) in s.dirs.iter().zip(&s.look).enumerate() {
-        let Some((_, ddens)) = *texel else { continue };
-        if lk.layer == u32::MAX {
+    for (x, (&ddens, lk)) in s.dens.iter().zip(&s.look).enumerate() {
+        if ddens < 0.0 || lk.layer == u32::MAX {
             continue;
         }
         let (level, m) = match job.integration_ratio(ddens, lk) {

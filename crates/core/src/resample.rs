@@ -16,7 +16,7 @@
 //! The work runs in parallel over rows with rayon and allocates nothing per texel.
 
 use crate::envmap::bilinear32;
-use crate::projection::{Lookup, Projection, WorldProjection};
+use crate::projection::{DirRun, Lookup, Projection, WorldProjection};
 use crate::{EnvMap, Image};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -267,10 +267,11 @@ const MAX_POINTS: usize = 256;
 
 /// Per-thread buffers for one output row.
 pub(crate) struct RowScratch {
-    pub(crate) dirs: Vec<Option<(DVec3, f64)>>,
     xs: Vec<f32>,
     ys: Vec<f32>,
     zs: Vec<f32>,
+    /// The output projection's density at each texel (−1: no direction, skip it).
+    pub(crate) dens: Vec<f32>,
     pub(crate) look: Vec<Lookup>,
 }
 
@@ -288,10 +289,10 @@ pub(crate) struct PointScratch {
 impl RowScratch {
     pub(crate) fn new(w: usize) -> RowScratch {
         RowScratch {
-            dirs: vec![None; w],
             xs: vec![0.0; w],
             ys: vec![0.0; w],
             zs: vec![0.0; w],
+            dens: vec![0.0; w],
             look: vec![Lookup::default(); w],
         }
     }
@@ -331,15 +332,20 @@ impl Job {
     /// projection), turned into the source, and where they land in the source, as one batch.
     #[inline(always)]
     pub(crate) fn locate(&self, s: &mut RowScratch, layer: usize, y: usize) {
-        let (dst, sproj, rot) = (&self.dst, &self.sproj, &self.rot);
-        dst.row_dirs(layer, y as u32, self.w, self.h, &mut s.dirs);
-        for (x, t) in s.dirs.iter().enumerate() {
-            let d = match t {
-                Some((d, _)) if self.rotate => rot.source_of(*d),
-                Some((d, _)) => *d,
-                None => DVec3::Z,
-            };
-            (s.xs[x], s.ys[x], s.zs[x]) = (d.x as f32, d.y as f32, d.z as f32);
+        let (dst, sproj) = (&self.dst, &self.sproj);
+        let run = DirRun {
+            x: &mut s.xs,
+            y: &mut s.ys,
+            z: &mut s.zs,
+            density: &mut s.dens,
+        };
+        dst.span_dirs_f32(layer, y as u32, self.w, self.h, 0, run);
+        if self.rotate {
+            let m = self.rot.to_source.as_mat3();
+            for ((x, y), z) in s.xs.iter_mut().zip(&mut s.ys).zip(&mut s.zs) {
+                let d = m * glam::Vec3::new(*x, *y, *z);
+                (*x, *y, *z) = (d.x, d.y, d.z);
+            }
         }
         sproj.lookup_batch(&s.xs, &s.ys, &s.zs, &mut s.look);
     }
@@ -347,9 +353,9 @@ impl Job {
     /// The footprint ratio of an output texel of density `ddens` whose centre landed at
     /// `lk`, when it is to be integrated; `None` when one bilinear lookup serves.
     #[inline(always)]
-    pub(crate) fn integration_ratio(&self, ddens: f64, lk: &Lookup) -> Option<f64> {
+    pub(crate) fn integration_ratio(&self, ddens: f32, lk: &Lookup) -> Option<f64> {
         let ratio = if lk.density > 0.0 {
-            ddens as f32 * self.area / lk.density
+            ddens * self.area / lk.density
         } else {
             f32::INFINITY
         };
@@ -375,9 +381,8 @@ impl Job {
         // Stage 3: filter.
         let sproj = &self.sproj;
         let base = pyr.level(0);
-        for (x, (texel, lk)) in s.dirs.iter().zip(&s.look).enumerate() {
-            let Some((_, ddens)) = *texel else { continue };
-            if lk.layer == u32::MAX {
+        for (x, (&ddens, lk)) in s.dens.iter().zip(&s.look).enumerate() {
+            if ddens < 0.0 || lk.layer == u32::MAX {
                 continue;
             }
             let out = &mut row[x * C..(x + 1) * C];

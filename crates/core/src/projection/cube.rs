@@ -1,6 +1,6 @@
 //! The cube projection (Greene 1986, §3), exactly as OpenGL samples a cube map.
 
-use super::{texel_range, Lookup, WorldProjection};
+use super::{texel_range, DirRun, Lookup, WorldProjection};
 use glam::{DVec2, DVec3};
 
 /// One face of a cube map, in OpenGL's order (ARB_texture_cube_map, OpenGL 4.6 §8.13):
@@ -239,6 +239,32 @@ impl WorldProjection for CubeMap {
             let inv = 1.0 / (1.0 + sc * sc + tc * tc).sqrt();
             // density 4/(1 + a² + b²)^{3/2}
             *o = Some((face.point(sc, tc) * inv, 4.0 * inv * inv * inv));
+        }
+    }
+    fn span_dirs_f32(&self, layer: usize, y: u32, w: u32, h: u32, x0: u32, out: DirRun) {
+        let Some(face) = CubeFace::from_index(layer) else {
+            return;
+        };
+        // Along a row the unnormalised direction is o + sc·e (e the face's s axis), and
+        // |o + sc·e|² = 1 + sc² + tc².
+        let tc = 2.0 * (y as f64 + 0.5) / h as f64 - 1.0;
+        let o = face.point(0.0, tc).as_vec3();
+        let e = (face.point(1.0, tc) - face.point(0.0, tc)).as_vec3();
+        let step = 2.0 / w as f32;
+        let n = out.x.len();
+        let (xs, ys, zs, ds) = (
+            out.x,
+            &mut out.y[..n],
+            &mut out.z[..n],
+            &mut out.density[..n],
+        );
+        for (i, (((x, y), z), d)) in xs.iter_mut().zip(ys).zip(zs).zip(ds).enumerate() {
+            let sc = ((x0 as usize + i) as f32 + 0.5) * step - 1.0;
+            let p = o + sc * e;
+            let inv = 1.0 / p.length();
+            (*x, *y, *z) = (p.x * inv, p.y * inv, p.z * inv);
+            // density 4/(1 + a² + b²)^{3/2}
+            *d = 4.0 * inv * inv * inv;
         }
     }
     #[inline]

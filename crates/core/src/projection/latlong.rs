@@ -2,7 +2,7 @@
 //! Hoffman 1984, Greene 1986 §6).
 
 use super::fastmath;
-use super::{texel_range, Lookup, WorldProjection};
+use super::{texel_range, DirRun, Lookup, WorldProjection};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -123,6 +123,24 @@ impl WorldProjection for LatLong {
         let (mut s, mut c) = lon_of_u((x0 as f64 + 0.5) / w as f64).sin_cos();
         for o in out.iter_mut() {
             *o = Some((DVec3::new(s * cp, sp, -c * cp), dens));
+            (s, c) = (s * cd + c * sd, c * cd - s * sd);
+        }
+    }
+    fn span_dirs_f32(&self, _layer: usize, y: u32, w: u32, h: u32, x0: u32, out: DirRun) {
+        // As span_dirs, written out in f32.
+        let (sp, cp) = (PI * (0.5 - (y as f64 + 0.5) / h as f64)).sin_cos();
+        let dens = (2.0 * PI * PI * cp) as f32;
+        let (sd, cd) = (TAU / w as f64).sin_cos();
+        let (mut s, mut c) = lon_of_u((x0 as f64 + 0.5) / w as f64).sin_cos();
+        let n = out.x.len();
+        let (xs, ys, zs, ds) = (
+            out.x,
+            &mut out.y[..n],
+            &mut out.z[..n],
+            &mut out.density[..n],
+        );
+        for (((x, y), z), d) in xs.iter_mut().zip(ys).zip(zs).zip(ds) {
+            (*x, *y, *z, *d) = ((s * cp) as f32, sp as f32, (-c * cp) as f32, dens);
             (s, c) = (s * cd + c * sd, c * cd - s * sd);
         }
     }

@@ -44,6 +44,19 @@ pub struct Lookup {
     pub density: f32,
 }
 
+/// A run of texel directions and densities in `f32`, one array per component, as
+/// [`WorldProjection::span_dirs_f32`] fills it. All four slices have the same length.
+pub struct DirRun<'a> {
+    /// x components of the unit directions.
+    pub x: &'a mut [f32],
+    /// y components.
+    pub y: &'a mut [f32],
+    /// z components.
+    pub z: &'a mut [f32],
+    /// The projection's density at each texel centre.
+    pub density: &'a mut [f32],
+}
+
 /// The behaviour every world projection shares. All math is in `f64`.
 pub trait WorldProjection {
     /// Number of layers: 6 for the cube types (OpenGL order +X −X +Y −Y +Z −Z), 2 for the
@@ -118,6 +131,28 @@ pub trait WorldProjection {
                     },
                 )
             });
+        }
+    }
+
+    /// [`span_dirs`](WorldProjection::span_dirs) in `f32`, one array per component (the
+    /// form the resampler's vector loops want), for the `out.x.len()` texels from `x0`: unit
+    /// direction and density there (0 outside the covered domain, −1 where the projection has
+    /// no direction at all, which none of mirrorball's has). The default converts
+    /// [`span_dirs`](WorldProjection::span_dirs); the cube and the lat-long compute it
+    /// directly.
+    fn span_dirs_f32(&self, layer: usize, y: u32, w: u32, h: u32, x0: u32, out: DirRun) {
+        const CHUNK: usize = 32;
+        let mut buf = [None; CHUNK];
+        let n = out.x.len();
+        for start in (0..n).step_by(CHUNK) {
+            let m = CHUNK.min(n - start);
+            self.span_dirs(layer, y, w, h, x0 + start as u32, &mut buf[..m]);
+            for (i, t) in buf[..m].iter().enumerate() {
+                let (d, dens) = t.unwrap_or((DVec3::Z, -1.0));
+                let k = start + i;
+                (out.x[k], out.y[k], out.z[k], out.density[k]) =
+                    (d.x as f32, d.y as f32, d.z as f32, dens as f32);
+            }
         }
     }
 
@@ -416,6 +451,9 @@ impl WorldProjection for Projection {
         out: &mut [Option<(DVec3, f64)>],
     ) {
         delegate!(self, p => p.span_dirs(layer, y, w, h, x0, out))
+    }
+    fn span_dirs_f32(&self, layer: usize, y: u32, w: u32, h: u32, x0: u32, out: DirRun) {
+        delegate!(self, p => p.span_dirs_f32(layer, y, w, h, x0, out))
     }
     fn lookup_batch(&self, xs: &[f32], ys: &[f32], zs: &[f32], out: &mut [Lookup]) {
         delegate!(self, p => p.lookup_batch(xs, ys, zs, out))

@@ -3,8 +3,8 @@
 use crate::util::{all_projections, angle, inside, Rng};
 use glam::{DVec2, DVec3};
 use mirrorball_core::{
-    ContinuousCube, CubeMap, DualParaboloid, EqualAreaOctahedral, LatLong, Octahedral, Projection,
-    SphereMap, WorldProjection,
+    ContinuousCube, CubeMap, DirRun, DualParaboloid, EqualAreaOctahedral, LatLong, Octahedral,
+    Projection, SphereMap, WorldProjection,
 };
 
 #[test]
@@ -429,12 +429,13 @@ fn batch_lookups_agree_with_the_f64_methods() {
     }
 }
 
-/// `span_dirs` (and `row_dirs`, which the resampler's texel loop uses, with their per-row
-/// shortcuts such as the lat-long longitude recurrence) agree with `uv_to_dir` and
+/// `span_dirs`, `span_dirs_f32` (which the resampler's texel loop uses) and `row_dirs`
+/// (with their per-row shortcuts such as the lat-long longitude recurrence) agree with
+/// `uv_to_dir` and
 /// `density` at the texel centres, for spans starting anywhere in a row: the integration
 /// points of a texel are such spans on a finer grid.
 #[test]
-fn span_dirs_agree_with_uv_to_dir_and_density_at_texel_centres() {
+fn span_dirs_in_f64_and_f32_agree_with_uv_to_dir_and_density_at_texel_centres() {
     for p in all_projections() {
         let (w, h) = p.layer_extent(36);
         for layer in 0..p.layer_count() {
@@ -444,6 +445,35 @@ fn span_dirs_agree_with_uv_to_dir_and_density_at_texel_centres() {
                 for (x0, n) in [(0, w), (1, 3), (w / 2 - 2, 4), (w - 2, 2), (w - 1, 1)] {
                     let mut span = vec![None; n as usize];
                     p.span_dirs(layer, y, w, h, x0, &mut span);
+                    // The f32 arrays the resampler reads: the same to f32 precision.
+                    let mut f = vec![vec![0.0f32; n as usize]; 4];
+                    let [fx, fy, fz, fd] = &mut f[..] else {
+                        unreachable!()
+                    };
+                    let run = DirRun {
+                        x: fx,
+                        y: fy,
+                        z: fz,
+                        density: fd,
+                    };
+                    p.span_dirs_f32(layer, y, w, h, x0, run);
+                    for (i, t) in span.iter().enumerate() {
+                        let (d, dens) = t.expect("a direction");
+                        let g = DVec3::new(f[0][i] as f64, f[1][i] as f64, f[2][i] as f64);
+                        assert!(
+                            angle(d, g) < 1e-6,
+                            "{} ({}, {y}) f32 direction",
+                            p.name(),
+                            x0 + i as u32
+                        );
+                        let gd = f[3][i] as f64;
+                        assert!(
+                            (gd - dens).abs() <= 1e-6 * dens.abs(),
+                            "{} ({}, {y}) f32 density {gd} vs {dens}",
+                            p.name(),
+                            x0 + i as u32
+                        );
+                    }
                     for (i, got) in span.iter().enumerate() {
                         let x = x0 + i as u32;
                         let uv =
