@@ -251,14 +251,7 @@ impl WorldProjection for CubeMap {
         let o = face.point(0.0, tc).as_vec3();
         let e = (face.point(1.0, tc) - face.point(0.0, tc)).as_vec3();
         let step = 2.0 / w as f32;
-        let n = out.x.len();
-        let (xs, ys, zs, ds) = (
-            out.x,
-            &mut out.y[..n],
-            &mut out.z[..n],
-            &mut out.density[..n],
-        );
-        for (i, (((x, y), z), d)) in xs.iter_mut().zip(ys).zip(zs).zip(ds).enumerate() {
+        for (i, (x, y, z, d)) in out.texels().enumerate() {
             let sc = ((x0 as usize + i) as f32 + 0.5) * step - 1.0;
             let p = o + sc * e;
             let inv = 1.0 / p.length();

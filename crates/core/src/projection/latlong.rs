@@ -132,14 +132,7 @@ impl WorldProjection for LatLong {
         let dens = (2.0 * PI * PI * cp) as f32;
         let (sd, cd) = (TAU / w as f64).sin_cos();
         let (mut s, mut c) = lon_of_u((x0 as f64 + 0.5) / w as f64).sin_cos();
-        let n = out.x.len();
-        let (xs, ys, zs, ds) = (
-            out.x,
-            &mut out.y[..n],
-            &mut out.z[..n],
-            &mut out.density[..n],
-        );
-        for (((x, y), z), d) in xs.iter_mut().zip(ys).zip(zs).zip(ds) {
+        for (x, y, z, d) in out.texels() {
             (*x, *y, *z, *d) = ((s * cp) as f32, sp as f32, (-c * cp) as f32, dens);
             (s, c) = (s * cd + c * sd, c * cd - s * sd);
         }

@@ -57,6 +57,22 @@ pub struct DirRun<'a> {
     pub density: &'a mut [f32],
 }
 
+impl<'a> DirRun<'a> {
+    /// Each texel's `(x, y, z, density)`, to fill in order (as many as `x` has).
+    pub fn texels(
+        self,
+    ) -> impl Iterator<Item = (&'a mut f32, &'a mut f32, &'a mut f32, &'a mut f32)> {
+        let n = self.x.len();
+        let (y, z, d) = (&mut self.y[..n], &mut self.z[..n], &mut self.density[..n]);
+        self.x
+            .iter_mut()
+            .zip(y)
+            .zip(z)
+            .zip(d)
+            .map(|(((x, y), z), d)| (x, y, z, d))
+    }
+}
+
 /// The behaviour every world projection shares. All math is in `f64`.
 pub trait WorldProjection {
     /// Number of layers: 6 for the cube types (OpenGL order +X −X +Y −Y +Z −Z), 2 for the
