@@ -685,9 +685,15 @@ fn read_zip_file(
             });
             block.resize(size, 0);
             read_at(file, block, at + 8)?;
-            crate::exr_zip::decompress(block, expected, inflated, zip, raw)
+            let lines = crate::exr_zip::inflate(block, expected, inflated, zip)
                 .map_err(|e| exr::error::Error::Invalid(e.into()))?;
-            scatter(raw, out, w, 0, w, bh, layout, false)
+            match lines {
+                crate::exr_zip::Lines::Split { evens, odds } if all_float(layout) => {
+                    scatter_split_f32(evens, odds, out, w, bh, layout);
+                    Ok(())
+                }
+                _ => scatter(lines.to_bytes(raw), out, w, 0, w, bh, layout, false),
+            }
         })
     })?;
     if let Some(k) = rows
@@ -704,6 +710,92 @@ fn read_zip_file(
     }
     drop(rows);
     Ok(image)
+}
+
+/// Whether every channel of a [`block_layout`] is 32-bit float.
+fn all_float(layout: &[(usize, SampleType)]) -> bool {
+    layout.iter().all(|&(_, st)| st == SampleType::F32)
+}
+
+/// [`scatter`] for a ZIP block of float lines (`layout` all [`SampleType::F32`], 3 or 4
+/// channels) still split into even- and odd-offset bytes ([`crate::exr_zip::Lines`]):
+/// each float is put together from the two halves as it is stored, so the raw bytes are
+/// never written out. On x86-64 four texels a step: each channel's four floats from one
+/// SSE2 byte interleave, then transposed into RGB(A) order.
+fn scatter_split_f32(
+    evens: &[u8],
+    odds: &[u8],
+    rows: &mut [f32],
+    w: usize,
+    bh: usize,
+    layout: &[(usize, SampleType)],
+) {
+    let n = layout.len();
+    // Where each texel channel's plane starts within a line, in the halves (2w bytes a plane).
+    let mut plane = [0usize; 4];
+    for (pos, &(c, _)) in layout.iter().enumerate() {
+        plane[c] = pos * 2 * w;
+    }
+    let half_line = n * 2 * w;
+    // Float x of the plane at `p` (an offset into the halves) of a line.
+    let float_at = |p: usize, x: usize| {
+        let k = p + 2 * x;
+        f32::from_le_bytes([evens[k], odds[k], evens[k + 1], odds[k + 1]])
+    };
+    for (y, row) in rows.chunks_exact_mut(w * n).take(bh).enumerate() {
+        let base = y * half_line;
+        let p = plane.map(|o| base + o);
+        let mut x = 0;
+        #[cfg(target_arch = "x86_64")]
+        if evens.len() >= base + half_line && odds.len() >= base + half_line {
+            use std::arch::x86_64::*;
+            // SAFETY: SSE2 is part of x86-64. Reads: 8 bytes from offset p[c] + 2x with
+            // x + 4 <= w, inside the line's n planes of 2w bytes, which both halves hold
+            // (checked above). Writes: n·4 floats from texel x, inside `row` (w·n floats).
+            unsafe {
+                let four = |c: usize, x: usize| {
+                    let at = p[c] + 2 * x;
+                    let e = _mm_loadl_epi64(evens.as_ptr().add(at) as *const __m128i);
+                    let o = _mm_loadl_epi64(odds.as_ptr().add(at) as *const __m128i);
+                    _mm_castsi128_ps(_mm_unpacklo_epi8(e, o))
+                };
+                let out = row.as_mut_ptr();
+                while x + 4 <= w {
+                    let (r, g, b) = (four(0, x), four(1, x), four(2, x));
+                    let dst = out.add(x * n);
+                    if n == 4 {
+                        let mut a = four(3, x);
+                        let (mut r, mut g, mut b) = (r, g, b);
+                        _MM_TRANSPOSE4_PS(&mut r, &mut g, &mut b, &mut a);
+                        _mm_storeu_ps(dst, r);
+                        _mm_storeu_ps(dst.add(4), g);
+                        _mm_storeu_ps(dst.add(8), b);
+                        _mm_storeu_ps(dst.add(12), a);
+                    } else {
+                        // [r0 g0 b0 r1] [g1 b1 r2 g2] [b2 r3 g3 b3]
+                        let lo = _mm_unpacklo_ps(r, g); // r0 g0 r1 g1
+                        let hi = _mm_unpackhi_ps(r, g); // r2 g2 r3 g3
+                        let t0 = _mm_shuffle_ps::<0b10_10_00_00>(b, lo); // b0 b0 r1 r1
+                        let o0 = _mm_shuffle_ps::<0b10_00_01_00>(lo, t0); // r0 g0 b0 r1
+                        let t1 = _mm_shuffle_ps::<0b01_01_11_11>(lo, b); // g1 g1 b1 b1
+                        let o1 = _mm_shuffle_ps::<0b01_00_10_00>(t1, hi); // g1 b1 r2 g2
+                        let t2 = _mm_shuffle_ps::<0b10_10_10_10>(b, hi); // b2 b2 r3 r3
+                        let t3 = _mm_shuffle_ps::<0b11_11_11_11>(hi, b); // g3 g3 b3 b3
+                        let o2 = _mm_shuffle_ps::<0b10_00_10_00>(t2, t3); // b2 r3 g3 b3
+                        _mm_storeu_ps(dst, o0);
+                        _mm_storeu_ps(dst.add(4), o1);
+                        _mm_storeu_ps(dst.add(8), o2);
+                    }
+                    x += 4;
+                }
+            }
+        }
+        for x in x..w {
+            for c in 0..n {
+                row[x * n + c] = float_at(p[c], x);
+            }
+        }
+    }
 }
 
 /// Fills `buf` from byte `at` of `file`, without moving (or needing) a shared cursor, so

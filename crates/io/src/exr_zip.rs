@@ -60,22 +60,49 @@ pub(crate) fn compress(raw: &[u8], scratch: &mut Vec<u8>, comp: &mut Zip, out: &
     }
 }
 
-/// Decompresses one ZIP/ZIPS block that holds `expected` raw bytes into `out` (replacing
-/// its contents), using `scratch` for the inflated stream. A block of exactly `expected`
-/// bytes is raw. Errors say what is wrong with the block.
-pub(crate) fn decompress(
-    block: &[u8],
-    expected: usize,
-    scratch: &mut Vec<u8>,
-    dec: &mut Zip,
-    out: &mut Vec<u8>,
-) -> Result<(), String> {
-    if block.len() == expected {
-        out.clear();
-        out.extend_from_slice(block);
-        return Ok(());
+/// A block's raw line bytes after [`inflate`]: stored as they are, or split into the bytes
+/// at even offsets and those at odd offsets (how ZIP blocks keep them), which a reader can
+/// interleave as it converts (see [`Lines::even_odd`]).
+pub(crate) enum Lines<'a> {
+    /// The raw bytes (a block stored uncompressed).
+    Raw(&'a [u8]),
+    /// Raw byte `2i` is `evens[i]`, byte `2i + 1` is `odds[i]`.
+    Split {
+        /// Bytes at even offsets (`⌈len/2⌉` of them).
+        evens: &'a [u8],
+        /// Bytes at odd offsets (`⌊len/2⌋`).
+        odds: &'a [u8],
+    },
+}
+
+impl Lines<'_> {
+    /// The raw bytes, interleaved into `out` where they were split.
+    pub(crate) fn to_bytes<'o>(&'o self, out: &'o mut Vec<u8>) -> &'o [u8] {
+        match *self {
+            Lines::Raw(b) => b,
+            Lines::Split { evens, odds } => {
+                // Overwritten whole: resizing a reused buffer writes nothing.
+                out.resize(evens.len() + odds.len(), 0);
+                interleave(evens, odds, out);
+                out
+            }
+        }
     }
-    // Both buffers are overwritten whole below: resizing a reused one writes nothing.
+}
+
+/// Inflates one ZIP/ZIPS block that holds `expected` raw bytes into `scratch` and undoes
+/// its predictor, leaving the bytes split (see [`Lines`]); a block of exactly `expected`
+/// bytes is raw. Errors say what is wrong with the block.
+pub(crate) fn inflate<'a>(
+    block: &'a [u8],
+    expected: usize,
+    scratch: &'a mut Vec<u8>,
+    dec: &mut Zip,
+) -> Result<Lines<'a>, String> {
+    if block.len() == expected {
+        return Ok(Lines::Raw(block));
+    }
+    // Overwritten whole below: resizing a reused buffer writes nothing.
     scratch.resize(expected, 0);
     let got = dec
         .decompressor
@@ -86,12 +113,26 @@ pub(crate) fn decompress(
             "a ZIP block inflates to {got} bytes where its lines need {expected}"
         ));
     }
-    // Undo the differences (a running sum), then put even and odd offsets back together.
+    // Undo the differences (a running sum); even and odd offsets stay apart.
     running_sum(scratch);
-    let half = expected.div_ceil(2);
-    let (evens, odds) = scratch.split_at(half);
-    out.resize(expected, 0);
-    interleave(evens, odds, out);
+    let (evens, odds) = scratch.split_at(expected.div_ceil(2));
+    Ok(Lines::Split { evens, odds })
+}
+
+/// [`inflate`], then the raw bytes interleaved into `out` (replacing its contents).
+#[cfg(test)]
+fn decompress(
+    block: &[u8],
+    expected: usize,
+    scratch: &mut Vec<u8>,
+    dec: &mut Zip,
+    out: &mut Vec<u8>,
+) -> Result<(), String> {
+    let mut tmp = Vec::new();
+    let bytes = inflate(block, expected, scratch, dec)?
+        .to_bytes(&mut tmp)
+        .to_vec();
+    *out = bytes;
     Ok(())
 }
 
