@@ -164,3 +164,20 @@ fn octahedral_orientation() {
         "corners are down"
     );
 }
+
+/// `bilinear_corner` (every f32 bilinear filter's first step) is `floor` of the texel-centre
+/// coordinate, with the fraction to the next texel, for coordinates on, between and
+/// outside the texels, negative ones included.
+#[test]
+fn bilinear_corner_is_floor_of_the_texel_centre_coordinate() {
+    let (w, h) = (7u32, 5u32);
+    for i in -300..=300 {
+        let u = i as f32 / 128.0; // −2.3 ..= 2.3
+        let v = 1.0 - u;
+        let (x0, y0, fx, fy) = mirrorball_core::bilinear_corner(u, v, w, h);
+        let (x, y) = (u * w as f32 - 0.5, v * h as f32 - 0.5);
+        assert_eq!((x0, y0), (x.floor() as i32, y.floor() as i32), "u = {u}");
+        assert_eq!((fx, fy), (x - x.floor(), y - y.floor()), "u = {u}");
+        assert!((0.0..1.0).contains(&fx) && (0.0..1.0).contains(&fy));
+    }
+}
