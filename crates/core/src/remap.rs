@@ -109,8 +109,14 @@ impl fmt::Display for RemapError {
 
 impl std::error::Error for RemapError {}
 
-/// A conversion from one projection and size to another, planned once; see the
-/// [module documentation](self).
+/// A conversion from one projection and size to another, planned once and applied to many
+/// maps, as `cv2.remap` applies precomputed coordinate maps. For each output texel the plan
+/// keeps what it reads: one bilinear lookup, or the solid-angle-weighted taps of a texel
+/// that is integrated or straddles a seam, so that applying it never works out a direction
+/// or branches on a seam. It is exactly [`resample`](crate::resample())'s filter, with
+/// bilinear fractions kept to 1/65536 of a texel: results agree with `resample` to about
+/// 1e-5 relative (tested). Memory: 8 bytes per output texel plus 16 per tap (a 6×1024² cube
+/// from a 4096×2048 lat-long: about 60 MB).
 ///
 /// ```
 /// use mirrorball_core::{EnvMap, ProjectionKind, Remap, ResampleOptions, resample};
