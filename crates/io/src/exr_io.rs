@@ -76,7 +76,10 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     let index = headers.iter().position(is_rgb_layer).unwrap_or(0);
     if let Some(layout) = block_layout(&headers[index]) {
         let header = headers[index].clone();
-        let image = if layer_count == 1 && is_zip_scanlines(&header) {
+        // A multi-part file (even one of a single part) puts a part number before each
+        // block: that the crate's reader handles.
+        let single_part = !chunks.meta_data().requirements.has_multiple_layers;
+        let image = if single_part && layer_count == 1 && is_zip_scanlines(&header) {
             drop(chunks);
             read_zip_file(&file, header_end.load(Ordering::Relaxed), &header, &layout)
         } else {

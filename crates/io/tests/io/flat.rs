@@ -556,7 +556,9 @@ fn exr_zip_blocks_out_of_place_are_input_errors() {
         .collect();
     assert_eq!(read_one(&path).0.data(), img.data());
 
-    let cases: [(&str, &str, Box<dyn Fn(&mut Vec<u8>)>); 6] = [
+    // (file name, what the message must say, how the bytes are tampered with)
+    type Case<'a> = (&'a str, &'a str, Box<dyn Fn(&mut Vec<u8>) + 'a>);
+    let cases: [Case; 6] = [
         (
             "same.exr",
             "two blocks claim",
