@@ -373,26 +373,47 @@ pub(crate) fn bilinear32<const C: usize>(
     v: f32,
     out: &mut [f32],
 ) {
+    let q = bilinear32_quad::<C>(proj, layers, layer, u, v);
+    out[..C].copy_from_slice(&q[..C]);
+}
+
+/// [`bilinear32`] as four lanes: the `C` channels, then (for `C = 3`) a lane to ignore,
+/// so that callers can go on with four-lane arithmetic (the resampler's weighted sums).
+#[inline(always)]
+pub(crate) fn bilinear32_quad<const C: usize>(
+    proj: &Projection,
+    layers: &[Image],
+    layer: usize,
+    u: f32,
+    v: f32,
+) -> [f32; 4] {
     let img = &layers[layer];
     let (x0, y0, fx, fy) = bilinear_corner(u, v, img.width(), img.height());
     let (w, h) = (img.width() as i32, img.height() as i32);
+    let mut out = [0.0f32; 4];
     if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h {
         let data = img.data();
         let stride = w as usize * C;
         let i00 = y0 as usize * stride + x0 as usize * C;
         if let Some(q) = lerp_quad::<C>(data, i00, stride, fx, fy) {
-            out[..C].copy_from_slice(&q[..C]);
-            return;
+            return q;
         }
         if let (Some(r0), Some(r1)) = (
             data.get(i00..i00 + 2 * C),
             data.get(i00 + stride..i00 + stride + 2 * C),
         ) {
-            lerp4::<C>(r0, r1, fx, fy, out);
-            return;
+            lerp4::<C>(r0, r1, fx, fy, &mut out[..C]);
+            return out;
         }
     }
-    bilinear(proj, layers, layer, DVec2::new(u as f64, v as f64), out);
+    bilinear(
+        proj,
+        layers,
+        layer,
+        DVec2::new(u as f64, v as f64),
+        &mut out[..C],
+    );
+    out
 }
 
 /// Bilinear blend of the 2×2 texels of `C` channels whose top-left texel starts at float

@@ -15,7 +15,7 @@
 //!
 //! The work runs in parallel over rows with rayon and allocates nothing per texel.
 
-use crate::envmap::bilinear32;
+use crate::envmap::{bilinear32, bilinear32_quad};
 use crate::projection::{DirRun, Lookup, Projection, WorldProjection};
 use crate::{EnvMap, Image};
 use glam::{DMat3, DVec3};
@@ -466,17 +466,17 @@ impl Job {
         let sproj = &self.sproj;
         let (level, m) = self.points(s, layer, x, y, ratio);
         let lv = pyr.level(level);
-        let mut acc = [0.0f32; C];
-        let mut tmp = [0.0f32; C];
+        // Four lanes (for RGB the fourth is ignored): one vector multiply-add a point.
+        let mut acc = [0.0f32; 4];
         let mut wsum = 0.0f32;
         for (k, sl) in s.slook[..m].iter().enumerate() {
             if sl.layer == u32::MAX {
                 continue;
             }
-            bilinear32::<C>(sproj, lv, sl.layer as usize, sl.u, sl.v, &mut tmp);
+            let q = bilinear32_quad::<C>(sproj, lv, sl.layer as usize, sl.u, sl.v);
             let wt = s.sw[k];
-            for q in 0..C {
-                acc[q] += wt * tmp[q];
+            for (a, v) in acc.iter_mut().zip(q) {
+                *a += wt * v;
             }
             wsum += wt;
         }
