@@ -290,10 +290,7 @@ where
         use exr::block::writer::ChunksWriter;
         let blocks: Vec<(usize, exr::block::BlockIndex)> =
             meta.enumerate_ordered_header_block_indices().collect();
-        let line_bytes: usize = w * layout
-            .iter()
-            .map(|&(_, st)| sample_bytes(st))
-            .sum::<usize>();
+        let line_bytes = line_bytes(w, &layout);
         // A batch of blocks compressed in parallel, then written in order.
         for batch in blocks.chunks(32) {
             let packed: Vec<Chunk> = batch
@@ -499,6 +496,14 @@ fn sample_bytes(st: SampleType) -> usize {
     }
 }
 
+/// Bytes a line of `w` texels laid out as `layout` takes in a block.
+fn line_bytes(w: usize, layout: &[(usize, SampleType)]) -> usize {
+    w * layout
+        .iter()
+        .map(|&(_, st)| sample_bytes(st))
+        .sum::<usize>()
+}
+
 fn outside() -> exr::error::Error {
     exr::error::Error::Invalid("a block lies outside its layer or is too short".into())
 }
@@ -613,10 +618,8 @@ fn read_zip_file(
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
     let n = layout.len();
     let lines = header.compression.scan_lines_per_block();
-    let line_bytes: usize = w * layout
-        .iter()
-        .map(|&(_, st)| sample_bytes(st))
-        .sum::<usize>();
+    let line_bytes = line_bytes(w, layout);
+    let float = all_float(layout);
     let top = header.own_attributes.layer_position.y() as i64;
     // The offset table: one u64 a block (the count follows from the header's size, which
     // the caller has checked against the limits).
@@ -691,7 +694,7 @@ fn read_zip_file(
             let lines = crate::exr_zip::inflate(block, expected, inflated, zip)
                 .map_err(|e| exr::error::Error::Invalid(e.into()))?;
             match lines {
-                crate::exr_zip::Lines::Split { evens, odds } if all_float(layout) => {
+                crate::exr_zip::Lines::Split { evens, odds } if float => {
                     scatter_split_f32(evens, odds, out, w, bh, layout);
                     Ok(())
                 }

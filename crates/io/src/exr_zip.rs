@@ -62,7 +62,7 @@ pub(crate) fn compress(raw: &[u8], scratch: &mut Vec<u8>, comp: &mut Zip, out: &
 
 /// A block's raw line bytes after [`inflate`]: stored as they are, or split into the bytes
 /// at even offsets and those at odd offsets (how ZIP blocks keep them), which a reader can
-/// interleave as it converts (see [`Lines::even_odd`]).
+/// interleave as it converts (or have [`Lines::to_bytes`] do it).
 pub(crate) enum Lines<'a> {
     /// The raw bytes (a block stored uncompressed).
     Raw(&'a [u8]),
@@ -117,23 +117,6 @@ pub(crate) fn inflate<'a>(
     running_sum(scratch);
     let (evens, odds) = scratch.split_at(expected.div_ceil(2));
     Ok(Lines::Split { evens, odds })
-}
-
-/// [`inflate`], then the raw bytes interleaved into `out` (replacing its contents).
-#[cfg(test)]
-fn decompress(
-    block: &[u8],
-    expected: usize,
-    scratch: &mut Vec<u8>,
-    dec: &mut Zip,
-    out: &mut Vec<u8>,
-) -> Result<(), String> {
-    let mut tmp = Vec::new();
-    let bytes = inflate(block, expected, scratch, dec)?
-        .to_bytes(&mut tmp)
-        .to_vec();
-    *out = bytes;
-    Ok(())
 }
 
 /// `b[i] = b[i − 1] + b[i] − 128` for every byte but the first (modulo 256): a prefix sum of
@@ -228,15 +211,15 @@ mod tests {
             } else if !raw.is_empty() {
                 assert!(packed.len() < raw.len() / 4, "a ramp compresses");
             }
-            decompress(&packed, raw.len(), &mut scratch, &mut zip, &mut back).unwrap();
-            assert_eq!(back, raw);
+            let lines = inflate(&packed, raw.len(), &mut scratch, &mut zip).unwrap();
+            assert_eq!(lines.to_bytes(&mut back), raw);
         }
         // A corrupt stream and one of the wrong length are errors, not panics.
         compress(&ramp, &mut scratch, &mut zip, &mut packed);
         let mut bad = packed.clone();
         bad[5] ^= 0xff;
         bad.truncate(bad.len() / 2);
-        assert!(decompress(&bad, ramp.len(), &mut scratch, &mut zip, &mut back).is_err());
-        assert!(decompress(&packed, ramp.len() + 10, &mut scratch, &mut zip, &mut back).is_err());
+        assert!(inflate(&bad, ramp.len(), &mut scratch, &mut zip).is_err());
+        assert!(inflate(&packed, ramp.len() + 10, &mut scratch, &mut zip).is_err());
     }
 }
