@@ -382,10 +382,12 @@ impl Job {
         let sproj = &self.sproj;
         let base = pyr.level(0);
         for (x, (&ddens, lk)) in s.dens.iter().zip(&s.look).enumerate() {
+            let out = &mut row[x * C..(x + 1) * C];
             if ddens < 0.0 || lk.layer == u32::MAX {
+                // Outside the projection's domain: black, whatever the buffer held.
+                out.fill(0.0);
                 continue;
             }
-            let out = &mut row[x * C..(x + 1) * C];
             match self.integration_ratio(ddens, lk) {
                 None => bilinear32::<C>(sproj, base, lk.layer as usize, lk.u, lk.v, out),
                 Some(ratio) => self.integrate::<C>(pyr, ps, layer, x, y, ratio, lk, out),
@@ -627,21 +629,38 @@ impl<'a> Resampler<'a> {
     /// Makes output layer `layer` (`0 .. projection().layer_count()`), `w`×`h` texels with
     /// the source's channel count.
     pub fn layer(&self, layer: usize) -> Image {
+        let mut img = Image::new(self.job.w, self.job.h, self.channels);
+        self.layer_into(layer, &mut img);
+        img
+    }
+
+    /// Makes output layer `layer` into `img`, overwriting every texel, so that a caller
+    /// making many layers can reuse one buffer (no allocation, and no first-touch page
+    /// faults after the first layer).
+    ///
+    /// # Panics
+    /// If `layer` is out of range, or `img` is not `w`×`h` texels with the source's channel
+    /// count.
+    pub fn layer_into(&self, layer: usize, img: &mut Image) {
         assert!(
             layer < self.job.dst.layer_count(),
             "layer {layer} of a {}-layer projection",
             self.job.dst.layer_count()
         );
-        let mut img = Image::new(self.job.w, self.job.h, self.channels);
+        assert!(
+            (img.width(), img.height(), img.channels()) == (self.job.w, self.job.h, self.channels),
+            "layer_into: a {}x{}x{} buffer for {}x{}x{} layers",
+            img.width(),
+            img.height(),
+            img.channels(),
+            self.job.w,
+            self.job.h,
+            self.channels
+        );
         let progress = self.progress.as_ref();
         match self.channels {
-            3 => self
-                .job
-                .layer::<3>(&self.pyramid, layer, &mut img, progress),
-            _ => self
-                .job
-                .layer::<4>(&self.pyramid, layer, &mut img, progress),
+            3 => self.job.layer::<3>(&self.pyramid, layer, img, progress),
+            _ => self.job.layer::<4>(&self.pyramid, layer, img, progress),
         }
-        img
     }
 }

@@ -296,11 +296,8 @@ where
             let packed: Vec<Chunk> = batch
                 .par_iter()
                 .map_init(
-                    || {
-                        let lanes = (Vec::new(), Vec::new());
-                        (crate::exr_zip::Zip::new(), Vec::new(), Vec::new(), lanes)
-                    },
-                    |(deflater, raw, scratch, lanes), (_, block)| {
+                    || (Vec::new(), Vec::new(), (Vec::new(), Vec::new())),
+                    |(raw, scratch, lanes), (_, block)| {
                         let (by, bh) = (block.pixel_position.y(), block.pixel_size.y());
                         // ZIP fills a buffer it keeps; uncompressed lines are the block.
                         let mut fresh = Vec::new();
@@ -310,7 +307,9 @@ where
                         pack_lines(rows, w, c, &layout, buf, lanes);
                         let packed = if zip {
                             let mut packed = Vec::new();
-                            crate::exr_zip::compress(raw, scratch, deflater, &mut packed);
+                            crate::exr_zip::THREAD_ZIP.with_borrow_mut(|deflater| {
+                                crate::exr_zip::compress(raw, scratch, deflater, &mut packed)
+                            });
                             packed
                         } else {
                             fresh

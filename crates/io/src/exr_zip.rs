@@ -49,8 +49,11 @@ pub(crate) fn compress(raw: &[u8], scratch: &mut Vec<u8>, comp: &mut Zip, out: &
         *v = cur.wrapping_sub(prev).wrapping_add(128);
         prev = cur;
     }
-    out.resize(comp.compressor.zlib_compress_bound(n), 0);
-    match comp.compressor.zlib_compress(scratch, out) {
+    let compressor = comp.compressor.get_or_insert_with(|| {
+        Compressor::new(CompressionLvl::new(LEVEL).expect("level 4 is valid"))
+    });
+    out.resize(compressor.zlib_compress_bound(n), 0);
+    match compressor.zlib_compress(scratch, out) {
         Ok(len) if len < n => out.truncate(len),
         // Not smaller (or no room, which the bound rules out): the raw bytes.
         _ => {
@@ -106,6 +109,7 @@ pub(crate) fn inflate<'a>(
     scratch.resize(expected, 0);
     let got = dec
         .decompressor
+        .get_or_insert_with(Decompressor::new)
         .zlib_decompress(block, scratch)
         .map_err(|e| format!("a ZIP block does not inflate ({e:?})"))?;
     if got != expected {
@@ -171,20 +175,25 @@ fn interleave(evens: &[u8], odds: &[u8], out: &mut [u8]) {
     }
 }
 
-/// A thread's libdeflate state (its compressor and decompressor allocate their tables
-/// once).
+/// A thread's libdeflate state. The compressor and decompressor are made on first use and
+/// kept: each allocates its tables (hundreds of KiB for the compressor) when made, which
+/// per block, or for a reader that never compresses, would cost more than the work.
+#[derive(Default)]
 pub(crate) struct Zip {
-    compressor: Compressor,
-    decompressor: Decompressor,
+    compressor: Option<Compressor>,
+    decompressor: Option<Decompressor>,
 }
 
 impl Zip {
     pub(crate) fn new() -> Zip {
-        Zip {
-            compressor: Compressor::new(CompressionLvl::new(LEVEL).expect("level 4 is valid")),
-            decompressor: Decompressor::new(),
-        }
+        Zip::default()
     }
+}
+
+thread_local! {
+    /// Each thread's libdeflate state, for writers whose work is split among rayon's
+    /// threads in pieces of any size.
+    pub(crate) static THREAD_ZIP: std::cell::RefCell<Zip> = std::cell::RefCell::new(Zip::new());
 }
 
 #[cfg(test)]

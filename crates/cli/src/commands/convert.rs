@@ -228,8 +228,11 @@ fn write_while_converting(
     opts: &WriteOptions,
 ) -> Result<Vec<PathBuf>, CliError> {
     std::thread::scope(|scope| {
-        // One layer waits while one is written: at most three in memory.
+        // One layer waits while one is written: at most three in memory. Written layers'
+        // buffers come back to be filled again, so that after the first few no layer pays
+        // for fresh memory (allocation, zeroing, first-touch page faults).
         let (tx, rx) = std::sync::mpsc::sync_channel::<(&PathBuf, Image)>(1);
+        let (give_back, take_back) = std::sync::mpsc::channel::<Image>();
         let writer = scope.spawn(move || -> Result<(), CliError> {
             // Its own threads: on the global pool, the file's blocks would queue behind
             // the conversion's rows, and writing would wait for conversion to finish.
@@ -239,11 +242,20 @@ fn write_while_converting(
                 .map_err(|e| CliError::input(format!("cannot start writer threads: {e}")))?;
             for (path, img) in rx {
                 pool.install(|| mirrorball_io::write_image(path, &img, opts))?;
+                // The converter may have finished and gone: then the buffer is dropped.
+                let _ = give_back.send(img);
             }
             Ok(())
         });
         for (layer, path) in paths.iter().enumerate() {
-            if tx.send((path, r.layer(layer))).is_err() {
+            let img = match take_back.try_recv() {
+                Ok(mut img) => {
+                    r.layer_into(layer, &mut img);
+                    img
+                }
+                Err(_) => r.layer(layer),
+            };
+            if tx.send((path, img)).is_err() {
                 break; // the writer stopped on an error, which join reports
             }
         }

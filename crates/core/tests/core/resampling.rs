@@ -393,3 +393,47 @@ fn sanitize_zeroes_nan_infinite_and_negative_colour_and_counts_them() {
         assert_eq!(env.sanitize(), 0, "nothing left to fix");
     }
 }
+
+/// `Resampler::layer_into` overwrites every texel of a reused buffer (those a projection
+/// leaves without a direction included), so that a buffer full of garbage comes out bit for
+/// bit as a fresh `layer` does, for every output projection and layer.
+#[test]
+fn a_resampler_fills_reused_buffers_exactly_as_fresh_ones() {
+    use mirrorball_core::{Image, Resampler};
+    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 64, 3, smooth);
+    for kind in ProjectionKind::ALL {
+        let dst = kind.default_projection();
+        let (w, h) = dst.layer_extent(24);
+        let r = Resampler::new(&src, dst, w, h, &ResampleOptions::default());
+        let mut reused = Image::new(w, h, 3);
+        for layer in 0..dst.layer_count() {
+            reused.data_mut().fill(f32::NAN);
+            let fresh = r.layer(layer);
+            r.layer_into(layer, &mut reused);
+            let same = fresh
+                .data()
+                .iter()
+                .zip(reused.data())
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(
+                same,
+                "{kind:?} layer {layer}: reused buffer differs from a fresh one"
+            );
+        }
+    }
+}
+
+#[test]
+#[should_panic(expected = "layer_into")]
+fn a_resampler_refuses_a_buffer_of_the_wrong_size() {
+    use mirrorball_core::{Image, Resampler};
+    let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 32, 3, smooth);
+    let r = Resampler::new(
+        &src,
+        ProjectionKind::Cube.default_projection(),
+        8,
+        8,
+        &ResampleOptions::default(),
+    );
+    r.layer_into(0, &mut Image::new(8, 9, 3));
+}
