@@ -23,17 +23,20 @@ pub fn with_progress<T: Send>(
             .progress_chars("=> "),
     );
     bar.set_message(label.to_string());
-    let done = Arc::new(AtomicU64::new(0));
+    // The updater waits on a channel rather than sleeping, so that it ends the moment the
+    // work does (a plain 50 ms sleep kept every command up to 50 ms past its work).
+    let (done, wait) = std::sync::mpsc::channel::<()>();
     std::thread::scope(|s| {
-        let (c, d, b) = (counter.clone(), done.clone(), bar.clone());
-        s.spawn(move || {
-            while d.load(Ordering::Relaxed) == 0 {
-                b.set_position(c.load(Ordering::Relaxed));
-                std::thread::sleep(Duration::from_millis(50));
+        let (c, b) = (counter.clone(), bar.clone());
+        s.spawn(move || loop {
+            b.set_position(c.load(Ordering::Relaxed));
+            match wait.recv_timeout(Duration::from_millis(50)) {
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => continue,
+                _ => break,
             }
         });
         let out = work(counter.clone());
-        done.store(1, Ordering::Relaxed);
+        drop(done);
         bar.finish_and_clear();
         out
     })
