@@ -274,8 +274,13 @@ fn sanitize_block(block: &mut [f32], rgba: bool) -> u32 {
                     _mm_and_ps(_mm_cmpge_ps(v, zero), _mm_cmplt_ps(v, inf)),
                     keep,
                 );
-                _mm_storeu_ps(quad.as_mut_ptr(), _mm_and_ps(v, ok));
-                n += (_mm_movemask_ps(ok) ^ 0xF).count_ones();
+                let bad = _mm_movemask_ps(ok) ^ 0xF;
+                // Written back only where something changed: a valid map (nearly every
+                // one) is read once and not rewritten.
+                if bad != 0 {
+                    _mm_storeu_ps(quad.as_mut_ptr(), _mm_and_ps(v, ok));
+                    n += bad.count_ones();
+                }
             }
         }
         // Only RGB blocks leave a remainder, and it holds no alpha.
