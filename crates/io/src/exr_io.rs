@@ -607,10 +607,12 @@ fn read_zip_file(
     use rayon::prelude::*;
     use std::cell::RefCell;
     use std::sync::Mutex;
-    /// A thread's inflater with its buffers (compressed block, inflated stream, raw lines).
-    type Scratch = (crate::exr_zip::Zip, Vec<u8>, Vec<u8>, Vec<u8>);
+    /// A thread's buffers (compressed block, inflated stream, raw lines); its inflater is
+    /// [`crate::exr_zip::THREAD_ZIP`].
+    type Scratch = (Vec<u8>, Vec<u8>, Vec<u8>);
     thread_local! {
-        static SCRATCH: RefCell<Option<Scratch>> = const { RefCell::new(None) };
+        static SCRATCH: RefCell<Scratch> =
+            const { RefCell::new((Vec::new(), Vec::new(), Vec::new())) };
     }
     let truncated = || exr::error::Error::Invalid("missing bytes: the file is truncated".into());
     let file_len = file.metadata()?.len();
@@ -678,19 +680,11 @@ fn read_zip_file(
         {
             return Err(truncated());
         }
-        SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            let (zip, block, inflated, raw) = s.get_or_insert_with(|| {
-                (
-                    crate::exr_zip::Zip::new(),
-                    Vec::new(),
-                    Vec::new(),
-                    Vec::new(),
-                )
-            });
+        SCRATCH.with_borrow_mut(|(block, inflated, raw)| {
             block.resize(size, 0);
             read_at(file, block, at + 8)?;
-            let lines = crate::exr_zip::inflate(block, expected, inflated, zip)
+            let lines = crate::exr_zip::THREAD_ZIP
+                .with_borrow_mut(|zip| crate::exr_zip::inflate(block, expected, inflated, zip))
                 .map_err(|e| exr::error::Error::Invalid(e.into()))?;
             match lines {
                 crate::exr_zip::Lines::Split { evens, odds } if float => {

@@ -191,8 +191,8 @@ impl Zip {
 }
 
 thread_local! {
-    /// Each thread's libdeflate state, for writers whose work is split among rayon's
-    /// threads in pieces of any size.
+    /// Each thread's libdeflate state, for the EXR reader and writer, whose work is split
+    /// among rayon's threads in pieces of any size.
     pub(crate) static THREAD_ZIP: std::cell::RefCell<Zip> = std::cell::RefCell::new(Zip::new());
 }
 

@@ -169,13 +169,13 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     {
         // One file a layer: each is written while the next is converted.
         Some(paths) => {
-            let written = with_progress("converting", rows, a.quiet, |counter| {
+            with_progress("converting", rows, a.quiet, |counter| {
                 plan.resample.progress = Some(counter);
                 let r = Resampler::new(&src.env, dst, w, h, &plan.resample);
                 write_while_converting(&r, &paths, &plan.save.write)
             })?;
             drop(src);
-            (written, t1.elapsed(), None)
+            (paths, t1.elapsed(), None)
         }
         None => {
             let out = with_progress("converting", rows, a.quiet, |counter| {
@@ -226,7 +226,7 @@ fn write_while_converting(
     r: &Resampler,
     paths: &[PathBuf],
     opts: &WriteOptions,
-) -> Result<Vec<PathBuf>, CliError> {
+) -> Result<(), CliError> {
     std::thread::scope(|scope| {
         // One layer waits while one is written: at most three in memory. Written layers'
         // buffers come back to be filled again, so that after the first few no layer pays
@@ -263,6 +263,5 @@ fn write_while_converting(
         writer
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e))
-    })?;
-    Ok(paths.to_vec())
+    })
 }
