@@ -273,7 +273,12 @@ pub(crate) struct RowScratch {
     /// The output projection's density at each texel (−1: no direction, skip it).
     pub(crate) dens: Vec<f32>,
     pub(crate) look: Vec<Lookup>,
+    /// Each texel's integration grid `(level, n)`, or [`NO_GRID`].
+    grid: Vec<(u16, u16)>,
 }
+
+/// A texel not integrated.
+const NO_GRID: (u16, u16) = (u16::MAX, 0);
 
 /// Per-thread buffers for one texel's integration points: directions, weights, lookups.
 pub(crate) struct PointScratch {
@@ -294,6 +299,7 @@ impl RowScratch {
             zs: vec![0.0; w],
             dens: vec![0.0; w],
             look: vec![Lookup::default(); w],
+            grid: vec![NO_GRID; w],
         }
     }
 }
@@ -366,7 +372,9 @@ impl Job {
         }
     }
 
-    /// Fills output row `y` of `layer` (`C` channels per texel).
+    /// Fills output row `y` of `layer` (`C` channels per texel): first every texel one
+    /// bilinear lookup serves (and those with no direction), then the texels to integrate,
+    /// in runs that share a grid ([`integrate_run`](Self::integrate_run)).
     #[inline(always)]
     fn row<const C: usize>(
         &self,
@@ -381,8 +389,10 @@ impl Job {
         // Stage 3: filter.
         let sproj = &self.sproj;
         let base = pyr.level(0);
-        for (x, (&ddens, lk)) in s.dens.iter().zip(&s.look).enumerate() {
+        let mut integrate = false;
+        for (x, ((&ddens, lk), grid)) in s.dens.iter().zip(&s.look).zip(&mut s.grid).enumerate() {
             let out = &mut row[x * C..(x + 1) * C];
+            *grid = NO_GRID;
             if ddens < 0.0 || lk.layer == u32::MAX {
                 // Outside the projection's domain: black, whatever the buffer held.
                 out.fill(0.0);
@@ -390,14 +400,128 @@ impl Job {
             }
             match self.integration_ratio(ddens, lk) {
                 None => bilinear32::<C>(sproj, base, lk.layer as usize, lk.u, lk.v, out),
-                Some(ratio) => self.integrate::<C>(pyr, ps, layer, x, y, ratio, lk, out),
+                Some(ratio) => {
+                    let (level, n) = self.grid(ratio);
+                    *grid = (level as u16, n as u16);
+                    integrate = true;
+                }
             }
-            if self.scale != 1.0 {
+        }
+        if integrate {
+            let mut x = 0;
+            while x < s.grid.len() {
+                let g = s.grid[x];
+                if g == NO_GRID {
+                    x += 1;
+                    continue;
+                }
+                let n = g.1 as usize;
+                // A run of texels with this grid, at most as many as the buffers hold.
+                let mut end = x + 1;
+                while end < s.grid.len() && s.grid[end] == g && (end + 1 - x) * n <= MAX_POINTS {
+                    end += 1;
+                }
+                self.integrate_run::<C>(pyr, ps, layer, y, x..end, g, &s.look, row);
+                x = end;
+            }
+        }
+        if self.scale != 1.0 {
+            for out in row.chunks_exact_mut(C) {
                 for v in &mut out[..3] {
                     *v *= self.scale;
                 }
             }
         }
+    }
+
+    /// Integrates the output texels `xs` of row `y`, which share a `(level, n)` grid: their
+    /// points (the texel centres of an n times finer grid) made a fine row at a time for the
+    /// whole run, so that the directions and source lookups go in long batches, then each
+    /// point's bilinear sample on the level added to its texel with its solid-angle weight.
+    /// A texel none of whose points has a direction takes one bilinear lookup at its centre
+    /// (`look`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn integrate_run<const C: usize>(
+        &self,
+        pyr: &Pyramid,
+        ps: &mut PointScratch,
+        layer: usize,
+        y: usize,
+        xs: std::ops::Range<usize>,
+        (level, n): (u16, u16),
+        look: &[Lookup],
+        row: &mut [f32],
+    ) {
+        let (level, n) = (level as usize, n as usize);
+        let count = xs.len();
+        let m = count * n;
+        let (sproj, lv) = (&self.sproj, pyr.level(level));
+        // Four lanes a texel (for RGB the fourth is ignored), and the weights' sum.
+        let mut acc = [[0.0f32; 4]; MAX_POINTS];
+        let mut wsum = [0.0f32; MAX_POINTS];
+        for j in 0..n {
+            let run = DirRun {
+                x: &mut ps.sx[..m],
+                y: &mut ps.sy[..m],
+                z: &mut ps.sz[..m],
+                density: &mut ps.sw[..m],
+            };
+            self.dst.span_dirs_f32(
+                layer,
+                (y * n + j) as u32,
+                self.w * n as u32,
+                self.h * n as u32,
+                (xs.start * n) as u32,
+                run,
+            );
+            if self.rotate {
+                let r = self.rot.to_source.as_mat3();
+                for k in 0..m {
+                    let d = r * glam::Vec3::new(ps.sx[k], ps.sy[k], ps.sz[k]);
+                    (ps.sx[k], ps.sy[k], ps.sz[k]) = (d.x, d.y, d.z);
+                }
+            }
+            sproj.lookup_batch(&ps.sx[..m], &ps.sy[..m], &ps.sz[..m], &mut ps.slook[..m]);
+            for (t, (a, ws)) in acc[..count].iter_mut().zip(&mut wsum[..count]).enumerate() {
+                for k in t * n..(t + 1) * n {
+                    let (sl, wt) = (&ps.slook[k], ps.sw[k]);
+                    if wt <= 0.0 || sl.layer == u32::MAX {
+                        continue;
+                    }
+                    let q = bilinear32_quad::<C>(sproj, lv, sl.layer as usize, sl.u, sl.v);
+                    for (a, v) in a.iter_mut().zip(q) {
+                        *a += wt * v;
+                    }
+                    *ws += wt;
+                }
+            }
+        }
+        for (t, x) in xs.enumerate() {
+            let out = &mut row[x * C..(x + 1) * C];
+            if wsum[t] > 0.0 {
+                for k in 0..C {
+                    out[k] = acc[t][k] / wsum[t];
+                }
+            } else {
+                let lk = &look[x];
+                bilinear32::<C>(sproj, pyr.level(0), lk.layer as usize, lk.u, lk.v, out);
+            }
+        }
+    }
+
+    /// The mip level and the points a side (`n`, an n×n grid) that integrate a footprint of
+    /// `ratio` source texels: the level where it covers at most `cap` texels, and about one
+    /// point a texel there.
+    #[inline]
+    fn grid(&self, ratio: f64) -> (usize, u32) {
+        let level = if ratio > self.cap {
+            (((ratio / self.cap).log2() * 0.5).ceil() as usize).min(self.levels - 1)
+        } else {
+            0
+        };
+        let r_l = ratio / 4f64.powi(level as i32);
+        (level, (r_l.sqrt().round() as u32).clamp(1, self.max_n))
     }
 
     /// The integration points of output texel `(x, y)`, whose footprint covers `ratio`
@@ -413,13 +537,7 @@ impl Job {
         ratio: f64,
     ) -> (usize, usize) {
         let (dst, sproj) = (&self.dst, &self.sproj);
-        let level = if ratio > self.cap {
-            (((ratio / self.cap).log2() * 0.5).ceil() as usize).min(self.levels - 1)
-        } else {
-            0
-        };
-        let r_l = ratio / 4f64.powi(level as i32);
-        let n = (r_l.sqrt().round() as u32).clamp(1, self.max_n);
+        let (level, n) = self.grid(ratio);
         // The points are the texel centres of a grid n times finer: row j of them is a span
         // of n texels of fine row n·y + j (one call a row, per-row work hoisted).
         let mut m = 0;
@@ -449,46 +567,6 @@ impl Job {
         }
         sproj.lookup_batch(&s.sx[..m], &s.sy[..m], &s.sz[..m], &mut s.slook[..m]);
         (level, m)
-    }
-
-    /// Integrates output texel `(x, y)` over its [`points`](Self::points).
-    #[inline(never)]
-    #[allow(clippy::too_many_arguments)]
-    fn integrate<const C: usize>(
-        &self,
-        pyr: &Pyramid,
-        s: &mut PointScratch,
-        layer: usize,
-        x: usize,
-        y: usize,
-        ratio: f64,
-        lk: &Lookup,
-        out: &mut [f32],
-    ) {
-        let sproj = &self.sproj;
-        let (level, m) = self.points(s, layer, x, y, ratio);
-        let lv = pyr.level(level);
-        // Four lanes (for RGB the fourth is ignored): one vector multiply-add a point.
-        let mut acc = [0.0f32; 4];
-        let mut wsum = 0.0f32;
-        for (k, sl) in s.slook[..m].iter().enumerate() {
-            if sl.layer == u32::MAX {
-                continue;
-            }
-            let q = bilinear32_quad::<C>(sproj, lv, sl.layer as usize, sl.u, sl.v);
-            let wt = s.sw[k];
-            for (a, v) in acc.iter_mut().zip(q) {
-                *a += wt * v;
-            }
-            wsum += wt;
-        }
-        if wsum > 0.0 {
-            for k in 0..C {
-                out[k] = acc[k] / wsum;
-            }
-        } else {
-            bilinear32::<C>(sproj, pyr.level(0), lk.layer as usize, lk.u, lk.v, out);
-        }
     }
 
     /// Fills one layer.

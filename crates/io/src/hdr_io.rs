@@ -2,7 +2,7 @@
 //! standard new-style run-length encoding.
 
 use crate::ldr_io::{check_limits, check_writable_size, decode_error, guard_decoder, open_input};
-use crate::{atomic_write, Error, Format, Limits, Loaded};
+use crate::{atomic::stage, Error, Format, Limits, Loaded, Staged};
 use image::codecs::hdr::HdrDecoder;
 use image::{DynamicImage, ImageDecoder};
 use mirrorball_core::Image;
@@ -78,9 +78,9 @@ fn header_is_complete(head: &[u8]) -> bool {
 
 /// Writes `image` as Radiance RGBE (alpha is dropped), run-length encoded for widths from
 /// 8 to 32767 and flat otherwise, rows encoded on all cores. Negative and NaN values are
-/// written as 0, values beyond the RGBE range as its largest value. The file is written
-/// atomically.
-pub fn write(path: &Path, image: &Image) -> Result<(), Error> {
+/// written as 0, values beyond the RGBE range as its largest value. Written to a temporary
+/// file that the returned [`Staged`] renames into place.
+pub fn write(path: &Path, image: &Image) -> Result<Staged, Error> {
     check_writable_size(path, image)?;
     let (w, h) = (image.width() as usize, image.height() as usize);
     let c = image.channels();
@@ -100,7 +100,7 @@ pub fn write(path: &Path, image: &Image) -> Result<(), Error> {
             out
         })
         .collect();
-    atomic_write(path, |out| {
+    stage(path, |out| {
         out.write_all(header.as_bytes())
             .map_err(|e| Error::io(path, e))?;
         for band in &bands {

@@ -5,7 +5,7 @@
 //! against [`Limits`], the guard that turns a decoder panic into an error, and the mapping
 //! of `image` crate errors.
 
-use crate::{atomic_write, Error, Format, Limits, Loaded, Precision, WriteOptions};
+use crate::{atomic::stage, Error, Format, Limits, Loaded, Precision, Staged, WriteOptions};
 use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::{DynamicImage, ExtendedColorType, ImageDecoder, ImageEncoder, ImageError, ImageFormat};
@@ -121,8 +121,13 @@ fn jpeg_is_complete(bytes: &[u8]) -> bool {
 /// Writes `image` as PNG (8-bit, or 16-bit with [`Precision::U16`]) or JPEG (8-bit,
 /// quality [`WriteOptions::jpeg_quality`], 92 when 0; alpha dropped), encoding linear light
 /// to sRGB with clamping to [0, 1] and rounding to nearest. Alpha is stored linearly.
-/// The file is written atomically.
-pub fn write(path: &Path, format: Format, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
+/// Written to a temporary file that the returned [`Staged`] renames into place.
+pub fn write(
+    path: &Path,
+    format: Format,
+    image: &Image,
+    opts: &WriteOptions,
+) -> Result<Staged, Error> {
     let sixteen = match (format, opts.precision) {
         (Format::Png | Format::Jpeg, None | Some(Precision::U8)) => false,
         (Format::Png, Some(Precision::U16)) => true,
@@ -165,7 +170,7 @@ pub fn write(path: &Path, format: Format, image: &Image, opts: &WriteOptions) ->
             q => q.min(100),
         };
         let bytes = encode_u8(image, 3);
-        return atomic_write(path, |out| {
+        return stage(path, |out| {
             JpegEncoder::new_with_quality(out, quality)
                 .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
                 .map_err(|e| encode_error(path, "JPEG", e))
@@ -194,7 +199,7 @@ pub fn write(path: &Path, format: Format, image: &Image, opts: &WriteOptions) ->
             },
         )
     };
-    atomic_write(path, |out| {
+    stage(path, |out| {
         PngEncoder::new(out)
             .write_image(&bytes, w, h, color)
             .map_err(|e| encode_error(path, "PNG", e))

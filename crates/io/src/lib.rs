@@ -16,7 +16,7 @@ mod hdr_io;
 mod ktx2_io;
 mod ldr_io;
 
-pub use atomic::atomic_write;
+pub use atomic::{atomic_write, Staged};
 pub use error::{Error, Fault};
 
 use mirrorball_core::{Image, ProjectionKind};
@@ -159,6 +159,17 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
 
 /// Writes one flat image (EXR, HDR, PNG or JPEG), atomically.
 pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
+    write_image_staged(path, image, opts)?.commit()
+}
+
+/// Writes one flat image as [`write_image`] does, to a temporary file beside `path` that
+/// [`Staged::commit`] renames into place (dropped uncommitted, it is removed): a caller
+/// writing many files can rename each on another thread (see [`Staged`] for why).
+pub fn write_image_staged(
+    path: &Path,
+    image: &Image,
+    opts: &WriteOptions,
+) -> Result<Staged, Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
         Format::Exr => exr_io::write(path, image, opts),

@@ -3,7 +3,8 @@
 
 use mirrorball_core::{Image, ProjectionKind};
 use mirrorball_io::{
-    read, write_image, Error, ExrCompression, Fault, Format, Limits, Precision, WriteOptions,
+    read, write_image, write_image_staged, Error, ExrCompression, Fault, Format, Limits, Precision,
+    WriteOptions,
 };
 use std::path::{Path, PathBuf};
 
@@ -226,6 +227,101 @@ fn exr_float_round_trip_every_compression() {
                 }
             } else {
                 assert_eq!(img.data(), back.data(), "{comp:?} must be exact");
+            }
+        }
+    }
+}
+
+/// What the `exr` crate's own writer makes of `img` uncompressed (half samples clamped to
+/// the finite range, as mirrorball writes them), with the `envmap` attribute when `latlong`.
+fn exr_crate_uncompressed(img: &Image, float: bool, latlong: bool) -> Vec<u8> {
+    use exr::prelude::*;
+    let st = if float {
+        SampleType::F32
+    } else {
+        SampleType::F16
+    };
+    let (w, c) = (img.width() as usize, img.channels());
+    let data = img.data();
+    let fit = move |v: f32| if float { v } else { v.clamp(-65504.0, 65504.0) };
+    let attrs = LayerAttributes {
+        environment_map: latlong.then_some(exr::meta::attribute::EnvironmentMap::LatitudeLongitude),
+        ..LayerAttributes::default()
+    };
+    let enc = Encoding {
+        compression: Compression::Uncompressed,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
+    let size = Vec2(w, img.height() as usize);
+    let d = |n: &str| ChannelDescription::named(n, st);
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    if c == 4 {
+        let px = move |p: Vec2<usize>| {
+            let i = (p.y() * w + p.x()) * 4;
+            (
+                fit(data[i]),
+                fit(data[i + 1]),
+                fit(data[i + 2]),
+                fit(data[i + 3]),
+            )
+        };
+        let ch = SpecificChannels {
+            channels: (d("R"), d("G"), d("B"), d("A")),
+            pixels: px,
+        };
+        exr::image::Image::from_layer(Layer::new(size, attrs, enc, ch))
+            .write()
+            .to_buffered(&mut bytes)
+            .unwrap();
+    } else {
+        let px = move |p: Vec2<usize>| {
+            let i = (p.y() * w + p.x()) * 3;
+            (fit(data[i]), fit(data[i + 1]), fit(data[i + 2]))
+        };
+        let ch = SpecificChannels {
+            channels: (d("R"), d("G"), d("B")),
+            pixels: px,
+        };
+        exr::image::Image::from_layer(Layer::new(size, attrs, enc, ch))
+            .write()
+            .to_buffered(&mut bytes)
+            .unwrap();
+    }
+    bytes.into_inner()
+}
+
+#[test]
+fn exr_uncompressed_files_are_byte_for_byte_what_the_exr_crate_writes() {
+    // mirrorball writes uncompressed files itself (header by the `exr` crate, offset table
+    // and lines packed here): the bytes must be the crate's own, for every sample type,
+    // channel count, a one-line image, lines past one write batch, and the envmap attribute.
+    let dir = tempfile::tempdir().unwrap();
+    for (w, h) in [(37, 45), (5, 1), (3000, 200)] {
+        for c in [3, 4] {
+            let img = hdr_image(w, h, c);
+            for float in [false, true] {
+                for latlong in [false, true] {
+                    let path = dir.path().join(format!("u-{w}-{c}-{float}-{latlong}.exr"));
+                    let o = WriteOptions {
+                        exr_compression: ExrCompression::None,
+                        precision: Some(if float {
+                            Precision::Float
+                        } else {
+                            Precision::Half
+                        }),
+                        declared: latlong.then_some(ProjectionKind::LatLong),
+                        ..WriteOptions::default()
+                    };
+                    write_image(&path, &img, &o).unwrap();
+                    let ours = std::fs::read(&path).unwrap();
+                    let theirs = exr_crate_uncompressed(&img, float, latlong);
+                    assert_eq!(ours.len(), theirs.len(), "{w}x{h}x{c} float {float}");
+                    assert!(
+                        ours == theirs,
+                        "{w}x{h}x{c} float {float} latlong {latlong}"
+                    );
+                }
             }
         }
     }
@@ -942,6 +1038,60 @@ fn failed_writes_leave_no_file_behind() {
     write_err(&path, &img, &opts(Some(Precision::Float)));
     assert_eq!(std::fs::read(&path).unwrap(), before);
     assert_dir_holds(dir.path(), &["keep.png"]);
+}
+
+#[test]
+fn a_staged_write_lands_only_when_committed() {
+    let dir = tempfile::tempdir().unwrap();
+    let img = hdr_image(8, 8, 3);
+    let path = dir.path().join("face.exr");
+    write_image(&path, &img, &WriteOptions::default()).unwrap();
+    let before = std::fs::read(&path).unwrap();
+    let other = hdr_image(9, 8, 3);
+    for name in ["face.exr", "face.hdr", "face.png"] {
+        let target = dir.path().join(name);
+        let existed = target.exists();
+        let count = || std::fs::read_dir(dir.path()).unwrap().count();
+        let before_count = count();
+        // Staged: the whole file is written beside the target, which is untouched.
+        let staged = write_image_staged(&target, &other, &WriteOptions::default()).unwrap();
+        assert_eq!(staged.path(), target.as_path());
+        assert_eq!(
+            count(),
+            before_count + 1,
+            "a temporary file beside the target"
+        );
+        assert_eq!(target.exists(), existed);
+        if name == "face.exr" {
+            assert_eq!(
+                std::fs::read(&path).unwrap(),
+                before,
+                "the old file is untouched"
+            );
+            // Dropped uncommitted: the temporary file goes, the old file stays.
+            drop(staged);
+            assert_dir_holds(dir.path(), &["face.exr"]);
+            assert_eq!(std::fs::read(&path).unwrap(), before);
+            let staged = write_image_staged(&target, &other, &WriteOptions::default()).unwrap();
+            staged.commit().unwrap();
+        } else {
+            staged.commit().unwrap();
+        }
+        assert_eq!(
+            read_one(&target).0.width(),
+            9,
+            "{name}: the new image is in place"
+        );
+    }
+    assert_dir_holds(dir.path(), &["face.exr", "face.hdr", "face.png"]);
+    // A rename that fails (the directory is gone) is an error naming the file, and leaves
+    // nothing behind.
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let staged = write_image_staged(&sub.join("x.exr"), &img, &WriteOptions::default()).unwrap();
+    std::fs::remove_dir_all(&sub).unwrap();
+    let e = staged.commit().unwrap_err();
+    assert!(e.to_string().contains("x.exr"), "{e}");
 }
 
 fn crc32(bytes: &[u8]) -> u32 {
