@@ -15,7 +15,7 @@
 //!
 //! The work runs in parallel over rows with rayon and allocates nothing per texel.
 
-use crate::envmap::{bilinear32, bilinear32_quad};
+use crate::envmap::{bilinear32, bilinear32_quad, bilinear_corner, lerp_quad};
 use crate::projection::{DirRun, Lookup, Projection, WorldProjection};
 use crate::{EnvMap, Image};
 use glam::{DMat3, DVec3};
@@ -239,14 +239,18 @@ fn levels_needed(
 ) -> usize {
     let step = (w.max(h) / 64).max(1);
     let mut ratios = Vec::new();
-    let mut dirs = vec![None; w as usize];
+    // Only the sampled texels' directions (a whole row's, for one in `step`, cost 4 ms
+    // before any work could start on a 1024² cube).
+    let mut one = [None];
     for layer in 0..dst.layer_count() {
         for y in (0..h).step_by(step as usize) {
-            dst.row_dirs(layer, y, w, h, &mut dirs);
-            for (d, dd) in dirs.iter().step_by(step as usize).flatten() {
-                ratios.push(
-                    footprint_ratio(*dd, sproj.density_of_dir(rot.source_of(*d)), area).min(1e12),
-                );
+            for x in (0..w).step_by(step as usize) {
+                dst.span_dirs(layer, y, w, h, x, &mut one);
+                if let [Some((d, dd))] = one {
+                    ratios.push(
+                        footprint_ratio(dd, sproj.density_of_dir(rot.source_of(d)), area).min(1e12),
+                    );
+                }
             }
         }
     }
@@ -273,12 +277,92 @@ pub(crate) struct RowScratch {
     /// The output projection's density at each texel (−1: no direction, skip it).
     pub(crate) dens: Vec<f32>,
     pub(crate) look: Vec<Lookup>,
-    /// Each texel's integration grid `(level, n)`, or [`NO_GRID`].
+    /// Each texel's integration grid `(level, n)`, or [`NO_GRID`] or [`SEAM`].
     grid: Vec<(u16, u16)>,
+    /// Each texel's bilinear lookup, or [`NO_TAP`].
+    taps: Vec<Tap>,
 }
 
 /// A texel not integrated.
 const NO_GRID: (u16, u16) = (u16::MAX, 0);
+/// A texel of one bilinear lookup that straddles a seam of the source (or reads its last
+/// floats), which [`bilinear32`]'s general path serves.
+const SEAM: (u16, u16) = (u16::MAX, 1);
+
+/// A bilinear lookup inside one source layer: the float where its top-left texel starts,
+/// and the fractions towards `+x` and `+y` (as [`bilinear32`] computes them).
+#[derive(Clone, Copy)]
+pub(crate) struct Tap {
+    layer: u32,
+    at: u32,
+    fx: f32,
+    fy: f32,
+}
+
+/// No lookup: the texel is black (or filled by a later pass).
+const NO_TAP: Tap = Tap {
+    layer: u32::MAX,
+    at: 0,
+    fx: 0.0,
+    fy: 0.0,
+};
+
+/// The [`Tap`] of `lk` when [`lerp_quad`](crate::envmap::lerp_quad)'s four-float reads at
+/// its four texels stay inside the layer (and its start fits a `u32`).
+#[inline(always)]
+fn inner_tap<const C: usize>(layers: &[Image], lk: &Lookup) -> Option<Tap> {
+    let img = layers.get(lk.layer as usize)?;
+    let (x0, y0, fx, fy) = bilinear_corner(lk.u, lk.v, img.width(), img.height());
+    let (w, h) = (img.width() as i32, img.height() as i32);
+    if x0 < 0 || y0 < 0 || x0 + 1 >= w || y0 + 1 >= h {
+        return None;
+    }
+    let stride = w as usize * C;
+    let at = y0 as usize * stride + x0 as usize * C;
+    if at + stride + C + 4 > img.data().len() {
+        return None;
+    }
+    Some(Tap {
+        layer: lk.layer,
+        at: u32::try_from(at).ok()?,
+        fx,
+        fy,
+    })
+}
+
+/// Taps ahead of the current one whose source texels [`gather`] asks for.
+const AHEAD: usize = 24;
+
+/// Writes every texel of `row`: its [`Tap`]'s bilinear blend, or zero for [`NO_TAP`].
+#[inline(always)]
+fn gather<const C: usize>(taps: &[Tap], layers: &[Image], row: &mut [f32]) {
+    for (x, (t, out)) in taps.iter().zip(row.chunks_exact_mut(C)).enumerate() {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(a) = taps.get(x + AHEAD) {
+            if let Some(img) = layers.get(a.layer as usize) {
+                // SAFETY: a prefetch never faults; `inner_tap` put both addresses (the
+                // tap's two rows) inside the layer.
+                unsafe {
+                    use std::arch::x86_64::*;
+                    let p = img.data().as_ptr().add(a.at as usize);
+                    let stride = img.width() as usize * C;
+                    _mm_prefetch::<_MM_HINT_T0>(p as *const i8);
+                    _mm_prefetch::<_MM_HINT_T0>(p.add(stride) as *const i8);
+                }
+            }
+        }
+        let _ = x;
+        match layers.get(t.layer as usize) {
+            Some(img) => {
+                let stride = img.width() as usize * C;
+                let q = lerp_quad::<C>(img.data(), t.at as usize, stride, t.fx, t.fy)
+                    .expect("inner_tap keeps the reads inside the layer");
+                out.copy_from_slice(&q[..C]);
+            }
+            None => out.fill(0.0),
+        }
+    }
+}
 
 /// Per-thread buffers for one texel's integration points: directions, weights, lookups.
 pub(crate) struct PointScratch {
@@ -300,6 +384,7 @@ impl RowScratch {
             dens: vec![0.0; w],
             look: vec![Lookup::default(); w],
             grid: vec![NO_GRID; w],
+            taps: vec![NO_TAP; w],
         }
     }
 }
@@ -386,32 +471,46 @@ impl Job {
         row: &mut [f32],
     ) {
         self.locate(s, layer, y);
-        // Stage 3: filter.
+        // Stage 3: filter, in passes. First each texel is sorted: one bilinear lookup whose
+        // 2×2 source texels lie inside a layer (its corner and fractions kept in `taps`),
+        // outside the projection (black), straddling a seam, or to integrate. Then the
+        // lookups are made in one tight pass that asks for the source texels a few texels
+        // ahead: the lookups wander over source rows in ways the hardware prefetcher does
+        // not foresee, and computing and reading in separate passes let a 4096×2048 lat-long
+        // go to a 1024² cube about 20% faster than one pass doing both. Last, the seams and
+        // the integrated texels.
         let sproj = &self.sproj;
         let base = pyr.level(0);
-        let mut integrate = false;
-        for (x, ((&ddens, lk), grid)) in s.dens.iter().zip(&s.look).zip(&mut s.grid).enumerate() {
-            let out = &mut row[x * C..(x + 1) * C];
-            *grid = NO_GRID;
+        let mut special = false;
+        let texels = s.dens.iter().zip(&s.look).zip(&mut s.grid).zip(&mut s.taps);
+        for (((&ddens, lk), grid), tap) in texels {
+            (*grid, *tap) = (NO_GRID, NO_TAP);
             if ddens < 0.0 || lk.layer == u32::MAX {
-                // Outside the projection's domain: black, whatever the buffer held.
-                out.fill(0.0);
-                continue;
+                continue; // outside the projection's domain: black
             }
             match self.integration_ratio(ddens, lk) {
-                None => bilinear32::<C>(sproj, base, lk.layer as usize, lk.u, lk.v, out),
+                None => match inner_tap::<C>(base, lk) {
+                    Some(t) => *tap = t,
+                    None => (*grid, special) = (SEAM, true),
+                },
                 Some(ratio) => {
                     let (level, n) = self.grid(ratio);
-                    *grid = (level as u16, n as u16);
-                    integrate = true;
+                    (*grid, special) = ((level as u16, n as u16), true);
                 }
             }
         }
-        if integrate {
+        gather::<C>(&s.taps, base, row);
+        if special {
             let mut x = 0;
             while x < s.grid.len() {
                 let g = s.grid[x];
                 if g == NO_GRID {
+                    x += 1;
+                    continue;
+                }
+                if g == SEAM {
+                    let (lk, out) = (&s.look[x], &mut row[x * C..(x + 1) * C]);
+                    bilinear32::<C>(sproj, base, lk.layer as usize, lk.u, lk.v, out);
                     x += 1;
                     continue;
                 }

@@ -118,6 +118,63 @@ fn shrinking_a_zone_plate_does_not_alias() {
     );
 }
 
+/// One bilinear lookup a texel (`max_samples = 1`, and growing a cube into a lat-long,
+/// where nothing is integrated) is the source's own `f64` bilinear filter (`EnvMap::sample`) at each output
+/// texel's centre direction: inside layers (the resampler's gather pass) and across the
+/// seams, the longitude wrap and the poles alike.
+#[test]
+fn one_lookup_a_texel_is_the_sources_bilinear_filter() {
+    let ll = ProjectionKind::LatLong.default_projection();
+    let cube = ProjectionKind::Cube.default_projection();
+    let noisy = |d: DVec3| {
+        let v = 1.0 + 0.5 * (37.0 * d.x).sin() * (23.0 * d.y).cos() + 0.2 * (51.0 * d.z).sin();
+        [
+            v as f32,
+            (2.0 + d.y) as f32,
+            (1.5 - 0.7 * d.x) as f32,
+            (0.5 + 0.4 * d.z) as f32,
+        ]
+    };
+    let point = ResampleOptions {
+        max_samples: 1,
+        ..Default::default()
+    };
+    let cases = [
+        (EnvMap::from_fn(ll, 256, 3, noisy), cube, 64, point.clone()),
+        (EnvMap::from_fn(ll, 128, 4, noisy), cube, 96, point.clone()),
+        (
+            EnvMap::from_fn(cube, 32, 3, noisy),
+            ll,
+            200,
+            ResampleOptions::default(),
+        ),
+    ];
+    for (src, dst, size, opts) in &cases {
+        let out = resample(src, *dst, *size, opts);
+        let (w, h) = (out.width(), out.height());
+        let mut worst: f64 = 0.0;
+        for (layer, img) in out.layers().iter().enumerate() {
+            for y in 0..h {
+                for x in 0..w {
+                    let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                    let d = dst.uv_to_dir(layer, uv).unwrap();
+                    let want = src.sample(d);
+                    for (c, &got) in img.get(x, y).iter().enumerate() {
+                        let e = (got as f64 - want[c] as f64).abs() / want[c].abs().max(0.1) as f64;
+                        worst = worst.max(e);
+                    }
+                }
+            }
+        }
+        // f32 directions and lookups place a sample within ~1e-6 of a texel.
+        assert!(
+            worst < 2e-4,
+            "{:?} → {dst:?}: worst relative difference {worst}",
+            src.projection()
+        );
+    }
+}
+
 /// Growing a small map: the values across every cube edge change no more than inside faces.
 #[test]
 fn growing_leaves_no_seams() {
