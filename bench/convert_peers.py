@@ -300,21 +300,31 @@ def in_memory(path: Path, reps: int, load: Load) -> dict:
     return res
 
 
-def end_to_end(path: Path, reps: int, load: Load) -> dict:
+def mirrorball_e2e_command(exe: Path, path: Path, out: Path) -> list[str]:
+    return [
+        str(exe), "convert", str(path), str(out / "cube_{face}.exr"),
+        "--to", "cube", "--size", str(FACE), "--layout", "separate",
+        "--precision", "float", "--compression", "none", "-q",
+    ]
+
+
+def end_to_end(path: Path, reps: int, load: Load, extra: dict[str, Path]) -> dict:
     py = sys.executable
     out = DATA / "e2e"
     methods = {
-        "mirrorball convert (CLI)": [
-            str(MIRRORBALL), "convert", str(path), str(out / "mirrorball" / "cube_{face}.exr"),
-            "--to", "cube", "--size", str(FACE), "--layout", "separate",
-            "--precision", "float", "--compression", "none", "-q",
-        ],
+        "mirrorball convert (CLI)": mirrorball_e2e_command(MIRRORBALL, path, out / "mirrorball"),
+        # Other builds of mirrorball (--e2e-also), in the same rounds: before/after a change.
+        **{
+            f"mirrorball {name}": mirrorball_e2e_command(exe, path, out / f"mirrorball-{name}")
+            for name, exe in extra.items()
+        },
         "python cv2.remap": [py, str(BENCH / "e2e_cv2_remap.py"), str(path), str(out / "cv2"), str(FACE)],
         "python py360convert": [
             py, str(BENCH / "e2e_py360convert.py"), str(path), str(out / "py360convert"), str(FACE)
         ],
     }
-    (out / "mirrorball").mkdir(parents=True, exist_ok=True)
+    for m in ["mirrorball", *(f"mirrorball-{name}" for name in extra)]:
+        (out / m).mkdir(parents=True, exist_ok=True)
     times: dict[str, list[float]] = {m: [] for m in methods}
     # One untimed warm-up each (page cache, .pyc files), then rounds that take the methods
     # in turn, so a burst of background load hits them alike.
@@ -454,7 +464,16 @@ def main() -> int:
                     help="before measuring, wait up to SECONDS for other rustc processes to "
                     "finish (timings are noisy while others compile); default 0")
     ap.add_argument("--json", default=str(RESULTS / "convert.json"), help="where to write results")
+    ap.add_argument("--e2e-also", action="append", default=[], metavar="NAME=PATH",
+                    help="also time another mirrorball binary end to end, in the same rounds "
+                    "(say, a build of an earlier commit); repeatable")
     args = ap.parse_args()
+    extra = {}
+    for spec in args.e2e_also:
+        name, sep, exe = spec.partition("=")
+        if not sep or not name or not Path(exe).is_file():
+            ap.error(f"--e2e-also {spec!r}: give NAME=PATH of an existing mirrorball binary")
+        extra[name] = Path(exe).resolve()
 
     import cv2
     import OpenEXR
@@ -526,7 +545,7 @@ def main() -> int:
 
     first = paths[names[0]]
     log(f"end to end: {first.name}")
-    results["end_to_end"] = {first.name: end_to_end(first, args.e2e_reps, load)}
+    results["end_to_end"] = {first.name: end_to_end(first, args.e2e_reps, load, extra)}
     load.sample("end")
     log("cross-checks")
     mb_psnr = results["in_memory"][first.name]["mirrorball resample"]["roundtrip_log_psnr_db"]
