@@ -266,6 +266,64 @@ fn levels_needed(
     }
 }
 
+/// A side face (±X, ±Z) of a cube made from a lat-long without rotation, where a texel's
+/// source longitude depends on its column alone: per column, `u` and `1/√(1 + sc²)` (`sc`
+/// the column's face coordinate), so that a texel's lookup is one short `atan`.
+///
+/// The face point is `(±1, −tc, ∓sc)` or `(±sc, −tc, ±1)`, so `√(x² + z²) = √(1 + sc²)`
+/// whatever the row, the longitude is that of the column, and with `a = tc/√(1 + sc²)`
+/// (`|a| ≤ 1`): latitude `−atan a`, so `v = ½ + atan(a)/π`; the lat-long density
+/// `2π² cos(lat) = 2π²/√(1 + a²)`; the cube's `4/(1 + sc² + tc²)^{3/2} =
+/// 4 (1/√(1 + sc²))³ / (1 + a²)^{3/2}`. The same values as the general path's directions
+/// and lookups, to `f32` rounding (tested).
+pub(crate) struct SideColumns {
+    u: Vec<f32>,
+    ic: Vec<f32>,
+}
+
+impl SideColumns {
+    /// The columns of side face `layer` of a `w`-wide cube, or `None` for the ±Y faces.
+    fn new(layer: usize, w: u32) -> Option<SideColumns> {
+        let face = crate::projection::CubeFace::from_index(layer)?;
+        let (mut u, mut ic) = (
+            Vec::with_capacity(w as usize),
+            Vec::with_capacity(w as usize),
+        );
+        for x in 0..w {
+            let sc = 2.0 * (x as f64 + 0.5) / w as f64 - 1.0;
+            let p = face.point(sc, 0.0);
+            if p.y != 0.0 {
+                return None; // a pole face
+            }
+            let lon_u = p.x.atan2(-p.z) / std::f64::consts::TAU + 0.5;
+            u.push(lon_u as f32);
+            ic.push((1.0 / (1.0 + sc * sc).sqrt()) as f32);
+        }
+        Some(SideColumns { u, ic })
+    }
+
+    /// Row `y` (of `h`): each texel's cube density in `s.dens` and lat-long lookup in
+    /// `s.look`.
+    #[inline(always)]
+    fn locate(&self, s: &mut RowScratch, y: usize, h: u32) {
+        use std::f32::consts::PI;
+        let tc = (2.0 * (y as f64 + 0.5) / h as f64 - 1.0) as f32;
+        let k = (2.0 * std::f64::consts::PI * std::f64::consts::PI) as f32;
+        let cols = self.u.iter().zip(&self.ic);
+        for (((&u, &ic), d), lk) in cols.zip(&mut s.dens).zip(&mut s.look) {
+            let a = tc * ic;
+            let r = 1.0 / (1.0 + a * a).sqrt();
+            *d = 4.0 * (ic * r) * (ic * r) * (ic * r);
+            *lk = Lookup {
+                layer: 0,
+                u,
+                v: 0.5 + crate::projection::fastmath::atan01_f32(a) * (1.0 / PI),
+                density: k * r,
+            };
+        }
+    }
+}
+
 /// Most integration points per output texel (16×16).
 const MAX_POINTS: usize = 256;
 
@@ -423,6 +481,15 @@ impl Job {
     /// projection), turned into the source, and where they land in the source, as one batch.
     #[inline(always)]
     pub(crate) fn locate(&self, s: &mut RowScratch, layer: usize, y: usize) {
+        self.locate_with(s, layer, y, None)
+    }
+
+    /// [`locate`](Self::locate), from a side face's [`SideColumns`] when given.
+    #[inline(always)]
+    fn locate_with(&self, s: &mut RowScratch, layer: usize, y: usize, side: Option<&SideColumns>) {
+        if let Some(cols) = side {
+            return cols.locate(s, y, self.h);
+        }
         let (dst, sproj) = (&self.dst, &self.sproj);
         let run = DirRun {
             x: &mut s.xs,
@@ -439,6 +506,15 @@ impl Job {
             }
         }
         sproj.lookup_batch(&s.xs, &s.ys, &s.zs, &mut s.look);
+    }
+
+    /// [`SideColumns`] for `layer` when this conversion is a lat-long into a cube side face
+    /// without rotation.
+    fn side_columns(&self, layer: usize) -> Option<SideColumns> {
+        let plain = matches!(self.dst, Projection::Cube(_))
+            && matches!(self.sproj, Projection::LatLong(_))
+            && !self.rotate;
+        plain.then(|| SideColumns::new(layer, self.w)).flatten()
     }
 
     /// The footprint ratio of an output texel of density `ddens` whose centre landed at
@@ -461,6 +537,7 @@ impl Job {
     /// bilinear lookup serves (and those with no direction), then the texels to integrate,
     /// in runs that share a grid ([`integrate_run`](Self::integrate_run)).
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn row<const C: usize>(
         &self,
         pyr: &Pyramid,
@@ -468,9 +545,10 @@ impl Job {
         ps: &mut PointScratch,
         layer: usize,
         y: usize,
+        side: Option<&SideColumns>,
         row: &mut [f32],
     ) {
-        self.locate(s, layer, y);
+        self.locate_with(s, layer, y, side);
         // Stage 3: filter, in passes. First each texel is sorted: one bilinear lookup whose
         // 2×2 source texels lie inside a layer (its corner and fractions kept in `taps`),
         // outside the projection (black), straddling a seam, or to integrate. Then the
@@ -677,13 +755,14 @@ impl Job {
         progress: Option<&Arc<AtomicU64>>,
     ) {
         let w = self.w as usize;
+        let side = self.side_columns(layer);
         img.data_mut()
             .par_chunks_mut(w * C)
             .enumerate()
             .for_each_init(
                 || (RowScratch::new(w), PointScratch::new()),
                 |(s, ps), (y, row)| {
-                    self.row::<C>(pyr, s, ps, layer, y, row);
+                    self.row::<C>(pyr, s, ps, layer, y, side.as_ref(), row);
                     if let Some(p) = progress {
                         p.fetch_add(1, Ordering::Relaxed);
                     }
@@ -839,5 +918,75 @@ impl<'a> Resampler<'a> {
             3 => self.job.layer::<3>(&self.pyramid, layer, img, progress),
             _ => self.job.layer::<4>(&self.pyramid, layer, img, progress),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ProjectionKind;
+
+    #[test]
+    fn side_columns_give_the_general_paths_lookups() {
+        let ll = ProjectionKind::LatLong.default_projection();
+        let cube = ProjectionKind::Cube.default_projection();
+        for (face, sw) in [(16u32, 64u32), (100, 512), (1024, 4096)] {
+            let job = Job::new(
+                ll,
+                (sw, sw / 2),
+                cube,
+                (face, face),
+                &ResampleOptions::default(),
+            );
+            let (mut a, mut b) = (
+                RowScratch::new(face as usize),
+                RowScratch::new(face as usize),
+            );
+            for layer in 0..6 {
+                let Some(side) = job.side_columns(layer) else {
+                    assert!(layer == 2 || layer == 3, "only ±Y are pole faces");
+                    continue;
+                };
+                for y in (0..face as usize).step_by((face as usize / 37).max(1)) {
+                    job.locate(&mut a, layer, y);
+                    job.locate_with(&mut b, layer, y, Some(&side));
+                    for x in 0..face as usize {
+                        let (p, q) = (&a.look[x], &b.look[x]);
+                        assert_eq!(p.layer, q.layer);
+                        // f32 rounding of two different formulas: ~1e-7 of a turn.
+                        assert!(
+                            (p.u - q.u).abs() < 5e-7,
+                            "{face} {layer} {x} {y}: u {} {}",
+                            p.u,
+                            q.u
+                        );
+                        assert!(
+                            (p.v - q.v).abs() < 5e-7,
+                            "{face} {layer} {x} {y}: v {} {}",
+                            p.v,
+                            q.v
+                        );
+                        assert!((p.density / q.density - 1.0).abs() < 1e-5);
+                        assert!((a.dens[x] / b.dens[x] - 1.0).abs() < 1e-5);
+                    }
+                }
+            }
+        }
+        // Turned, or another pair of projections: the general path.
+        let turned = ResampleOptions {
+            rotation: Rotation::from_euler_deg(10.0, 0.0, 0.0),
+            ..Default::default()
+        };
+        assert!(Job::new(ll, (64, 32), cube, (16, 16), &turned)
+            .side_columns(0)
+            .is_none());
+        let cc = ProjectionKind::ContinuousCube.default_projection();
+        let opts = ResampleOptions::default();
+        assert!(Job::new(ll, (64, 32), cc, (16, 16), &opts)
+            .side_columns(0)
+            .is_none());
+        assert!(Job::new(cube, (16, 16), cube, (16, 16), &opts)
+            .side_columns(0)
+            .is_none());
     }
 }

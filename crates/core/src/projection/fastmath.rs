@@ -81,9 +81,9 @@ pub fn atan2(y: f64, x: f64) -> f64 {
 }
 
 /// `atan(a)` for `a ∈ [0, 1]` in `f32`: an odd degree-15 polynomial fitted for the least
-/// maximum error, 1.2e-7 rad (f32 rounding included).
+/// maximum error, 1.2e-7 rad (f32 rounding included). Odd, so it serves `a ∈ [−1, 1]` too.
 #[inline(always)]
-fn atan01_f32(a: f32) -> f32 {
+pub(crate) fn atan01_f32(a: f32) -> f32 {
     const C: [f32; 8] = [
         0.999_999_34,
         -0.333_298_6,
