@@ -165,6 +165,17 @@ pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<()
 /// Writes one flat image as [`write_image`] does, to a temporary file beside `path` that
 /// [`Staged::commit`] renames into place (dropped uncommitted, it is removed): a caller
 /// writing many files can rename each on another thread (see [`Staged`] for why).
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_io::{write_image_staged, WriteOptions};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("face.exr");
+/// let staged = write_image_staged(&path, &Image::new(4, 4, 3), &WriteOptions::default()).unwrap();
+/// assert!(!path.exists()); // written beside it, not yet in place
+/// staged.commit().unwrap();
+/// assert!(path.exists());
+/// ```
 pub fn write_image_staged(
     path: &Path,
     image: &Image,
