@@ -276,7 +276,7 @@ fn levels_needed(
 /// `2π² cos(lat) = 2π²/√(1 + a²)`; the cube's `4/(1 + sc² + tc²)^{3/2} =
 /// 4 (1/√(1 + sc²))³ / (1 + a²)^{3/2}`. The same values as the general path's directions
 /// and lookups, to `f32` rounding (tested).
-pub(crate) struct SideColumns {
+struct SideColumns {
     u: Vec<f32>,
     ic: Vec<f32>,
 }
@@ -350,7 +350,7 @@ const SEAM: (u16, u16) = (u16::MAX, 1);
 /// A bilinear lookup inside one source layer: the float where its top-left texel starts,
 /// and the fractions towards `+x` and `+y` (as [`bilinear32`] computes them).
 #[derive(Clone, Copy)]
-pub(crate) struct Tap {
+struct Tap {
     layer: u32,
     at: u32,
     fx: f32,
@@ -391,25 +391,33 @@ fn inner_tap<const C: usize>(layers: &[Image], lk: &Lookup) -> Option<Tap> {
 /// Taps ahead of the current one whose source texels [`gather`] asks for.
 const AHEAD: usize = 24;
 
+/// Asks for the source texels of `tap` ahead of reading them (a hint: nothing off x86-64,
+/// or for [`NO_TAP`]).
+#[inline(always)]
+fn prefetch<const C: usize>(tap: &Tap, layers: &[Image]) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(img) = layers.get(tap.layer as usize) {
+        // SAFETY: a prefetch never faults; `inner_tap` put both addresses (the tap's two
+        // rows) inside the layer.
+        unsafe {
+            use std::arch::x86_64::*;
+            let p = img.data().as_ptr().add(tap.at as usize);
+            let stride = img.width() as usize * C;
+            _mm_prefetch::<_MM_HINT_T0>(p as *const i8);
+            _mm_prefetch::<_MM_HINT_T0>(p.add(stride) as *const i8);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (tap, layers);
+}
+
 /// Writes every texel of `row`: its [`Tap`]'s bilinear blend, or zero for [`NO_TAP`].
 #[inline(always)]
 fn gather<const C: usize>(taps: &[Tap], layers: &[Image], row: &mut [f32]) {
     for (x, (t, out)) in taps.iter().zip(row.chunks_exact_mut(C)).enumerate() {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(a) = taps.get(x + AHEAD) {
-            if let Some(img) = layers.get(a.layer as usize) {
-                // SAFETY: a prefetch never faults; `inner_tap` put both addresses (the
-                // tap's two rows) inside the layer.
-                unsafe {
-                    use std::arch::x86_64::*;
-                    let p = img.data().as_ptr().add(a.at as usize);
-                    let stride = img.width() as usize * C;
-                    _mm_prefetch::<_MM_HINT_T0>(p as *const i8);
-                    _mm_prefetch::<_MM_HINT_T0>(p.add(stride) as *const i8);
-                }
-            }
+        if let Some(ahead) = taps.get(x + AHEAD) {
+            prefetch::<C>(ahead, layers);
         }
-        let _ = x;
         match layers.get(t.layer as usize) {
             Some(img) => {
                 let stride = img.width() as usize * C;

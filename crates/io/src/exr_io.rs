@@ -334,8 +334,9 @@ where
 /// also writes their bytes): the offset table follows from the line size, and the lines
 /// (each its `y`, its byte count and its samples, [`pack_lines`]) are packed on all cores a
 /// batch of about 2 MiB at a time straight into a buffer, which goes to the file as one
-/// write while the next batch is packed into a second. (Through the crate's chunk writer each line was a fresh zeroed buffer, then
-/// copied again into the file's buffer: 150 MB of memory traffic for a 6×1024² float cube.)
+/// write while the next batch is packed into a second. (Through the crate's chunk writer
+/// each line was a fresh zeroed buffer, then copied again into the file's buffer: 150 MB of
+/// memory traffic for a 6×1024² float cube.)
 /// The bytes are exactly those the `exr` crate writes (a test compares them).
 fn write_uncompressed(
     out: &mut std::io::BufWriter<File>,

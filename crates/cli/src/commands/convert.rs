@@ -222,9 +222,9 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
 /// Converts the layers of `r` one after another and writes layer `i` to `paths[i]` on
 /// another thread meanwhile, so that the file's encoding and the kernel's share of writing
 /// it overlap the next layer's conversion. Each written file is renamed into place on a
-/// third thread: replacing an existing file makes ext4 start writing the new one out at
-/// the rename and wait on the disk queue (7–12 ms a 12 MB face here), which on the writer's
-/// thread held back the next file. Stops at the first failed write or rename.
+/// third thread: replacing an existing file costs 7–12 ms a 12 MB face here, mostly
+/// waiting (see `mirrorball_io::Staged`), which on the writer's thread held back the next
+/// file. Stops at the first failed write or rename.
 fn write_while_converting(
     r: &Resampler,
     paths: &[PathBuf],
