@@ -28,6 +28,10 @@ pub struct Source {
     pub description: String,
     /// How projection and layout were decided (said to the user).
     pub decided: String,
+    /// NaN, infinite and negative values the reader counted in what it decoded, if it
+    /// counted (see `mirrorball_io::Loaded::invalid`): `Some(0)` spares [`Source::prepare`]
+    /// its scan of the whole map.
+    pub invalid: Option<u64>,
 }
 
 impl Source {
@@ -48,7 +52,7 @@ impl Source {
             env.height(),
             self.decided
         )];
-        if !keep_invalid {
+        if !keep_invalid && self.invalid != Some(0) {
             let fixed = self.env.sanitize();
             if fixed > 0 {
                 lines.push(format!(
@@ -76,6 +80,7 @@ pub fn load(
         layers,
         declared,
         description,
+        invalid,
         ..
     } = loaded;
     if layers.len() == 6 {
@@ -93,6 +98,7 @@ pub fn load(
             env,
             description,
             decided: format!("{} (six faces in the container)", spec.kind),
+            invalid,
         });
     }
     let image = layers
@@ -143,6 +149,7 @@ pub fn load(
         env,
         description,
         decided,
+        invalid,
     })
 }
 
@@ -210,6 +217,8 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
         .par_iter()
         .map(|p| mirrorball_io::read(p, limits))
         .collect::<Result<_, _>>()?;
+    // Counted in every file, or not known.
+    let invalid = loaded.iter().map(|l| l.invalid).sum::<Option<u64>>();
     let mut layers: Vec<Image> = Vec::new();
     for (l, p) in loaded.into_iter().zip(&paths) {
         let img = l
@@ -234,5 +243,6 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
         env,
         description: format!("{} files", names.len()),
         decided: format!("{} from one file per layer", spec.kind),
+        invalid,
     })
 }

@@ -244,50 +244,77 @@ impl EnvMap {
     }
 }
 
-/// [`EnvMap::sanitize`] of one block of texels (`rgba`: four channels, the fourth alpha,
-/// which is left alone; the block a whole number of texels), four values a step with SSE2
-/// masks on x86-64 (a per-texel loop over three colours does not vectorise and ran ten
-/// times slower). Returns how many values it changed.
-fn sanitize_block(block: &mut [f32], rgba: bool) -> u32 {
-    // `x ≥ 0` is false for NaN, `x < ∞` for +∞.
-    let scalar = |run: &mut [f32], n: &mut u32| {
-        for (i, v) in run.iter_mut().enumerate() {
-            let x = *v;
-            let ok = (0.0..f32::INFINITY).contains(&x) || (rgba && i % 4 == 3);
-            *n += u32::from(!ok);
-            *v = if ok { x } else { 0.0 };
-        }
+/// How many colour values of `texels` [`EnvMap::sanitize`] would change: NaN, infinite or
+/// negative. `texels` are interleaved, four channels when `rgba` (the fourth, alpha, is not
+/// counted) else three. A reader can count a block of texels as it decodes it, while the
+/// block is still in cache, and a map found clean need not be scanned again.
+///
+/// ```
+/// use mirrorball_core::count_invalid;
+/// assert_eq!(count_invalid(&[1.0, -2.0, f32::NAN, 0.0, f32::INFINITY, 3.0], false), 3);
+/// assert_eq!(count_invalid(&[1.0, 1.0, 1.0, -1.0], true), 0); // alpha is not a colour
+/// ```
+pub fn count_invalid(texels: &[f32], rgba: bool) -> u64 {
+    texels
+        .chunks(if rgba { 4 } else { 3 } * 16384)
+        .map(|block| u64::from(count_block(block, rgba)))
+        .sum()
+}
+
+/// Whether `x` at position `i` of a block is a valid value (`x ≥ 0` is false for NaN, `x < ∞`
+/// for +∞): alpha (every fourth of an RGBA block) always is.
+#[inline(always)]
+fn valid(i: usize, x: f32, rgba: bool) -> bool {
+    (0.0..f32::INFINITY).contains(&x) || (rgba && i % 4 == 3)
+}
+
+/// [`count_invalid`] of one block of whole texels, four values a step with SSE2 masks on
+/// x86-64 (a per-texel loop over three colours does not vectorise and ran ten times slower).
+fn count_block(block: &[f32], rgba: bool) -> u32 {
+    let scalar = |run: &[f32]| {
+        run.iter()
+            .enumerate()
+            .filter(|&(i, &x)| !valid(i, x, rgba))
+            .count() as u32
     };
-    let mut n = 0u32;
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::*;
-        let mut quads = block.chunks_exact_mut(4);
-        // SAFETY: SSE2 is part of x86-64; each access is to the four floats of `quad`.
+        let quads = block.chunks_exact(4);
+        // Only RGB blocks leave a remainder, and it holds no alpha.
+        let mut n = scalar(quads.remainder());
+        // SAFETY: SSE2 is part of x86-64; each load is of the four floats of `quad`.
         unsafe {
             let (zero, inf) = (_mm_setzero_ps(), _mm_set1_ps(f32::INFINITY));
             // RGBA: the fourth lane (alpha) always passes.
             let keep = _mm_castsi128_ps(_mm_set_epi32(-(rgba as i32), 0, 0, 0));
-            for quad in &mut quads {
+            for quad in quads {
                 let v = _mm_loadu_ps(quad.as_ptr());
                 let ok = _mm_or_ps(
                     _mm_and_ps(_mm_cmpge_ps(v, zero), _mm_cmplt_ps(v, inf)),
                     keep,
                 );
-                let bad = _mm_movemask_ps(ok) ^ 0xF;
-                // Written back only where something changed: a valid map (nearly every
-                // one) is read once and not rewritten.
-                if bad != 0 {
-                    _mm_storeu_ps(quad.as_mut_ptr(), _mm_and_ps(v, ok));
-                    n += bad.count_ones();
-                }
+                n += (_mm_movemask_ps(ok) ^ 0xF).count_ones();
             }
         }
-        // Only RGB blocks leave a remainder, and it holds no alpha.
-        scalar(quads.into_remainder(), &mut n);
+        n
     }
     #[cfg(not(target_arch = "x86_64"))]
-    scalar(block, &mut n);
+    scalar(block)
+}
+
+/// [`EnvMap::sanitize`] of one block of whole texels: counted first, read only, so that a
+/// valid block (nearly every one) is read once and not rewritten; fixed only where the
+/// count finds something. Returns how many values it changed.
+fn sanitize_block(block: &mut [f32], rgba: bool) -> u32 {
+    let n = count_block(block, rgba);
+    if n > 0 {
+        for (i, v) in block.iter_mut().enumerate() {
+            if !valid(i, *v, rgba) {
+                *v = 0.0;
+            }
+        }
+    }
     n
 }
 

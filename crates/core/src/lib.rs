@@ -24,7 +24,7 @@ pub mod projection;
 mod remap;
 mod resample;
 
-pub use envmap::{bilinear_corner, EnvMap, EnvMapError, Stats};
+pub use envmap::{bilinear_corner, count_invalid, EnvMap, EnvMapError, Stats};
 pub use image::Image;
 pub use layout::{guess, Guess, Layout};
 pub use projection::{

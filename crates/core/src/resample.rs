@@ -755,27 +755,28 @@ impl Job {
     }
 
     /// Fills one layer.
-    fn layer<const C: usize>(
+    /// Fills `out` with rows `first_row ..` of `layer` (as many as it holds), in parallel
+    /// over rows. `side` is [`side_columns`](Self::side_columns) of `layer`.
+    #[allow(clippy::too_many_arguments)]
+    fn rows<const C: usize>(
         &self,
         pyr: &Pyramid,
         layer: usize,
-        img: &mut Image,
+        first_row: usize,
+        side: Option<&SideColumns>,
+        out: &mut [f32],
         progress: Option<&Arc<AtomicU64>>,
     ) {
         let w = self.w as usize;
-        let side = self.side_columns(layer);
-        img.data_mut()
-            .par_chunks_mut(w * C)
-            .enumerate()
-            .for_each_init(
-                || (RowScratch::new(w), PointScratch::new()),
-                |(s, ps), (y, row)| {
-                    self.row::<C>(pyr, s, ps, layer, y, side.as_ref(), row);
-                    if let Some(p) = progress {
-                        p.fetch_add(1, Ordering::Relaxed);
-                    }
-                },
-            );
+        out.par_chunks_mut(w * C).enumerate().for_each_init(
+            || (RowScratch::new(w), PointScratch::new()),
+            |(s, ps), (k, row)| {
+                self.row::<C>(pyr, s, ps, layer, first_row + k, side, row);
+                if let Some(p) = progress {
+                    p.fetch_add(1, Ordering::Relaxed);
+                }
+            },
+        );
     }
 
     /// The conversion from a `sw`×`sh` source in `sproj` to `w`×`h` layers of `dst`.
@@ -858,6 +859,8 @@ pub struct Resampler<'a> {
     pyramid: Pyramid<'a>,
     channels: usize,
     progress: Option<Arc<AtomicU64>>,
+    /// Each layer's [`SideColumns`], where it has them: made once, not once a band.
+    sides: Vec<Option<SideColumns>>,
 }
 
 impl<'a> Resampler<'a> {
@@ -877,17 +880,36 @@ impl<'a> Resampler<'a> {
             opts,
         );
         let pyramid = Pyramid::new(src, job.levels - 1);
+        let sides = (0..dst.layer_count())
+            .map(|layer| job.side_columns(layer))
+            .collect();
         Resampler {
             job,
             pyramid,
             channels: src.channels(),
             progress: opts.progress.clone(),
+            sides,
         }
     }
 
     /// The output projection.
     pub fn projection(&self) -> &Projection {
         &self.job.dst
+    }
+
+    /// The output layers' width in texels.
+    pub fn width(&self) -> u32 {
+        self.job.w
+    }
+
+    /// The output layers' height in texels.
+    pub fn height(&self) -> u32 {
+        self.job.h
+    }
+
+    /// Channels a texel (the source's: 3 or 4).
+    pub fn channels(&self) -> usize {
+        self.channels
     }
 
     /// Makes output layer `layer` (`0 .. projection().layer_count()`), `w`×`h` texels with
@@ -921,10 +943,49 @@ impl<'a> Resampler<'a> {
             self.job.h,
             self.channels
         );
-        let progress = self.progress.as_ref();
-        match self.channels {
-            3 => self.job.layer::<3>(&self.pyramid, layer, img, progress),
-            _ => self.job.layer::<4>(&self.pyramid, layer, img, progress),
+        self.rows_into(layer, 0, img.data_mut());
+    }
+
+    /// Makes rows `first_row ..` of output layer `layer` into `out`, as many as it holds
+    /// (interleaved texels with the source's channel count, `w` a row), so that a caller can
+    /// hand a layer on a band of rows at a time: to a file, say, while the next band is
+    /// made. The rows are those [`layer_into`](Self::layer_into) makes, bit for bit.
+    ///
+    /// ```
+    /// use mirrorball_core::{EnvMap, ProjectionKind, ResampleOptions, Resampler};
+    /// let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 64, 3, |d| {
+    ///     [d.x as f32, d.y as f32, d.z as f32, 1.0]
+    /// });
+    /// let cube = ProjectionKind::Cube.default_projection();
+    /// let r = Resampler::new(&src, cube, 16, 16, &ResampleOptions::default());
+    /// let mut band = vec![0.0; 4 * 16 * 3]; // four rows of +Y
+    /// r.rows_into(2, 8, &mut band);
+    /// assert_eq!(band, r.layer(2).data()[8 * 16 * 3..12 * 16 * 3]);
+    /// ```
+    ///
+    /// # Panics
+    /// If `layer` is out of range, `out` is not whole rows, or the rows run past the layer.
+    pub fn rows_into(&self, layer: usize, first_row: u32, out: &mut [f32]) {
+        let (w, h, c) = (self.job.w as usize, self.job.h as usize, self.channels);
+        assert!(
+            layer < self.job.dst.layer_count(),
+            "layer {layer} of a {}-layer projection",
+            self.job.dst.layer_count()
+        );
+        assert!(
+            out.len().is_multiple_of(w * c) && first_row as usize + out.len() / (w * c) <= h,
+            "rows_into: {} samples from row {first_row} are not whole rows of a {w}x{h}x{c} layer",
+            out.len()
+        );
+        let (progress, side) = (self.progress.as_ref(), self.sides[layer].as_ref());
+        let first = first_row as usize;
+        match c {
+            3 => self
+                .job
+                .rows::<3>(&self.pyramid, layer, first, side, out, progress),
+            _ => self
+                .job
+                .rows::<4>(&self.pyramid, layer, first, side, out, progress),
         }
     }
 }

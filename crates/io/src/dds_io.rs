@@ -225,6 +225,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         declared,
         format: Format::Dds,
         description,
+        invalid: None,
     })
 }
 

@@ -81,11 +81,12 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
         // A multi-part file (even one of a single part) puts a part number before each
         // block: that the crate's reader handles.
         let single_part = !chunks.meta_data().requirements.has_multiple_layers;
-        let image = if single_part && layer_count == 1 && is_zip_scanlines(&header) {
+        let (image, invalid) = if single_part && layer_count == 1 && is_zip_scanlines(&header) {
             drop(chunks);
             read_zip_file(&file, header_end.load(Ordering::Relaxed), &header, &layout)
+                .map(|(image, invalid)| (image, Some(invalid)))
         } else {
-            read_blocks(chunks, index, &header, &layout)
+            read_blocks(chunks, index, &header, &layout).map(|image| (image, None))
         }
         .map_err(|e| read_error(path, e))?;
         let declared = header.own_attributes.environment_map.map(|m| match m {
@@ -112,6 +113,7 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
             declared,
             format: Format::Exr,
             description,
+            invalid,
         });
     }
 
@@ -158,6 +160,7 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     );
 
     Ok(Loaded {
+        invalid: None,
         layers: vec![image],
         declared,
         format: Format::Exr,
@@ -165,13 +168,6 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     })
 }
 
-/// Writes `image` as a single-part scan-line OpenEXR file: half texels unless
-/// `opts.precision` asks for float, compressed with `opts.exr_compression`, RGB or RGBA by
-/// the image's channel count. Blocks are compressed on all cores, into a temporary file
-/// that the returned [`Staged`] renames into place.
-///
-/// Half output clamps finite values to ±65504 (the largest half) instead of overflowing to
-/// infinity.
 /// Layer attributes for a written file: the `envmap` attribute for lat-long maps.
 fn layer_attributes(opts: &WriteOptions) -> LayerAttributes {
     LayerAttributes {
@@ -181,6 +177,13 @@ fn layer_attributes(opts: &WriteOptions) -> LayerAttributes {
     }
 }
 
+/// Writes `image` as a single-part scan-line OpenEXR file: half texels unless
+/// `opts.precision` asks for float, compressed with `opts.exr_compression`, RGB or RGBA by
+/// the image's channel count. Blocks are compressed on all cores, into a temporary file
+/// that the returned [`Staged`] renames into place.
+///
+/// Half output clamps finite values to ±65504 (the largest half) instead of overflowing to
+/// infinity.
 pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, Error> {
     let sample_type = match opts.precision {
         None | Some(Precision::Half) => SampleType::F16,
@@ -395,7 +398,7 @@ fn write_uncompressed(
         );
     };
     // Two buffers: each batch is handed to the kernel while the next is packed.
-    let (mut ready, mut next) = (Vec::new(), Vec::new());
+    let [mut ready, mut next] = LineBuffers::take();
     pack(0, &mut ready);
     for start in (batch..h).step_by(batch) {
         let (written, ()) = rayon::join(|| out.write_all(&ready), || pack(start, &mut next));
@@ -403,7 +406,43 @@ fn write_uncompressed(
         std::mem::swap(&mut ready, &mut next);
     }
     out.write_all(&ready)?;
+    LineBuffers::give_back([ready, next]);
     Ok(())
+}
+
+/// The uncompressed writer's two batch buffers (~2 MiB each), kept between files.
+///
+/// Freed, they would go back to the kernel (the allocator maps and unmaps blocks this
+/// large), and the next file's would be fresh memory again, zeroed and mapped a page at a
+/// time on first touch: in a `mirrorball convert` to six float faces these buffers took
+/// half the process's page faults. `convert` writes one file a cube face, so the six faces
+/// share one pair.
+struct LineBuffers;
+
+impl LineBuffers {
+    fn slot() -> &'static std::sync::Mutex<Vec<Vec<u8>>> {
+        static SLOT: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
+        &SLOT
+    }
+
+    /// Two buffers: kept ones where there are, else empty ones.
+    fn take() -> [Vec<u8>; 2] {
+        let mut kept = Self::slot().lock().unwrap_or_else(|p| p.into_inner());
+        [
+            kept.pop().unwrap_or_default(),
+            kept.pop().unwrap_or_default(),
+        ]
+    }
+
+    /// Keeps `bufs` for the next file (at most two pairs, for writers on two threads).
+    fn give_back(bufs: [Vec<u8>; 2]) {
+        let mut kept = Self::slot().lock().unwrap_or_else(|p| p.into_inner());
+        for b in bufs {
+            if kept.len() < 4 {
+                kept.push(b);
+            }
+        }
+    }
 }
 
 /// Lays out `rows` (interleaved texels, `w` a row, `c` channels) as a scan-line block's raw
@@ -677,7 +716,7 @@ fn read_zip_file(
     table_at: u64,
     header: &Header,
     layout: &[(usize, SampleType)],
-) -> Result<Image, exr::error::Error> {
+) -> Result<(Image, u64), exr::error::Error> {
     use rayon::prelude::*;
     use std::cell::RefCell;
     use std::sync::Mutex;
@@ -716,6 +755,7 @@ fn read_zip_file(
         .chunks_mut(w * n * lines)
         .map(|r| Mutex::new(Some(r)))
         .collect();
+    let invalid = AtomicU64::new(0);
     table.par_chunks_exact(8).try_for_each(|entry| {
         let at = u64::from_le_bytes(entry.try_into().expect("8 bytes"));
         let mut head = [0u8; 8];
@@ -763,10 +803,13 @@ fn read_zip_file(
             match lines {
                 crate::exr_zip::Lines::Split { evens, odds } if float => {
                     scatter_split_f32(evens, odds, out, w, bh, layout);
-                    Ok(())
                 }
-                _ => scatter(lines.to_bytes(raw), out, w, 0, w, bh, layout, false),
+                _ => scatter(lines.to_bytes(raw), out, w, 0, w, bh, layout, false)?,
             }
+            // Counted while the block is in cache: a clean map then needs no other pass.
+            let bad = mirrorball_core::count_invalid(out, n == 4);
+            invalid.fetch_add(bad, Ordering::Relaxed);
+            Ok(())
         })
     })?;
     if let Some(k) = rows
@@ -782,7 +825,7 @@ fn read_zip_file(
         ));
     }
     drop(rows);
-    Ok(image)
+    Ok((image, invalid.into_inner()))
 }
 
 /// Whether every channel of a [`block_layout`] is 32-bit float.

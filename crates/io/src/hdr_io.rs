@@ -64,6 +64,8 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             declared: None,
             format: Format::Hdr,
             description: "Radiance RGBE".to_string(),
+            // RGBE holds no NaN, infinite or negative values.
+            invalid: Some(0),
         })
     })
 }

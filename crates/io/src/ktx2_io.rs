@@ -619,5 +619,6 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         declared,
         format: Format::Ktx2,
         description,
+        invalid: None,
     })
 }

@@ -104,6 +104,8 @@ fn decode<R: BufRead + Seek>(
         declared: None,
         format,
         description,
+        // 8- and 16-bit texels decode to values in [0, 1].
+        invalid: Some(0),
     })
 }
 

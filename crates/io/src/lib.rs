@@ -143,6 +143,11 @@ pub struct Loaded {
     pub format: Format,
     /// A one-line description for people: "OpenEXR, half, ZIP compression, RGB".
     pub description: String,
+    /// How many NaN, infinite or negative colour values the texels hold (see
+    /// [`mirrorball_core::count_invalid`]), where the reader counted them as it decoded
+    /// (ZIP-compressed scan-line OpenEXR files, the common download): a caller that would
+    /// scan the map for them need not when this is `Some(0)`. `None`: not counted.
+    pub invalid: Option<u64>,
 }
 
 /// Reads an image or cube map, checking declared sizes against `limits` before allocating.

@@ -7,7 +7,7 @@ use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
 use mirrorball_core::{
-    resample, Image, Layout, ResampleOptions, Resampler, Rotation, WorldProjection,
+    resample, Image, Layout, Projection, ResampleOptions, Resampler, Rotation, WorldProjection,
 };
 use mirrorball_io::{ExrCompression, Format, Precision, WriteOptions};
 use std::path::{Path, PathBuf};
@@ -172,10 +172,15 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
         Some(paths) => {
             with_progress("converting", rows, a.quiet, |counter| {
                 plan.resample.progress = Some(counter);
-                let r = Resampler::new(&src.env, dst, w, h, &plan.resample);
-                write_while_converting(&r, &paths, &plan.save.write)
+                let job = Job {
+                    src,
+                    dst,
+                    w,
+                    h,
+                    opts: &plan.resample,
+                };
+                write_while_converting(job, &paths, &plan.save.write)
             })?;
-            drop(src);
             (paths, t1.elapsed(), None)
         }
         None => {
@@ -219,18 +224,38 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Converts the layers of `r` one after another and writes layer `i` to `paths[i]` on
+/// What `write_while_converting` makes: `src` in `dst`'s projection, layers `w`×`h`.
+struct Job<'a> {
+    src: load::Source,
+    dst: Projection,
+    w: u32,
+    h: u32,
+    opts: &'a ResampleOptions,
+}
+
+/// Converts the job's layers one after another and writes layer `i` to `paths[i]` on
 /// another thread meanwhile, so that the file's encoding and the kernel's share of writing
 /// it overlap the next layer's conversion. Each written file is renamed into place on a
-/// third thread: replacing an existing file costs 7–12 ms a 12 MB face here, mostly
+/// third thread: replacing an existing file costs 7–16 ms a 12 MB face here, mostly
 /// waiting (see `mirrorball_io::Staged`), which on the writer's thread held back the next
 /// file. Stops at the first failed write or rename.
+///
+/// The source is freed as soon as the last layer is made, while that layer is still being
+/// written: handing 100 MB back to the kernel takes it ~15 ms of one core.
 fn write_while_converting(
-    r: &Resampler,
+    job: Job,
     paths: &[PathBuf],
     opts: &WriteOptions,
 ) -> Result<(), CliError> {
+    let Job {
+        src,
+        dst,
+        w,
+        h,
+        opts: resample,
+    } = job;
     std::thread::scope(|scope| {
+        let r = Resampler::new(&src.env, dst, w, h, resample);
         let (to_commit, staged) = mpsc::channel::<mirrorball_io::Staged>();
         let committer = scope.spawn(move || -> Result<(), CliError> {
             for file in staged {
@@ -238,10 +263,12 @@ fn write_while_converting(
             }
             Ok(())
         });
-        // One layer waits while one is written: at most three in memory. Written layers'
-        // buffers come back to be filled again, so that after the first few no layer pays
-        // for fresh memory (allocation, zeroing, first-touch page faults).
-        let (tx, rx) = mpsc::sync_channel::<(&PathBuf, Image)>(1);
+        // At most two layers in memory: one is made while the other is written. Written
+        // layers' buffers come back to be filled again, so that only the first two pay for
+        // fresh memory (the kernel zeroes and maps it a page at a time on first touch).
+        // Writing a face takes well under making one, so the maker seldom waits.
+        const IN_MEMORY: usize = 2;
+        let (tx, rx) = mpsc::sync_channel::<(&PathBuf, Image)>(IN_MEMORY - 1);
         let (give_back, take_back) = mpsc::channel::<Image>();
         let writer = scope.spawn(move || -> Result<(), CliError> {
             // Its own threads: on the global pool, the file's blocks would queue behind
@@ -264,18 +291,21 @@ fn write_while_converting(
             Ok(())
         });
         for (layer, path) in paths.iter().enumerate() {
-            let img = match take_back.try_recv() {
-                Ok(mut img) => {
-                    r.layer_into(layer, &mut img);
-                    img
-                }
-                Err(_) => r.layer(layer),
+            let img = if layer < IN_MEMORY {
+                r.layer(layer)
+            } else {
+                // Err: the writer stopped on an error, which its join reports.
+                let Ok(mut img) = take_back.recv() else { break };
+                r.layer_into(layer, &mut img);
+                img
             };
             if tx.send((path, img)).is_err() {
                 break; // the writer stopped on an error, which join reports
             }
         }
         drop(tx);
+        drop(r);
+        drop(src);
         let written = writer
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));

@@ -232,6 +232,84 @@ fn exr_float_round_trip_every_compression() {
     }
 }
 
+/// The reader's count of NaN, infinite and negative values (`Loaded::invalid`), where it
+/// counts (ZIP and ZIPS scan lines, half and float, RGB and RGBA), is the number of such
+/// colour values in the decoded texels, counted here one by one; readers that do not count
+/// say so (`None`), and formats that cannot hold such values say `Some(0)`.
+#[test]
+fn readers_count_invalid_values_where_they_can() {
+    let dir = tempfile::tempdir().unwrap();
+    let brute = |img: &Image| {
+        let c = img.channels();
+        img.data()
+            .iter()
+            .enumerate()
+            .filter(|&(i, v)| {
+                let alpha = c == 4 && i % 4 == 3;
+                let valid = *v >= 0.0 && v.is_finite();
+                !alpha && !valid
+            })
+            .count() as u64
+    };
+    for c in [3, 4] {
+        let mut img = hdr_image(41, 35, c);
+        // Scattered over blocks, lanes and the ragged end of the rows; alpha too, which does
+        // not count.
+        for (k, &v) in [f32::NAN, -1.0, f32::INFINITY, f32::NEG_INFINITY, -0.001]
+            .iter()
+            .enumerate()
+        {
+            let (x, y) = ((k as u32 * 17 + 3) % 41, (k as u32 * 11 + 1) % 35);
+            let mut px = img.get(x, y).to_vec();
+            px[k % 3] = v;
+            if c == 4 {
+                px[3] = -5.0;
+            }
+            img.set(x, y, &px);
+        }
+        img.set(40, 34, &[f32::NAN, 1.0, -2.0, 1.0][..c]);
+        for precision in [Precision::Half, Precision::Float] {
+            for comp in COMPRESSIONS {
+                let path = dir
+                    .path()
+                    .join(format!("bad-{c}-{precision:?}-{comp:?}.exr"));
+                let o = WriteOptions {
+                    exr_compression: comp,
+                    precision: Some(precision),
+                    ..WriteOptions::default()
+                };
+                write_image(&path, &img, &o).unwrap();
+                let (back, loaded) = read_one(&path);
+                let expected = brute(&back);
+                // (Half clamps +∞ to 65504, which is valid.)
+                assert!(expected >= 6, "{c} {precision:?} {comp:?}: {expected}");
+                match comp {
+                    ExrCompression::Zip | ExrCompression::Zips => {
+                        assert_eq!(loaded.invalid, Some(expected), "{c} {precision:?} {comp:?}")
+                    }
+                    _ => assert!(
+                        loaded.invalid.is_none() || loaded.invalid == Some(expected),
+                        "{c} {precision:?} {comp:?}: {:?}",
+                        loaded.invalid
+                    ),
+                }
+            }
+        }
+        // A clean map counts zero.
+        let clean = hdr_image(41, 35, c);
+        let path = dir.path().join(format!("clean-{c}.exr"));
+        write_image(&path, &clean, &opts(Some(Precision::Float))).unwrap();
+        assert_eq!(read_one(&path).1.invalid, Some(0));
+    }
+    // RGBE and 8/16-bit PNG hold no such values.
+    let hdr = dir.path().join("a.hdr");
+    write_image(&hdr, &hdr_image(9, 5, 3), &opts(None)).unwrap();
+    assert_eq!(read_one(&hdr).1.invalid, Some(0));
+    let png = dir.path().join("a.png");
+    write_image(&png, &ldr_image(9, 5, 3), &opts(None)).unwrap();
+    assert_eq!(read_one(&png).1.invalid, Some(0));
+}
+
 /// What the `exr` crate's own writer makes of `img` uncompressed (half samples clamped to
 /// the finite range, as mirrorball writes them), with the `envmap` attribute when `latlong`.
 fn exr_crate_uncompressed(img: &Image, float: bool, latlong: bool) -> Vec<u8> {
