@@ -568,22 +568,27 @@ impl Job {
         let sproj = &self.sproj;
         let base = pyr.level(0);
         let mut special = false;
-        let texels = s.dens.iter().zip(&s.look).zip(&mut s.grid).zip(&mut s.taps);
-        for (((&ddens, lk), grid), tap) in texels {
-            (*grid, *tap) = (NO_GRID, NO_TAP);
-            if ddens < 0.0 || lk.layer == u32::MAX {
-                continue; // outside the projection's domain: black
-            }
-            match self.integration_ratio(ddens, lk) {
-                None => match inner_tap::<C>(base, lk) {
-                    Some(t) => *tap = t,
-                    None => (*grid, special) = (SEAM, true),
-                },
-                Some(ratio) => {
-                    let (level, n) = self.grid(ratio);
-                    (*grid, special) = ((level as u16, n as u16), true);
+        // Four texels a step where all four are plain inner lookups (nearly all of them);
+        // any other four, and the last few, one at a time.
+        let n = s.look.len();
+        let mut x = 0;
+        while x + 4 <= n {
+            let (dens, look) = (&s.dens[x..x + 4], &s.look[x..x + 4]);
+            match self.inner_taps4::<C>(base, dens.try_into().expect("4"), look) {
+                Some(taps) => {
+                    s.taps[x..x + 4].copy_from_slice(&taps);
+                    s.grid[x..x + 4].fill(NO_GRID);
+                }
+                None => {
+                    for k in x..x + 4 {
+                        special |= self.sort_texel::<C>(base, s, k);
+                    }
                 }
             }
+            x += 4;
+        }
+        for k in x..n {
+            special |= self.sort_texel::<C>(base, s, k);
         }
         gather::<C>(&s.taps, base, row);
         if special {
@@ -616,6 +621,134 @@ impl Job {
                     *v *= self.scale;
                 }
             }
+        }
+    }
+
+    /// Sorts texel `k` of a located row: sets its grid and tap in `s` (see [`row`]) and
+    /// returns whether it needs a later pass (a seam or integration).
+    #[inline(always)]
+    fn sort_texel<const C: usize>(&self, base: &[Image], s: &mut RowScratch, k: usize) -> bool {
+        let (ddens, lk) = (s.dens[k], &s.look[k]);
+        (s.grid[k], s.taps[k]) = (NO_GRID, NO_TAP);
+        if ddens < 0.0 || lk.layer == u32::MAX {
+            return false; // outside the projection's domain: black
+        }
+        match self.integration_ratio(ddens, lk) {
+            None => match inner_tap::<C>(base, lk) {
+                Some(t) => {
+                    s.taps[k] = t;
+                    false
+                }
+                None => {
+                    s.grid[k] = SEAM;
+                    true
+                }
+            },
+            Some(ratio) => {
+                let (level, n) = self.grid(ratio);
+                s.grid[k] = (level as u16, n as u16);
+                true
+            }
+        }
+    }
+
+    /// The [`Tap`]s of four texels when all four are what [`sort_texel`](Self::sort_texel)
+    /// makes a plain inner lookup of (a direction, one bilinear lookup, its 2×2 texels
+    /// inside one layer), all on the same layer; else `None`, and they are sorted one at a
+    /// time. The same arithmetic as [`bilinear_corner`] and
+    /// [`integration_ratio`](Self::integration_ratio), four lanes at once with SSE2, so the
+    /// same taps to the bit (tested); elsewhere always `None`.
+    #[inline(always)]
+    fn inner_taps4<const C: usize>(
+        &self,
+        base: &[Image],
+        dens: &[f32; 4],
+        look: &[Lookup],
+    ) -> Option<[Tap; 4]> {
+        let layer = look[0].layer;
+        if look[1..4].iter().any(|l| l.layer != layer) {
+            return None;
+        }
+        let img = base.get(layer as usize)?;
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of x86-64; `look` holds four `Lookup`s of four 4-byte
+        // fields each (`repr(C)`), read as four unaligned 16-byte loads.
+        unsafe {
+            use std::arch::x86_64::*;
+            let p = look.as_ptr() as *const f32;
+            let (mut l, mut u, mut v, mut d) = (
+                _mm_loadu_ps(p),
+                _mm_loadu_ps(p.add(4)),
+                _mm_loadu_ps(p.add(8)),
+                _mm_loadu_ps(p.add(12)),
+            );
+            _MM_TRANSPOSE4_PS(&mut l, &mut u, &mut v, &mut d);
+            let dd = _mm_loadu_ps(dens.as_ptr());
+            let zero = _mm_setzero_ps();
+            // A direction (ddens ≥ 0; NaN fails) and one bilinear lookup: ratio < 4, where
+            // ratio = ddens·area/density (∞ where density ≤ 0), or max_n = 1, or ddens = 0.
+            let mut ok = _mm_cmpge_ps(dd, zero);
+            if self.max_n != 1 {
+                let ratio = _mm_div_ps(_mm_mul_ps(dd, _mm_set1_ps(self.area)), d);
+                let small = _mm_and_ps(
+                    _mm_cmpgt_ps(d, zero),
+                    _mm_cmplt_ps(ratio, _mm_set1_ps(BILINEAR_MAX_RATIO as f32)),
+                );
+                ok = _mm_and_ps(ok, _mm_or_ps(small, _mm_cmpeq_ps(dd, zero)));
+            }
+            // bilinear_corner, four at once.
+            let (w, h) = (img.width() as i32, img.height() as i32);
+            let half = _mm_set1_ps(0.5);
+            let x = _mm_sub_ps(_mm_mul_ps(u, _mm_set1_ps(w as f32)), half);
+            let y = _mm_sub_ps(_mm_mul_ps(v, _mm_set1_ps(h as f32)), half);
+            let floor = |x: __m128| {
+                let xi = _mm_cvttps_epi32(x);
+                // −1 (all ones) where truncation went up: below zero.
+                let up = _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(xi), x));
+                _mm_add_epi32(xi, up)
+            };
+            let (x0, y0) = (floor(x), floor(y));
+            let fx = _mm_sub_ps(x, _mm_cvtepi32_ps(x0));
+            let fy = _mm_sub_ps(y, _mm_cvtepi32_ps(y0));
+            // Inside: 0 ≤ x0 < w − 1 and 0 ≤ y0 < h − 1.
+            let minus1 = _mm_set1_epi32(-1);
+            let inside = _mm_and_si128(
+                _mm_and_si128(_mm_cmpgt_epi32(x0, minus1), _mm_cmpgt_epi32(y0, minus1)),
+                _mm_and_si128(
+                    _mm_cmplt_epi32(x0, _mm_set1_epi32(w - 1)),
+                    _mm_cmplt_epi32(y0, _mm_set1_epi32(h - 1)),
+                ),
+            );
+            ok = _mm_and_ps(ok, _mm_castsi128_ps(inside));
+            if _mm_movemask_ps(ok) != 0xF {
+                return None;
+            }
+            let (mut xs, mut ys, mut fxs, mut fys) = ([0i32; 4], [0i32; 4], [0f32; 4], [0f32; 4]);
+            _mm_storeu_si128(xs.as_mut_ptr() as *mut __m128i, x0);
+            _mm_storeu_si128(ys.as_mut_ptr() as *mut __m128i, y0);
+            _mm_storeu_ps(fxs.as_mut_ptr(), fx);
+            _mm_storeu_ps(fys.as_mut_ptr(), fy);
+            // As inner_tap: the start, and the reads' end inside the layer.
+            let (stride, len) = (w as usize * C, img.data().len());
+            let mut taps = [NO_TAP; 4];
+            for (k, t) in taps.iter_mut().enumerate() {
+                let at = ys[k] as usize * stride + xs[k] as usize * C;
+                if at + stride + C + 4 > len {
+                    return None;
+                }
+                *t = Tap {
+                    layer,
+                    at: u32::try_from(at).ok()?,
+                    fx: fxs[k],
+                    fy: fys[k],
+                };
+            }
+            Some(taps)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (img, dens);
+            None
         }
     }
 
@@ -994,6 +1127,100 @@ impl<'a> Resampler<'a> {
 mod tests {
     use super::*;
     use crate::ProjectionKind;
+
+    /// The four-at-once sorting gives, wherever it answers, the very taps the one-at-a-time
+    /// sorting gives (bit for bit), and answers for ordinary texels; edge cases (no
+    /// direction, NaN, zero and negative densities, footprints to integrate, lookups at and
+    /// past the layer's edges, mixed layers) it leaves to the one-at-a-time sorting.
+    #[test]
+    fn four_texels_at_once_sort_as_one_at_a_time() {
+        let ll = ProjectionKind::LatLong.default_projection();
+        let cube = ProjectionKind::Cube.default_projection();
+        let src_l = EnvMap::from_fn(ll, 64, 3, |_| [1.0; 4]);
+        let src_c = EnvMap::from_fn(cube, 16, 4, |_| [1.0; 4]);
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let specials = [f32::NAN, -1.0, 0.0, -0.0, 1e-30, f32::INFINITY, 1.0, 2.0];
+        // In odd cases, with probability p, one of the special values.
+        let special = |next: &mut dyn FnMut() -> f32, odd: bool, p: f32| {
+            (odd && next() < p).then(|| specials[(next() * 8.0) as usize % 8])
+        };
+        let (mut answered, mut declined) = (0, 0);
+        for (src, max_n) in [(&src_l, 4), (&src_l, 1), (&src_c, 4)] {
+            let opts = ResampleOptions {
+                max_samples: max_n,
+                ..Default::default()
+            };
+            let (sw, sh) = (src.width(), src.height());
+            let job = Job::new(*src.projection(), (sw, sh), cube, (8, 8), &opts);
+            let base = src.layers();
+            let layers = base.len() as u32;
+            let mut s = RowScratch::new(4);
+            // Output over source texel area, in uv units, as Job::new has it.
+            let area = (sw * sh) as f32 / 64.0;
+            for case in 0..20_000 {
+                let odd = case % 3 == 0;
+                for k in 0..4 {
+                    let density = special(&mut next, odd, 0.2).unwrap_or(0.1 + next() * 4.0);
+                    // Footprint ratios from 0 to 5: most one lookup, some to integrate.
+                    let dens =
+                        special(&mut next, odd, 0.3).unwrap_or(next() * 5.0 * density.abs() / area);
+                    let layer = match special(&mut next, odd, 0.1) {
+                        Some(_) => [u32::MAX, layers - 1, 0][(next() * 3.0) as usize % 3],
+                        None => (case as u32 / 7) % layers,
+                    };
+                    // Now and then right at or past the edges, or on a texel centre (where
+                    // the corner's floor is exact).
+                    let mut coord = |n: u32| {
+                        let centre = next() < 0.2;
+                        let at = ((next() * n as f32).floor() + 0.5) / n as f32;
+                        special(&mut next, odd, 0.2).unwrap_or(if centre { at } else { next() })
+                    };
+                    let (u, v) = (coord(sw), coord(sh));
+                    s.dens[k] = dens;
+                    s.look[k] = Lookup {
+                        layer,
+                        u,
+                        v,
+                        density,
+                    };
+                }
+                let dens: [f32; 4] = s.dens[..].try_into().unwrap();
+                let four = match src.channels() {
+                    3 => job.inner_taps4::<3>(base, &dens, &s.look),
+                    _ => job.inner_taps4::<4>(base, &dens, &s.look),
+                };
+                let Some(four) = four else {
+                    declined += 1;
+                    continue;
+                };
+                answered += 1;
+                for (k, a) in four.iter().enumerate() {
+                    let special = match src.channels() {
+                        3 => job.sort_texel::<3>(base, &mut s, k),
+                        _ => job.sort_texel::<4>(base, &mut s, k),
+                    };
+                    assert!(!special && s.grid[k] == NO_GRID, "case {case} lane {k}");
+                    let b = s.taps[k];
+                    assert_eq!(
+                        (a.layer, a.at, a.fx.to_bits(), a.fy.to_bits()),
+                        (b.layer, b.at, b.fx.to_bits(), b.fy.to_bits()),
+                        "case {case} lane {k}"
+                    );
+                }
+            }
+        }
+        // Ordinary texels are answered four at a time; the odd ones are declined.
+        assert!(
+            answered > 15_000 && declined > 5_000,
+            "{answered} {declined}"
+        );
+    }
 
     #[test]
     fn side_columns_give_the_general_paths_lookups() {

@@ -33,6 +33,7 @@ use std::str::FromStr;
 /// the layer (`u32::MAX` where the direction is not covered), the texture coordinates and the
 /// density there.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)] // four 4-byte fields in this order: the resampler loads four at once
 pub struct Lookup {
     /// Layer, or `u32::MAX` when not covered.
     pub layer: u32,
