@@ -388,6 +388,157 @@ fn inner_tap<const C: usize>(layers: &[Image], lk: &Lookup) -> Option<Tap> {
     })
 }
 
+/// Four [`Lookup`]s as four lanes each of layer (bits), `u`, `v` and density.
+///
+/// # Safety
+/// `look` holds at least four lookups.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn load4(
+    look: &[Lookup],
+) -> (
+    std::arch::x86_64::__m128,
+    std::arch::x86_64::__m128,
+    std::arch::x86_64::__m128,
+    std::arch::x86_64::__m128,
+) {
+    use std::arch::x86_64::*;
+    debug_assert!(look.len() >= 4);
+    // `Lookup` is `repr(C)`: four 4-byte fields; four lookups are sixteen floats' bytes.
+    let p = look.as_ptr() as *const f32;
+    let (mut l, mut u, mut v, mut d) = (
+        _mm_loadu_ps(p),
+        _mm_loadu_ps(p.add(4)),
+        _mm_loadu_ps(p.add(8)),
+        _mm_loadu_ps(p.add(12)),
+    );
+    _MM_TRANSPOSE4_PS(&mut l, &mut u, &mut v, &mut d);
+    (l, u, v, d)
+}
+
+/// The [`Tap`]s of four lookups at `(u, v)` on `img` (layer `layer`), when all four lanes
+/// of `ok` are set and every lookup is what [`inner_tap`] makes a tap of: [`bilinear_corner`]
+/// four lanes at once (the same operations, so the same corners and fractions to the bit),
+/// the bounds as `inner_tap` has them. Else `None`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn corner_taps4<const C: usize>(
+    img: &Image,
+    layer: u32,
+    u: std::arch::x86_64::__m128,
+    v: std::arch::x86_64::__m128,
+    ok: std::arch::x86_64::__m128,
+) -> Option<[Tap; 4]> {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE2 is part of x86-64; the stores go to local arrays of four lanes.
+    unsafe {
+        let (w, h) = (img.width() as i32, img.height() as i32);
+        let half = _mm_set1_ps(0.5);
+        let x = _mm_sub_ps(_mm_mul_ps(u, _mm_set1_ps(w as f32)), half);
+        let y = _mm_sub_ps(_mm_mul_ps(v, _mm_set1_ps(h as f32)), half);
+        let floor = |x: __m128| {
+            let xi = _mm_cvttps_epi32(x);
+            // −1 (all ones) where truncation went up: below zero.
+            let up = _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(xi), x));
+            _mm_add_epi32(xi, up)
+        };
+        let (x0, y0) = (floor(x), floor(y));
+        let fx = _mm_sub_ps(x, _mm_cvtepi32_ps(x0));
+        let fy = _mm_sub_ps(y, _mm_cvtepi32_ps(y0));
+        // Inside: 0 ≤ x0 < w − 1 and 0 ≤ y0 < h − 1.
+        let minus1 = _mm_set1_epi32(-1);
+        let inside = _mm_and_si128(
+            _mm_and_si128(_mm_cmpgt_epi32(x0, minus1), _mm_cmpgt_epi32(y0, minus1)),
+            _mm_and_si128(
+                _mm_cmplt_epi32(x0, _mm_set1_epi32(w - 1)),
+                _mm_cmplt_epi32(y0, _mm_set1_epi32(h - 1)),
+            ),
+        );
+        if _mm_movemask_ps(_mm_and_ps(ok, _mm_castsi128_ps(inside))) != 0xF {
+            return None;
+        }
+        let (mut xs, mut ys, mut fxs, mut fys) = ([0i32; 4], [0i32; 4], [0f32; 4], [0f32; 4]);
+        _mm_storeu_si128(xs.as_mut_ptr() as *mut __m128i, x0);
+        _mm_storeu_si128(ys.as_mut_ptr() as *mut __m128i, y0);
+        _mm_storeu_ps(fxs.as_mut_ptr(), fx);
+        _mm_storeu_ps(fys.as_mut_ptr(), fy);
+        // As inner_tap: the start, and the reads' end inside the layer.
+        let (stride, len) = (w as usize * C, img.data().len());
+        let mut taps = [NO_TAP; 4];
+        for (k, t) in taps.iter_mut().enumerate() {
+            let at = ys[k] as usize * stride + xs[k] as usize * C;
+            if at + stride + C + 4 > len {
+                return None;
+            }
+            *t = Tap {
+                layer,
+                at: u32::try_from(at).ok()?,
+                fx: fxs[k],
+                fy: fys[k],
+            };
+        }
+        Some(taps)
+    }
+}
+
+/// In [`PointScratch::staps`]: a point that adds nothing (no weight, or no direction).
+const SKIP_POINT: u32 = u32::MAX;
+/// In [`PointScratch::staps`]: a point whose lookup is no [`inner_tap`] (a seam, an edge),
+/// which [`bilinear32_quad`]'s general path serves.
+const SLOW_POINT: u32 = u32::MAX - 1;
+
+/// Each integration point's lookup on the level `lv`, for the accumulation in
+/// [`Job::integrate_run`]: an [`inner_tap`] (four points at a time with [`corner_taps4`]
+/// where all four are plain), or [`SKIP_POINT`] where the point adds nothing (`weight ≤ 0`,
+/// or no direction), or [`SLOW_POINT`]. The same lookups, to the bit, as
+/// [`bilinear32_quad`] makes of each point.
+#[inline(always)]
+fn point_taps<const C: usize>(lv: &[Image], weight: &[f32], look: &[Lookup], taps: &mut [Tap]) {
+    let one = |w: f32, lk: &Lookup| {
+        if w <= 0.0 || lk.layer == u32::MAX {
+            Tap {
+                layer: SKIP_POINT,
+                ..NO_TAP
+            }
+        } else {
+            inner_tap::<C>(lv, lk).unwrap_or(Tap {
+                layer: SLOW_POINT,
+                ..NO_TAP
+            })
+        }
+    };
+    let mut k = 0;
+    #[cfg(target_arch = "x86_64")]
+    while k + 4 <= look.len() {
+        let (w4, l4) = (&weight[k..k + 4], &look[k..k + 4]);
+        let layer = l4[0].layer;
+        let four = match lv.get(layer as usize) {
+            Some(img) if l4[1..].iter().all(|l| l.layer == layer) => {
+                // SAFETY: SSE2 is part of x86-64; `l4` and `w4` hold four values each.
+                unsafe {
+                    use std::arch::x86_64::*;
+                    let (_, u, v, _) = load4(l4);
+                    let ok = _mm_cmpgt_ps(_mm_loadu_ps(w4.as_ptr()), _mm_setzero_ps());
+                    corner_taps4::<C>(img, layer, u, v, ok)
+                }
+            }
+            _ => None,
+        };
+        match four {
+            Some(t) => taps[k..k + 4].copy_from_slice(&t),
+            None => {
+                for j in k..k + 4 {
+                    taps[j] = one(weight[j], &look[j]);
+                }
+            }
+        }
+        k += 4;
+    }
+    for j in k..look.len() {
+        taps[j] = one(weight[j], &look[j]);
+    }
+}
+
 /// Taps ahead of the current one whose source texels [`gather`] asks for.
 const AHEAD: usize = 24;
 
@@ -439,6 +590,8 @@ pub(crate) struct PointScratch {
     sz: Vec<f32>,
     pub(crate) sw: Vec<f32>,
     pub(crate) slook: Vec<Lookup>,
+    /// Each point's bilinear lookup on the level ([`Job::point_taps`]).
+    staps: Vec<Tap>,
 }
 
 impl RowScratch {
@@ -464,6 +617,7 @@ impl PointScratch {
             sz: vec![0.0; MAX_POINTS],
             sw: vec![0.0; MAX_POINTS],
             slook: vec![Lookup::default(); MAX_POINTS],
+            staps: vec![NO_TAP; MAX_POINTS],
         }
     }
 }
@@ -671,18 +825,10 @@ impl Job {
         }
         let img = base.get(layer as usize)?;
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: SSE2 is part of x86-64; `look` holds four `Lookup`s of four 4-byte
-        // fields each (`repr(C)`), read as four unaligned 16-byte loads.
+        // SAFETY: SSE2 is part of x86-64; `look` holds four lookups (its layers read above).
         unsafe {
             use std::arch::x86_64::*;
-            let p = look.as_ptr() as *const f32;
-            let (mut l, mut u, mut v, mut d) = (
-                _mm_loadu_ps(p),
-                _mm_loadu_ps(p.add(4)),
-                _mm_loadu_ps(p.add(8)),
-                _mm_loadu_ps(p.add(12)),
-            );
-            _MM_TRANSPOSE4_PS(&mut l, &mut u, &mut v, &mut d);
+            let (_, u, v, d) = load4(look);
             let dd = _mm_loadu_ps(dens.as_ptr());
             let zero = _mm_setzero_ps();
             // A direction (ddens ≥ 0; NaN fails) and one bilinear lookup: ratio < 4, where
@@ -696,54 +842,7 @@ impl Job {
                 );
                 ok = _mm_and_ps(ok, _mm_or_ps(small, _mm_cmpeq_ps(dd, zero)));
             }
-            // bilinear_corner, four at once.
-            let (w, h) = (img.width() as i32, img.height() as i32);
-            let half = _mm_set1_ps(0.5);
-            let x = _mm_sub_ps(_mm_mul_ps(u, _mm_set1_ps(w as f32)), half);
-            let y = _mm_sub_ps(_mm_mul_ps(v, _mm_set1_ps(h as f32)), half);
-            let floor = |x: __m128| {
-                let xi = _mm_cvttps_epi32(x);
-                // −1 (all ones) where truncation went up: below zero.
-                let up = _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(xi), x));
-                _mm_add_epi32(xi, up)
-            };
-            let (x0, y0) = (floor(x), floor(y));
-            let fx = _mm_sub_ps(x, _mm_cvtepi32_ps(x0));
-            let fy = _mm_sub_ps(y, _mm_cvtepi32_ps(y0));
-            // Inside: 0 ≤ x0 < w − 1 and 0 ≤ y0 < h − 1.
-            let minus1 = _mm_set1_epi32(-1);
-            let inside = _mm_and_si128(
-                _mm_and_si128(_mm_cmpgt_epi32(x0, minus1), _mm_cmpgt_epi32(y0, minus1)),
-                _mm_and_si128(
-                    _mm_cmplt_epi32(x0, _mm_set1_epi32(w - 1)),
-                    _mm_cmplt_epi32(y0, _mm_set1_epi32(h - 1)),
-                ),
-            );
-            ok = _mm_and_ps(ok, _mm_castsi128_ps(inside));
-            if _mm_movemask_ps(ok) != 0xF {
-                return None;
-            }
-            let (mut xs, mut ys, mut fxs, mut fys) = ([0i32; 4], [0i32; 4], [0f32; 4], [0f32; 4]);
-            _mm_storeu_si128(xs.as_mut_ptr() as *mut __m128i, x0);
-            _mm_storeu_si128(ys.as_mut_ptr() as *mut __m128i, y0);
-            _mm_storeu_ps(fxs.as_mut_ptr(), fx);
-            _mm_storeu_ps(fys.as_mut_ptr(), fy);
-            // As inner_tap: the start, and the reads' end inside the layer.
-            let (stride, len) = (w as usize * C, img.data().len());
-            let mut taps = [NO_TAP; 4];
-            for (k, t) in taps.iter_mut().enumerate() {
-                let at = ys[k] as usize * stride + xs[k] as usize * C;
-                if at + stride + C + 4 > len {
-                    return None;
-                }
-                *t = Tap {
-                    layer,
-                    at: u32::try_from(at).ok()?,
-                    fx: fxs[k],
-                    fy: fys[k],
-                };
-            }
-            Some(taps)
+            corner_taps4::<C>(img, layer, u, v, ok)
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
@@ -801,13 +900,28 @@ impl Job {
                 }
             }
             sproj.lookup_batch(&ps.sx[..m], &ps.sy[..m], &ps.sz[..m], &mut ps.slook[..m]);
+            point_taps::<C>(lv, &ps.sw[..m], &ps.slook[..m], &mut ps.staps[..m]);
+            // The points' samples, read as in `gather`: their source texels asked for a
+            // few points ahead.
             for (t, (a, ws)) in acc[..count].iter_mut().zip(&mut wsum[..count]).enumerate() {
                 for k in t * n..(t + 1) * n {
-                    let (sl, wt) = (&ps.slook[k], ps.sw[k]);
-                    if wt <= 0.0 || sl.layer == u32::MAX {
-                        continue;
+                    if let Some(ahead) = ps.staps[..m].get(k + AHEAD) {
+                        prefetch::<C>(ahead, lv);
                     }
-                    let q = bilinear32_quad::<C>(sproj, lv, sl.layer as usize, sl.u, sl.v);
+                    let (tap, wt) = (&ps.staps[k], ps.sw[k]);
+                    let q = match tap.layer {
+                        SKIP_POINT => continue,
+                        SLOW_POINT => {
+                            let sl = &ps.slook[k];
+                            bilinear32_quad::<C>(sproj, lv, sl.layer as usize, sl.u, sl.v)
+                        }
+                        l => {
+                            let img = &lv[l as usize];
+                            let stride = img.width() as usize * C;
+                            lerp_quad::<C>(img.data(), tap.at as usize, stride, tap.fx, tap.fy)
+                                .expect("inner_tap keeps the reads inside the layer")
+                        }
+                    };
                     for (a, v) in a.iter_mut().zip(q) {
                         *a += wt * v;
                     }
@@ -1128,6 +1242,16 @@ mod tests {
     use super::*;
     use crate::ProjectionKind;
 
+    /// A deterministic generator of numbers in [0, 1) (xorshift).
+    fn rng(mut seed: u64) -> impl FnMut() -> f32 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
     /// The four-at-once sorting gives, wherever it answers, the very taps the one-at-a-time
     /// sorting gives (bit for bit), and answers for ordinary texels; edge cases (no
     /// direction, NaN, zero and negative densities, footprints to integrate, lookups at and
@@ -1138,13 +1262,7 @@ mod tests {
         let cube = ProjectionKind::Cube.default_projection();
         let src_l = EnvMap::from_fn(ll, 64, 3, |_| [1.0; 4]);
         let src_c = EnvMap::from_fn(cube, 16, 4, |_| [1.0; 4]);
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = rng(0x2545_f491_4f6c_dd1du64);
         let specials = [f32::NAN, -1.0, 0.0, -0.0, 1e-30, f32::INFINITY, 1.0, 2.0];
         // In odd cases, with probability p, one of the special values.
         let special = |next: &mut dyn FnMut() -> f32, odd: bool, p: f32| {
@@ -1220,6 +1338,89 @@ mod tests {
             answered > 15_000 && declined > 5_000,
             "{answered} {declined}"
         );
+    }
+
+    /// Integration points read through `point_taps` give each point the very sample
+    /// `bilinear32_quad` gives it (bit for bit), skip exactly the points with no weight or
+    /// no direction, and take the four-at-once path for ordinary points.
+    #[test]
+    fn point_taps_sample_as_bilinear32_quad() {
+        let ll = ProjectionKind::LatLong.default_projection();
+        let cube = ProjectionKind::Cube.default_projection();
+        let ramp = |d: glam::DVec3| {
+            [
+                (1.5 + d.x) as f32,
+                (2.0 + d.y) as f32,
+                (d.z * d.z) as f32,
+                0.5,
+            ]
+        };
+        let src_l = EnvMap::from_fn(ll, 64, 3, ramp);
+        let src_c = EnvMap::from_fn(cube, 16, 4, ramp);
+        let mut next = rng(0x9e37_79b9_7f4a_7c15u64);
+        let mut fast = 0;
+        for src in [&src_l, &src_c] {
+            let (proj, lv) = (src.projection(), src.layers());
+            let layers = lv.len() as u32;
+            let m = 64;
+            let (mut weight, mut look, mut taps) =
+                (vec![0.0; m], vec![Lookup::default(); m], vec![NO_TAP; m]);
+            for case in 0..2000 {
+                for k in 0..m {
+                    let odd = next() < 0.05;
+                    weight[k] = if odd {
+                        [0.0, -1.0, f32::NAN][k % 3]
+                    } else {
+                        next()
+                    };
+                    let edge = |r: f32| if r < 0.05 { [0.0, 1.0, -0.1][k % 3] } else { r };
+                    look[k] = Lookup {
+                        layer: if next() < 0.03 {
+                            u32::MAX
+                        } else {
+                            (case as u32) % layers
+                        },
+                        u: edge(next()),
+                        v: edge(next()),
+                        density: 1.0,
+                    };
+                }
+                match src.channels() {
+                    3 => point_taps::<3>(lv, &weight, &look, &mut taps),
+                    _ => point_taps::<4>(lv, &weight, &look, &mut taps),
+                }
+                for k in 0..m {
+                    let (t, lk) = (&taps[k], &look[k]);
+                    let skip = weight[k] <= 0.0 || lk.layer == u32::MAX;
+                    assert_eq!(t.layer == SKIP_POINT, skip, "case {case} point {k}");
+                    if skip {
+                        continue;
+                    }
+                    let (l, c) = (lk.layer as usize, src.channels());
+                    let want = match c {
+                        3 => bilinear32_quad::<3>(proj, lv, l, lk.u, lk.v),
+                        _ => bilinear32_quad::<4>(proj, lv, l, lk.u, lk.v),
+                    };
+                    if t.layer == SLOW_POINT {
+                        continue; // served by bilinear32_quad itself
+                    }
+                    fast += 1;
+                    let img = &lv[t.layer as usize];
+                    let stride = img.width() as usize * c;
+                    let got = match c {
+                        3 => lerp_quad::<3>(img.data(), t.at as usize, stride, t.fx, t.fy),
+                        _ => lerp_quad::<4>(img.data(), t.at as usize, stride, t.fx, t.fy),
+                    }
+                    .unwrap();
+                    assert_eq!(
+                        got[..c].iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                        want[..c].iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                        "case {case} point {k}"
+                    );
+                }
+            }
+        }
+        assert!(fast > 150_000, "{fast}");
     }
 
     #[test]
