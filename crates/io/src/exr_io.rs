@@ -800,14 +800,17 @@ fn read_zip_file(
             let lines = crate::exr_zip::THREAD_ZIP
                 .with_borrow_mut(|zip| crate::exr_zip::inflate(block, expected, inflated, zip))
                 .map_err(|e| exr::error::Error::Invalid(e.into()))?;
-            match lines {
+            // Counted as the texels are laid out, or while the block is in cache: a clean
+            // map then needs no other pass.
+            let bad = match lines {
                 crate::exr_zip::Lines::Split { evens, odds } if float => {
-                    scatter_split_f32(evens, odds, out, w, bh, layout);
+                    scatter_split_f32(evens, odds, out, w, bh, layout)
                 }
-                _ => scatter(lines.to_bytes(raw), out, w, 0, w, bh, layout, false)?,
-            }
-            // Counted while the block is in cache: a clean map then needs no other pass.
-            let bad = mirrorball_core::count_invalid(out, n == 4);
+                _ => {
+                    scatter(lines.to_bytes(raw), out, w, 0, w, bh, layout, false)?;
+                    mirrorball_core::count_invalid(out, n == 4)
+                }
+            };
             invalid.fetch_add(bad, Ordering::Relaxed);
             Ok(())
         })
@@ -845,8 +848,11 @@ fn scatter_split_f32(
     w: usize,
     bh: usize,
     layout: &[(usize, SampleType)],
-) {
+) -> u64 {
     let n = layout.len();
+    // NaN, infinite and negative colour values, counted as they go by (see
+    // `mirrorball_core::count_invalid`).
+    let mut invalid = 0u64;
     // Where each texel channel's plane starts within a line, in the halves (2w bytes a plane).
     let mut plane = [0usize; 4];
     for (pos, &(c, _)) in layout.iter().enumerate() {
@@ -876,8 +882,15 @@ fn scatter_split_f32(
                     _mm_castsi128_ps(_mm_unpacklo_epi8(e, o))
                 };
                 let out = row.as_mut_ptr();
+                let (zero, inf) = (_mm_setzero_ps(), _mm_set1_ps(f32::INFINITY));
+                // Lanes of `v` that are NaN, infinite or negative (`v ≥ 0` fails for NaN).
+                let bad = |v: __m128| {
+                    let ok = _mm_and_ps(_mm_cmpge_ps(v, zero), _mm_cmplt_ps(v, inf));
+                    (_mm_movemask_ps(ok) ^ 0xF).count_ones() as u64
+                };
                 while x + 4 <= w {
                     let (r, g, b) = (four(0, x), four(1, x), four(2, x));
+                    invalid += bad(r) + bad(g) + bad(b);
                     let dst = out.add(x * n);
                     if n == 4 {
                         let mut a = four(3, x);
@@ -908,10 +921,13 @@ fn scatter_split_f32(
         }
         for x in x..w {
             for c in 0..n {
-                row[x * n + c] = float_at(p[c], x);
+                let v = float_at(p[c], x);
+                row[x * n + c] = v;
+                invalid += u64::from(c < 3 && !(v >= 0.0 && v < f32::INFINITY));
             }
         }
     }
+    invalid
 }
 
 /// Fills `buf` from byte `at` of `file`, without moving (or needing) a shared cursor, so
