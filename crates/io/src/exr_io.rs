@@ -459,6 +459,9 @@ fn pack_lines(
     (lane, halves): &mut (Vec<f32>, Vec<half::f16>),
 ) {
     use half::slice::HalfFloatSliceExt;
+    if all_float(layout) {
+        return pack_float_lines(rows, w, c, layout, out);
+    }
     lane.resize(w, 0.0);
     halves.resize(w, half::f16::ZERO);
     let mut at = 0;
@@ -831,6 +834,83 @@ fn read_zip_file(
     Ok((image, invalid.into_inner()))
 }
 
+/// [`pack_lines`] for float channels (`layout` all [`SampleType::F32`], `c` 3 or 4): each
+/// texel's samples stored straight into their channels' planes, on x86-64 four texels a
+/// step (an SSE2 transpose of RGB(A) into R, G, B (and A) lanes), the rest one at a time.
+fn pack_float_lines(
+    rows: &[f32],
+    w: usize,
+    c: usize,
+    layout: &[(usize, SampleType)],
+    out: &mut [u8],
+) {
+    // Where each texel channel's plane starts within a line's bytes.
+    let mut plane = [0usize; 4];
+    for (pos, &(k, _)) in layout.iter().enumerate() {
+        plane[k] = pos * 4 * w;
+    }
+    for (row, line) in rows
+        .chunks_exact(w * c)
+        .zip(out.chunks_exact_mut(c * 4 * w))
+    {
+        let mut x = 0;
+        #[cfg(target_arch = "x86_64")]
+        if line.len() == c * 4 * w && row.len() == w * c {
+            use std::arch::x86_64::*;
+            // SAFETY: SSE2 is part of x86-64. Reads: `c` × 4 floats from texel x with
+            // x + 4 <= w, inside `row` (w·c floats). Writes: 16 bytes at plane[k] + 4x,
+            // inside the line's c planes of 4w bytes (checked above).
+            unsafe {
+                let (src, dst) = (row.as_ptr(), line.as_mut_ptr());
+                let put = |k: usize, x: usize, v: __m128| {
+                    _mm_storeu_ps(dst.add(plane[k] + 4 * x) as *mut f32, v);
+                };
+                while x + 4 <= w {
+                    let p = src.add(x * c);
+                    if c == 4 {
+                        let (mut r, mut g, mut b, mut a) = (
+                            _mm_loadu_ps(p),
+                            _mm_loadu_ps(p.add(4)),
+                            _mm_loadu_ps(p.add(8)),
+                            _mm_loadu_ps(p.add(12)),
+                        );
+                        _MM_TRANSPOSE4_PS(&mut r, &mut g, &mut b, &mut a);
+                        put(3, x, a);
+                        put(0, x, r);
+                        put(1, x, g);
+                        put(2, x, b);
+                    } else {
+                        // [r0 g0 b0 r1] [g1 b1 r2 g2] [b2 r3 g3 b3] (the scatter's inverse)
+                        let (o0, o1, o2) = (
+                            _mm_loadu_ps(p),
+                            _mm_loadu_ps(p.add(4)),
+                            _mm_loadu_ps(p.add(8)),
+                        );
+                        let rr = _mm_shuffle_ps::<0b01_01_10_10>(o1, o2); // r2 r2 r3 r3
+                        let r = _mm_shuffle_ps::<0b10_00_11_00>(o0, rr); // r0 r1 r2 r3
+                        let g01 = _mm_shuffle_ps::<0b00_00_01_01>(o0, o1); // g0 g0 g1 g1
+                        let g23 = _mm_shuffle_ps::<0b10_10_11_11>(o1, o2); // g2 g2 g3 g3
+                        let g = _mm_shuffle_ps::<0b10_00_10_00>(g01, g23); // g0 g1 g2 g3
+                        let b01 = _mm_shuffle_ps::<0b01_01_10_10>(o0, o1); // b0 b0 b1 b1
+                        let b23 = _mm_shuffle_ps::<0b11_11_00_00>(o2, o2); // b2 b2 b3 b3
+                        let b = _mm_shuffle_ps::<0b10_00_10_00>(b01, b23); // b0 b1 b2 b3
+                        put(0, x, r);
+                        put(1, x, g);
+                        put(2, x, b);
+                    }
+                    x += 4;
+                }
+            }
+        }
+        for x in x..w {
+            for k in 0..c {
+                let at = plane[k] + 4 * x;
+                line[at..at + 4].copy_from_slice(&row[x * c + k].to_le_bytes());
+            }
+        }
+    }
+}
+
 /// Whether every channel of a [`block_layout`] is 32-bit float.
 fn all_float(layout: &[(usize, SampleType)]) -> bool {
     layout.iter().all(|&(_, st)| st == SampleType::F32)
@@ -923,7 +1003,7 @@ fn scatter_split_f32(
             for c in 0..n {
                 let v = float_at(p[c], x);
                 row[x * n + c] = v;
-                invalid += u64::from(c < 3 && !(v >= 0.0 && v < f32::INFINITY));
+                invalid += u64::from(c < 3 && !(0.0..f32::INFINITY).contains(&v));
             }
         }
     }
