@@ -236,9 +236,9 @@ struct Job<'a> {
 /// Converts the job's layers one after another and writes layer `i` to `paths[i]` on
 /// another thread meanwhile, so that the file's encoding and the kernel's share of writing
 /// it overlap the next layer's conversion. Each written file is renamed into place on a
-/// third thread: replacing an existing file costs 7–16 ms a 12 MB face here, mostly
+/// thread of its own: replacing an existing file costs 7–20 ms a 12 MB face here, mostly
 /// waiting (see `mirrorball_io::Staged`), which on the writer's thread held back the next
-/// file. Stops at the first failed write or rename.
+/// file. Stops at the first failed write; a failed rename is reported when all are done.
 ///
 /// The source is freed as soon as the last layer is made, while that layer is still being
 /// written: handing 100 MB back to the kernel takes it ~15 ms of one core.
@@ -258,10 +258,21 @@ fn write_while_converting(
         let r = Resampler::new(&src.env, dst, w, h, resample);
         let (to_commit, staged) = mpsc::channel::<mirrorball_io::Staged>();
         let committer = scope.spawn(move || -> Result<(), CliError> {
-            for file in staged {
-                file.commit()?;
-            }
-            Ok(())
+            // Each rename on its own thread: a rename over an existing file waits on the
+            // file system for 10-20 ms here, and one after another they queued up, so that
+            // the last face's waited for the others' (end to end, median 0.356 -> 0.327 s).
+            std::thread::scope(|renames| {
+                let all: Vec<_> = staged
+                    .into_iter()
+                    .map(|file| renames.spawn(move || file.commit()))
+                    .collect();
+                let mut result = Ok(());
+                for h in all {
+                    let r = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+                    result = result.and(r.map_err(CliError::from));
+                }
+                result
+            })
         });
         // At most two layers in memory: one is made while the other is written. Written
         // layers' buffers come back to be filled again, so that only the first two pay for

@@ -205,8 +205,9 @@ fn nan_inf_and_negative_texels_are_reported_and_fixed() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("0 NaN, 0 infinite, 0 negative"));
 }
 
-/// A face that cannot be written (a folder stands where its file would go) stops a
-/// conversion to one file a face with a message naming it, and leaves no temporary files.
+/// A face that cannot be put in place (a folder stands where its file would go) fails a
+/// conversion to one file a face with a message naming it, and leaves no temporary files
+/// (the faces that could be renamed into place are whole files).
 #[test]
 fn an_unwritable_face_is_named_and_leaves_no_temporary_files() {
     let dir = tempfile::tempdir().unwrap();
