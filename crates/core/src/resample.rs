@@ -388,6 +388,17 @@ fn inner_tap<const C: usize>(layers: &[Image], lk: &Lookup) -> Option<Tap> {
     })
 }
 
+/// The layer the first four lookups of `look` share and its image in `layers`, when they
+/// share one that `layers` has (not `u32::MAX`, no direction); else `None`.
+#[inline(always)]
+fn one_layer<'a>(layers: &'a [Image], look: &[Lookup]) -> Option<(u32, &'a Image)> {
+    let layer = look[0].layer;
+    if look[1..4].iter().any(|l| l.layer != layer) {
+        return None;
+    }
+    Some((layer, layers.get(layer as usize)?))
+}
+
 /// Four [`Lookup`]s as four lanes each of layer (bits), `u`, `v` and density.
 ///
 /// # Safety
@@ -511,19 +522,13 @@ fn point_taps<const C: usize>(lv: &[Image], weight: &[f32], look: &[Lookup], tap
     #[cfg(target_arch = "x86_64")]
     while k + 4 <= look.len() {
         let (w4, l4) = (&weight[k..k + 4], &look[k..k + 4]);
-        let layer = l4[0].layer;
-        let four = match lv.get(layer as usize) {
-            Some(img) if l4[1..].iter().all(|l| l.layer == layer) => {
-                // SAFETY: SSE2 is part of x86-64; `l4` and `w4` hold four values each.
-                unsafe {
-                    use std::arch::x86_64::*;
-                    let (_, u, v, _) = load4(l4);
-                    let ok = _mm_cmpgt_ps(_mm_loadu_ps(w4.as_ptr()), _mm_setzero_ps());
-                    corner_taps4::<C>(img, layer, u, v, ok)
-                }
-            }
-            _ => None,
-        };
+        // SAFETY: SSE2 is part of x86-64; `l4` and `w4` hold four values each.
+        let four = one_layer(lv, l4).and_then(|(layer, img)| unsafe {
+            use std::arch::x86_64::*;
+            let (_, u, v, _) = load4(l4);
+            let ok = _mm_cmpgt_ps(_mm_loadu_ps(w4.as_ptr()), _mm_setzero_ps());
+            corner_taps4::<C>(img, layer, u, v, ok)
+        });
         match four {
             Some(t) => taps[k..k + 4].copy_from_slice(&t),
             None => {
@@ -819,11 +824,7 @@ impl Job {
         dens: &[f32; 4],
         look: &[Lookup],
     ) -> Option<[Tap; 4]> {
-        let layer = look[0].layer;
-        if look[1..4].iter().any(|l| l.layer != layer) {
-            return None;
-        }
-        let img = base.get(layer as usize)?;
+        let (layer, img) = one_layer(base, look)?;
         #[cfg(target_arch = "x86_64")]
         // SAFETY: SSE2 is part of x86-64; `look` holds four lookups (its layers read above).
         unsafe {
@@ -1142,21 +1143,6 @@ impl<'a> Resampler<'a> {
     /// The output projection.
     pub fn projection(&self) -> &Projection {
         &self.job.dst
-    }
-
-    /// The output layers' width in texels.
-    pub fn width(&self) -> u32 {
-        self.job.w
-    }
-
-    /// The output layers' height in texels.
-    pub fn height(&self) -> u32 {
-        self.job.h
-    }
-
-    /// Channels a texel (the source's: 3 or 4).
-    pub fn channels(&self) -> usize {
-        self.channels
     }
 
     /// Makes output layer `layer` (`0 .. projection().layer_count()`), `w`×`h` texels with

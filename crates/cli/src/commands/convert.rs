@@ -238,7 +238,8 @@ struct Job<'a> {
 /// it overlap the next layer's conversion. Each written file is renamed into place on a
 /// thread of its own: replacing an existing file costs 7–20 ms a 12 MB face here, mostly
 /// waiting (see `mirrorball_io::Staged`), which on the writer's thread held back the next
-/// file. Stops at the first failed write; a failed rename is reported when all are done.
+/// file. Stops at the first failed write; a failed rename is reported once the writing is
+/// done (the files renamed into place are whole).
 ///
 /// The source is freed as soon as the last layer is made, while that layer is still being
 /// written: handing 100 MB back to the kernel takes it ~15 ms of one core.
@@ -256,24 +257,6 @@ fn write_while_converting(
     } = job;
     std::thread::scope(|scope| {
         let r = Resampler::new(&src.env, dst, w, h, resample);
-        let (to_commit, staged) = mpsc::channel::<mirrorball_io::Staged>();
-        let committer = scope.spawn(move || -> Result<(), CliError> {
-            // Each rename on its own thread: a rename over an existing file waits on the
-            // file system for 10-20 ms here, and one after another they queued up, so that
-            // the last face's waited for the others' (end to end, median 0.356 -> 0.327 s).
-            std::thread::scope(|renames| {
-                let all: Vec<_> = staged
-                    .into_iter()
-                    .map(|file| renames.spawn(move || file.commit()))
-                    .collect();
-                let mut result = Ok(());
-                for h in all {
-                    let r = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
-                    result = result.and(r.map_err(CliError::from));
-                }
-                result
-            })
-        });
         // At most two layers in memory: one is made while the other is written. Written
         // layers' buffers come back to be filled again, so that only the first two pay for
         // fresh memory (the kernel zeroes and maps it a page at a time on first touch).
@@ -288,18 +271,23 @@ fn write_while_converting(
                 .num_threads(rayon::current_num_threads())
                 .build()
                 .map_err(|e| CliError::input(format!("cannot start writer threads: {e}")))?;
+            // Each written file is renamed into place on a thread of its own: a rename over
+            // an existing file waits on the file system for 10-20 ms here, and one after
+            // another they queued up, so that the last face's waited for the others' (end
+            // to end, median 0.356 -> 0.327 s).
+            let mut renames = Vec::new();
             for (path, img) in rx {
                 let file = pool.install(|| mirrorball_io::write_image_staged(path, &img, opts))?;
                 // The converter may have finished and gone: then the buffer is dropped.
                 let _ = give_back.send(img);
-                if let Err(mpsc::SendError(file)) = to_commit.send(file) {
-                    // The committer stopped on an error, which its join reports; this file
-                    // is removed uncommitted.
-                    drop(file);
-                    break;
-                }
+                renames.push(scope.spawn(move || file.commit()));
             }
-            Ok(())
+            renames.into_iter().try_for_each(|rename| {
+                let done = rename
+                    .join()
+                    .unwrap_or_else(|e| std::panic::resume_unwind(e));
+                done.map_err(CliError::from)
+            })
         });
         for (layer, path) in paths.iter().enumerate() {
             let img = if layer < IN_MEMORY {
@@ -317,13 +305,8 @@ fn write_while_converting(
         drop(tx);
         drop(r);
         drop(src);
-        let written = writer
+        writer
             .join()
-            .unwrap_or_else(|e| std::panic::resume_unwind(e));
-        let committed = committer
-            .join()
-            .unwrap_or_else(|e| std::panic::resume_unwind(e));
-        // A failed write stops the writer before the committer; report that first.
-        written.and(committed)
+            .unwrap_or_else(|e| std::panic::resume_unwind(e))
     })
 }
