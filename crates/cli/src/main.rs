@@ -3,8 +3,10 @@
 //! Raw arguments become a validated plan (projection specs parsed, output container and
 //! layout checked, folders checked) before any file is read or any work starts.
 
+mod budget;
 mod commands;
 mod error;
+mod guard;
 mod load;
 mod progress;
 mod save;
@@ -20,6 +22,10 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Refuse a job estimated to need more memory than this (8G, 512M; default: the
+    /// memory available when it starts).
+    #[arg(long, global = true, value_name = "SIZE", value_parser = budget::parse_bytes)]
+    max_memory: Option<u64>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -83,20 +89,20 @@ pub struct ConvertArgs {
     #[command(flatten)]
     input_args: InputArgs,
     /// Turn the environment about +Y (degrees; positive turns it to the left).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = finite_f64, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw: f64,
     /// Then about +X (degrees).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = finite_f64, default_value_t = 0.0, allow_hyphen_values = true)]
     pitch: f64,
     /// Then about the view axis (degrees).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = finite_f64, default_value_t = 0.0, allow_hyphen_values = true)]
     roll: f64,
     /// Mirror the environment across a plane: x, y or z (z switches between right- and
     /// left-handed worlds). May be repeated.
     #[arg(long, value_name = "AXIS")]
     flip: Vec<String>,
     /// Exposure in stops (texels times 2^EV).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
     /// Texel precision: half, float (EXR/KTX2/DDS) or 8, 16 (PNG).
     #[arg(long)]
@@ -149,7 +155,7 @@ pub struct DemoArgs {
     #[arg(long, default_value_t = 1024)]
     size: u32,
     /// Exposure of the PNG previews, in stops.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
 }
 
@@ -200,7 +206,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "1,1,1")]
     tint: String,
     /// Reflectance at normal incidence for fresnel.
-    #[arg(long, default_value_t = 0.04)]
+    #[arg(long, value_parser = finite_f32, default_value_t = 0.04)]
     f0: f32,
     /// Camera position x,y,z.
     #[arg(long, default_value = "0,0,3.5", allow_hyphen_values = true)]
@@ -212,23 +218,23 @@ pub struct RenderArgs {
     #[arg(long, default_value = "+y", allow_hyphen_values = true)]
     up: String,
     /// Vertical field of view in degrees (perspective).
-    #[arg(long, default_value_t = 40.0)]
+    #[arg(long, value_parser = finite_f32, default_value_t = 40.0)]
     fov: f32,
     /// Orthographic camera with this half height instead of perspective.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_f32)]
     ortho: Option<f32>,
     /// Fisheye (Omnimax, Greene §10) camera with this full field of view in degrees: the
     /// scene is captured as a cube at --eye and resampled to a WIDTHxWIDTH fisheye picture.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_f64)]
     fisheye: Option<f64>,
     /// Lens of --fisheye: equidistant, equisolid, stereographic, orthographic.
     #[arg(long, default_value = "equidistant")]
     fisheye_lens: String,
     /// Near clipping distance.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, value_parser = finite_f32, default_value_t = 0.05)]
     near: f32,
     /// Far clipping distance.
-    #[arg(long, default_value_t = 1000.0)]
+    #[arg(long, value_parser = finite_f32, default_value_t = 1000.0)]
     far: f32,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480")]
@@ -237,7 +243,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 2)]
     ss: u32,
     /// Exposure in stops.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
     /// Tone curve for PNG/JPEG: aces, reinhard, clamp.
     #[arg(long, default_value = "aces")]
@@ -247,7 +253,7 @@ pub struct RenderArgs {
     no_background: bool,
     /// Camera-rotation motion blur of the background (Greene §9): the camera panned this
     /// many degrees (about its up axis) since the previous frame.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, value_parser = finite_f32, allow_hyphen_values = true)]
     pan_blur: Option<f32>,
     /// Also write the diagnostic channels as float EXRs beside the image: -st (u, v,
     /// layer read), -reflect (world reflected vector), -normal, -depth (eye depth, window
@@ -348,7 +354,7 @@ pub struct PrefilterArgs {
     #[arg(long)]
     no_preview: bool,
     /// Exposure of the preview sheet in stops (level 0's mean is shown at 18% grey).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     preview_exposure: f32,
     /// Also write the split-sum BRDF table (A, B in red and green) to this .exr or .png.
     #[arg(long)]
@@ -370,8 +376,55 @@ pub struct PrefilterArgs {
     quiet: bool,
 }
 
+/// On SIGINT, SIGTERM or SIGHUP: let a set of files being renamed into place land, remove
+/// every temporary file, and exit with 128 + the signal's number (130 for Ctrl-C), as
+/// shells do.
+#[cfg(unix)]
+fn on_interrupt_clean_up() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return; // no handler: the default action (exit) still leaves no half-written output
+    };
+    std::thread::spawn(move || {
+        if let Some(sig) = signals.forever().next() {
+            let removed = mirrorball_io::interrupted();
+            let what = match sig {
+                SIGINT => "interrupted",
+                SIGTERM => "terminated",
+                _ => "hung up",
+            };
+            // A new line: a progress bar may be on this one.
+            eprintln!("\nmirrorball: {what}; removed {removed} unfinished file(s), nothing half-written left");
+            std::process::exit(128 + sig);
+        }
+    });
+}
+
+#[cfg(not(unix))]
+fn on_interrupt_clean_up() {}
+
+/// A number flag's value: finite (`nan`, `inf` and `1e999` are refused by name).
+fn finite_f64(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!("'{s}' is not a finite number")),
+        Err(_) => Err(format!("'{s}' is not a number")),
+    }
+}
+
+/// [`finite_f64`], for `f32` flags (and in `f32`'s range).
+fn finite_f32(s: &str) -> Result<f32, String> {
+    let v = finite_f64(s)?;
+    if v.abs() > f32::MAX as f64 {
+        return Err(format!("'{s}' is too large"));
+    }
+    Ok(v as f32)
+}
+
 fn main() -> ExitCode {
+    on_interrupt_clean_up();
     let cli = Cli::parse();
+    budget::set_max(cli.max_memory);
     let result: Result<(), CliError> = match cli.command {
         Command::Convert(a) => commands::convert::run(a),
         Command::Info(a) => commands::info::run(a),

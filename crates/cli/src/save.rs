@@ -141,11 +141,13 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
     let n = env.layers().len();
     let layout = output_layout(out, n, opts);
     if let Some(paths) = layer_files(out, n, opts) {
-        paths
+        // Renamed into place together: a failed or interrupted run leaves the set as it was.
+        let staged = paths
             .par_iter()
             .zip(env.layers().par_iter())
-            .map(|(p, img)| mirrorball_io::write_image(p, img, &opts.write))
-            .collect::<Result<Vec<()>, _>>()?;
+            .map(|(p, img)| mirrorball_io::write_image_staged(p, img, &opts.write))
+            .collect::<Result<Vec<_>, _>>()?;
+        mirrorball_io::commit_all(staged)?;
         return Ok(paths);
     }
     let mut write = opts.write;
@@ -159,8 +161,10 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
     Ok(vec![path.to_path_buf()])
 }
 
-/// The natural default edge for a conversion from `src` to `kind`: about the same number of
-/// texels per steradian as the source has at its finest.
+/// The natural default edge for a conversion from `src` to `kind`: the power of two nearest
+/// (in ratio) to the edge that keeps the source's texels per steradian, so that cube faces
+/// are 256, 512, 1024 … and lat-longs 2:1 (1024×512, 4096×2048 …), as engines and
+/// users expect.
 pub fn default_size(src: &EnvMap, kind: ProjectionKind) -> u32 {
     // Texels per steradian of the source, spread evenly.
     let n_src = src.width() as f64 * src.height() as f64 * src.layers().len() as f64;
@@ -170,5 +174,6 @@ pub fn default_size(src: &EnvMap, kind: ProjectionKind) -> u32 {
     let texels_1024 = w1 as f64 * h1 as f64 * dst.layer_count() as f64;
     let want = per_sr * dst.covered_solid_angle();
     let size = 1024.0 * (want / texels_1024).sqrt();
-    (size.round() as u32).clamp(1, 16384)
+    let log2 = size.max(1.0).log2().round().clamp(0.0, 14.0);
+    1 << log2 as u32
 }

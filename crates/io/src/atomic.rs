@@ -1,19 +1,56 @@
-//! Write to a temporary file beside the target, then rename: never a half-written output.
+//! Write to a temporary file beside the target, then rename: never a half-written output,
+//! and nothing left behind when the write fails or the process is interrupted.
+//!
+//! - Every temporary file is registered while it exists, so that [`interrupted`] (called
+//!   on SIGINT/SIGTERM) can remove them all before the process exits.
+//! - A set of files that belong together (six cube faces, a mip chain) is renamed into
+//!   place by [`commit_all`] under one guard: an interrupt waits for the set to land, and no
+//!   set starts landing after an interrupt, so a set is either all new or all old.
+//! - An output that is a symbolic link is written through (the file it points to is
+//!   replaced, the link kept), as `cp` does.
+//! - A temporary file is named `.NAME.PID.tmp`; a later run that writes `NAME` removes the
+//!   ones a killed run (SIGKILL, power loss) left, once their process is gone.
 
 use crate::Error;
+use std::collections::{HashMap, HashSet};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, RwLock};
+
+/// Temporary files being written or waiting to be renamed.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Set by [`interrupted`] (under `PENDING`'s lock): no temporary file is made after it.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+/// Held shared while files are renamed into place, exclusively by [`interrupted`].
+static COMMITS: RwLock<()> = RwLock::new(());
+/// A folder's leftover temporary files of dead processes, by the base name of the file
+/// they were meant to become.
+type Leftovers = HashMap<String, Vec<PathBuf>>;
+/// Per folder already looked at, its [`Leftovers`].
+static LEFTOVERS: Mutex<Option<HashMap<PathBuf, Leftovers>>> = Mutex::new(None);
 
 /// Calls `write` with a buffered writer on a temporary file in `path`'s directory, flushes
 /// it, and renames it over `path`. On any error the temporary file is removed and `path` is
 /// left as it was: no reader ever sees a half-written output.
 ///
 /// The file is not synced to disk (`fsync`) before the rename, as `cp`, OpenEXR and image
-/// editors do not: a sync waits for the disk (10–15 ms a file here, a third of writing six
-/// cube faces) and guards only against the machine losing power, which is the file
-/// system's business (ext4, for one, flushes a file renamed over another before the
-/// rename is committed).
+/// editors do not: a sync waits for the disk and guards only against the machine losing
+/// power, which is the file system's business (ext4, for one, flushes a file renamed over
+/// another before the rename is committed).
+///
+/// ```
+/// use std::io::Write;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("note.txt");
+/// mirrorball_io::atomic_write(&path, |w| {
+///     w.write_all(b"hello").map_err(|e| mirrorball_io::Error::io(&path, e))
+/// })
+/// .unwrap();
+/// assert_eq!(std::fs::read(&path).unwrap(), b"hello");
+/// assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1); // no temporary left
+/// ```
 pub fn atomic_write<F>(path: &Path, write: F) -> Result<(), Error>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<(), Error>,
@@ -22,19 +59,16 @@ where
 }
 
 /// A complete output written to a temporary file beside its destination, waiting to be
-/// renamed into place by [`Staged::commit`]; dropped uncommitted, the temporary file is
-/// removed and the destination is left as it was.
-///
-/// Renaming is split from writing because renaming over an existing file can be slow: on
-/// ext4 it starts writing the new file out (about 2 ms for a 12 MB cube face here) and
-/// frees the old file's blocks (about 6 ms on this `discard`-mounted disk), 7–12 ms in all,
-/// mostly waiting. A caller writing many files can commit each on another thread and go on
-/// writing the next.
+/// renamed into place by [`Staged::commit`] (or with others by [`commit_all`]); dropped
+/// uncommitted, the temporary file is removed and the destination is left as it was.
 #[must_use = "a staged file is removed unless committed"]
 #[derive(Debug)]
 pub struct Staged {
     /// The temporary file, until committed.
     tmp: Option<PathBuf>,
+    /// Where it goes (through symbolic links).
+    target: PathBuf,
+    /// The destination as asked, for messages.
     path: PathBuf,
 }
 
@@ -46,21 +80,67 @@ impl Staged {
 
     /// Renames the temporary file over the destination. On failure the temporary file is
     /// removed and the destination is left as it was.
-    pub fn commit(mut self) -> Result<(), Error> {
+    pub fn commit(self) -> Result<(), Error> {
+        let _guard = COMMITS.read().unwrap_or_else(|e| e.into_inner());
+        self.rename()
+    }
+
+    fn rename(mut self) -> Result<(), Error> {
         let tmp = self.tmp.take().expect("a staged file is committed once");
-        std::fs::rename(&tmp, &self.path).map_err(|e| {
+        let done = std::fs::rename(&tmp, &self.target).map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
             Error::io(&self.path, e)
-        })
+        });
+        forget_pending(&tmp);
+        done
     }
 }
 
 impl Drop for Staged {
     fn drop(&mut self) {
         if let Some(tmp) = self.tmp.take() {
-            let _ = std::fs::remove_file(tmp);
+            let _ = std::fs::remove_file(&tmp);
+            forget_pending(&tmp);
         }
     }
+}
+
+/// Renames a set of staged files into place together (on a thread each: a rename over an
+/// existing file can wait on the file system for milliseconds). An interrupt that comes
+/// meanwhile waits for the whole set; one that came before keeps the set from landing.
+/// Every file is tried; the first error is returned, and the files that failed are removed.
+pub fn commit_all(staged: Vec<Staged>) -> Result<(), Error> {
+    let _guard = COMMITS.read().unwrap_or_else(|e| e.into_inner());
+    let results: Vec<Result<(), Error>> = std::thread::scope(|scope| {
+        let renames: Vec<_> = staged
+            .into_iter()
+            .map(|s| scope.spawn(move || s.rename()))
+            .collect();
+        renames
+            .into_iter()
+            .map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    results.into_iter().collect()
+}
+
+/// For a signal handler: waits for a set of files being renamed into place to land, keeps
+/// any other from starting, and removes every temporary file still pending. Returns how
+/// many it removed. The process is expected to exit right after; writes still running on
+/// other threads fail harmlessly, their files gone.
+pub fn interrupted() -> usize {
+    let guard = COMMITS.write().unwrap_or_else(|e| e.into_inner());
+    // Held until the process exits: no rename starts after an interrupt.
+    std::mem::forget(guard);
+    let pending = {
+        let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+        INTERRUPTED.store(true, Ordering::SeqCst);
+        std::mem::take(&mut *pending)
+    };
+    pending
+        .iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .count()
 }
 
 /// The first half of [`atomic_write`]: `write` fills a temporary file beside `path`, which
@@ -69,13 +149,25 @@ pub(crate) fn stage<F>(path: &Path, write: F) -> Result<Staged, Error>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<(), Error>,
 {
+    let target = write_through(path);
+    remove_leftovers(&target);
+    let tmp = temp_path(&target, std::process::id());
+    // Made and registered under one lock, so that an interrupt finds every temporary file.
+    let file = {
+        let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            return Err(Error::request(path, "interrupted".into()));
+        }
+        let file = File::create(&tmp).map_err(|e| Error::io(path, e))?;
+        pending.push(tmp.clone());
+        file
+    };
+    // From here an early return drops `staged`, which removes what was written.
     let staged = Staged {
-        tmp: Some(temp_path(path)),
+        tmp: Some(tmp),
+        target,
         path: path.to_path_buf(),
     };
-    let tmp = staged.tmp.as_deref().expect("just set");
-    // From here an early return drops `staged`, which removes what was written.
-    let file = File::create(tmp).map_err(|e| Error::io(path, e))?;
     let mut w = BufWriter::with_capacity(1 << 20, file);
     write(&mut w)?;
     w.flush().map_err(|e| Error::io(path, e))?;
@@ -86,11 +178,166 @@ where
     Ok(staged)
 }
 
-fn temp_path(path: &Path) -> PathBuf {
+fn forget_pending(tmp: &Path) {
+    let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(i) = pending.iter().position(|p| p == tmp) {
+        pending.swap_remove(i);
+    }
+}
+
+/// The file `path` names once symbolic links are followed (at most 40 of them, as Linux
+/// does); `path` itself when it is no link, or a loop.
+fn write_through(path: &Path) -> PathBuf {
+    let mut p = path.to_path_buf();
+    for _ in 0..40 {
+        let is_link = std::fs::symlink_metadata(&p)
+            .map(|m| m.file_type().is_symlink())
+            .unwrap_or(false);
+        if !is_link {
+            return p;
+        }
+        let Ok(next) = std::fs::read_link(&p) else {
+            return p;
+        };
+        p = match p.parent() {
+            Some(dir) if next.is_relative() => dir.join(next),
+            _ => next,
+        };
+    }
+    path.to_path_buf()
+}
+
+/// Longest file name most file systems take (ext4, XFS, APFS, NTFS: 255 bytes).
+const NAME_MAX: usize = 255;
+
+/// What a temporary file for `path` is called, less its `.PID.tmp`: `.NAME`, or for names
+/// too long to take the suffix, a prefix of `NAME` and a hash of the whole name.
+fn temp_base(path: &Path) -> String {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let unique = format!(".{}.{}.tmp", name, std::process::id());
-    path.with_file_name(unique)
+    // `.` + name + `.` + pid (at most 10 digits) + `.tmp`.
+    let room = NAME_MAX - 1 - 1 - 10 - 4;
+    if name.len() <= room {
+        return format!(".{name}");
+    }
+    let hash = fnv1a(name.as_bytes());
+    let mut cut = room - 17; // `~` and 16 hex digits
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!(".{}~{hash:016x}", &name[..cut])
+}
+
+fn temp_path(path: &Path, pid: u32) -> PathBuf {
+    path.with_file_name(format!("{}.{pid}.tmp", temp_base(path)))
+}
+
+/// 64-bit FNV-1a: a stable hash (the same in every build) for shortened temporary names.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// Removes the temporary files a dead process left for `path`. Each folder is listed once
+/// per process.
+fn remove_leftovers(path: &Path) {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let base = temp_base(path);
+    let mut cache = LEFTOVERS.lock().unwrap_or_else(|e| e.into_inner());
+    let by_dir = cache.get_or_insert_with(HashMap::new);
+    let found = by_dir
+        .entry(dir.clone())
+        .or_insert_with(|| leftovers_in(&dir));
+    if let Some(files) = found.remove(&base) {
+        for f in files {
+            let _ = std::fs::remove_file(f);
+        }
+    }
+}
+
+/// The temporary files in `dir` whose process is gone, by their base name.
+fn leftovers_in(dir: &Path) -> Leftovers {
+    let mut out = Leftovers::new();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return out;
+    };
+    let mut alive: HashSet<u32> = HashSet::new();
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Some((base, pid)) = parse_temp_name(name) else {
+            continue;
+        };
+        if pid == std::process::id() || alive.contains(&pid) {
+            continue;
+        }
+        if process_alive(pid) {
+            alive.insert(pid);
+            continue;
+        }
+        out.entry(base.to_string()).or_default().push(e.path());
+    }
+    out
+}
+
+/// `(".NAME", pid)` of a temporary file's name `.NAME.PID.tmp`.
+fn parse_temp_name(name: &str) -> Option<(&str, u32)> {
+    let rest = name.strip_suffix(".tmp")?;
+    let (base, pid) = rest.rsplit_once('.')?;
+    if !base.starts_with('.') || base.len() < 2 || pid.is_empty() {
+        return None;
+    }
+    if !pid.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    Some((base, pid.parse().ok()?))
+}
+
+/// Whether process `pid` exists. Where that cannot be told, every process is taken to be
+/// alive, so that nothing is removed.
+fn process_alive(pid: u32) -> bool {
+    if cfg!(target_os = "linux") {
+        Path::new("/proc").join(pid.to_string()).exists()
+    } else {
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temp_names_fit_the_file_system() {
+        for len in [1usize, 100, 238, 239, 240, 250, 255] {
+            let name = "é".repeat(len / 2) + &"a".repeat(len % 2);
+            let p = Path::new("/x").join(&name);
+            let t = temp_path(&p, u32::MAX);
+            let t_name = t.file_name().unwrap().to_str().unwrap();
+            assert!(t_name.len() <= NAME_MAX, "{len}: {}", t_name.len());
+            assert_eq!(
+                parse_temp_name(t_name),
+                Some((temp_base(&p).as_str(), u32::MAX))
+            );
+        }
+        // Short names keep their plain form; long ones that share a prefix stay apart.
+        assert_eq!(temp_base(Path::new("sky.exr")), ".sky.exr");
+        let a = "a".repeat(250) + "1.exr";
+        let b = "a".repeat(250) + "2.exr";
+        assert_ne!(temp_base(Path::new(&a)), temp_base(Path::new(&b)));
+    }
+
+    #[test]
+    fn temp_names_are_recognised() {
+        assert_eq!(parse_temp_name(".sky.exr.123.tmp"), Some((".sky.exr", 123)));
+        assert_eq!(parse_temp_name("sky.exr.123.tmp"), None);
+        assert_eq!(parse_temp_name(".sky.exr.12a.tmp"), None);
+        assert_eq!(parse_temp_name(".sky.exr.tmp"), None);
+    }
 }

@@ -16,7 +16,7 @@ mod hdr_io;
 mod ktx2_io;
 mod ldr_io;
 
-pub use atomic::{atomic_write, Staged};
+pub use atomic::{atomic_write, commit_all, interrupted, Staged};
 pub use error::{Error, Fault};
 
 use mirrorball_core::{Image, ProjectionKind};
@@ -215,6 +215,20 @@ pub fn write_cube(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Re
             "only .ktx2 and .dds hold a whole cube map".into(),
         )),
     }
+}
+
+/// Whether `a` and `b` name the same file (the same device and inode, through hard links,
+/// symbolic links, `..` and relative names alike). `false` when either does not exist.
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// let a = dir.path().join("a.exr");
+/// std::fs::write(&a, b"x").unwrap();
+/// assert!(mirrorball_io::same_file(&a, &dir.path().join(".").join("a.exr")));
+/// assert!(!mirrorball_io::same_file(&a, &dir.path().join("b.exr")));
+/// ```
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    same_file::is_same_file(a, b).unwrap_or(false)
 }
 
 fn unknown_ext() -> String {

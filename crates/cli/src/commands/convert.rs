@@ -1,7 +1,9 @@
 //! `mirrorball convert`: any projection, size, layout or container to any other.
 
 use super::InputPlan;
+use crate::budget;
 use crate::error::CliError;
+use crate::guard::Files;
 use crate::progress::with_progress;
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
@@ -10,7 +12,7 @@ use mirrorball_core::{
     resample, Image, Layout, Projection, ResampleOptions, Resampler, Rotation, WorldProjection,
 };
 use mirrorball_io::{ExrCompression, Format, Precision, WriteOptions};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::Instant;
 
@@ -95,9 +97,6 @@ impl Plan {
                 "--mips applies to .ktx2 and .dds outputs",
             ));
         }
-        if Path::new(&a.input) == Path::new(&a.output) {
-            return Err(CliError::request("the output would overwrite the input"));
-        }
         let mut rotation = Rotation::from_euler_deg(a.yaw, a.pitch, a.roll);
         for f in &a.flip {
             let axis = match f.to_ascii_lowercase().as_str() {
@@ -121,15 +120,28 @@ impl Plan {
             jpeg_quality: 92,
             declared: None,
         };
+        let save = SaveOptions {
+            layout,
+            write,
+            mips: a.mips,
+        };
+        let layers = to.build(None).map_err(|e| bad("--to", e))?.layer_count();
+        let mut files = Files::new();
+        files.input_arg("the input", &a.input);
+        match save::layer_files(&a.output, layers, &save) {
+            Some(paths) => paths.into_iter().for_each(|p| {
+                files.output("the output", p);
+            }),
+            None => {
+                files.output("the output", &a.output);
+            }
+        }
+        files.check()?;
         Ok(Plan {
             input,
             to,
             size: a.size,
-            save: SaveOptions {
-                layout,
-                write,
-                mips: a.mips,
-            },
+            save,
             resample: ResampleOptions {
                 rotation,
                 exposure: a.exposure,
@@ -165,9 +177,30 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
         .unwrap_or_else(|| save::default_size(&src.env, dst.kind()));
     let (w, h) = dst.layer_extent(size);
     let rows = h as u64 * dst.layer_count() as u64;
-    let t1 = Instant::now();
-    let (files, t_conv, t_write) = match save::layer_files(&a.output, dst.layer_count(), &plan.save)
+    let layer_files = save::layer_files(&a.output, dst.layer_count(), &plan.save);
     {
+        let env = &src.env;
+        let c = env.channels() as u64;
+        let held = budget::f32_texels(
+            env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
+            c,
+        );
+        let layer = budget::f32_texels(w as u64 * h as u64, c);
+        // One file a layer: two layers in memory. One file: the map, and a packed copy for
+        // flat layouts (a third more for a mip chain).
+        let more = match &layer_files {
+            Some(_) => 2 * layer,
+            None => layer.saturating_mul(dst.layer_count() as u64 * 2),
+        };
+        budget::check(
+            &format!("{} {w}x{h}x{}", dst.name(), dst.layer_count()),
+            held,
+            more,
+            "a smaller --size",
+        )?;
+    }
+    let t1 = Instant::now();
+    let (files, t_conv, t_write) = match layer_files {
         // One file a layer: each is written while the next is converted.
         Some(paths) => {
             with_progress("converting", rows, a.quiet, |counter| {
@@ -235,14 +268,12 @@ struct Job<'a> {
 
 /// Converts the job's layers one after another and writes layer `i` to `paths[i]` on
 /// another thread meanwhile, so that the file's encoding and the kernel's share of writing
-/// it overlap the next layer's conversion. Each written file is renamed into place on a
-/// thread of its own: replacing an existing file costs 7–20 ms a 12 MB face here, mostly
-/// waiting (see `mirrorball_io::Staged`), which on the writer's thread held back the next
-/// file. Stops at the first failed write; a failed rename is reported once the writing is
-/// done (the files renamed into place are whole).
+/// it overlap the next layer's conversion. The files are renamed into place together once
+/// all are written (`mirrorball_io::commit_all`): an interrupted or failed run leaves the
+/// set as it was. Stops at the first failed write.
 ///
 /// The source is freed as soon as the last layer is made, while that layer is still being
-/// written: handing 100 MB back to the kernel takes it ~15 ms of one core.
+/// written.
 fn write_while_converting(
     job: Job,
     paths: &[PathBuf],
@@ -260,7 +291,6 @@ fn write_while_converting(
         // At most two layers in memory: one is made while the other is written. Written
         // layers' buffers come back to be filled again, so that only the first two pay for
         // fresh memory (the kernel zeroes and maps it a page at a time on first touch).
-        // Writing a face takes well under making one, so the maker seldom waits.
         const IN_MEMORY: usize = 2;
         let (tx, rx) = mpsc::sync_channel::<(&PathBuf, Image)>(IN_MEMORY - 1);
         let (give_back, take_back) = mpsc::channel::<Image>();
@@ -271,23 +301,13 @@ fn write_while_converting(
                 .num_threads(rayon::current_num_threads())
                 .build()
                 .map_err(|e| CliError::input(format!("cannot start writer threads: {e}")))?;
-            // Each written file is renamed into place on a thread of its own: a rename over
-            // an existing file waits on the file system for 10-20 ms here, and one after
-            // another they queued up, so that the last face's waited for the others' (end
-            // to end, median 0.356 -> 0.327 s).
-            let mut renames = Vec::new();
+            let mut staged = Vec::with_capacity(paths.len());
             for (path, img) in rx {
-                let file = pool.install(|| mirrorball_io::write_image_staged(path, &img, opts))?;
+                staged.push(pool.install(|| mirrorball_io::write_image_staged(path, &img, opts))?);
                 // The converter may have finished and gone: then the buffer is dropped.
                 let _ = give_back.send(img);
-                renames.push(scope.spawn(move || file.commit()));
             }
-            renames.into_iter().try_for_each(|rename| {
-                let done = rename
-                    .join()
-                    .unwrap_or_else(|e| std::panic::resume_unwind(e));
-                done.map_err(CliError::from)
-            })
+            mirrorball_io::commit_all(staged).map_err(CliError::from)
         });
         for (layer, path) in paths.iter().enumerate() {
             let img = if layer < IN_MEMORY {

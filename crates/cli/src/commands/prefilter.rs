@@ -9,6 +9,7 @@
 use super::InputPlan;
 use crate::commands::convert::parse_precision;
 use crate::error::CliError;
+use crate::guard::Files;
 use crate::progress::with_progress;
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
@@ -258,13 +259,43 @@ impl Plan {
                 a.lut_size
             )));
         }
-        let same = |p: &Path| p == Path::new(&a.input);
-        if same(Path::new(&a.output))
-            || sh_path.as_deref().is_some_and(same)
-            || preview_path.as_deref().is_some_and(same)
-        {
-            return Err(CliError::request("an output would overwrite the input"));
+        let save = SaveOptions {
+            layout,
+            write: WriteOptions {
+                precision,
+                ..Default::default()
+            },
+            mips: false,
+        };
+        let mut files = Files::new();
+        files.input_arg("the input", &a.input);
+        if format.is_cube_container() {
+            files.output("the output", &a.output);
+        } else {
+            // Every level the chain may have (its length is known once the source is read).
+            let layers = to.build(None).map_err(|e| bad("--to", e))?.layer_count();
+            for i in 0..a.levels.unwrap_or(16) {
+                let level = level_path(&a.output, i);
+                match save::layer_files(&level, layers, &save) {
+                    Some(paths) => paths.into_iter().for_each(|p| {
+                        files.output("a level of the output", p);
+                    }),
+                    None => {
+                        files.output("a level of the output", level);
+                    }
+                }
+            }
         }
+        for (what, p) in [
+            ("--sh", &sh_path),
+            ("--preview", &preview_path),
+            ("--lut", &lut_path),
+        ] {
+            if let Some(p) = p {
+                files.output(what, p);
+            }
+        }
+        files.check()?;
         Ok(Plan {
             input,
             kind,
@@ -280,14 +311,7 @@ impl Plan {
             sh_path,
             preview_path,
             lut_path,
-            save: SaveOptions {
-                layout,
-                write: WriteOptions {
-                    precision,
-                    ..Default::default()
-                },
-                mips: false,
-            },
+            save,
             opts: PrefilterOptions {
                 samples: a.samples,
                 cube_size: a.cube_size,

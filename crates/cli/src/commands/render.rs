@@ -7,6 +7,7 @@
 
 use super::InputPlan;
 use crate::error::CliError;
+use crate::guard::Files;
 use crate::progress::with_progress;
 use crate::spec::{bad, parse_dir, ProjSpec};
 use crate::{load, RenderArgs};
@@ -756,8 +757,47 @@ fn write(path: &Path, img: &Image, format: Format, plan: &RenderPlan) -> Result<
     Ok(())
 }
 
+/// Every file the render reads and writes, checked so that no output is an input or
+/// another output.
+fn files(plan: &RenderPlan, a: &RenderArgs) -> Files {
+    let mut f = Files::new();
+    if let Some(e) = &plan.env_file {
+        f.input_arg("the environment", e);
+    }
+    if let Some(s) = &a.scene {
+        f.input("the scene", s);
+    }
+    for o in &plan.objects {
+        if let MeshSource::File(p) = &o.source {
+            f.input("the mesh", p);
+        }
+    }
+    let frames = plan.frames;
+    for i in 0..frames {
+        let path = if frames > 1 {
+            sibling(&plan.output, &format!("{i:04}"), ext_of(plan.format))
+        } else {
+            plan.output.clone()
+        };
+        if plan.diagnostics {
+            f.output("the diagnostics", sibling(&path, "diag", "png"));
+        }
+        if a.aovs {
+            for tag in ["st", "reflect", "normal", "depth"] {
+                f.output("a diagnostic channel", sibling(&path, tag, "exr"));
+            }
+        }
+        f.output("the output", path);
+    }
+    if frames > 1 && plan.format == Format::Png {
+        f.output("the animation", sibling(&plan.output, "turntable", "png"));
+    }
+    f
+}
+
 pub fn run(a: RenderArgs) -> Result<(), CliError> {
     let plan = RenderPlan::new(&a)?;
+    files(&plan, &a).check()?;
     let environment = match &plan.env_file {
         Some(f) => {
             let src = load::load(
@@ -941,21 +981,20 @@ fn srgb8(x: f32) -> u8 {
 }
 
 /// Writes display-ready frames (linear, in `[0, 1]`) as an animated PNG that loops, at
-/// `fps` frames per second; written beside the target and renamed into place.
+/// `fps` frames per second, atomically.
 fn write_apng(path: &Path, frames: &[Image], fps: u16) -> Result<(), CliError> {
-    let fail = |e: String| CliError::input(format!("{}: {e}", path.display()));
     let (w, h) = (frames[0].width(), frames[0].height());
-    let tmp = path.with_extension("png.partial");
-    let result = (|| -> Result<(), String> {
-        let file = std::fs::File::create(&tmp).map_err(|e| e.to_string())?;
-        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), w, h);
+    let fail = |e: String| mirrorball_io::Error::input(path, e);
+    mirrorball_io::atomic_write(path, |out| {
+        let mut enc = png::Encoder::new(out, w, h);
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(png::BitDepth::Eight);
         enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         enc.set_animated(frames.len() as u32, 0)
-            .map_err(|e| e.to_string())?;
-        enc.set_frame_delay(1, fps).map_err(|e| e.to_string())?;
-        let mut wr = enc.write_header().map_err(|e| e.to_string())?;
+            .map_err(|e| fail(e.to_string()))?;
+        enc.set_frame_delay(1, fps)
+            .map_err(|e| fail(e.to_string()))?;
+        let mut wr = enc.write_header().map_err(|e| fail(e.to_string()))?;
         for f in frames {
             let c = f.channels();
             let bytes: Vec<u8> = f
@@ -971,17 +1010,12 @@ fn write_apng(path: &Path, frames: &[Image], fps: u16) -> Result<(), CliError> {
                     ]
                 })
                 .collect();
-            wr.write_image_data(&bytes).map_err(|e| e.to_string())?;
+            wr.write_image_data(&bytes)
+                .map_err(|e| fail(e.to_string()))?;
         }
-        wr.finish().map_err(|e| e.to_string())
-    })();
-    match result {
-        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| fail(e.to_string())),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(fail(e))
-        }
-    }
+        wr.finish().map_err(|e| fail(e.to_string()))
+    })?;
+    Ok(())
 }
 
 /// An RGB picture as RGBA with alpha 1.

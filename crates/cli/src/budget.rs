@@ -1,0 +1,105 @@
+//! Memory a job will need, estimated before it starts and refused, with a message that says
+//! how much and what to do, when it would not fit (instead of the allocator's abort).
+
+use crate::error::CliError;
+use std::sync::OnceLock;
+
+/// `--max-memory`, when given.
+static MAX: OnceLock<u64> = OnceLock::new();
+
+/// Sets the limit from `--max-memory`.
+pub fn set_max(bytes: Option<u64>) {
+    if let Some(b) = bytes {
+        let _ = MAX.set(b);
+    }
+}
+
+/// The limit: `--max-memory`, or else the memory the system has available now (Linux:
+/// `MemAvailable` in `/proc/meminfo`); `None` when neither is known.
+fn limit() -> Option<(u64, &'static str)> {
+    if let Some(&m) = MAX.get() {
+        return Some((m, "--max-memory"));
+    }
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some((kb * 1024, "available memory"))
+}
+
+/// Refuses `what` when it needs more than the limit: `held` bytes it already holds (a
+/// source read into memory) and `more` it will allocate. `hint` says what to change ("a
+/// smaller --size").
+pub fn check(what: &str, held: u64, more: u64, hint: &str) -> Result<(), CliError> {
+    let Some((max, source)) = limit() else {
+        return Ok(());
+    };
+    // Memory available now excludes what is already held.
+    let max = if MAX.get().is_some() {
+        max
+    } else {
+        max.saturating_add(held)
+    };
+    let bytes = held.saturating_add(more);
+    if bytes <= max {
+        return Ok(());
+    }
+    Err(CliError::request(format!(
+        "{what} needs about {} of memory, more than the {} of {source}; use {hint}, or raise --max-memory",
+        human(bytes),
+        human(max)
+    )))
+}
+
+/// `bytes` for people: "12.9 GB".
+pub fn human(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else if b >= 1e6 {
+        format!("{:.0} MB", b / 1e6)
+    } else {
+        format!("{:.0} kB", (b / 1e3).max(1.0))
+    }
+}
+
+/// Parses a `--max-memory` value: bytes, or a number with K, M, G or T (powers of 1024;
+/// an optional `B` or `iB` after it).
+pub fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let lower = t.to_ascii_lowercase();
+    let digits = lower.trim_end_matches(['b', 'i']);
+    let (num, mult) = match digits.chars().last() {
+        Some('k') => (&digits[..digits.len() - 1], 1u64 << 10),
+        Some('m') => (&digits[..digits.len() - 1], 1 << 20),
+        Some('g') => (&digits[..digits.len() - 1], 1 << 30),
+        Some('t') => (&digits[..digits.len() - 1], 1 << 40),
+        _ => (digits, 1),
+    };
+    match num.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v * (mult as f64) < 1.8e19 => {
+            Ok((v * mult as f64) as u64)
+        }
+        _ => Err(format!("'{s}' is not a memory size (for example 8G, 512M)")),
+    }
+}
+
+/// Bytes of `texels` texels of `channels` `f32` channels.
+pub fn f32_texels(texels: u64, channels: u64) -> u64 {
+    texels.saturating_mul(channels).saturating_mul(4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_bytes("8G"), Ok(8 << 30));
+        assert_eq!(parse_bytes("512MiB"), Ok(512 << 20));
+        assert_eq!(parse_bytes("1.5k"), Ok(1536));
+        assert_eq!(parse_bytes("1000"), Ok(1000));
+        for bad in ["", "G", "-1G", "nan", "x", "1e30T"] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
+        }
+    }
+}

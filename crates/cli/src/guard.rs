@@ -1,0 +1,149 @@
+//! No output may be an input, nor two outputs one file: checked on the files themselves
+//! (device and inode), so that `./s.exr`, `$PWD/s.exr`, `sub/../s.exr`, hard links and
+//! symbolic links are all caught, before anything is written.
+
+use crate::error::CliError;
+use std::path::{Path, PathBuf};
+
+/// The files a command reads and writes, gathered while its plan is made.
+#[derive(Default)]
+pub struct Files {
+    inputs: Vec<(String, PathBuf)>,
+    outputs: Vec<(String, PathBuf)>,
+}
+
+impl Files {
+    /// No files yet.
+    pub fn new() -> Files {
+        Files::default()
+    }
+
+    /// A file the command reads; `what` names it for messages ("the input", "--env").
+    pub fn input(&mut self, what: &str, path: impl Into<PathBuf>) -> &mut Files {
+        self.inputs.push((what.to_string(), path.into()));
+        self
+    }
+
+    /// The file(s) of an input argument: one per layer when the name holds `{face}`.
+    pub fn input_arg(&mut self, what: &str, arg: &str) -> &mut Files {
+        if arg.contains(crate::load::FACE) {
+            for n in crate::load::layer_names(6)
+                .iter()
+                .chain(crate::load::layer_names(2))
+            {
+                self.input(what, arg.replace(crate::load::FACE, n));
+            }
+            self
+        } else {
+            self.input(what, arg)
+        }
+    }
+
+    /// A file the command writes; `what` names it for messages ("the output", "--sh").
+    pub fn output(&mut self, what: &str, path: impl Into<PathBuf>) -> &mut Files {
+        self.outputs.push((what.to_string(), path.into()));
+        self
+    }
+
+    /// Refuses the request when an output is one of the inputs or two outputs are one
+    /// file.
+    pub fn check(&self) -> Result<(), CliError> {
+        for (what_out, out) in &self.outputs {
+            for (what_in, inp) in &self.inputs {
+                if mirrorball_io::same_file(inp, out) {
+                    return Err(CliError::request(format!(
+                        "{}: {what_out} would overwrite {what_in} {} (the same file); choose another name",
+                        out.display(),
+                        inp.display()
+                    )));
+                }
+            }
+        }
+        let ids: Vec<Option<PathBuf>> = self.outputs.iter().map(|(_, p)| identity(p)).collect();
+        for (i, (what_a, a)) in self.outputs.iter().enumerate() {
+            for (j, (what_b, b)) in self.outputs.iter().enumerate().skip(i + 1) {
+                let same = match (&ids[i], &ids[j]) {
+                    (Some(x), Some(y)) => x == y,
+                    _ => false,
+                } || mirrorball_io::same_file(a, b);
+                if same {
+                    return Err(CliError::request(format!(
+                        "{}: {what_a} and {what_b} ({}) are the same file; give them different names",
+                        a.display(),
+                        b.display()
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Where `p` will be written: its folder resolved (symbolic links, `..`) joined with its
+/// name, or the file itself resolved when it exists; `None` when the folder does not exist.
+fn identity(p: &Path) -> Option<PathBuf> {
+    if let Ok(c) = std::fs::canonicalize(p) {
+        return Some(c);
+    }
+    let name = p.file_name()?;
+    let dir = match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    Some(std::fs::canonicalize(dir).ok()?.join(name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_name_of_the_input_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let input = d.join("s.exr");
+        std::fs::write(&input, b"x").unwrap();
+        std::fs::create_dir(d.join("sub")).unwrap();
+        std::fs::hard_link(&input, d.join("hard.exr")).unwrap();
+        #[cfg(unix)]
+        std::os::unix::fs::symlink(&input, d.join("soft.exr")).unwrap();
+        let mut names = vec![
+            d.join("./s.exr"),
+            d.join("sub/../s.exr"),
+            d.join("hard.exr"),
+        ];
+        if cfg!(unix) {
+            names.push(d.join("soft.exr"));
+        }
+        for out in names {
+            let mut f = Files::new();
+            f.input("the input", &input).output("the output", &out);
+            let e = f.check().expect_err(&out.display().to_string());
+            assert_eq!(e.code, 2);
+            assert!(
+                e.message.contains("would overwrite the input"),
+                "{}",
+                e.message
+            );
+        }
+        let mut f = Files::new();
+        f.input("the input", &input)
+            .output("the output", d.join("t.exr"));
+        assert!(f.check().is_ok());
+    }
+
+    #[test]
+    fn two_outputs_that_are_one_file_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::create_dir(d.join("sub")).unwrap();
+        let mut f = Files::new();
+        f.output("the output", d.join("a.png"))
+            .output("--preview", d.join("sub/../a.png"));
+        assert!(f.check().unwrap_err().message.contains("are the same file"));
+        let mut f = Files::new();
+        f.output("the output", d.join("a.png"))
+            .output("--preview", d.join("b.png"));
+        assert!(f.check().is_ok());
+    }
+}
