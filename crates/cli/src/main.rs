@@ -196,11 +196,16 @@ pub struct RenderArgs {
     /// footprint, objects and background; mode 4 always filters: EWA unless trilinear).
     #[arg(long, default_value = "bilinear")]
     filter: String,
-    /// Material: mirror, fresnel, cheap-chrome, diffuse,
-    /// greene[:dc=R,G,B][:sc=R,G,B][:phong=EXP|:ggx=ROUGHNESS] (Greene's dc·D + sc·S from
-    /// prefiltered maps), phong-map[:exponent=N][:light=X,Y,Z][:specular=R,G,B][:ambient=A]
-    /// (highlights from a sphere map of Phong intensities, light in eye space).
-    #[arg(long, default_value = "mirror")]
+    // The help is an attribute, not a doc comment: rustdoc would read its brackets as links.
+    #[arg(
+        long,
+        default_value = "mirror",
+        help = "Material: mirror, fresnel, cheap-chrome, diffuse, \
+                greene[:dc=R,G,B][:sc=R,G,B][:phong=EXP|:ggx=ROUGHNESS] (Greene's dc·D + sc·S \
+                from prefiltered maps), \
+                phong-map[:exponent=N][:light=X,Y,Z][:specular=R,G,B][:ambient=A] \
+                (highlights from a sphere map of Phong intensities, light in eye space)"
+    )]
     material: String,
     /// Tint of a mirror, base colour of fresnel/diffuse: r,g,b.
     #[arg(long, default_value = "1,1,1")]
@@ -333,9 +338,12 @@ pub struct PrefilterArgs {
     /// the energy removed is reported.
     #[arg(long, default_value = "none")]
     compress: String,
-    /// Window against spherical-harmonic ringing: none, hann[:W], lanczos[:W], auto (the
-    /// weakest Hann window with non-negative irradiance).
-    #[arg(long, default_value = "none")]
+    #[arg(
+        long,
+        default_value = "none",
+        help = "Window against spherical-harmonic ringing: none, hann[:W], lanczos[:W], auto \
+                (the weakest Hann window with non-negative irradiance)"
+    )]
     sh_window: String,
     /// How lambert maps are computed: exact (the brute-force sum, fast) or sh (nine
     /// coefficients, windowed by --sh-window).

@@ -41,3 +41,20 @@ pub fn with_progress<T: Send>(
         out
     })
 }
+
+/// Runs `work` while a spinner with the elapsed time says `label`: for work that cannot
+/// count its progress (encoding and writing a file).
+pub fn with_spinner<T: Send>(label: &str, quiet: bool, work: impl FnOnce() -> T + Send) -> T {
+    if quiet {
+        return work();
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>10} {spinner} {elapsed}").expect("valid template"),
+    );
+    bar.set_message(label.to_string());
+    bar.enable_steady_tick(Duration::from_millis(100));
+    let out = work();
+    bar.finish_and_clear();
+    out
+}

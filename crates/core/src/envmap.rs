@@ -56,11 +56,12 @@ pub struct Stats {
     pub max: f32,
     /// Mean colour (RGB) over the sphere, each texel weighted by its exact solid angle.
     pub mean: [f64; 3],
-    /// Texels with a NaN in a colour channel.
+    /// NaN colour values (a texel counts up to three times, once per channel; alpha is not
+    /// counted): with `inf` and `negative`, what [`EnvMap::sanitize`] changes.
     pub nan: u64,
-    /// Texels with an infinite colour channel.
+    /// Infinite colour values.
     pub inf: u64,
-    /// Texels with a negative colour channel.
+    /// Negative (finite) colour values.
     pub negative: u64,
     /// Solid angle the texels cover (should be the projection's covered solid angle).
     pub solid_angle: f64,
@@ -193,16 +194,13 @@ impl EnvMap {
             let weights = self.solid_angles(layer);
             for (px, &w) in img.data().chunks_exact(c).zip(&weights) {
                 let rgb = &px[..3];
-                if rgb.iter().any(|v| v.is_nan()) {
-                    s.nan += 1;
+                let nan = rgb.iter().filter(|v| v.is_nan()).count() as u64;
+                let inf = rgb.iter().filter(|v| v.is_infinite()).count() as u64;
+                s.nan += nan;
+                s.inf += inf;
+                s.negative += rgb.iter().filter(|&&v| v < 0.0 && v.is_finite()).count() as u64;
+                if nan + inf > 0 {
                     continue;
-                }
-                if rgb.iter().any(|v| v.is_infinite()) {
-                    s.inf += 1;
-                    continue;
-                }
-                if rgb.iter().any(|&v| v < 0.0) {
-                    s.negative += 1;
                 }
                 if w <= 0.0 {
                     continue;

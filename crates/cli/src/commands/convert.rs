@@ -4,7 +4,7 @@ use super::InputPlan;
 use crate::budget;
 use crate::error::CliError;
 use crate::guard::Files;
-use crate::progress::with_progress;
+use crate::progress::{with_progress, with_spinner};
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
@@ -79,9 +79,9 @@ impl Plan {
             (Format::Png, Some(Precision::Half | Precision::Float))
             | (Format::Jpeg, Some(Precision::Half | Precision::Float | Precision::U16)) => {
                 return Err(CliError::request(format!(
-                    "{}: --precision {:?} does not fit this container",
+                    "{}: --precision {} does not fit this container (PNG: 8 or 16; JPEG: 8)",
                     a.output,
-                    precision.unwrap()
+                    a.precision.as_deref().unwrap_or_default()
                 )))
             }
             (Format::Exr | Format::Ktx2 | Format::Dds, Some(Precision::U8 | Precision::U16)) => {
@@ -224,7 +224,9 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
             let t_conv = t1.elapsed();
             drop(src);
             let t2 = Instant::now();
-            let files = save::save(&out, &a.output, &plan.save)?;
+            let files = with_spinner("writing", a.quiet, || {
+                save::save(&out, &a.output, &plan.save)
+            })?;
             (files, t_conv, Some(t2.elapsed()))
         }
     };

@@ -31,9 +31,9 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
             "min": s.min,
             "max": s.max,
             "mean_rgb": s.mean,
-            "nan_texels": s.nan,
-            "inf_texels": s.inf,
-            "negative_texels": s.negative,
+            "nan_values": s.nan,
+            "inf_values": s.inf,
+            "negative_values": s.negative,
         });
         println!(
             "{}",
@@ -66,8 +66,11 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
         s.mean[0], s.mean[1], s.mean[2]
     );
     println!(
-        "invalid:     {} NaN, {} infinite, {} negative texels",
-        s.nan, s.inf, s.negative
+        "invalid:     {} NaN, {} infinite, {} negative colour values ({} in all; convert and prefilter set them to 0)",
+        s.nan,
+        s.inf,
+        s.negative,
+        s.nan + s.inf + s.negative
     );
     Ok(())
 }

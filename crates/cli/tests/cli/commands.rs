@@ -245,7 +245,23 @@ fn info_reports_guess_stats_and_json() {
     let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("valid JSON");
     assert_eq!(v["projection"], "latlong");
     assert!((v["solid_angle_sr"].as_f64().unwrap() - 4.0 * std::f64::consts::PI).abs() < 1e-6);
-    assert!(v["negative_texels"].as_u64().is_some());
+    // The bundled map's negative values, as many as convert reports setting to 0.
+    let negative = v["negative_values"].as_u64().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.exr");
+    let e = ok(&[
+        "convert",
+        asset("city.exr").to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--to",
+        "cube",
+        "--size",
+        "8",
+    ]);
+    assert!(
+        negative > 0 && e.contains(&format!("{negative} NaN, infinite or negative values")),
+        "{negative}: {e}"
+    );
 }
 
 #[test]
