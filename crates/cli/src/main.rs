@@ -35,7 +35,7 @@ enum Command {
     /// Describe an environment map: projection, size, layout, radiance statistics.
     Info(InfoArgs),
     /// Compare two environment maps (the second is converted to the first's projection and
-    /// size) and print the log-domain PSNR.
+    /// size) and print the log-domain PSNR over the directions both cover.
     Compare(CompareArgs),
     /// Convert a bundled HDR environment into every projection and write previews.
     Demo(DemoArgs),
@@ -144,6 +144,13 @@ pub struct CompareArgs {
     /// Projection of the test map (guessed when omitted).
     #[arg(long = "test-from")]
     test_from: Option<String>,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Also write where they differ, in the reference's projection and layout: a .png heat
+    /// map (black equal, white the largest difference) or an .exr of |ln(1+r) − ln(1+t)|.
+    #[arg(long, value_name = "FILE")]
+    diff: Option<String>,
 }
 
 #[derive(Args, Debug)]

@@ -377,3 +377,62 @@ fn latlong_exr_outputs_declare_their_projection() {
         None
     );
 }
+
+/// `compare` scores what both maps cover (a 180° fisheye: half the sphere), says so in its
+/// JSON, and draws where they differ in the reference's projection.
+#[test]
+fn compare_scores_the_common_coverage_with_json_and_a_difference_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let city = asset("city.exr");
+    let c = city.to_str().unwrap();
+    let fe = d.join("fe.exr");
+    let f = fe.to_str().unwrap();
+    ok(&[
+        "convert",
+        c,
+        f,
+        "--to",
+        "fisheye:fov=180",
+        "--size",
+        "256",
+        "-q",
+    ]);
+    let diff = d.join("diff.png");
+    let o = run(&[
+        "compare",
+        c,
+        f,
+        "--test-from",
+        "fisheye:fov=180",
+        "--json",
+        "--diff",
+        diff.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("valid JSON");
+    assert!(
+        (v["compared_fraction_of_sphere"].as_f64().unwrap() - 0.5).abs() < 1e-3,
+        "{v}"
+    );
+    // Over the half it covers the fisheye is close; counted over the whole sphere, the
+    // uncovered half (black) would drag it far down.
+    let psnr = v["log_psnr_db"].as_f64().unwrap();
+    assert!(psnr > 35.0, "{v}");
+    let picture = mirrorball_io::read(&diff, &Default::default()).unwrap();
+    assert_eq!(
+        (picture.layers[0].width(), picture.layers[0].height()),
+        (512, 256)
+    );
+    // A map against itself: no difference anywhere, an all-black picture.
+    let same = d.join("same.exr");
+    let o = run(&["compare", c, c, "--json", "--diff", same.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("valid JSON");
+    assert_eq!(v["log_psnr_db"], "inf");
+    assert!((v["compared_fraction_of_sphere"].as_f64().unwrap() - 1.0).abs() < 1e-9);
+    let zero = mirrorball_io::read(&same, &Default::default()).unwrap();
+    assert!(zero.layers[0].data().iter().all(|&x| x == 0.0));
+    // The difference picture may not replace an input.
+    let o = run(&["compare", c, f, "--diff", c]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
