@@ -47,6 +47,16 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
         )));
     }
     let layers = kind.default_projection().layer_count();
+    if out.contains(FACE) && (layers == 1 || format.is_cube_container()) {
+        return Err(CliError::request(format!(
+            "{out}: {FACE} in the name writes one file per layer, but {}",
+            if layers == 1 {
+                format!("a {kind} map has one layer; leave {FACE} out")
+            } else {
+                "KTX2 and DDS hold all six faces in one file; leave it out".to_string()
+            }
+        )));
+    }
     if let Some(l) = layout {
         if !l.fits(layers) {
             return Err(CliError::request(format!(
