@@ -376,7 +376,13 @@ fn a_face_placeholder_where_there_is_one_layer_is_refused() {
     let city = asset("city.exr");
     for (to, out) in [("latlong", "ll_{face}.exr"), ("cube", "c_{face}.ktx2")] {
         let o = dir.path().join(out);
-        let r = run(&["convert", city.to_str().unwrap(), o.to_str().unwrap(), "--to", to]);
+        let r = run(&[
+            "convert",
+            city.to_str().unwrap(),
+            o.to_str().unwrap(),
+            "--to",
+            to,
+        ]);
         let e = stderr(&r);
         assert_eq!(r.status.code(), Some(2), "{e}");
         assert!(e.contains("{face}") && e.contains("leave"), "{e}");
