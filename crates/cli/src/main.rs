@@ -12,7 +12,8 @@ mod progress;
 mod save;
 mod spec;
 
-use clap::{Args, Parser, Subcommand};
+use clap::parser::ValueSource;
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use error::CliError;
 use std::process::ExitCode;
 
@@ -169,7 +170,7 @@ pub struct DemoArgs {
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// A scene file (.json or .toml, the same schema: meshes with model matrices, camera,
-    /// environment, material, indexing); its values override the flags.
+    /// environment, material, indexing); a flag given on the command line wins over it.
     scene: Option<String>,
     /// Output image: .png/.jpg (exposure, tone curve, sRGB) or .exr/.hdr (linear).
     #[arg(short, long, default_value = "render.png")]
@@ -282,6 +283,10 @@ pub struct RenderArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
+    /// The flags given on the command line (their ids), which win over the scene file's
+    /// values; filled from clap's matches, not parsed.
+    #[arg(skip)]
+    given: Vec<String>,
 }
 
 #[derive(Args, Debug)]
@@ -438,7 +443,16 @@ fn finite_f32(s: &str) -> Result<f32, String> {
 
 fn main() -> ExitCode {
     on_interrupt_clean_up();
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let mut cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    if let (Command::Render(r), Some(m)) = (&mut cli.command, matches.subcommand_matches("render"))
+    {
+        r.given = m
+            .ids()
+            .filter(|id| m.value_source(id.as_str()) == Some(ValueSource::CommandLine))
+            .map(|id| id.to_string())
+            .collect();
+    }
     budget::set_max(cli.max_memory);
     let result: Result<(), CliError> = match cli.command {
         Command::Convert(a) => commands::convert::run(a),

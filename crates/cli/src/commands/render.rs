@@ -360,7 +360,10 @@ impl RenderPlan {
             quiet: a.quiet,
         };
         if let Some(scene) = &a.scene {
+            let flags = FlagValues::of(&plan);
             apply_scene_file(&mut plan, Path::new(scene))?;
+            flags.win_over_the_scene(&mut plan, &a.given);
+            plan.camera.validate().map_err(|e| bad("camera", e))?;
         }
         let needs_env =
             plan.background || plan.objects.iter().any(|o| o.material.uses_environment());
@@ -370,6 +373,94 @@ impl RenderPlan {
             ));
         }
         Ok(plan)
+    }
+}
+
+/// What the flags made of the plan, kept while a scene file is applied so that the flags
+/// given on the command line can win over it afterwards.
+struct FlagValues {
+    camera: Camera,
+    objects: Vec<ObjectPlan>,
+    env_file: Option<String>,
+    from: Option<ProjSpec>,
+    layout: Option<mirrorball_core::Layout>,
+    attach: Attach,
+    filter: Filter,
+    settings: Settings,
+    background: bool,
+}
+
+impl FlagValues {
+    fn of(plan: &RenderPlan) -> FlagValues {
+        FlagValues {
+            camera: plan.camera,
+            objects: plan.objects.clone(),
+            env_file: plan.env_file.clone(),
+            from: plan.input.from.clone(),
+            layout: plan.input.layout,
+            attach: plan.attach,
+            filter: plan.filter,
+            settings: plan.settings,
+            background: plan.background,
+        }
+    }
+
+    /// Puts back into `plan` what each flag in `given` (clap's ids) set.
+    fn win_over_the_scene(self, plan: &mut RenderPlan, given: &[String]) {
+        let g = |id: &str| given.iter().any(|x| x == id);
+        let (c, f) = (&mut plan.camera, &self.camera);
+        if g("eye") {
+            c.eye = f.eye;
+        }
+        if g("target") {
+            c.target = f.target;
+        }
+        if g("up") {
+            c.up = f.up;
+        }
+        if g("fov") || g("ortho") {
+            c.lens = f.lens;
+        }
+        if g("near") {
+            c.near = f.near;
+        }
+        if g("far") {
+            c.far = f.far;
+        }
+        if g("size") {
+            (c.width, c.height) = (f.width, f.height);
+        }
+        if g("object") || g("tessellation") {
+            plan.objects = self.objects.clone();
+        }
+        if g("material") || g("tint") || g("f0") {
+            let m = self.objects[0].material.clone();
+            plan.objects.iter_mut().for_each(|o| o.material = m.clone());
+        }
+        if g("env") {
+            plan.env_file = self.env_file;
+        }
+        if g("from") {
+            plan.input.from = self.from;
+        }
+        if g("in_layout") {
+            plan.input.layout = self.layout;
+        }
+        if g("attach") {
+            plan.attach = self.attach;
+        }
+        if g("filter") {
+            plan.filter = self.filter;
+        }
+        if g("mode") {
+            plan.settings.indexing = self.settings.indexing;
+        }
+        if g("ss") {
+            plan.settings.supersample = self.settings.supersample;
+        }
+        if g("no_background") {
+            plan.background = self.background;
+        }
     }
 }
 

@@ -517,3 +517,42 @@ fn render_bad_material_and_filter_specs_say_what_is_wrong() {
     assert!(stderr(&r).contains("trilinear or ewa"));
     assert!(!out.exists());
 }
+
+/// A flag given on the command line wins over the scene file; the scene's other values
+/// stay (its camera size and samples, its indexing mode, when no flag names them).
+#[test]
+fn flags_on_the_command_line_win_over_the_scene_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/scenes/greene-trio.toml");
+    let out = dir.path().join("trio.png");
+    let e = crate::util::ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--size",
+        "64x36",
+        "--ss",
+        "2",
+        "--mode",
+        "pixel",
+    ]);
+    assert!(
+        e.contains("64x36") && e.contains("2x2 samples") && e.contains("mode pixel"),
+        "{e}"
+    );
+    let img = mirrorball_io::read(&out, &Default::default()).unwrap();
+    assert_eq!((img.layers[0].width(), img.layers[0].height()), (64, 36));
+    // Without the flags, the scene's own values.
+    let e = crate::util::ok(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("320x180") && e.contains("1x1 samples") && e.contains("mode cone"),
+        "{e}"
+    );
+}
