@@ -52,6 +52,7 @@ pub use cpu::set_portable;
 pub use lookup::{EnvCache, SpecularLobe};
 pub use mesh::{Builtin, Mesh};
 pub use render::{
-    render, render_into, sphere_map_texcoords, texture_space_diagram, Aovs, Frame, RenderError,
+    render, render_into, render_with_progress, sphere_map_texcoords, texture_space_diagram, Aovs,
+    Frame, RenderError,
 };
 pub use scene::{Attach, Environment, Filter, Indexing, Material, Object, Ramp, Scene, Settings};

@@ -14,6 +14,7 @@ use crate::scene::{Attach, Filter, Indexing, Material, Scene, Settings};
 use glam::{DVec2, DVec3, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4};
 use mirrorball_core::{Image, Projection, SphereMap, WorldProjection};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A rendered picture and, when asked, its diagnostic channels.
 #[derive(Clone, Debug)]
@@ -149,6 +150,32 @@ pub fn render_into(
     settings: &Settings,
     frame: &mut Frame,
 ) -> Result<(), RenderError> {
+    render_counting(scene, cam, settings, frame, None)
+}
+
+/// [`render`], adding to `rows_done` the pixel rows of each band as it is finished (for a
+/// progress bar: `cam.height` in all).
+pub fn render_with_progress(
+    scene: &Scene,
+    cam: &Camera,
+    settings: &Settings,
+    rows_done: &AtomicU64,
+) -> Result<Frame, RenderError> {
+    let mut frame = Frame {
+        color: Image::new(0, 0, 4),
+        aovs: None,
+    };
+    render_counting(scene, cam, settings, &mut frame, Some(rows_done))?;
+    Ok(frame)
+}
+
+fn render_counting(
+    scene: &Scene,
+    cam: &Camera,
+    settings: &Settings,
+    frame: &mut Frame,
+    rows_done: Option<&AtomicU64>,
+) -> Result<(), RenderError> {
     cam.validate().map_err(RenderError)?;
     if let Some(prev) = &settings.motion_from {
         prev.validate()
@@ -222,77 +249,88 @@ pub fn render_into(
     let mirrors = (ss == 1 && !settings.aovs)
         .then(|| p.mirror_setups(&binned))
         .flatten();
+    // One band of pixel rows: rasterised into `buf`, shaded into `out`; its diagnostic
+    // channels when asked for.
+    let shade_band = |buf: &mut crate::raster::BandBuffer,
+                      b: usize,
+                      out: &mut [f32],
+                      rows: u32|
+     -> Option<[Vec<f32>; 4]> {
+        let y0 = b as u32 * band_px;
+        let mut aov: Option<[Vec<f32>; 4]> = settings
+            .aovs
+            .then(|| std::array::from_fn(|_| vec![0.0f32; (w * rows * 3) as usize]));
+        if binned.band_is_empty(b) && !scene.background && aov.is_none() {
+            out.fill(0.0); // transparent black
+            return None;
+        }
+        let cols = binned.scan_band(b, buf);
+        let (depth, ids) = (buf.depth(), buf.ids());
+        if ss == 1 && aov.is_none() {
+            let vis = BandVis {
+                binned: &binned,
+                depth,
+                ids,
+                cols,
+                mirrors: mirrors.as_deref(),
+            };
+            p.shade_band_fast(y0, &vis, out);
+            return None;
+        }
+        for ly in 0..rows {
+            for x in 0..w {
+                let mut acc = [0.0f32; 3];
+                let mut hits = 0u32;
+                for j in 0..ss {
+                    for i in 0..ss {
+                        let (sx, lsy) = (x * ss + i, ly * ss + j);
+                        let sy = y0 * ss + lsy;
+                        let k = (lsy * p.sw + sx) as usize;
+                        if ids[k] == NO_HIT && fast_empty {
+                            continue; // transparent black, nothing to record
+                        }
+                        let s = binned.sample(ids[k], depth[k], sx, sy);
+                        let sh = p.shade(sx, sy, s);
+                        hits += sh.covered as u32;
+                        for (a, c) in acc.iter_mut().zip(sh.color) {
+                            *a += c;
+                        }
+                        if let (Some(aov), true) = (aov.as_mut(), i == centre && j == centre) {
+                            let k = ((ly * w + x) * 3) as usize;
+                            aov[0][k..k + 3].copy_from_slice(&sh.st);
+                            aov[1][k..k + 3].copy_from_slice(&sh.r.to_array());
+                            aov[2][k..k + 3].copy_from_slice(&sh.n.to_array());
+                            aov[3][k] = sh.eye_depth;
+                            aov[3][k + 1] = sh.win_depth;
+                        }
+                    }
+                }
+                let cov = hits as f32 * inv;
+                let k = ((ly * w + x) * 4) as usize;
+                for c in 0..3 {
+                    out[k + c] = acc[c] * inv;
+                }
+                out[k + 3] = if scene.background { 1.0 } else { cov };
+                if let Some(aov) = aov.as_mut() {
+                    aov[3][((ly * w + x) * 3 + 2) as usize] = cov;
+                }
+            }
+        }
+        aov
+    };
     let aov_bands: Vec<Option<[Vec<f32>; 4]>> = color
         .data_mut()
         .par_chunks_mut(row_len * band_px as usize)
         .enumerate()
         .map_init(
             crate::raster::BandBuffer::default,
-            |buf: &mut crate::raster::BandBuffer, (b, out)| {
+            |buf: &mut crate::raster::BandBuffer, (b, out): (usize, &mut [f32])| {
                 let rows = (out.len() / row_len) as u32;
-                let y0 = b as u32 * band_px;
-                let mut aov: Option<[Vec<f32>; 4]> = settings
-                    .aovs
-                    .then(|| std::array::from_fn(|_| vec![0.0f32; (w * rows * 3) as usize]));
-                if binned.band_is_empty(b) && !scene.background && aov.is_none() {
-                    out.fill(0.0); // transparent black
-                    return None;
+                let band = shade_band(buf, b, out, rows);
+                if let Some(done) = rows_done {
+                    done.fetch_add(rows as u64, Ordering::Relaxed);
                 }
-                let cols = binned.scan_band(b, buf);
-                let (depth, ids) = (buf.depth(), buf.ids());
-                if ss == 1 && aov.is_none() {
-                    let vis = BandVis {
-                        binned: &binned,
-                        depth,
-                        ids,
-                        cols,
-                        mirrors: mirrors.as_deref(),
-                    };
-                    p.shade_band_fast(y0, &vis, out);
-                    return None;
-                }
-                for ly in 0..rows {
-                    for x in 0..w {
-                        let mut acc = [0.0f32; 3];
-                        let mut hits = 0u32;
-                        for j in 0..ss {
-                            for i in 0..ss {
-                                let (sx, lsy) = (x * ss + i, ly * ss + j);
-                                let sy = y0 * ss + lsy;
-                                let k = (lsy * p.sw + sx) as usize;
-                                if ids[k] == NO_HIT && fast_empty {
-                                    continue; // transparent black, nothing to record
-                                }
-                                let s = binned.sample(ids[k], depth[k], sx, sy);
-                                let sh = p.shade(sx, sy, s);
-                                hits += sh.covered as u32;
-                                for (a, c) in acc.iter_mut().zip(sh.color) {
-                                    *a += c;
-                                }
-                                if let (Some(aov), true) =
-                                    (aov.as_mut(), i == centre && j == centre)
-                                {
-                                    let k = ((ly * w + x) * 3) as usize;
-                                    aov[0][k..k + 3].copy_from_slice(&sh.st);
-                                    aov[1][k..k + 3].copy_from_slice(&sh.r.to_array());
-                                    aov[2][k..k + 3].copy_from_slice(&sh.n.to_array());
-                                    aov[3][k] = sh.eye_depth;
-                                    aov[3][k + 1] = sh.win_depth;
-                                }
-                            }
-                        }
-                        let cov = hits as f32 * inv;
-                        let k = ((ly * w + x) * 4) as usize;
-                        for c in 0..3 {
-                            out[k + c] = acc[c] * inv;
-                        }
-                        out[k + 3] = if scene.background { 1.0 } else { cov };
-                        if let Some(aov) = aov.as_mut() {
-                            aov[3][((ly * w + x) * 3 + 2) as usize] = cov;
-                        }
-                    }
-                }
-                aov
+                band
             },
         )
         .collect();

@@ -947,7 +947,9 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     let frames = plan.frames;
     let label = if frames > 1 { "frames" } else { "render" };
     let started = std::time::Instant::now();
-    let results = with_progress(label, frames as u64, plan.quiet || frames == 1, |counter| {
+    // Progress in pixel rows, every frame's.
+    let rows = plan.camera.height as u64;
+    let results = with_progress(label, frames as u64 * rows, plan.quiet, |counter| {
         (0..frames)
             .map(|i| {
                 let angle = std::f32::consts::TAU * i as f32 / frames as f32;
@@ -968,14 +970,18 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                         (cam.width / 2).max(16),
                         &settings,
                     )
-                    .map(|img| mirrorball_render::Frame {
-                        color: with_alpha(&img),
-                        aovs: None,
+                    .map(|img| {
+                        counter.fetch_add(rows, Ordering::Relaxed);
+                        mirrorball_render::Frame {
+                            color: with_alpha(&img),
+                            aovs: None,
+                        }
                     }),
-                    None => mirrorball_render::render(&scene, &cam, &settings),
+                    None => {
+                        mirrorball_render::render_with_progress(&scene, &cam, &settings, &counter)
+                    }
                 }
                 .map_err(|e| CliError::request(e.to_string()));
-                counter.fetch_add(1, Ordering::Relaxed);
                 f
             })
             .collect::<Vec<_>>()
