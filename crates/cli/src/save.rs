@@ -4,7 +4,7 @@
 use crate::error::CliError;
 use crate::load::{layer_names, FACE};
 use mirrorball_core::{resample, EnvMap, Layout, ProjectionKind, ResampleOptions, WorldProjection};
-use mirrorball_io::{Format, WriteOptions};
+use mirrorball_io::{Format, MapInfo, WriteOptions};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -135,7 +135,12 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
                 size /= 2;
             }
         }
-        mirrorball_io::write_cube(path, &levels, &opts.write)?;
+        let mut write = opts.write;
+        write.declared = Some(MapInfo {
+            projection: *env.projection(),
+            layout: None,
+        });
+        mirrorball_io::write_cube(path, &levels, &write)?;
         return Ok(vec![path.to_path_buf()]);
     }
     let n = env.layers().len();
@@ -149,7 +154,11 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
         return Ok(paths);
     }
     let mut write = opts.write;
-    write.declared = Some(env.projection().kind());
+    // Recorded in the file, so that reading it back needs no --from.
+    write.declared = Some(MapInfo {
+        projection: *env.projection(),
+        layout: Some(layout),
+    });
     let img = layout.pack(env).ok_or_else(|| {
         CliError::request(format!(
             "{out}: layout {layout} does not fit a map of {n} layer(s)"

@@ -13,7 +13,7 @@ use crate::ldr_io::{check_limits, check_writable_size, guard_decoder, open_input
 use crate::{
     atomic::stage, Error, ExrCompression, Format, Limits, Loaded, Precision, Staged, WriteOptions,
 };
-use exr::meta::attribute::EnvironmentMap;
+use exr::meta::attribute::{AttributeValue, EnvironmentMap, Text};
 use exr::meta::header::Header;
 use exr::prelude::{
     ChannelDescription, Compression, Encoding, LayerAttributes, LineOrder, ReadChannels,
@@ -33,7 +33,8 @@ const HALF_MAX: f32 = 65504.0;
 /// Reads the first RGB(A) layer of an OpenEXR file as linear `f32` texels.
 ///
 /// The `envmap` header attribute, if present, becomes [`Loaded::declared`] (latlong or
-/// cube). Files using a compression the `exr` crate cannot decode (HTJ2K) are refused
+/// cube), and the `mirrorball:projection` and `mirrorball:layout` string attributes
+/// [`Loaded::recorded`]. Files using a compression the `exr` crate cannot decode (HTJ2K) are refused
 /// before any texel is decoded, with a message that says how to re-save them.
 pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let file = open_input(path)?;
@@ -89,10 +90,8 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
             read_blocks(chunks, index, &header, &layout).map(|image| (image, None))
         }
         .map_err(|e| read_error(path, e))?;
-        let declared = header.own_attributes.environment_map.map(|m| match m {
-            EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
-            EnvironmentMap::Cube => ProjectionKind::Cube,
-        });
+        let declared = envmap_kind(header.own_attributes.environment_map);
+        let recorded = recorded_info(&header.own_attributes, image.width(), image.height());
         let types: Vec<SampleType> = header.channels.list.iter().map(|c| c.sample_type).collect();
         let layer_name = header
             .own_attributes
@@ -111,6 +110,7 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
         return Ok(Loaded {
             layers: vec![image],
             declared,
+            recorded,
             format: Format::Exr,
             description,
             invalid,
@@ -128,10 +128,12 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
 
     // Describe the layer that was read (the first readable RGB one).
     let layer = exr_image.layer_data;
-    let declared = layer.attributes.environment_map.map(|m| match m {
-        EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
-        EnvironmentMap::Cube => ProjectionKind::Cube,
-    });
+    let declared = envmap_kind(layer.attributes.environment_map);
+    let recorded = recorded_info(
+        &layer.attributes,
+        layer.size.width() as u32,
+        layer.size.height() as u32,
+    );
     let compression = layer.encoding.compression;
     let tiled = matches!(layer.encoding.blocks, exr::image::Blocks::Tiles(_));
     let layer_name = layer.attributes.layer_name.as_ref().map(|n| n.to_string());
@@ -163,18 +165,55 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
         invalid: None,
         layers: vec![image],
         declared,
+        recorded,
         format: Format::Exr,
         description,
     })
 }
 
-/// Layer attributes for a written file: the `envmap` attribute for lat-long maps.
+/// The kind OpenEXR's `envmap` attribute names.
+fn envmap_kind(envmap: Option<EnvironmentMap>) -> Option<ProjectionKind> {
+    envmap.map(|m| match m {
+        EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
+        EnvironmentMap::Cube => ProjectionKind::Cube,
+    })
+}
+
+/// [`Loaded::recorded`] from a layer's string attributes.
+fn recorded_info(
+    attributes: &LayerAttributes,
+    w: u32,
+    h: u32,
+) -> Option<Result<crate::MapInfo, String>> {
+    let get = |key: &str| match attributes.other.get(&Text::new_or_panic(key)) {
+        Some(AttributeValue::Text(t)) => Some(t.to_string()),
+        _ => None,
+    };
+    crate::recorded(get, w, h)
+}
+
+/// Layer attributes for a written file: the projection and layout as string attributes
+/// ([`crate::PROJECTION_KEY`], [`crate::LAYOUT_KEY`]). No `envmap` attribute: OpenEXR's
+/// lat-long and cube conventions are not mirrorball's (see [`crate::openexr`]), and pictures
+/// are written in mirrorball's.
 fn layer_attributes(opts: &WriteOptions) -> LayerAttributes {
-    LayerAttributes {
-        environment_map: (opts.declared == Some(ProjectionKind::LatLong))
-            .then_some(EnvironmentMap::LatitudeLongitude),
-        ..LayerAttributes::default()
+    let mut attributes = LayerAttributes::default();
+    if let Some(info) = &opts.declared {
+        let (projection, layout) = info.texts();
+        let mut put = |key: &str, value: String| {
+            // The texts are ASCII, which OpenEXR's strings hold.
+            if let Some(v) = Text::new_or_none(value) {
+                attributes
+                    .other
+                    .insert(Text::new_or_panic(key), AttributeValue::Text(v));
+            }
+        };
+        put(crate::PROJECTION_KEY, projection);
+        if let Some(l) = layout {
+            put(crate::LAYOUT_KEY, l);
+        }
     }
+    attributes
 }
 
 /// Writes `image` as a single-part scan-line OpenEXR file: half texels unless

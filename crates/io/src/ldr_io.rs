@@ -27,7 +27,8 @@ const CHUNK_TEXELS: usize = 1 << 14;
 /// linear, as stored.
 ///
 /// The declared size is checked against `limits` from the header, before any texel is
-/// decoded.
+/// decoded. A PNG's `mirrorball:projection` and `mirrorball:layout` text chunks become
+/// [`Loaded::recorded`].
 pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Error> {
     let (image_format, name) = match format {
         Format::Png => (ImageFormat::Png, "PNG"),
@@ -42,6 +43,15 @@ pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Erro
     };
     let file = open_input(path)?;
     guard_decoder(path, name, || {
+        if format == Format::Png {
+            let mut reader = BufReader::new(file);
+            let texts = crate::png_text::read_texts(&mut reader).map_err(|e| Error::io(path, e))?;
+            let mut loaded = decode(path, reader, image_format, format, name, limits)?;
+            let get = |key: &str| texts.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
+            let image = &loaded.layers[0];
+            loaded.recorded = crate::recorded(get, image.width(), image.height());
+            return Ok(loaded);
+        }
         if format != Format::Jpeg {
             return decode(
                 path,
@@ -102,6 +112,7 @@ fn decode<R: BufRead + Seek>(
     Ok(Loaded {
         layers: vec![image],
         declared: None,
+        recorded: None,
         format,
         description,
         // 8- and 16-bit texels decode to values in [0, 1].
@@ -122,7 +133,8 @@ fn jpeg_is_complete(bytes: &[u8]) -> bool {
 
 /// Writes `image` as PNG (8-bit, or 16-bit with [`Precision::U16`]) or JPEG (8-bit,
 /// quality [`WriteOptions::jpeg_quality`], 92 when 0; alpha dropped), encoding linear light
-/// to sRGB with clamping to [0, 1] and rounding to nearest. Alpha is stored linearly.
+/// to sRGB with clamping to [0, 1] and rounding to nearest. Alpha is stored linearly. A PNG
+/// records [`WriteOptions::declared`] in `tEXt` chunks (JPEG records nothing).
 /// Written to a temporary file that the returned [`Staged`] renames into place.
 pub fn write(
     path: &Path,
@@ -201,8 +213,20 @@ pub fn write(
             },
         )
     };
+    // The projection and layout as tEXt chunks right after IHDR.
+    let mut chunks = Vec::new();
+    if let Some(info) = &opts.declared {
+        let (projection, layout) = info.texts();
+        chunks.extend(crate::png_text::text_chunk(
+            crate::PROJECTION_KEY,
+            &projection,
+        ));
+        if let Some(l) = layout {
+            chunks.extend(crate::png_text::text_chunk(crate::LAYOUT_KEY, &l));
+        }
+    }
     stage(path, |out| {
-        PngEncoder::new(out)
+        PngEncoder::new(crate::png_text::WithText::new(out, chunks))
             .write_image(&bytes, w, h, color)
             .map_err(|e| encode_error(path, "PNG", e))
     })

@@ -22,6 +22,9 @@ pub fn run(a: CompareArgs) -> Result<(), CliError> {
     let limits = mirrorball_io::Limits::default();
     let mut r = load::load(&a.reference, from.as_ref(), None, &limits)?;
     let mut t = load::load(&a.test, test_from.as_ref(), None, &limits)?;
+    for (name, src) in [(&a.reference, &r), (&a.test, &t)] {
+        eprintln!("{name}: {} ({})", src.env.projection().name(), src.decided);
+    }
     r.env.sanitize();
     t.env.sanitize();
     let same = r.env.projection() == t.env.projection()
