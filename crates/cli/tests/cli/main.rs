@@ -6,4 +6,5 @@ mod commands;
 mod prefilter;
 mod quality;
 mod render;
+mod roundtrip;
 mod util;
