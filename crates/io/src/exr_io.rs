@@ -192,28 +192,38 @@ fn recorded_info(
     crate::recorded(get, w, h)
 }
 
-/// Layer attributes for a written file: the projection and layout as string attributes
-/// ([`crate::PROJECTION_KEY`], [`crate::LAYOUT_KEY`]). No `envmap` attribute: OpenEXR's
-/// lat-long and cube conventions are not mirrorball's (see [`crate::openexr`]), and pictures
-/// are written in mirrorball's.
+/// The string attribute `key = value` (the texts are ASCII, which OpenEXR's strings hold).
+fn text_attribute(key: &str, value: String) -> Option<(Text, AttributeValue)> {
+    Some((
+        Text::new_or_none(key)?,
+        AttributeValue::Text(Text::new_or_none(value)?),
+    ))
+}
+
+/// Layer attributes for a written file: the projection as a string attribute
+/// ([`crate::PROJECTION_KEY`]). No `envmap` attribute: OpenEXR's lat-long and cube
+/// conventions are not mirrorball's (see [`crate::openexr`]), and pictures are written in
+/// mirrorball's.
 fn layer_attributes(opts: &WriteOptions) -> LayerAttributes {
     let mut attributes = LayerAttributes::default();
     if let Some(info) = &opts.declared {
-        let (projection, layout) = info.texts();
-        let mut put = |key: &str, value: String| {
-            // The texts are ASCII, which OpenEXR's strings hold.
-            if let Some(v) = Text::new_or_none(value) {
-                attributes
-                    .other
-                    .insert(Text::new_or_panic(key), AttributeValue::Text(v));
-            }
-        };
-        put(crate::PROJECTION_KEY, projection);
-        if let Some(l) = layout {
-            put(crate::LAYOUT_KEY, l);
-        }
+        attributes
+            .other
+            .extend(text_attribute(crate::PROJECTION_KEY, info.texts().0));
     }
     attributes
+}
+
+/// The layout attribute ([`crate::LAYOUT_KEY`]) of a written file, given to the image's
+/// attributes: the `exr` crate keeps each set of extra attributes in a hash map, which
+/// orders them differently from run to run, so with one in each the header's bytes are the
+/// same every time. (Readers find both in the one header.)
+fn image_other(opts: &WriteOptions) -> std::collections::HashMap<Text, AttributeValue> {
+    let layout = opts.declared.as_ref().and_then(|info| info.texts().1);
+    layout
+        .and_then(|l| text_attribute(crate::LAYOUT_KEY, l))
+        .into_iter()
+        .collect()
 }
 
 /// Writes `image` as a single-part scan-line OpenEXR file: half texels unless
@@ -279,7 +289,8 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
             },
         };
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
-        let exr_image = exr::image::Image::from_layer(layer);
+        let mut exr_image = exr::image::Image::from_layer(layer);
+        exr_image.attributes.other = image_other(opts);
         stage(path, |out| {
             write_layer(out, exr_image.write(), image).map_err(|e| write_error(path, e))
         })
@@ -292,7 +303,8 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
             },
         };
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
-        let exr_image = exr::image::Image::from_layer(layer);
+        let mut exr_image = exr::image::Image::from_layer(layer);
+        exr_image.attributes.other = image_other(opts);
         stage(path, |out| {
             write_layer(out, exr_image.write(), image).map_err(|e| write_error(path, e))
         })
