@@ -215,11 +215,12 @@ pub fn load(
             })?;
             let l = layout.unwrap_or(g.layout);
             let proj = build_from(&ProjSpec::of(g.kind), w, h)?;
+            let note = records_other(&proj);
             (
                 proj,
                 l,
                 format!(
-                    "guessed {} {}: {} (override with --from/--layout)",
+                    "guessed {} {}: {} (override with --from/--layout){note}",
                     g.kind, g.layout, g.reason
                 ),
             )
