@@ -10,9 +10,9 @@
 //! **What a file says about its map.** Written maps record their projection with every
 //! parameter ([`MapInfo`], the text of [`Projection`]'s `Display`) and, for several layers
 //! packed into one picture, the [`Layout`], where the container has a place for text:
-//! OpenEXR string attributes, KTX2 key/value data, PNG `tEXt` chunks and Radiance header
-//! lines, each under the keys [`PROJECTION_KEY`] and [`LAYOUT_KEY`]. JPEG and DDS files
-//! record nothing (DDS has no field for it; the JPEG writer adds no comment segment).
+//! OpenEXR string attributes, KTX2 key/value data, PNG `tEXt` chunks, a JPEG comment
+//! segment and Radiance header lines, each under the keys [`PROJECTION_KEY`] and
+//! [`LAYOUT_KEY`]. DDS files record nothing: DDS has no place for text.
 //! Reading gives them back as [`Loaded::recorded`]. OpenEXR's own `envmap` attribute is
 //! reported as [`Loaded::declared`]; its pictures follow OpenEXR's conventions, which
 //! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
@@ -25,8 +25,8 @@ mod exr_zip;
 mod hdr_io;
 mod ktx2_io;
 mod ldr_io;
+mod meta_text;
 pub mod openexr;
-mod png_text;
 
 pub use atomic::{atomic_write, Staged};
 pub use error::{Error, Fault};

@@ -1,6 +1,8 @@
-//! PNG text chunks (PNG specification, 3rd edition, §11.3.3): `tEXt` chunks written right
-//! after `IHDR` as the encoder streams the file out, and `tEXt` and uncompressed `iTXt`
-//! chunks found anywhere in a file read back.
+//! Text in 8-bit image files: PNG text chunks (PNG specification, 3rd edition, §11.3.3),
+//! `tEXt` written right after `IHDR` as the encoder streams the file out and `tEXt` and
+//! uncompressed `iTXt` read back from anywhere in the file; and a JPEG comment segment (`COM`,
+//! ITU T.81 §B.2.4.5) of `key=value` lines, written after `SOI` and the JFIF `APP0` segment
+//! and read back from before the first scan.
 
 use std::io::{self, Read, Seek, SeekFrom, Write};
 
@@ -131,6 +133,66 @@ fn parse_text(international: bool, data: &[u8]) -> Option<(String, String)> {
     let trans_end = rest.iter().position(|&b| b == 0)?;
     let text = std::str::from_utf8(&rest[trans_end + 1..]).ok()?;
     Some((keyword, text.to_string()))
+}
+
+/// JPEG markers: start of image, the JFIF application segment, comment, start of scan, end
+/// of image.
+const SOI: u8 = 0xD8;
+const APP0: u8 = 0xE0;
+const COM: u8 = 0xFE;
+const SOS: u8 = 0xDA;
+const EOI: u8 = 0xD9;
+
+/// `jpeg` (a whole file) with a comment segment holding `pairs` as `key=value` lines, put
+/// after `SOI` and, when there is one, the `APP0` segment (JFIF wants `APP0` first).
+pub(crate) fn with_jpeg_comment(jpeg: Vec<u8>, pairs: &[(&str, String)]) -> Vec<u8> {
+    let text: Vec<String> = pairs.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    let text = text.join("\n");
+    if text.is_empty() || text.len() > 65533 || jpeg.len() < 2 || jpeg[..2] != [0xFF, SOI] {
+        return jpeg;
+    }
+    let mut at = 2;
+    if jpeg.len() >= 6 && jpeg[2] == 0xFF && jpeg[3] == APP0 {
+        at = (4 + usize::from(u16::from_be_bytes([jpeg[4], jpeg[5]]))).min(jpeg.len());
+    }
+    let mut out = Vec::with_capacity(jpeg.len() + text.len() + 4);
+    out.extend_from_slice(&jpeg[..at]);
+    out.extend_from_slice(&[0xFF, COM]);
+    out.extend_from_slice(&((text.len() + 2) as u16).to_be_bytes());
+    out.extend_from_slice(text.as_bytes());
+    out.extend_from_slice(&jpeg[at..]);
+    out
+}
+
+/// The `key=value` lines of a JPEG's comment segments before its first scan (other lines
+/// are skipped). A malformed stream ends the walk: the decoder reports it.
+pub(crate) fn jpeg_comments(jpeg: &[u8]) -> Vec<(String, String)> {
+    let mut pairs = Vec::new();
+    let mut i = 2;
+    while i + 4 <= jpeg.len() && jpeg[i] == 0xFF {
+        let marker = jpeg[i + 1];
+        if marker == 0xFF {
+            i += 1; // fill byte
+            continue;
+        }
+        if marker == SOS || marker == EOI {
+            break;
+        }
+        let len = usize::from(u16::from_be_bytes([jpeg[i + 2], jpeg[i + 3]]));
+        let Some(body) = jpeg.get(i + 4..i + 2 + len).filter(|_| len >= 2) else {
+            break;
+        };
+        if marker == COM {
+            let text = String::from_utf8_lossy(body);
+            for line in text.lines() {
+                if let Some((k, v)) = line.split_once('=') {
+                    pairs.push((k.to_string(), v.to_string()));
+                }
+            }
+        }
+        i += 2 + len;
+    }
+    pairs
 }
 
 #[cfg(test)]
