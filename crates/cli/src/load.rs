@@ -1,10 +1,14 @@
-//! Reading an environment map: file(s) → layers → projection and layout, guessed where the
-//! user did not say, and the guess reported.
+//! Reading an environment map: file(s) → layers → projection and layout, and what was
+//! decided reported. Without `--from`, the projection is what the file records
+//! (`mirrorball:projection`, `mirrorball:layout`), else what OpenEXR's `envmap` tag says (in
+//! OpenEXR's conventions), else guessed from the picture's shape.
 
 use crate::error::CliError;
 use crate::spec::ProjSpec;
-use mirrorball_core::{guess, EnvMap, Image, Layout, Projection, ProjectionKind, WorldProjection};
-use mirrorball_io::{Limits, Loaded};
+use mirrorball_core::{
+    guess, CubeMap, EnvMap, Image, LatLong, Layout, Projection, ProjectionKind, WorldProjection,
+};
+use mirrorball_io::{openexr, Format, Limits, Loaded};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -79,25 +83,60 @@ pub fn load(
     let Loaded {
         layers,
         declared,
+        recorded,
+        format,
         description,
         invalid,
-        ..
     } = loaded;
+    // What the file records (see `mirrorball_io::MapInfo`): unreadable, it matters only
+    // when nothing else says the projection.
+    let recorded = match recorded {
+        Some(Err(e)) if from.is_none() => {
+            return Err(CliError::input(format!(
+                "{input}: {e}; say the projection with --from"
+            )))
+        }
+        Some(r) => r.ok(),
+        None => None,
+    };
+    // Said after "as asked" when the file says something else.
+    let records_other = |p: &Projection| match (&recorded, declared) {
+        (Some(info), _) if info.projection != *p => {
+            format!("; the file records {}", info.projection)
+        }
+        (None, Some(kind)) if format == Format::Exr => {
+            format!("; the file's envmap={kind} tag (OpenEXR's convention) is not followed")
+        }
+        _ => String::new(),
+    };
     if layers.len() == 6 {
         // A cube container: KTX2 or DDS.
-        let (spec, proj) = multi_layer(from)?;
+        let (spec, proj) = match (&recorded, from) {
+            (Some(info), None) if info.projection.layer_count() == 6 => {
+                (info.projection.spec(), info.projection)
+            }
+            _ => multi_layer(from)?,
+        };
         if proj.layer_count() != 6 {
             return Err(CliError::request(format!(
                 "{input}: holds six cube faces, which cannot be read as {}",
                 spec.kind
             )));
         }
+        let decided = match (&recorded, from) {
+            (Some(_), None) => format!("{proj}, recorded in the file"),
+            _ => format!(
+                "{} (six faces in the container){}",
+                spec.kind,
+                records_other(&proj)
+            ),
+        };
         let env =
             EnvMap::new(proj, layers).map_err(|e| CliError::input(format!("{input}: {e}")))?;
         return Ok(Source {
             env,
             description,
-            decided: format!("{} (six faces in the container)", spec.kind),
+            decided,
             invalid,
         });
     }
@@ -106,38 +145,91 @@ pub fn load(
         .next()
         .ok_or_else(|| CliError::input(format!("{input}: no image")))?;
     let (w, h) = (image.width(), image.height());
-    let (spec, layout, decided) = match (from, layout) {
-        (Some(spec), Some(l)) => (spec.clone(), l, "as asked".to_string()),
-        (Some(spec), None) => {
+    // OpenEXR's `envmap` tag, when it alone says the projection: its pictures follow
+    // OpenEXR's conventions (ImfEnvmap), turned into mirrorball's here.
+    let tagged = from.is_none() && layout.is_none() && recorded.is_none() && format == Format::Exr;
+    match declared.filter(|_| tagged) {
+        Some(ProjectionKind::LatLong) => {
+            let env = EnvMap::new(LatLong.into(), vec![openexr::latlong_to_mirrorball(&image)])
+                .map_err(|e| CliError::input(format!("{input}: {e}")))?;
+            return Ok(Source {
+                env,
+                description,
+                decided: "the file is tagged envmap=latlong: OpenEXR's lat-long (+Z at the centre), turned half a turn into mirrorball's (--from latlong reads the picture as mirrorball's)".to_string(),
+                invalid,
+            });
+        }
+        Some(ProjectionKind::Cube) => {
+            let faces = openexr::cube_to_faces(&image)
+                .map_err(|e| CliError::input(format!("{input}: {e}")))?;
+            let env = EnvMap::new(CubeMap.into(), faces)
+                .map_err(|e| CliError::input(format!("{input}: {e}")))?;
+            return Ok(Source {
+                env,
+                description,
+                decided: "the file is tagged envmap=cube: OpenEXR's vertical strip of faces, read into OpenGL's faces (--from cube --layout vstrip reads the picture as mirrorball's strip)".to_string(),
+                invalid,
+            });
+        }
+        _ => {}
+    }
+    let (proj, layout, decided) = match (from, layout, recorded) {
+        (Some(spec), Some(l), _) => {
+            let proj = build_from(spec, w, h)?;
+            let note = records_other(&proj);
+            (proj, l, format!("as asked{note}"))
+        }
+        (Some(spec), None, _) => {
             let n = spec.kind.default_projection().layer_count();
             let (l, _, _) =
                 Layout::from_extent(w, h, n).ok_or_else(|| no_layout(input, w, h, spec.kind))?;
-            (spec.clone(), l, format!("as asked; {w}x{h} fits {l}"))
+            let proj = build_from(spec, w, h)?;
+            let note = records_other(&proj);
+            (proj, l, format!("as asked; {w}x{h} fits {l}{note}"))
         }
-        (None, _) => {
+        (None, asked, Some(info)) => {
+            let proj = info.projection;
+            let n = proj.layer_count();
+            let l = match asked.or(info.layout) {
+                Some(l) => l,
+                None => {
+                    Layout::from_extent(w, h, n)
+                        .ok_or_else(|| no_layout(input, w, h, proj.kind()))?
+                        .0
+                }
+            };
+            let how = if n == 1 {
+                String::new()
+            } else if asked.is_some() {
+                format!(", {l} as asked")
+            } else {
+                format!(", {l}")
+            };
+            (proj, l, format!("{proj}{how}, recorded in the file"))
+        }
+        (None, _, None) => {
             let g = guess(w, h, declared).ok_or_else(|| {
                 CliError::input(format!(
                     "{input}: cannot tell the projection of a {w}x{h} picture (2:1 is lat-long, 4:3, 3:4, 6:1 and 1:6 are cube layouts, 1:1 a sphere map); say it with --from"
                 ))
             })?;
             let l = layout.unwrap_or(g.layout);
+            let proj = build_from(&ProjSpec::of(g.kind), w, h)?;
+            let note = records_other(&proj);
             (
-                ProjSpec::of(g.kind),
+                proj,
                 l,
                 format!(
-                    "guessed {} {}: {} (override with --from/--layout)",
+                    "guessed {} {}: {} (override with --from/--in-layout){note}",
                     g.kind, g.layout, g.reason
                 ),
             )
         }
     };
-    let proj = spec
-        .build(Some((w, h)))
-        .map_err(|e| CliError::request(format!("--from: {e}")))?;
     if layout == Layout::Separate && proj.layer_count() > 1 {
         return Err(CliError::request(format!(
             "{input}: a {} map has {} layers; give one file per layer with {FACE} in the name, or a packed layout",
-            spec.kind,
+            proj.kind(),
             proj.layer_count()
         )));
     }
@@ -151,6 +243,12 @@ pub fn load(
         decided,
         invalid,
     })
+}
+
+/// The projection `spec` names, for a `w`×`h` picture.
+fn build_from(spec: &ProjSpec, w: u32, h: u32) -> Result<Projection, CliError> {
+    spec.build(Some((w, h)))
+        .map_err(|e| CliError::request(format!("--from: {e}")))
 }
 
 fn no_layout(input: &str, w: u32, h: u32, kind: ProjectionKind) -> CliError {
@@ -203,8 +301,22 @@ fn multi_layer(from: Option<&ProjSpec>) -> Result<(ProjSpec, Projection), CliErr
 }
 
 /// Reads one file per layer: `{face}` becomes px nx py ny pz nz (cube) or front back.
+///
+/// Without `--from`: the projection the files record (each face file mirrorball writes
+/// records it), else a cube, or a dual paraboloid when only `front`/`back` files exist.
 fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<Source, CliError> {
-    let (spec, proj) = multi_layer(from)?;
+    let guessed = from.is_none()
+        && !Path::new(&input.replace(FACE, "px")).exists()
+        && Path::new(&input.replace(FACE, "front")).exists();
+    let (spec, proj) = if guessed {
+        let spec = ProjSpec::of(ProjectionKind::Paraboloid);
+        let proj = spec
+            .build(None)
+            .map_err(|e| CliError::request(format!("--from: {e}")))?;
+        (spec, proj)
+    } else {
+        multi_layer(from)?
+    };
     let names = layer_names(proj.layer_count());
     if names.len() < 2 {
         return Err(CliError::request(format!("{input}: {FACE} files need a projection with several layers (cube, continuous-cube, paraboloid), not {}", spec.kind)));
@@ -219,6 +331,36 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
         .collect::<Result<_, _>>()?;
     // Counted in every file, or not known.
     let invalid = loaded.iter().map(|l| l.invalid).sum::<Option<u64>>();
+    // The projection every file records, when they agree and it has this many layers.
+    let recorded = match (from, &loaded[0].recorded) {
+        (None, Some(Ok(info)))
+            if info.projection.layer_count() == proj.layer_count()
+                && loaded.iter().all(
+                    |l| matches!(&l.recorded, Some(Ok(i)) if i.projection == info.projection),
+                ) =>
+        {
+            Some(info.projection)
+        }
+        _ => None,
+    };
+    let (proj, decided) = match recorded {
+        Some(p) => (
+            p,
+            format!("{p} from one file per layer, recorded in the files"),
+        ),
+        None => (
+            proj,
+            format!(
+                "{} from one file per layer{}",
+                spec.kind,
+                if from.is_some() {
+                    ""
+                } else {
+                    " (guessed from the file names; --from overrides)"
+                }
+            ),
+        ),
+    };
     let mut layers: Vec<Image> = Vec::new();
     for (l, p) in loaded.into_iter().zip(&paths) {
         let img = l
@@ -242,7 +384,7 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
     Ok(Source {
         env,
         description: format!("{} files", names.len()),
-        decided: format!("{} from one file per layer", spec.kind),
+        decided,
         invalid,
     })
 }

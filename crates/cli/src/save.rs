@@ -4,7 +4,7 @@
 use crate::error::CliError;
 use crate::load::{layer_names, FACE};
 use mirrorball_core::{resample, EnvMap, Layout, ProjectionKind, ResampleOptions, WorldProjection};
-use mirrorball_io::{Format, WriteOptions};
+use mirrorball_io::{Format, MapInfo, WriteOptions};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -145,23 +145,33 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
                 size /= 2;
             }
         }
-        mirrorball_io::write_cube(path, &levels, &opts.write)?;
+        let mut write = opts.write;
+        write.declared = Some(MapInfo {
+            projection: *env.projection(),
+            layout: None,
+        });
+        mirrorball_io::write_cube(path, &levels, &write)?;
         return Ok(vec![path.to_path_buf()]);
     }
     let n = env.layers().len();
     let layout = output_layout(out, n, opts);
     if let Some(paths) = layer_files(out, n, opts) {
+        let write = per_layer_write(&opts.write, *env.projection());
         // Renamed into place together: a failed or interrupted run leaves the set as it was.
         let staged = paths
             .par_iter()
             .zip(env.layers().par_iter())
-            .map(|(p, img)| mirrorball_io::write_image_staged(p, img, &opts.write))
+            .map(|(p, img)| mirrorball_io::write_image_staged(p, img, &write))
             .collect::<Result<Vec<_>, _>>()?;
         mirrorball_io::commit_all(staged)?;
         return Ok(paths);
     }
     let mut write = opts.write;
-    write.declared = Some(env.projection().kind());
+    // Recorded in the file, so that reading it back needs no --from.
+    write.declared = Some(MapInfo {
+        projection: *env.projection(),
+        layout: Some(layout),
+    });
     let img = layout.pack(env).ok_or_else(|| {
         CliError::request(format!(
             "{out}: layout {layout} does not fit a map of {n} layer(s)"
@@ -169,6 +179,21 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
     })?;
     mirrorball_io::write_image(path, &img, &write)?;
     Ok(vec![path.to_path_buf()])
+}
+
+/// The options for one file a layer of a `projection` map: each file records the projection
+/// (and the `separate` layout), so that `{face}` reads the set back without `--from`.
+pub fn per_layer_write(
+    write: &WriteOptions,
+    projection: mirrorball_core::Projection,
+) -> WriteOptions {
+    WriteOptions {
+        declared: Some(MapInfo {
+            projection,
+            layout: Some(Layout::Separate),
+        }),
+        ..*write
+    }
 }
 
 /// The natural default edge for a conversion from `src` to `kind`: the power of two nearest

@@ -11,6 +11,9 @@
 //! face with row 0 at the top (v = 0), which is mirrorball's `t = 0` row, so face images are
 //! stored unchanged, exactly as in KTX2.
 //!
+//! DDS has no place for text, so the projection is not recorded (a DDS cube is a cube by its
+//! header's cube-map flags).
+//!
 //! The reader takes level 0 of DX10 RGBA16F, RGBA32F, RGB32F, R11G11B10F and RGB9E5 files and
 //! of legacy `D3DFMT_A16B16G16R16F` (113) and `D3DFMT_A32B32G32R32F` (116) files, cube maps or
 //! 2D textures. It parses the headers with `ddsfile`, checks the declared size against the
@@ -223,6 +226,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     Ok(Loaded {
         layers,
         declared,
+        recorded: None,
         format: Format::Dds,
         description,
         invalid: None,

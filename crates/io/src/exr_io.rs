@@ -13,7 +13,7 @@ use crate::ldr_io::{check_limits, check_writable_size, guard_decoder, open_input
 use crate::{
     atomic::stage, Error, ExrCompression, Format, Limits, Loaded, Precision, Staged, WriteOptions,
 };
-use exr::meta::attribute::EnvironmentMap;
+use exr::meta::attribute::{AttributeValue, EnvironmentMap, Text};
 use exr::meta::header::Header;
 use exr::prelude::{
     ChannelDescription, Compression, Encoding, LayerAttributes, LineOrder, ReadChannels,
@@ -33,7 +33,8 @@ const HALF_MAX: f32 = 65504.0;
 /// Reads the first RGB(A) layer of an OpenEXR file as linear `f32` texels.
 ///
 /// The `envmap` header attribute, if present, becomes [`Loaded::declared`] (latlong or
-/// cube). Files using a compression the `exr` crate cannot decode (HTJ2K) are refused
+/// cube), and the `mirrorball:projection` and `mirrorball:layout` string attributes
+/// [`Loaded::recorded`]. Files using a compression the `exr` crate cannot decode (HTJ2K) are refused
 /// before any texel is decoded, with a message that says how to re-save them.
 pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let file = open_input(path)?;
@@ -89,10 +90,8 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
             read_blocks(chunks, index, &header, &layout).map(|image| (image, None))
         }
         .map_err(|e| read_error(path, e))?;
-        let declared = header.own_attributes.environment_map.map(|m| match m {
-            EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
-            EnvironmentMap::Cube => ProjectionKind::Cube,
-        });
+        let declared = envmap_kind(header.own_attributes.environment_map);
+        let recorded = recorded_info(&header.own_attributes, image.width(), image.height());
         let types: Vec<SampleType> = header.channels.list.iter().map(|c| c.sample_type).collect();
         let layer_name = header
             .own_attributes
@@ -111,6 +110,7 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
         return Ok(Loaded {
             layers: vec![image],
             declared,
+            recorded,
             format: Format::Exr,
             description,
             invalid,
@@ -128,10 +128,12 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
 
     // Describe the layer that was read (the first readable RGB one).
     let layer = exr_image.layer_data;
-    let declared = layer.attributes.environment_map.map(|m| match m {
-        EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
-        EnvironmentMap::Cube => ProjectionKind::Cube,
-    });
+    let declared = envmap_kind(layer.attributes.environment_map);
+    let recorded = recorded_info(
+        &layer.attributes,
+        layer.size.width() as u32,
+        layer.size.height() as u32,
+    );
     let compression = layer.encoding.compression;
     let tiled = matches!(layer.encoding.blocks, exr::image::Blocks::Tiles(_));
     let layer_name = layer.attributes.layer_name.as_ref().map(|n| n.to_string());
@@ -163,18 +165,65 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
         invalid: None,
         layers: vec![image],
         declared,
+        recorded,
         format: Format::Exr,
         description,
     })
 }
 
-/// Layer attributes for a written file: the `envmap` attribute for lat-long maps.
+/// The kind OpenEXR's `envmap` attribute names.
+fn envmap_kind(envmap: Option<EnvironmentMap>) -> Option<ProjectionKind> {
+    envmap.map(|m| match m {
+        EnvironmentMap::LatitudeLongitude => ProjectionKind::LatLong,
+        EnvironmentMap::Cube => ProjectionKind::Cube,
+    })
+}
+
+/// [`Loaded::recorded`] from a layer's string attributes.
+fn recorded_info(
+    attributes: &LayerAttributes,
+    w: u32,
+    h: u32,
+) -> Option<Result<crate::MapInfo, String>> {
+    let get = |key: &str| match attributes.other.get(&Text::new_or_panic(key)) {
+        Some(AttributeValue::Text(t)) => Some(t.to_string()),
+        _ => None,
+    };
+    crate::recorded(get, w, h)
+}
+
+/// The string attribute `key = value` (the texts are ASCII, which OpenEXR's strings hold).
+fn text_attribute(key: &str, value: String) -> Option<(Text, AttributeValue)> {
+    Some((
+        Text::new_or_none(key)?,
+        AttributeValue::Text(Text::new_or_none(value)?),
+    ))
+}
+
+/// Layer attributes for a written file: the projection as a string attribute
+/// ([`crate::PROJECTION_KEY`]). No `envmap` attribute: OpenEXR's lat-long and cube
+/// conventions are not mirrorball's (see [`crate::openexr`]), and pictures are written in
+/// mirrorball's.
 fn layer_attributes(opts: &WriteOptions) -> LayerAttributes {
-    LayerAttributes {
-        environment_map: (opts.declared == Some(ProjectionKind::LatLong))
-            .then_some(EnvironmentMap::LatitudeLongitude),
-        ..LayerAttributes::default()
+    let mut attributes = LayerAttributes::default();
+    if let Some(info) = &opts.declared {
+        attributes
+            .other
+            .extend(text_attribute(crate::PROJECTION_KEY, info.texts().0));
     }
+    attributes
+}
+
+/// The layout attribute ([`crate::LAYOUT_KEY`]) of a written file, given to the image's
+/// attributes: the `exr` crate keeps each set of extra attributes in a hash map, which
+/// orders them differently from run to run, so with one in each the header's bytes are the
+/// same every time. (Readers find both in the one header.)
+fn image_other(opts: &WriteOptions) -> std::collections::HashMap<Text, AttributeValue> {
+    let layout = opts.declared.as_ref().and_then(|info| info.texts().1);
+    layout
+        .and_then(|l| text_attribute(crate::LAYOUT_KEY, l))
+        .into_iter()
+        .collect()
 }
 
 /// Writes `image` as a single-part scan-line OpenEXR file: half texels unless
@@ -240,7 +289,8 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
             },
         };
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
-        let exr_image = exr::image::Image::from_layer(layer);
+        let mut exr_image = exr::image::Image::from_layer(layer);
+        exr_image.attributes.other = image_other(opts);
         stage(path, |out| {
             write_layer(out, exr_image.write(), image).map_err(|e| write_error(path, e))
         })
@@ -253,7 +303,8 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
             },
         };
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
-        let exr_image = exr::image::Image::from_layer(layer);
+        let mut exr_image = exr::image::Image::from_layer(layer);
+        exr_image.attributes.other = image_other(opts);
         stage(path, |out| {
             write_layer(out, exr_image.write(), image).map_err(|e| write_error(path, e))
         })

@@ -2,7 +2,7 @@
 //! standard new-style run-length encoding.
 
 use crate::ldr_io::{check_limits, check_writable_size, decode_error, guard_decoder, open_input};
-use crate::{atomic::stage, Error, Format, Limits, Loaded, Staged};
+use crate::{atomic::stage, Error, Format, Limits, Loaded, Staged, WriteOptions};
 use image::codecs::hdr::HdrDecoder;
 use image::{DynamicImage, ImageDecoder};
 use mirrorball_core::Image;
@@ -25,7 +25,8 @@ const PEEK: usize = 1 << 16;
 /// Reads a Radiance RGBE file as linear `f32` RGB.
 ///
 /// Accepts the `#?RADIANCE` and `#?RGBE` signatures and the standard `-Y H +X W`
-/// orientation; the declared size is checked against `limits` before decoding.
+/// orientation; the declared size is checked against `limits` before decoding. Header lines
+/// `mirrorball:projection=…` and `mirrorball:layout=…` become [`Loaded::recorded`].
 pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let file = open_input(path)?;
     guard_decoder(path, "Radiance HDR", || {
@@ -50,6 +51,9 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             HdrDecoder::new_nonstrict(reader).map_err(|e| decode_error(path, "Radiance HDR", e))?;
         let (width, height) = decoder.dimensions();
         check_limits(path, width as u64, height as u64, limits)?;
+        let lines = decoder.metadata().custom_attributes;
+        let get = |key: &str| lines.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
+        let recorded = crate::recorded(get, width, height);
         let decoded = DynamicImage::from_decoder(decoder)
             .map_err(|e| decode_error(path, "Radiance HDR", e))?;
         let data = match decoded {
@@ -62,6 +66,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         Ok(Loaded {
             layers: vec![image],
             declared: None,
+            recorded,
             format: Format::Hdr,
             description: "Radiance RGBE".to_string(),
             // RGBE holds no NaN, infinite or negative values.
@@ -81,12 +86,22 @@ fn header_is_complete(head: &[u8]) -> bool {
 /// Writes `image` as Radiance RGBE (alpha is dropped), run-length encoded for widths from
 /// 8 to 32767 and flat otherwise, rows encoded on all cores. Negative and NaN values are
 /// written as 0, values beyond the RGBE range as its largest value. Written to a temporary
-/// file that the returned [`Staged`] renames into place.
-pub fn write(path: &Path, image: &Image) -> Result<Staged, Error> {
+/// file that the returned [`Staged`] renames into place. The map's projection and layout
+/// ([`WriteOptions::declared`]) go into the header as `mirrorball:projection=…` and
+/// `mirrorball:layout=…` lines (Radiance headers hold `NAME=value` lines).
+pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, Error> {
     check_writable_size(path, image)?;
     let (w, h) = (image.width() as usize, image.height() as usize);
     let c = image.channels();
-    let header = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n");
+    let mut header = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n".to_string();
+    if let Some(info) = &opts.declared {
+        let (projection, layout) = info.texts();
+        header += &format!("{}={projection}\n", crate::PROJECTION_KEY);
+        if let Some(l) = layout {
+            header += &format!("{}={l}\n", crate::LAYOUT_KEY);
+        }
+    }
+    header += &format!("\n-Y {h} +X {w}\n");
     let bands: Vec<Vec<u8>> = image
         .data()
         .par_chunks(w * c * ROWS_PER_BAND)

@@ -3,7 +3,8 @@
 //! The writer is written by hand from the specification: RGBA16F
 //! (`VK_FORMAT_R16G16B16A16_SFLOAT`) or RGBA32F (`VK_FORMAT_R32G32B32A32_SFLOAT`), faceCount 6,
 //! every mip level given, no supercompression, a basic Data Format Descriptor and the
-//! `KTXorientation` = `rd` and `KTXwriter` metadata. Faces go in the order +X −X +Y −Y +Z −Z
+//! `KTXorientation` = `rd` and `KTXwriter` metadata (and `mirrorball:projection` when the
+//! projection is given, read back as [`Loaded::recorded`]). Faces go in the order +X −X +Y −Y +Z −Z
 //! with row 0 (`t = 0`) first, which is how KTX2 and Vulkan define cube faces (orientation
 //! `rd`: s increases to the right, t downwards), so mirrorball's face images are stored
 //! unchanged.
@@ -288,13 +289,14 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
     };
 
     let dfd = data_format_descriptor(format);
-    let kvd = key_value_data(&[
-        ("KTXorientation", "rd"),
-        (
-            "KTXwriter",
-            &format!("mirrorball {}", env!("CARGO_PKG_VERSION")),
-        ),
-    ]);
+    let writer = format!("mirrorball {}", env!("CARGO_PKG_VERSION"));
+    let mut pairs = vec![("KTXorientation", "rd".to_string()), ("KTXwriter", writer)];
+    if let Some(info) = &opts.declared {
+        // Sorted by key, as the specification requires: "KTX…" < "mirrorball:…".
+        pairs.push((crate::PROJECTION_KEY, info.texts().0));
+    }
+    let pairs: Vec<(&str, &str)> = pairs.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    let kvd = key_value_data(&pairs);
     let dfd_offset = HEADER_LEN + LEVEL_INDEX_LEN * level_count;
     let kvd_offset = dfd_offset + dfd.len();
     let data_start = (kvd_offset + kvd.len()) as u64;
@@ -590,6 +592,17 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     }
 
     let levels = mip_phrase(level_count);
+    let get = |key: &str| {
+        reader
+            .key_value_data()
+            .find(|(k, _)| *k == key)
+            .map(|(_, v)| {
+                String::from_utf8_lossy(v)
+                    .trim_end_matches('\0')
+                    .to_string()
+            })
+    };
+    let recorded = crate::recorded(get, width, height);
     let (declared, description) = if faces == 6 {
         // Cube faces are always `rd` (the specification requires it), so they are kept as is.
         (
@@ -617,6 +630,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     Ok(Loaded {
         layers,
         declared,
+        recorded,
         format: Format::Ktx2,
         description,
         invalid: None,

@@ -27,7 +27,8 @@ const CHUNK_TEXELS: usize = 1 << 14;
 /// linear, as stored.
 ///
 /// The declared size is checked against `limits` from the header, before any texel is
-/// decoded.
+/// decoded. A PNG's `mirrorball:projection` and `mirrorball:layout` text chunks, or the
+/// same `key=value` lines in a JPEG comment segment, become [`Loaded::recorded`].
 pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Error> {
     let (image_format, name) = match format {
         Format::Png => (ImageFormat::Png, "PNG"),
@@ -42,6 +43,16 @@ pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Erro
     };
     let file = open_input(path)?;
     guard_decoder(path, name, || {
+        if format == Format::Png {
+            let mut reader = BufReader::new(file);
+            let texts =
+                crate::meta_text::read_texts(&mut reader).map_err(|e| Error::io(path, e))?;
+            let mut loaded = decode(path, reader, image_format, format, name, limits)?;
+            let get = |key: &str| texts.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
+            let image = &loaded.layers[0];
+            loaded.recorded = crate::recorded(get, image.width(), image.height());
+            return Ok(loaded);
+        }
         if format != Format::Jpeg {
             return decode(
                 path,
@@ -69,7 +80,17 @@ pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Erro
                 "file is truncated (the JPEG end-of-image marker is missing)".into(),
             ));
         }
-        decode(path, Cursor::new(bytes), image_format, format, name, limits)
+        let comments = crate::meta_text::jpeg_comments(&bytes);
+        let mut loaded = decode(path, Cursor::new(bytes), image_format, format, name, limits)?;
+        let get = |key: &str| {
+            comments
+                .iter()
+                .find(|(k, _)| k == key)
+                .map(|(_, v)| v.clone())
+        };
+        let image = &loaded.layers[0];
+        loaded.recorded = crate::recorded(get, image.width(), image.height());
+        Ok(loaded)
     })
 }
 
@@ -102,6 +123,7 @@ fn decode<R: BufRead + Seek>(
     Ok(Loaded {
         layers: vec![image],
         declared: None,
+        recorded: None,
         format,
         description,
         // 8- and 16-bit texels decode to values in [0, 1].
@@ -122,7 +144,8 @@ fn jpeg_is_complete(bytes: &[u8]) -> bool {
 
 /// Writes `image` as PNG (8-bit, or 16-bit with [`Precision::U16`]) or JPEG (8-bit,
 /// quality [`WriteOptions::jpeg_quality`], 92 when 0; alpha dropped), encoding linear light
-/// to sRGB with clamping to [0, 1] and rounding to nearest. Alpha is stored linearly.
+/// to sRGB with clamping to [0, 1] and rounding to nearest. Alpha is stored linearly. A PNG
+/// records [`WriteOptions::declared`] in `tEXt` chunks, a JPEG in a comment segment.
 /// Written to a temporary file that the returned [`Staged`] renames into place.
 pub fn write(
     path: &Path,
@@ -172,10 +195,24 @@ pub fn write(
             q => q.min(100),
         };
         let bytes = encode_u8(image, 3);
+        let Some(info) = &opts.declared else {
+            return stage(path, |out| {
+                JpegEncoder::new_with_quality(out, quality)
+                    .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
+                    .map_err(|e| encode_error(path, "JPEG", e))
+            });
+        };
+        // The projection and layout in a comment segment, spliced into the encoded file.
+        let mut jpeg = Vec::new();
+        JpegEncoder::new_with_quality(&mut jpeg, quality)
+            .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
+            .map_err(|e| encode_error(path, "JPEG", e))?;
+        let (projection, layout) = info.texts();
+        let mut pairs = vec![(crate::PROJECTION_KEY, projection)];
+        pairs.extend(layout.map(|l| (crate::LAYOUT_KEY, l)));
+        let jpeg = crate::meta_text::with_jpeg_comment(jpeg, &pairs);
         return stage(path, |out| {
-            JpegEncoder::new_with_quality(out, quality)
-                .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
-                .map_err(|e| encode_error(path, "JPEG", e))
+            std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
         });
     }
 
@@ -201,8 +238,20 @@ pub fn write(
             },
         )
     };
+    // The projection and layout as tEXt chunks right after IHDR.
+    let mut chunks = Vec::new();
+    if let Some(info) = &opts.declared {
+        let (projection, layout) = info.texts();
+        chunks.extend(crate::meta_text::text_chunk(
+            crate::PROJECTION_KEY,
+            &projection,
+        ));
+        if let Some(l) = layout {
+            chunks.extend(crate::meta_text::text_chunk(crate::LAYOUT_KEY, &l));
+        }
+    }
     stage(path, |out| {
-        PngEncoder::new(out)
+        PngEncoder::new(crate::meta_text::WithText::new(out, chunks))
             .write_image(&bytes, w, h, color)
             .map_err(|e| encode_error(path, "PNG", e))
     })

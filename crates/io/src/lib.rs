@@ -6,6 +6,16 @@
 //! light); writing goes to a temporary file beside the target that is renamed into place, so
 //! a failed write never leaves a half-written output. Every error names the file and says
 //! whose fault it is ([`Fault`]).
+//!
+//! **What a file says about its map.** Written maps record their projection with every
+//! parameter ([`MapInfo`], the text of [`Projection`]'s `Display`) and, for several layers
+//! packed into one picture, the [`Layout`], where the container has a place for text:
+//! OpenEXR string attributes, KTX2 key/value data, PNG `tEXt` chunks, a JPEG comment
+//! segment and Radiance header lines, each under the keys [`PROJECTION_KEY`] and
+//! [`LAYOUT_KEY`]. DDS files record nothing: DDS has no place for text.
+//! Reading gives them back as [`Loaded::recorded`]. OpenEXR's own `envmap` attribute is
+//! reported as [`Loaded::declared`]; its pictures follow OpenEXR's conventions, which
+//! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
 
 mod atomic;
 mod dds_io;
@@ -15,12 +25,66 @@ mod exr_zip;
 mod hdr_io;
 mod ktx2_io;
 mod ldr_io;
+mod meta_text;
+pub mod openexr;
 
 pub use atomic::{atomic_write, commit_all, interrupted, Staged};
 pub use error::{Error, Fault};
 
-use mirrorball_core::{Image, ProjectionKind};
+use mirrorball_core::projection::ProjectionSpec;
+use mirrorball_core::{Image, Layout, Projection, ProjectionKind, WorldProjection};
 use std::path::Path;
+
+/// The key under which files record their projection (see [`MapInfo`]).
+pub const PROJECTION_KEY: &str = "mirrorball:projection";
+/// The key under which files record how several layers are packed into one picture.
+pub const LAYOUT_KEY: &str = "mirrorball:layout";
+
+/// What mirrorball records about the map in a file it writes: the projection with every
+/// parameter, and the layout of a multi-layer map packed into one picture.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapInfo {
+    /// The projection, recorded as its canonical text (`fisheye:fov=190:lens=equisolid:look=0,1,0`).
+    pub projection: Projection,
+    /// How the layers are packed into the picture (recorded only for maps of several
+    /// layers).
+    pub layout: Option<Layout>,
+}
+
+impl MapInfo {
+    /// The texts to record under [`PROJECTION_KEY`] and [`LAYOUT_KEY`].
+    pub fn texts(&self) -> (String, Option<String>) {
+        let layout = self
+            .layout
+            .filter(|_| self.projection.layer_count() > 1)
+            .map(|l| l.name().to_string());
+        (self.projection.to_string(), layout)
+    }
+
+    /// Reads the recorded texts back for a `w`×`h` picture (whose shape fixes a Mercator
+    /// map's latitude limit when the text has none). The error says what was recorded and
+    /// why it cannot be read.
+    pub fn from_texts(
+        projection: &str,
+        layout: Option<&str>,
+        w: u32,
+        h: u32,
+    ) -> Result<MapInfo, String> {
+        let unreadable = |key: &str, text: &str, e: String| {
+            format!("records {key} = '{text}', which cannot be read ({e})")
+        };
+        let projection = ProjectionSpec::parse(projection)
+            .and_then(|s| s.build(Some((w, h))))
+            .map_err(|e| unreadable(PROJECTION_KEY, projection, e))?;
+        let layout = layout
+            .map(|l| {
+                l.parse::<Layout>()
+                    .map_err(|e| unreadable(LAYOUT_KEY, l, e))
+            })
+            .transpose()?;
+        Ok(MapInfo { projection, layout })
+    }
+}
 
 /// File formats mirrorball reads and writes, chosen by file extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -124,10 +188,9 @@ pub struct WriteOptions {
     pub exr_compression: ExrCompression,
     /// JPEG quality 1..=100 (default 92 when 0).
     pub jpeg_quality: u8,
-    /// The projection of the picture, recorded where the container has a place for it: a
-    /// lat-long EXR gets the standard `envmap` attribute. (OpenEXR's cube-map convention
-    /// differs from OpenGL's, so cubes are not tagged.)
-    pub declared: Option<ProjectionKind>,
+    /// The projection (and packing) of the picture, recorded where the container has a place
+    /// for it (see the crate documentation).
+    pub declared: Option<MapInfo>,
 }
 
 /// What [`read`] found in a file.
@@ -136,9 +199,14 @@ pub struct Loaded {
     /// The pictures: one for flat images; the six cube faces (level 0, OpenGL order) from a
     /// KTX2 or DDS cube.
     pub layers: Vec<Image>,
-    /// The projection the file declares, if it does: the EXR `envmap` attribute (latlong or
-    /// cube), or cube for KTX2/DDS cube maps.
+    /// The projection the container's own conventions declare, if they do: OpenEXR's
+    /// `envmap` attribute (latlong or cube, in OpenEXR's conventions: see [`openexr`]), or
+    /// cube for KTX2/DDS cube maps.
     pub declared: Option<ProjectionKind>,
+    /// What the file records in mirrorball's own keys ([`PROJECTION_KEY`], [`LAYOUT_KEY`]):
+    /// `None` when it records nothing, an error (saying what was recorded) when the record
+    /// cannot be read.
+    pub recorded: Option<Result<MapInfo, String>>,
     /// The container.
     pub format: Format,
     /// A one-line description for people: "OpenEXR, half, ZIP compression, RGB".
@@ -189,7 +257,7 @@ pub fn write_image_staged(
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
         Format::Exr => exr_io::write(path, image, opts),
-        Format::Hdr => hdr_io::write(path, image),
+        Format::Hdr => hdr_io::write(path, image, opts),
         Format::Png | Format::Jpeg => ldr_io::write(path, format, image, opts),
         Format::Webp => Err(Error::request(
             path,
@@ -233,4 +301,21 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 
 fn unknown_ext() -> String {
     "unknown file extension (known: .exr .hdr .png .jpg .jpeg .webp .ktx2 .dds)".to_string()
+}
+
+/// [`Loaded::recorded`] from a file's text metadata (`get` looks a key up) for a `w`×`h`
+/// picture: nothing unless the projection key is there.
+pub(crate) fn recorded(
+    get: impl Fn(&str) -> Option<String>,
+    w: u32,
+    h: u32,
+) -> Option<Result<MapInfo, String>> {
+    let projection = get(PROJECTION_KEY)?;
+    let layout = get(LAYOUT_KEY);
+    Some(MapInfo::from_texts(
+        projection.trim(),
+        layout.as_deref().map(str::trim),
+        w,
+        h,
+    ))
 }

@@ -46,8 +46,9 @@ pub fn run(a: CompareArgs) -> Result<(), CliError> {
     let mut r = load::load(&a.reference, from.as_ref(), None, &limits)?;
     let mut t = load::load(&a.test, test_from.as_ref(), None, &limits)?;
     if !a.json {
-        eprintln!("reference: {} — {}", a.reference, r.decided);
-        eprintln!("test:      {} — {}", a.test, t.decided);
+        for (name, src) in [(&a.reference, &r), (&a.test, &t)] {
+            eprintln!("{name}: {} ({})", src.env.projection().name(), src.decided);
+        }
     }
     r.env.sanitize();
     t.env.sanitize();

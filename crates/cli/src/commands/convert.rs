@@ -212,7 +212,8 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
                     h,
                     opts: &plan.resample,
                 };
-                write_while_converting(job, &paths, &plan.save.write)
+                let write = save::per_layer_write(&plan.save.write, dst);
+                write_while_converting(job, &paths, &write)
             })?;
             (paths, t1.elapsed(), None)
         }

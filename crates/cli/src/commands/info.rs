@@ -21,6 +21,7 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
             "file": a.input,
             "container": src.description,
             "projection": p.name(),
+            "spec": p.to_string(),
             "decided": src.decided,
             "layers": env.layers().len(),
             "width": env.width(),

@@ -151,7 +151,8 @@ fn bad_requests_fail_before_any_work() {
             "--to",
             "fisheye:fov=400:lens=stereographic",
         ],
-        &["fisheye"],
+        // Names as the user spells them, not Rust's debug form ("Stereographic").
+        &["the stereographic fisheye lens covers at most"],
     );
     fails(
         &["convert", s, &o("a.exr"), "--to", "cube", "--size", "0"],

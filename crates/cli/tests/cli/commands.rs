@@ -346,7 +346,9 @@ fn converted_cube_samples_like_its_source() {
 }
 
 #[test]
-fn latlong_exr_outputs_declare_their_projection() {
+fn exr_outputs_record_their_projection() {
+    // Recorded in mirrorball's attributes; no OpenEXR `envmap` tag, whose lat-long and cube
+    // conventions are not mirrorball's.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ll.exr");
     ok(&[
@@ -359,7 +361,9 @@ fn latlong_exr_outputs_declare_their_projection() {
         "64",
     ]);
     let l = mirrorball_io::read(&out, &Default::default()).unwrap();
-    assert_eq!(l.declared, Some(ProjectionKind::LatLong));
+    assert_eq!(l.declared, None);
+    let info = l.recorded.unwrap().unwrap();
+    assert_eq!(info.projection.kind(), ProjectionKind::LatLong);
     let cube = dir.path().join("c.exr");
     ok(&[
         "convert",
@@ -370,12 +374,11 @@ fn latlong_exr_outputs_declare_their_projection() {
         "--size",
         "16",
     ]);
-    assert_eq!(
-        mirrorball_io::read(&cube, &Default::default())
-            .unwrap()
-            .declared,
-        None
-    );
+    let l = mirrorball_io::read(&cube, &Default::default()).unwrap();
+    assert_eq!(l.declared, None);
+    let info = l.recorded.unwrap().unwrap();
+    assert_eq!(info.projection.kind(), ProjectionKind::Cube);
+    assert_eq!(info.layout, Some(mirrorball_core::Layout::HorizontalCross));
 }
 
 /// `compare` scores what both maps cover (a 180° fisheye: half the sphere), says so in its

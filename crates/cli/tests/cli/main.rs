@@ -7,5 +7,6 @@ mod prefilter;
 mod production;
 mod quality;
 mod render;
+mod roundtrip;
 mod safety;
 mod util;

@@ -69,6 +69,18 @@ impl Frame {
         })
     }
 
+    /// The frame looking along `forward` whose up is `up` made perpendicular to it (right =
+    /// forward × up). `None` for zero or non-finite vectors, or `up` along `forward`.
+    pub fn looking_along_up(forward: DVec3, up: DVec3) -> Option<Frame> {
+        let f = forward.try_normalize()?;
+        let right = f.cross(up).try_normalize()?;
+        Some(Frame {
+            right,
+            up: right.cross(f),
+            forward: f,
+        })
+    }
+
     /// `(right·d, up·d, forward·d)`.
     #[inline]
     pub fn to_local(&self, d: DVec3) -> DVec3 {
@@ -109,6 +121,16 @@ impl Lens {
             "orthographic" => Lens::Orthographic,
             _ => return None,
         })
+    }
+
+    /// The canonical name, as [`Lens::from_name`] reads it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Lens::Equidistant => "equidistant",
+            Lens::Equisolid => "equisolid",
+            Lens::Stereographic => "stereographic",
+            Lens::Orthographic => "orthographic",
+        }
     }
 
     /// The largest half field of view the lens supports.
@@ -546,6 +568,11 @@ impl DualParaboloid {
         let back =
             RadialMap::new(frame.turned_around(), Lens::Stereographic, FRAC_PI_2).expect("valid");
         DualParaboloid { front, back }
+    }
+
+    /// The frame of the front half (layer 0); the back half looks the other way.
+    pub fn frame(&self) -> &Frame {
+        self.front.frame()
     }
 
     #[inline]

@@ -18,12 +18,14 @@ pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
 pub mod quadrature;
+mod spec;
 
 pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap, SphereMap};
 pub use continuous_cube::ContinuousCube;
 pub use cube::{CubeFace, CubeMap};
 pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
+pub use spec::{parse_dir, ProjectionSpec};
 
 use glam::{DVec2, DVec3};
 use std::fmt;

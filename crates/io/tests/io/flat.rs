@@ -3,8 +3,8 @@
 
 use mirrorball_core::{Image, ProjectionKind};
 use mirrorball_io::{
-    read, write_image, write_image_staged, Error, ExrCompression, Fault, Format, Limits, Precision,
-    WriteOptions,
+    read, write_image, write_image_staged, Error, ExrCompression, Fault, Format, Limits, MapInfo,
+    Precision, WriteOptions,
 };
 use std::path::{Path, PathBuf};
 
@@ -322,10 +322,15 @@ fn exr_crate_uncompressed(img: &Image, float: bool, latlong: bool) -> Vec<u8> {
     let (w, c) = (img.width() as usize, img.channels());
     let data = img.data();
     let fit = move |v: f32| if float { v } else { v.clamp(-65504.0, 65504.0) };
-    let attrs = LayerAttributes {
-        environment_map: latlong.then_some(exr::meta::attribute::EnvironmentMap::LatitudeLongitude),
-        ..LayerAttributes::default()
-    };
+    // mirrorball records the projection as a string attribute (and writes no `envmap`).
+    let mut attrs = LayerAttributes::default();
+    if latlong {
+        use exr::meta::attribute::{AttributeValue, Text};
+        attrs.other.insert(
+            Text::from("mirrorball:projection"),
+            AttributeValue::Text(Text::from("latlong")),
+        );
+    }
     let enc = Encoding {
         compression: Compression::Uncompressed,
         blocks: Blocks::ScanLines,
@@ -388,7 +393,10 @@ fn exr_uncompressed_files_are_byte_for_byte_what_the_exr_crate_writes() {
                         } else {
                             Precision::Half
                         }),
-                        declared: latlong.then_some(ProjectionKind::LatLong),
+                        declared: latlong.then_some(MapInfo {
+                            projection: mirrorball_core::LatLong.into(),
+                            layout: None,
+                        }),
                         ..WriteOptions::default()
                     };
                     write_image(&path, &img, &o).unwrap();

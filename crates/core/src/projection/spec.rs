@@ -1,0 +1,374 @@
+//! Projections as text: `NAME[:key=value[:key=value…]]`, the form the command line takes and
+//! files record (`mirrorball:projection`).
+//!
+//! Keys: `look=DIR` (the direction a sphere map's camera, an angular map's or fisheye's
+//! centre, or a paraboloid's front half looks along: `+x`, `-z`, or `x,y,z`), `up=DIR` (the
+//! picture's up, when it is not the one [`Frame::looking_along`] picks), `fov=DEG` and
+//! `lens=equidistant|equisolid|stereographic|orthographic` (fisheye), `max-lat=DEG`
+//! (Mercator).
+//!
+//! [`Projection::spec`] gives every parameter of a built projection, and its text (the
+//! `Display` of [`ProjectionSpec`] or [`Projection`]) is canonical: the name, then the keys
+//! that apply in the order `fov`, `lens`, `max-lat`, `look`, `up`, numbers rounded to 1e-9
+//! (of a degree, or of a unit vector's component). [`ProjectionSpec::parse`] reads it back to
+//! the same projection, to that rounding.
+
+use super::{
+    AngularMap, DualParaboloid, Fisheye, Frame, Lens, Mercator, Projection, ProjectionKind,
+    SphereMap, UnknownProjection,
+};
+use glam::DVec3;
+use std::fmt;
+
+/// A projection named in text, with the parameters it was given: [`ProjectionSpec::build`]
+/// fills in the rest with their defaults.
+///
+/// ```
+/// use mirrorball_core::projection::ProjectionSpec;
+/// use mirrorball_core::ProjectionKind;
+/// let s = ProjectionSpec::parse("fisheye:fov=190:lens=equisolid:look=+y").unwrap();
+/// assert_eq!(s.kind, ProjectionKind::Fisheye);
+/// let p = s.build(None).unwrap();
+/// assert_eq!(p.to_string(), "fisheye:fov=190:lens=equisolid:look=0,1,0");
+/// assert_eq!(ProjectionSpec::parse(&p.to_string()).unwrap().build(None).unwrap(), p);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProjectionSpec {
+    /// The kind.
+    pub kind: ProjectionKind,
+    look: Option<DVec3>,
+    up: Option<DVec3>,
+    fov: Option<f64>,
+    lens: Option<Lens>,
+    max_lat: Option<f64>,
+}
+
+/// Parses a direction: `+x`, `-y`, `z`, or three numbers `x,y,z`.
+pub fn parse_dir(s: &str) -> Result<DVec3, String> {
+    let t = s.trim().to_ascii_lowercase();
+    let axis = match t.as_str() {
+        "+x" | "x" => Some(DVec3::X),
+        "-x" => Some(DVec3::NEG_X),
+        "+y" | "y" | "up" => Some(DVec3::Y),
+        "-y" | "down" => Some(DVec3::NEG_Y),
+        "+z" | "z" | "back" => Some(DVec3::Z),
+        "-z" | "forward" => Some(DVec3::NEG_Z),
+        _ => None,
+    };
+    if let Some(a) = axis {
+        return Ok(a);
+    }
+    let parts: Vec<f64> = t
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not a direction (use +x, -z, or x,y,z)"))?;
+    if parts.len() != 3 || parts.iter().any(|v| !v.is_finite()) {
+        return Err(format!("'{s}' is not a direction (use +x, -z, or x,y,z)"));
+    }
+    let d = DVec3::new(parts[0], parts[1], parts[2]);
+    if d.length() == 0.0 {
+        return Err(format!("'{s}' is the zero vector, which points nowhere"));
+    }
+    Ok(d)
+}
+
+impl ProjectionSpec {
+    /// Parses `NAME[:key=value…]`, checking that each key applies to the kind and that the
+    /// values make a projection.
+    pub fn parse(s: &str) -> Result<ProjectionSpec, String> {
+        let mut parts = s.split(':');
+        let name = parts.next().unwrap_or_default();
+        let kind: ProjectionKind = name.parse().map_err(|e: UnknownProjection| e.to_string())?;
+        let mut spec = ProjectionSpec::of(kind);
+        for kv in parts {
+            let (k, v) = kv
+                .split_once('=')
+                .ok_or_else(|| format!("'{kv}' in '{s}' is not key=value"))?;
+            let num = |v: &str| {
+                v.parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| format!("'{v}' is not a number (in '{s}')"))
+            };
+            match k.trim() {
+                "look" | "dir" | "view" => spec.look = Some(parse_dir(v)?),
+                "up" => spec.up = Some(parse_dir(v)?),
+                "fov" => spec.fov = Some(num(v)?),
+                "lens" => {
+                    spec.lens = Some(Lens::from_name(v).ok_or_else(|| {
+                        format!("unknown lens '{v}' (known: equidistant, equisolid, stereographic, orthographic)")
+                    })?)
+                }
+                "max-lat" | "maxlat" | "lat" => spec.max_lat = Some(num(v)?),
+                other => return Err(format!("unknown option '{other}' in '{s}' (known: look, up, fov, lens, max-lat)")),
+            }
+        }
+        let applies = |ok: bool, key: &str| {
+            if ok {
+                Ok(())
+            } else {
+                Err(format!("'{key}' does not apply to {}", kind.name()))
+            }
+        };
+        use ProjectionKind as K;
+        if spec.look.is_some() || spec.up.is_some() {
+            applies(
+                matches!(kind, K::Sphere | K::Angular | K::Fisheye | K::Paraboloid),
+                "look/up",
+            )?;
+        }
+        if spec.fov.is_some() || spec.lens.is_some() {
+            applies(kind == K::Fisheye, "fov/lens")?;
+        }
+        if spec.max_lat.is_some() {
+            applies(kind == K::Mercator, "max-lat")?;
+        }
+        spec.build(None)?; // validate values now, before any work
+        Ok(spec)
+    }
+
+    /// A spec of this kind with default parameters.
+    pub fn of(kind: ProjectionKind) -> ProjectionSpec {
+        ProjectionSpec {
+            kind,
+            look: None,
+            up: None,
+            fov: None,
+            lens: None,
+            max_lat: None,
+        }
+    }
+
+    /// The projection. For Mercator without `max-lat`, `extent` (an input picture's size)
+    /// fixes the limit from the aspect ratio.
+    pub fn build(&self, extent: Option<(u32, u32)>) -> Result<Projection, String> {
+        let frame = match (self.look, self.up) {
+            (Some(d), Some(up)) => Frame::looking_along_up(d, up)
+                .ok_or("the up direction must not be along the look direction")?,
+            (Some(d), None) => {
+                Frame::looking_along(d).ok_or("the look direction must be non-zero")?
+            }
+            (None, Some(up)) => Frame::looking_along_up(Frame::default().forward, up)
+                .ok_or("the up direction must not be along the look direction")?,
+            (None, None) => Frame::default(),
+        };
+        Ok(match self.kind {
+            ProjectionKind::Sphere => SphereMap::new(frame).into(),
+            ProjectionKind::Angular => AngularMap::new(frame).into(),
+            ProjectionKind::Paraboloid => DualParaboloid::new(frame).into(),
+            ProjectionKind::Fisheye => {
+                let lens = self.lens.unwrap_or(Lens::Equidistant);
+                let fov = self.fov.unwrap_or(180.0);
+                Fisheye::new(frame, lens, fov)
+                    .ok_or_else(|| {
+                        format!(
+                            "the {} fisheye lens covers at most {:.0}° (fov={fov} asked)",
+                            lens.name(),
+                            2.0 * lens.max_half_fov().to_degrees()
+                        )
+                    })?
+                    .into()
+            }
+            ProjectionKind::Mercator => match (self.max_lat, extent) {
+                (Some(l), _) => Mercator::new(l)
+                    .ok_or_else(|| format!("max-lat must be between 0 and 90 degrees, not {l}"))?
+                    .into(),
+                (None, Some((w, h))) => Mercator::from_extent(w, h).ok_or("empty picture")?.into(),
+                (None, None) => Mercator::default().into(),
+            },
+            k => k.default_projection(),
+        })
+    }
+}
+
+impl Projection {
+    /// Every parameter of this projection as a spec: building it gives this projection back
+    /// (to the rounding of its text form; see the module documentation).
+    pub fn spec(&self) -> ProjectionSpec {
+        let mut s = ProjectionSpec::of(self.kind());
+        let frame = match self {
+            Projection::Sphere(p) => Some(*p.eye()),
+            Projection::Angular(p) => Some(*p.radial().frame()),
+            Projection::Fisheye(p) => {
+                s.fov = Some(2.0 * p.radial().theta_max().to_degrees());
+                s.lens = Some(p.radial().lens());
+                Some(*p.radial().frame())
+            }
+            Projection::Paraboloid(p) => Some(*p.frame()),
+            Projection::Mercator(p) => {
+                s.max_lat = Some(p.max_latitude_deg());
+                None
+            }
+            _ => None,
+        };
+        if let Some(f) = frame {
+            s.look = Some(f.forward);
+            let usual = Frame::looking_along(f.forward).map(|g| g.up);
+            if usual.is_none_or(|u| (u - f.up).length() > 1e-9) {
+                s.up = Some(f.up);
+            }
+        }
+        s
+    }
+}
+
+/// A number for the text form: rounded to 1e-9, without a sign on zero.
+struct Num(f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let r = (self.0 * 1e9).round() / 1e9;
+        write!(f, "{}", if r == 0.0 { 0.0 } else { r })
+    }
+}
+
+/// A direction for the text form: `x,y,z`.
+struct Dir(DVec3);
+
+impl fmt::Display for Dir {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{},{},{}", Num(self.0.x), Num(self.0.y), Num(self.0.z))
+    }
+}
+
+impl fmt::Display for ProjectionSpec {
+    /// The canonical text: the name, then the parameters given, in the order `fov`, `lens`,
+    /// `max-lat`, `look`, `up`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.kind.name())?;
+        if let Some(v) = self.fov {
+            write!(f, ":fov={}", Num(v))?;
+        }
+        if let Some(l) = self.lens {
+            write!(f, ":lens={}", l.name())?;
+        }
+        if let Some(v) = self.max_lat {
+            write!(f, ":max-lat={}", Num(v))?;
+        }
+        if let Some(d) = self.look {
+            write!(f, ":look={}", Dir(d))?;
+        }
+        if let Some(d) = self.up {
+            write!(f, ":up={}", Dir(d))?;
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for Projection {
+    /// The canonical text of [`Projection::spec`]: `sphere:look=0,0,-1`,
+    /// `fisheye:fov=190:lens=equisolid:look=0,1,0`, `mercator:max-lat=85.051128780`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.spec().fmt(f)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::WorldProjection;
+    use glam::DVec2;
+
+    #[test]
+    fn parses_names_and_options() {
+        let s = ProjectionSpec::parse("fisheye:fov=220:lens=equisolid:look=+y").unwrap();
+        assert_eq!(s.kind, ProjectionKind::Fisheye);
+        assert!(ProjectionSpec::parse("equirect").is_ok());
+        assert!(ProjectionSpec::parse("fisheye:fov=400:lens=stereographic").is_err());
+        assert!(ProjectionSpec::parse("cube:fov=90")
+            .unwrap_err()
+            .contains("does not apply"));
+        assert!(ProjectionSpec::parse("sphere:look=0,0,0").is_err());
+        assert!(ProjectionSpec::parse("sphere:look=+y:up=0,2,0").is_err());
+        assert!(ProjectionSpec::parse("mercator:max-lat=95").is_err());
+        assert!(ProjectionSpec::parse("nope").unwrap_err().contains("known"));
+    }
+
+    /// The largest difference in direction between two projections over a grid of texture
+    /// coordinates of every layer: zero when they are the same mapping.
+    fn max_dir_diff(a: &Projection, b: &Projection) -> f64 {
+        let mut worst = 0.0f64;
+        for layer in 0..a.layer_count() {
+            for i in 0..17 {
+                for j in 0..17 {
+                    let uv = DVec2::new((i as f64 + 0.5) / 17.0, (j as f64 + 0.5) / 17.0);
+                    match (a.uv_to_dir(layer, uv), b.uv_to_dir(layer, uv)) {
+                        (Some(x), Some(y)) => worst = worst.max((x - y).length()),
+                        (None, None) => {}
+                        _ => return f64::INFINITY,
+                    }
+                }
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn text_form_round_trips_every_projection() {
+        let frame_up = Frame::looking_along_up(DVec3::new(1.0, 0.2, -0.3), DVec3::Z).unwrap();
+        let mut cases: Vec<Projection> = ProjectionKind::ALL
+            .iter()
+            .map(|k| k.default_projection())
+            .collect();
+        cases.extend::<[Projection; 7]>([
+            Fisheye::new(
+                Frame::looking_along(DVec3::Y).unwrap(),
+                Lens::Equisolid,
+                190.0,
+            )
+            .unwrap()
+            .into(),
+            Fisheye::new(frame_up, Lens::Stereographic, 123.456)
+                .unwrap()
+                .into(),
+            SphereMap::new(Frame::looking_along(DVec3::new(1.0, 1.0, 0.0)).unwrap()).into(),
+            AngularMap::new(frame_up).into(),
+            DualParaboloid::new(Frame::looking_along(DVec3::X).unwrap()).into(),
+            Mercator::new(70.0).unwrap().into(),
+            Mercator::from_extent(300, 200).unwrap().into(),
+        ]);
+        for p in cases {
+            let text = p.to_string();
+            let back = ProjectionSpec::parse(&text)
+                .unwrap_or_else(|e| panic!("{text}: {e}"))
+                .build(None)
+                .unwrap();
+            assert_eq!(back.kind(), p.kind(), "{text}");
+            let d = max_dir_diff(&p, &back);
+            assert!(d < 1e-8, "{text}: directions differ by {d}");
+            // Canonical: the text of what was read is the text that was written (with an
+            // `up`, made perpendicular again after rounding, the last digit may move).
+            if !text.contains(":up=") {
+                assert_eq!(back.to_string(), text);
+            }
+        }
+        assert_eq!(
+            Projection::from(
+                Fisheye::new(
+                    Frame::looking_along(DVec3::Y).unwrap(),
+                    Lens::Equisolid,
+                    190.0
+                )
+                .unwrap()
+            )
+            .to_string(),
+            "fisheye:fov=190:lens=equisolid:look=0,1,0"
+        );
+        assert_eq!(
+            Projection::from(SphereMap::default()).to_string(),
+            "sphere:look=0,0,-1"
+        );
+        assert_eq!(
+            Projection::from(frame_up_angular())
+                .to_string()
+                .matches(":up=")
+                .count(),
+            1
+        );
+    }
+
+    fn frame_up_angular() -> AngularMap {
+        AngularMap::new(Frame::looking_along_up(DVec3::NEG_Z, DVec3::X).unwrap())
+    }
+}
