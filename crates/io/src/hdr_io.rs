@@ -50,6 +50,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             HdrDecoder::new_nonstrict(reader).map_err(|e| decode_error(path, "Radiance HDR", e))?;
         let (width, height) = decoder.dimensions();
         check_limits(path, width as u64, height as u64, limits)?;
+        crate::bounds::check_lines_fit(path, height as u64)?;
         let decoded = DynamicImage::from_decoder(decoder)
             .map_err(|e| decode_error(path, "Radiance HDR", e))?;
         let data = match decoded {

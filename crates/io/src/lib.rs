@@ -8,6 +8,7 @@
 //! whose fault it is ([`Fault`]).
 
 mod atomic;
+mod bounds;
 mod dds_io;
 mod error;
 mod exr_io;

@@ -1,3 +1,4 @@
 //! The mirrorball-io integration tests: one binary, one module per concern.
 mod cube;
 mod flat;
+mod hostile;
