@@ -2,3 +2,4 @@
 mod cube;
 mod flat;
 mod hostile;
+mod mutate;
