@@ -1213,7 +1213,10 @@ fn check_dwa_blocks(path: &Path) -> Result<(), Error> {
         let Some(header) = headers.get(chunk.layer_index) else {
             continue; // the decoder reports a bad layer index
         };
-        if !matches!(header.compression, Compression::DWAA(_) | Compression::DWAB(_)) {
+        if !matches!(
+            header.compression,
+            Compression::DWAA(_) | Compression::DWAB(_)
+        ) {
             continue;
         }
         use exr::block::chunk::CompressedBlock;
@@ -1265,9 +1268,8 @@ fn dwa_block_problem(bytes: &[u8], header: &Header, size: Vec2<usize>) -> Option
     if bytes.is_empty() || bytes.len() as u64 == raw || bytes.len() < 8 * NAMES.len() {
         return None;
     }
-    let counter = |i: usize| {
-        u64::from_le_bytes(bytes[8 * i..8 * i + 8].try_into().expect("8 bytes"))
-    };
+    let counter =
+        |i: usize| u64::from_le_bytes(bytes[8 * i..8 * i + 8].try_into().expect("8 bytes"));
     // Samples of the block with each channel padded to whole 8×8 DCT blocks: at most 64
     // coefficients (63 AC, 1 DC) each.
     let padded: u64 = header

@@ -28,15 +28,14 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, String> {
             path.display()
         )),
     };
-    let mesh = std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse)).unwrap_or_else(
-        |_| {
+    let mesh =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse)).unwrap_or_else(|_| {
             Err(format!(
                 "{}: the {} reader failed on malformed data",
                 path.display(),
                 if ext == "obj" { "OBJ" } else { "glTF" }
             ))
-        },
-    )?;
+        })?;
     if mesh.triangles.is_empty() {
         return Err(format!("{}: no triangles", path.display()));
     }
@@ -58,7 +57,7 @@ fn check_extent(mesh: &Mesh) -> Result<(), String> {
         return Ok(());
     };
     let extent = (hi - lo).max_element();
-    if !(extent <= MAX_EXTENT) {
+    if extent.is_nan() || extent > MAX_EXTENT {
         let far = mesh
             .positions
             .iter()

@@ -3,7 +3,14 @@
 mod analyze;
 mod bad_input;
 mod commands;
+#[allow(dead_code)]
+#[path = "../../src/error.rs"]
+mod error;
+mod hostile;
 mod prefilter;
 mod quality;
 mod render;
+#[allow(dead_code)]
+#[path = "../../src/spec.rs"]
+mod spec;
 mod util;

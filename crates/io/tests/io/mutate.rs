@@ -90,4 +90,3 @@ pub fn apply_script(seed: &[u8], script: &[u8]) -> Vec<u8> {
     }
     m
 }
-

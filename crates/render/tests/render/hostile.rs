@@ -133,7 +133,9 @@ fn vertices_that_are_not_finite_or_too_far_apart_are_named() {
     std::fs::write(&nan, "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let e = load_mesh(&nan).unwrap_err();
     assert!(
-        e.starts_with(&nan.display().to_string()) && e.contains("vertex 1") && e.contains("not finite"),
+        e.starts_with(&nan.display().to_string())
+            && e.contains("vertex 1")
+            && e.contains("not finite"),
         "{e}"
     );
     let huge = dir.path().join("huge.obj");
