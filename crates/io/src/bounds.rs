@@ -4,7 +4,10 @@
 //! can hold, so that a few kilobytes cannot make a reader allocate gigabytes. Each format
 //! packs at most so many texels into a byte of its file (deflate expands at most 1032:1,
 //! every JPEG block costs at least a bit, every Radiance scan line at least 4 bytes); a
-//! file declaring more is corrupt, and is refused before anything is allocated. Formats
+//! file declaring more is corrupt, and is refused before anything is allocated. Where a
+//! rare but valid coding can pack more (Radiance's old-style chained runs), the bound is
+//! set well above the common coding's (64 texels a byte where new-style runs reach 16), and
+//! every file may declare [`FLOOR_TEXELS`]. Formats
 //! whose coding has no such bound (DWA's DCT with deflated DC values, WebP's arithmetic
 //! and backward-reference coding) are left to the limits.
 

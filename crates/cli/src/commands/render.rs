@@ -389,6 +389,26 @@ impl RenderPlan {
                     .to_string(),
             }));
         }
+        // Each built-in is within the budget; so must they be together (a scene can list
+        // any number).
+        let triangles: u64 = plan
+            .objects
+            .iter()
+            .map(|o| match o.source {
+                MeshSource::Builtin(b, l) => b.triangle_count(l),
+                MeshSource::File(_) => 0,
+            })
+            .sum();
+        if triangles > MAX_TRIANGLES {
+            return Err(CliError::request(format!(
+                "{}the built-in meshes make {triangles} triangles in all; at most \
+                 {MAX_TRIANGLES} are allowed: lower their tessellations",
+                a.scene
+                    .as_ref()
+                    .map(|s| format!("{s}: "))
+                    .unwrap_or_default(),
+            )));
+        }
         let bytes = plan.image_bytes();
         if bytes > MAX_RENDER_BYTES {
             let (w, h) = (plan.camera.width, plan.camera.height);

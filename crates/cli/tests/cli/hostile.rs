@@ -168,7 +168,22 @@ fn tessellations_beyond_the_triangle_budget_are_refused_before_building() {
         e.contains("pots.toml") && e.contains("meshes[0]") && e.contains("1073741824"),
         "{e}"
     );
-    // The largest allowed still renders (a small picture).
+    // Within the budget one by one, not together.
+    let scene = dir.path().join("spheres.json");
+    std::fs::write(
+        &scene,
+        r#"{"background": false, "material": {"kind": "cheap-chrome"},
+            "meshes": [{"mesh": "sphere", "tessellation": 4096},
+                       {"mesh": "sphere", "tessellation": 4096}]}"#,
+    )
+    .unwrap();
+    let (r, _) = run_capped(&["render", scene.to_str().unwrap(), "-o", o]);
+    let e = stderr(&r);
+    assert!(
+        e.contains("spheres.json") && e.contains("33538048 triangles in all"),
+        "{e}"
+    );
+    // A tessellation within the budget renders (a small picture).
     let (r, _) = flag("teapot", "64");
     assert!(r.status.success(), "{}", stderr(&r));
 }

@@ -360,6 +360,16 @@ fn a_small_file_declaring_a_large_image_is_refused() {
     .unwrap();
     let e = read(&path, &limits).expect_err("refused");
     assert!(e.problem().contains("60000 scan lines"), "{e}");
+    // Room for its 100 lines, not for 65536 texels in each.
+    let mut wide = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100 +X 65536\n".to_vec();
+    wide.resize(400, 1);
+    let path = dir.path().join("wide.hdr");
+    std::fs::write(&path, &wide).unwrap();
+    let e = read(&path, &limits).expect_err("refused");
+    assert!(
+        e.problem().contains("65536×100") && e.problem().contains("400 bytes"),
+        "{e}"
+    );
 
     // An uncompressed EXR seed whose data window says 8192×8192.
     let seed = std::fs::read(corpus().join("exr/none.exr")).unwrap();
