@@ -304,6 +304,16 @@ fn mutated_image_files_end_cleanly_in_info_and_convert() {
         .collect();
     formats.sort();
     for format in formats {
+        // Past crashes, as they are.
+        let crashes = format.join("crashes");
+        if crashes.is_dir() {
+            for crash in corpus_in(&crashes) {
+                let name = crash.file_name().unwrap().to_string_lossy().into_owned();
+                let (r, took) = run_capped(&["info", crash.to_str().unwrap()]);
+                assert_clean(&r, took, &name, &name);
+                runs += 1;
+            }
+        }
         for (k, seed) in corpus_in(&format).iter().enumerate() {
             let bytes = std::fs::read(seed).unwrap();
             // The inflated size fields (the mutations after the cuts and flips), every

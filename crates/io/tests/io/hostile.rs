@@ -174,7 +174,11 @@ fn fuzz_format(format: &str) {
         .iter()
         .map(|p| (p.clone(), std::fs::read(p).unwrap()))
         .collect();
+    // The inputs go to a fresh folder, or to $MIRRORBALL_FUZZ_KEEP, where the one that
+    // failed is left (to be saved under `crashes/`).
     let dir = tempfile::tempdir().unwrap();
+    let keep = std::env::var_os("MIRRORBALL_FUZZ_KEEP").map(PathBuf::from);
+    let out = keep.unwrap_or_else(|| dir.path().to_path_buf());
     let limits = Limits::default();
     bolero::check!()
         .with_iterations(200)
@@ -185,7 +189,7 @@ fn fuzz_format(format: &str) {
             let (seed_path, seed) = &seeds[pick as usize % seeds.len()];
             let ext = seed_path.extension().unwrap().to_str().unwrap();
             let name = seed_path.file_stem().unwrap().to_str().unwrap();
-            let path = dir.path().join(format!("fuzz-{name}.{ext}"));
+            let path = out.join(format!("fuzz-{name}.{ext}"));
             std::fs::write(&path, apply_script(seed, script)).unwrap();
             let mut tally = Tally::default();
             check_read(&path, &limits, &mut tally);
