@@ -67,9 +67,16 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
             h.layer_size.height() as u64,
             limits,
         )?;
+        check_fits_file(path, h)?;
     }
     if let Some(problem) = undecodable_compression(header.compression) {
         return Err(Error::input(path, problem));
+    }
+    if headers
+        .iter()
+        .any(|h| matches!(h.compression, Compression::DWAA(_) | Compression::DWAB(_)))
+    {
+        check_dwa_blocks(path)?;
     }
 
     let layer_count = headers.len();
@@ -117,12 +124,15 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
         });
     }
 
+    // On this thread: the crate's parallel decoding runs blocks on a pool of its own, where
+    // a decoder's panic aborts the process instead of reaching `guard_decoder`.
     let exr_image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
         .rgba_channels(create_texels, set_texel)
         .first_valid_layer()
         .all_attributes()
+        .non_parallel()
         .from_chunks(chunks)
         .map_err(|e| read_error(path, e))?;
 
@@ -616,6 +626,12 @@ fn block_layout(header: &Header) -> Option<Vec<(usize, SampleType)>> {
 /// blocks, decompressed on all cores, each block's lines of per-channel samples
 /// interleaved straight into the texels. Blocks that do not fit the layer are an error,
 /// never a panic.
+///
+/// The blocks are decompressed here, a batch at a time with rayon, rather than by the
+/// crate's `decompress_parallel`: that runs each block on a thread pool of its own, where
+/// a decoder panicking on a malformed block (B44 overflowed on one in the hostile corpus)
+/// aborts the whole process, while a panic under `par_iter` comes back to this thread,
+/// where [`guard_decoder`] turns it into an error.
 fn read_blocks<R: std::io::Read + std::io::Seek + Send>(
     chunks: exr::block::reader::Reader<R>,
     index: usize,
@@ -629,7 +645,8 @@ fn read_blocks<R: std::io::Read + std::io::Seek + Send>(
         block.layer == index && block.level == Vec2(0, 0)
     })?;
     let mut data = vec![0.0f32; w * h * n];
-    reader.decompress_parallel(false, |_, block| {
+    let meta = reader.meta_data().clone();
+    let mut insert = |block: exr::block::UncompressedBlock| {
         let (bx, by) = (
             block.index.pixel_position.x(),
             block.index.pixel_position.y(),
@@ -648,7 +665,22 @@ fn read_blocks<R: std::io::Read + std::io::Seek + Send>(
             layout,
             true,
         )
-    })?;
+    };
+    use rayon::prelude::*;
+    let mut chunks = reader.peekable();
+    // Enough blocks in a batch to keep every core busy, few enough to bound the memory.
+    let batch = rayon::current_num_threads() * 4;
+    while chunks.peek().is_some() {
+        let taken: Vec<exr::block::chunk::Chunk> =
+            chunks.by_ref().take(batch).collect::<Result<_, _>>()?;
+        let blocks: Vec<exr::block::UncompressedBlock> = taken
+            .into_par_iter()
+            .map(|chunk| exr::block::UncompressedBlock::decompress_chunk(chunk, &meta, false))
+            .collect::<Result<_, _>>()?;
+        for block in blocks {
+            insert(block)?;
+        }
+    }
     Image::from_vec(w as u32, h as u32, n, data)
         .ok_or_else(|| exr::error::Error::Invalid("inconsistent layer size".into()))
 }
@@ -1190,10 +1222,151 @@ fn sample_type_names(types: &[SampleType]) -> String {
     }
 }
 
+/// Refuses a layer (of a size within the limits) whose samples the file is too short to
+/// hold, by the most its compression expands a byte (see [`crate::bounds`]): 1 stored raw,
+/// 64 for RLE (a count and a byte for a run of up to 128), 1032 for deflate (ZIP, ZIPS,
+/// PXR24) and taken for PIZ too (a Huffman run code of at least 9 bits stands for at most
+/// 255 16-bit values, under 460:1), 11 for B44(A)
+/// (a flat 4×4 block of halves in 3 bytes). DWAA/DWAB have no useful bound (a constant
+/// image's DC values deflate 1032:1 and stand for 64 samples each); their blocks are checked
+/// one by one instead ([`check_dwa_blocks`]).
+fn check_fits_file(path: &Path, header: &Header) -> Result<(), Error> {
+    let ratio = match header.compression {
+        Compression::Uncompressed => 1,
+        Compression::RLE => 64,
+        Compression::ZIP1 | Compression::ZIP16 | Compression::PXR24 | Compression::PIZ => 1032,
+        Compression::B44 | Compression::B44A => 11,
+        _ => return Ok(()),
+    };
+    let raw = header.total_pixel_bytes() as u64;
+    let what = format!("{} compression", compression_name(header.compression));
+    crate::bounds::check_raw_bytes_fit(path, raw, ratio, &what)
+}
+
+/// Checks the counters at the start of every DWAA/DWAB block against what the block's
+/// pixels can need, before the `exr` crate decodes any block: the crate sizes its buffers
+/// from these counters (the AC coefficient count, for one, becomes a `Vec::with_capacity`),
+/// so a 3 KB file whose block claims 2⁴⁰ coefficients would make it ask for 2 TB and
+/// abort. The blocks are read here through the crate's own chunk reader (each block's bytes
+/// bounded by the largest block the header allows), found through the offset tables as
+/// the decoder finds them, so the bytes checked are the bytes decoded; a DWA file is
+/// therefore read twice. Blocks of other compressions are skipped.
+fn check_dwa_blocks(path: &Path) -> Result<(), Error> {
+    // A handle of its own: the caller's is part way through the file.
+    let file = open_input(path)?;
+    let reader = exr::block::read(BufReader::new(file), false).map_err(|e| read_error(path, e))?;
+    let headers: Vec<Header> = reader.headers().to_vec();
+    let chunks = reader
+        .filter_chunks(false, |_, _, _| true)
+        .map_err(|e| read_error(path, e))?;
+    for (k, chunk) in chunks.enumerate() {
+        let chunk = chunk.map_err(|e| read_error(path, e))?;
+        let Some(header) = headers.get(chunk.layer_index) else {
+            continue; // the decoder reports a bad layer index
+        };
+        if !matches!(
+            header.compression,
+            Compression::DWAA(_) | Compression::DWAB(_)
+        ) {
+            continue;
+        }
+        use exr::block::chunk::CompressedBlock;
+        let bytes = match &chunk.compressed_block {
+            CompressedBlock::ScanLine(b) => &b.compressed_pixels_le,
+            CompressedBlock::Tile(b) => &b.compressed_pixels_le,
+            _ => continue, // deep data: refused by the decoder
+        };
+        // The block's place exactly as the decoder works it out; a bad one it reports.
+        let Ok(size) = header
+            .get_block_data_indices(&chunk.compressed_block)
+            .and_then(|t| header.get_absolute_block_pixel_coordinates(t))
+            .map(|b| b.size)
+        else {
+            continue;
+        };
+        if let Some(problem) = dwa_block_problem(bytes, header, size) {
+            return Err(Error::input(
+                path,
+                format!("not a valid OpenEXR file (DWA block {k}: {problem})"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// What is wrong with the counters of a DWA block of `size` pixels (`bytes` as stored),
+/// if anything: each must fit the block. The bounds are loose (a valid writer stays well
+/// inside them) but keep every buffer the decoder sizes from them within a small multiple
+/// of the block's raw size. Blocks stored raw (exactly the raw size) or empty have no
+/// counters; a block too short for them the decoder reports as truncated.
+fn dwa_block_problem(bytes: &[u8], header: &Header, size: Vec2<usize>) -> Option<String> {
+    /// The counters (`DataSizesSingle` in OpenEXR's `internal_dwa_compressor.h`): eleven
+    /// little-endian u64 at the start of the block.
+    const NAMES: [&str; 11] = [
+        "version",
+        "unknownUncompressedSize",
+        "unknownCompressedSize",
+        "acCompressedSize",
+        "dcCompressedSize",
+        "rleCompressedSize",
+        "rleUncompressedSize",
+        "rleRawSize",
+        "totalAcUncompressedCount",
+        "totalDcUncompressedCount",
+        "acCompression",
+    ];
+    let raw = (size.area() as u64).saturating_mul(header.channels.bytes_per_pixel as u64);
+    if bytes.is_empty() || bytes.len() as u64 == raw || bytes.len() < 8 * NAMES.len() {
+        return None;
+    }
+    let counter =
+        |i: usize| u64::from_le_bytes(bytes[8 * i..8 * i + 8].try_into().expect("8 bytes"));
+    // Samples of the block with each channel padded to whole 8×8 DCT blocks: at most 64
+    // coefficients (63 AC, 1 DC) each.
+    let padded: u64 = header
+        .channels
+        .list
+        .iter()
+        .map(|c| {
+            let w = size.x().div_ceil(c.sampling.x().max(1)).div_ceil(8) as u64 * 8;
+            let h = size.y().div_ceil(c.sampling.y().max(1)).div_ceil(8) as u64 * 8;
+            w * h
+        })
+        .sum();
+    // (counter, the most it may be): raw bytes of the unknown and RLE channels; the RLE
+    // stream (a count byte per run, so at most twice its bytes); a u16 per AC coefficient
+    // (at most 64 per 8×8 block) and per DC value (one per 8×8 block).
+    let bounds = [
+        (1, raw),
+        (6, raw.saturating_mul(2).saturating_add(64)),
+        (7, raw),
+        (8, padded),
+        (9, padded / 64),
+    ];
+    for (i, most) in bounds {
+        let v = counter(i);
+        if v > most {
+            return Some(format!(
+                "{} is {v}, but a block of {}×{} pixels needs at most {most}",
+                NAMES[i],
+                size.x(),
+                size.y()
+            ));
+        }
+    }
+    None
+}
+
 /// Turns an `exr` reading error into an input error naming the problem.
 fn read_error(path: &Path, e: exr::error::Error) -> Error {
     use exr::error::Error as E;
     match e {
+        // A seek to an offset the file's tables give that the system refuses (negative,
+        // or past what a file can be): the file's fault, not the system's.
+        E::Io(io) if io.kind() == std::io::ErrorKind::InvalidInput => Error::input(
+            path,
+            format!("not a valid OpenEXR file (it points outside itself: {io})"),
+        ),
         E::Io(io) => Error::io(path, io),
         E::Invalid(msg) if msg.contains("missing bytes") => Error::input(
             path,

@@ -423,6 +423,32 @@ fn read_u32(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"))
 }
 
+/// What `ktx2` 0.5 would panic on in the Data Format Descriptor at `offset` (`len` bytes)
+/// of `bytes`, if anything: a basic block's texel block dimension byte of 255 (it adds one
+/// to the byte as a `u8` and unwraps a `NonZeroU8`; found by fuzzing). Walks the blocks as
+/// the crate does: after `dfdTotalSize`, each block's 8-byte header (vendor and type in
+/// the first word, its size in the upper half of the second), the basic block's
+/// dimensions four bytes after the header. Malformed bounds are left to the crate.
+fn dfd_problem(bytes: &[u8], offset: usize, len: usize) -> Option<String> {
+    let end = offset.checked_add(len)?.min(bytes.len());
+    let mut at = offset.checked_add(4)?;
+    while at + 8 <= end {
+        let kind = read_u32(bytes, at);
+        let size = u16::from_le_bytes([bytes[at + 6], bytes[at + 7]]) as usize;
+        // Vendor 0 (Khronos), type 0: the basic block.
+        if kind == 0 && at + 16 <= end && bytes[at + 12..at + 16].contains(&255) {
+            return Some(
+                "its data format descriptor gives a texel block dimension of 256".to_string(),
+            );
+        }
+        if size < 8 {
+            break;
+        }
+        at += size;
+    }
+    None
+}
+
 fn read_u64(bytes: &[u8], at: usize) -> u64 {
     u64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"))
 }
@@ -571,6 +597,13 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         return Err(invalid(
             "file is truncated (it shrank while being read)".into(),
         ));
+    }
+    if let Some(problem) = dfd_problem(
+        &bytes,
+        index_fields.dfd_byte_offset as usize,
+        index_fields.dfd_byte_length as usize,
+    ) {
+        return Err(invalid(format!("invalid KTX2 file: {problem}")));
     }
     let reader = ktx2::Reader::new(bytes.as_slice())
         .map_err(|e| invalid(format!("invalid KTX2 file: {e}")))?;

@@ -117,6 +117,7 @@ fn decode<R: BufRead + Seek>(
     })?;
     let (width, height) = decoder.dimensions();
     check_limits(path, width as u64, height as u64, limits)?;
+    check_fits_file(path, format, name, width, height)?;
     let decoded = DynamicImage::from_decoder(decoder).map_err(|e| decode_error(path, name, e))?;
     let (image, depth, layout) = to_linear(path, decoded)?;
     let description = format!("{name}, {depth} sRGB, {layout}");
@@ -129,6 +130,27 @@ fn decode<R: BufRead + Seek>(
         // 8- and 16-bit texels decode to values in [0, 1].
         invalid: Some(0),
     })
+}
+
+/// Refuses a PNG or JPEG whose declared size its length cannot hold (see
+/// [`crate::bounds`]). PNG: deflate expands a byte to at most 1032, and a 1-bit grey texel
+/// takes an eighth of a raw byte, so at most 8 × 1032 (plus slack) texels a byte. JPEG
+/// (Huffman-coded, as the decoder reads it): every 8×8 block of the fullest component costs
+/// at least a bit for its DC value, so at most 512 texels a byte (doubled for slack). WebP's
+/// coding has no such bound: it is left to the limits.
+fn check_fits_file(
+    path: &Path,
+    format: Format,
+    name: &str,
+    width: u32,
+    height: u32,
+) -> Result<(), Error> {
+    let per_byte = match format {
+        Format::Png => 8 * 1040,
+        Format::Jpeg => 1024,
+        _ => return Ok(()),
+    };
+    crate::bounds::check_texels_fit(path, width as u64, height as u64, per_byte, name)
 }
 
 /// Whether the last scan of a JPEG stream is followed by an end-of-image marker. Marker

@@ -18,6 +18,7 @@
 //! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
 
 mod atomic;
+mod bounds;
 mod dds_io;
 mod error;
 mod exr_io;
@@ -225,8 +226,10 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         Format::Exr => exr_io::read(path, limits),
         Format::Hdr => hdr_io::read(path, limits),
         Format::Png | Format::Jpeg | Format::Webp => ldr_io::read(path, format, limits),
-        Format::Ktx2 => ktx2_io::read(path, limits),
-        Format::Dds => dds_io::read(path, limits),
+        // The header parsers are other crates' (`ktx2` 0.5 panics on a DFD block dimension
+        // of 255): a panic becomes an error.
+        Format::Ktx2 => ldr_io::guard_decoder(path, "KTX2", || ktx2_io::read(path, limits)),
+        Format::Dds => ldr_io::guard_decoder(path, "DDS", || dds_io::read(path, limits)),
     }
 }
 

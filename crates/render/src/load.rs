@@ -18,22 +18,59 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, String> {
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
-    let mesh = match ext.as_str() {
-        "glb" | "gltf" => load_gltf(path)?,
-        "obj" => load_obj(path)?,
-        _ => {
-            return Err(format!(
-                "{}: unknown mesh format (known: .glb .gltf .obj)",
-                path.display()
-            ))
-        }
+    // The parsers are other crates': a panic on malformed data (gltf-json 1.4 indexes the
+    // accessors with a POSITION attribute's index before checking it) becomes an error.
+    let parse = || match ext.as_str() {
+        "glb" | "gltf" => load_gltf(path),
+        "obj" => load_obj(path),
+        _ => Err(format!(
+            "{}: unknown mesh format (known: .glb .gltf .obj)",
+            path.display()
+        )),
     };
+    let mesh =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse)).unwrap_or_else(|_| {
+            Err(format!(
+                "{}: the {} reader failed on malformed data",
+                path.display(),
+                if ext == "obj" { "OBJ" } else { "glTF" }
+            ))
+        })?;
     if mesh.triangles.is_empty() {
         return Err(format!("{}: no triangles", path.display()));
     }
     mesh.validate()
         .map_err(|e| format!("{}: {e}", path.display()))?;
+    check_extent(&mesh).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(mesh)
+}
+
+/// The largest extent of a loaded mesh, in its own units, that can be framed: scaled to
+/// unit size (`Mesh::normalizing_transform`), a larger mesh's transform has a determinant
+/// (the scale cubed) too small for `f32`, and the renderer would take it for singular.
+pub const MAX_EXTENT: f32 = 1e12;
+
+/// Refuses a mesh whose vertices spread over more than [`MAX_EXTENT`] (finite vertices
+/// can still be 3·10³⁸ apart).
+fn check_extent(mesh: &Mesh) -> Result<(), String> {
+    let Some((lo, hi)) = mesh.bounds() else {
+        return Ok(());
+    };
+    let extent = (hi - lo).max_element();
+    if extent.is_nan() || extent > MAX_EXTENT {
+        let far = mesh
+            .positions
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.abs().max_element().total_cmp(&b.1.abs().max_element()))
+            .map(|(i, p)| format!("; vertex {i} is at ({}, {}, {})", p.x, p.y, p.z))
+            .unwrap_or_default();
+        return Err(format!(
+            "the vertices span {extent:e} units, more than the {MAX_EXTENT:e} mirrorball can \
+             frame{far}"
+        ));
+    }
+    Ok(())
 }
 
 fn load_gltf(path: &Path) -> Result<Mesh, String> {
@@ -74,6 +111,17 @@ fn load_gltf(path: &Path) -> Result<Mesh, String> {
                     ..Mesh::default()
                 };
                 let n = part.positions.len() as u32;
+                // The reader panics on indices of any other type.
+                if let Some(a) = prim.indices() {
+                    use gltf::accessor::DataType;
+                    if !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32) {
+                        return Err(format!(
+                            "{name}: mesh {}: the indices are {:?}, not unsigned integers",
+                            mesh.index(),
+                            a.data_type()
+                        ));
+                    }
+                }
                 let idx: Vec<u32> = match reader.read_indices() {
                     Some(i) => i.into_u32().collect(),
                     None => (0..n).collect(),

@@ -212,6 +212,23 @@ impl Mesh {
         if !self.uvs.is_empty() && self.uvs.len() != n {
             return Err(format!("{} uvs for {n} vertices", self.uvs.len()));
         }
+        if let Some((i, p)) = self
+            .positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| !p.is_finite())
+        {
+            return Err(format!(
+                "vertex {i} ({}, {}, {}) is not finite",
+                p.x, p.y, p.z
+            ));
+        }
+        if let Some((i, p)) = self.uvs.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+            return Err(format!(
+                "the texture coordinates ({}, {}) of vertex {i} are not finite",
+                p.x, p.y
+            ));
+        }
         if let Some(t) = self
             .triangles
             .iter()
@@ -223,10 +240,16 @@ impl Mesh {
     }
 
     /// Replaces the normals by area-weighted averages of the face normals (for meshes read
-    /// without normals).
+    /// without normals). Triangles that index past the vertices are skipped (a loader
+    /// calls this before [`Mesh::validate`], which reports them).
     pub fn compute_normals(&mut self) {
-        let mut acc = vec![Vec3::ZERO; self.positions.len()];
-        for t in &self.triangles {
+        let n = self.positions.len();
+        let mut acc = vec![Vec3::ZERO; n];
+        for t in self
+            .triangles
+            .iter()
+            .filter(|t| t.iter().all(|&i| (i as usize) < n))
+        {
             let [a, b, c] = t.map(|i| self.positions[i as usize]);
             let n = (b - a).cross(c - a);
             for &i in t {
@@ -439,6 +462,12 @@ pub enum Builtin {
     Teapot,
 }
 
+/// The most triangles a built-in may be tessellated into: 2²⁴, which the sphere and the
+/// torus stay within up to their largest tessellation (4096). The teapot at 4096 would be
+/// 2³⁰ triangles and the cube 2·10⁸, more than the renderer's per-triangle buffers fit in
+/// memory.
+pub const MAX_TRIANGLES: u64 = 1 << 24;
+
 impl Builtin {
     /// Every built-in.
     pub const ALL: [Builtin; 5] = [
@@ -481,6 +510,42 @@ impl Builtin {
             Builtin::Cube | Builtin::Quad => 1,
             Builtin::Teapot => 8,
         }
+    }
+
+    /// How many triangles [`Builtin::mesh`] makes at tessellation `level`, worked out
+    /// without building it: exact for the sphere, torus, cube and quad; for the teapot an
+    /// upper bound (patch edges that collapse to a point lose a few).
+    pub fn triangle_count(self, level: u32) -> u64 {
+        let l = level as u64;
+        // Saturating: `max_tessellation` asks about levels up to 2³¹.
+        let sq = |a: u64, b: u64, k: u64| k.saturating_mul(a).saturating_mul(b);
+        match self {
+            Builtin::Sphere => {
+                let (nu, nv) = (l.max(3), (l / 2).max(2));
+                // Each of the nv rings of nu cells has two triangles, but the polar rings one.
+                sq(nu, nv, 2) - 2 * nu
+            }
+            Builtin::Torus => sq(l.max(3), (l / 2).max(3), 2),
+            Builtin::Cube => sq(l.max(1), l.max(1), 12),
+            Builtin::Quad => sq(l.max(1), l.max(1), 2),
+            Builtin::Teapot => sq(l.max(1), l.max(1), 64),
+        }
+    }
+
+    /// The largest tessellation whose [`Builtin::triangle_count`] is at most `max`
+    /// (at least 1).
+    pub fn max_tessellation(self, max: u64) -> u32 {
+        // triangle_count grows with the level: bisect for the last level within `max`.
+        let (mut lo, mut hi) = (1u32, u32::MAX / 2);
+        while lo < hi {
+            let mid = lo + (hi - lo).div_ceil(2);
+            if self.triangle_count(mid) <= max {
+                lo = mid;
+            } else {
+                hi = mid - 1;
+            }
+        }
+        lo
     }
 
     /// The mesh at tessellation `level`.

@@ -6,6 +6,7 @@
 //! EXR/HDR (linear) `→` diagnostic channels as separate float EXRs beside the image.
 
 use super::InputPlan;
+use crate::budget;
 use crate::error::CliError;
 use crate::guard::Files;
 use crate::progress::with_progress;
@@ -14,6 +15,7 @@ use crate::{load, RenderArgs};
 use mirrorball_core::glam::{Mat4, Vec3};
 use mirrorball_core::{resample, EnvMap, Image, ResampleOptions, WorldProjection};
 use mirrorball_io::{Format, Precision, WriteOptions};
+use mirrorball_render::mesh::MAX_TRIANGLES;
 use mirrorball_render::tone::{self, Tone};
 use mirrorball_render::{
     Attach, Builtin, Camera, Environment, Filter, Indexing, Lens, Material, Mesh, Object, Ramp,
@@ -176,6 +178,19 @@ fn parse_object(s: &str, level: Option<u32>) -> Result<MeshSource, CliError> {
         let l = level.unwrap_or(b.default_tessellation());
         if !(1..=4096).contains(&l) {
             return Err(bad("--tessellation", format!("{l} is outside 1..=4096")));
+        }
+        // Counted before anything is built: the teapot at 4096 would be 2³⁰ triangles.
+        let triangles = b.triangle_count(l);
+        if triangles > MAX_TRIANGLES {
+            return Err(bad(
+                "--tessellation",
+                format!(
+                    "{l} makes the {name} {triangles} triangles; at most {MAX_TRIANGLES} are \
+                     allowed (the {name} up to tessellation {})",
+                    b.max_tessellation(MAX_TRIANGLES),
+                    name = b.name()
+                ),
+            ));
         }
         return Ok(MeshSource::Builtin(b, l));
     }
@@ -368,11 +383,95 @@ impl RenderPlan {
         let needs_env =
             plan.background || plan.objects.iter().any(|o| o.material.uses_environment());
         if needs_env && plan.env_file.is_none() {
-            return Err(CliError::request(
-                "--env: an environment map is needed (or use --material cheap-chrome or diffuse with --no-background)",
-            ));
+            return Err(CliError::request(match &a.scene {
+                Some(scene) => format!(
+                    "{scene}: no environment map: give `environment.file` in the scene or \
+                     --env (or use materials that need none, cheap-chrome or diffuse, with \
+                     `background = false`)"
+                ),
+                None => "--env: an environment map is needed (or use --material cheap-chrome \
+                         or diffuse with --no-background)"
+                    .to_string(),
+            }));
         }
+        // Each built-in is within the budget; so must they be together (a scene can list
+        // any number).
+        let triangles: u64 = plan
+            .objects
+            .iter()
+            .map(|o| match o.source {
+                MeshSource::Builtin(b, l) => b.triangle_count(l),
+                MeshSource::File(_) => 0,
+            })
+            .sum();
+        if triangles > MAX_TRIANGLES {
+            return Err(CliError::request(format!(
+                "{}the built-in meshes make {triangles} triangles in all; at most \
+                 {MAX_TRIANGLES} are allowed: lower their tessellations",
+                a.scene
+                    .as_ref()
+                    .map(|s| format!("{s}: "))
+                    .unwrap_or_default(),
+            )));
+        }
+        let (w, h) = (plan.camera.width, plan.camera.height);
+        budget::check(
+            &format!(
+                "{}the render's images ({w}×{h} pixels{}{}{})",
+                a.scene
+                    .as_ref()
+                    .map(|s| format!("{s}: "))
+                    .unwrap_or_default(),
+                if plan.frames > 1 {
+                    format!(", {} frames", plan.frames)
+                } else {
+                    String::new()
+                },
+                if plan.settings.aovs {
+                    ", diagnostic channels"
+                } else {
+                    ""
+                },
+                if plan.fisheye.is_some() {
+                    ", fisheye"
+                } else {
+                    ""
+                },
+            ),
+            0,
+            plan.image_bytes(),
+            "a smaller --size or fewer --turntable frames",
+        )?;
         Ok(plan)
+    }
+
+    /// About how many bytes the plan's images take at their peak: every frame's colour
+    /// (RGBA `f32`) is kept until all are written, and so is its tone-mapped copy for an
+    /// animated PNG; the diagnostic channels are four RGB `f32` images made in bands and
+    /// then copied (twice their size); a fisheye frame is made from a cube of faces half
+    /// its width (each face rendered as RGBA, then kept as RGB) and is square; writing
+    /// copies one frame. Meshes and the environment are not counted.
+    fn image_bytes(&self) -> u64 {
+        let (w, h) = (self.camera.width as u64, self.camera.height as u64);
+        let frames = self.frames as u64;
+        let (pixels, scratch) = match self.fisheye {
+            Some(_) => {
+                let face = (w / 2).max(16);
+                (w * w, 6 * face * face * (16 + 12) + w * w * 12)
+            }
+            None => (w * h, 0),
+        };
+        let mut per_frame = pixels * 16;
+        if self.settings.aovs {
+            per_frame += pixels * 4 * 12 * 2;
+        }
+        if frames > 1 && self.format == Format::Png {
+            per_frame += pixels * 16;
+        }
+        per_frame
+            .saturating_mul(frames)
+            .saturating_add(scratch)
+            .saturating_add(pixels * 16)
     }
 }
 
@@ -747,6 +846,12 @@ fn apply_scene_file(plan: &mut RenderPlan, path: &Path) -> Result<(), CliError> 
             width: c.width.unwrap_or(plan.camera.width),
             height: c.height.unwrap_or(plan.camera.height),
         };
+        // The bounds of --size.
+        for (key, side) in [("width", c.width), ("height", c.height)] {
+            if let Some(n) = side.filter(|n| !(1..=16384).contains(n)) {
+                return Err(err(format!("camera.{key} {n} is outside 1..=16384")));
+            }
+        }
         plan.camera
             .validate()
             .map_err(|e| err(format!("camera: {e}")))?;

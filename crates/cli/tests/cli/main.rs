@@ -3,6 +3,7 @@
 mod analyze;
 mod bad_input;
 mod commands;
+mod hostile;
 mod prefilter;
 mod production;
 mod quality;

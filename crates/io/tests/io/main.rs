@@ -1,5 +1,7 @@
 //! The mirrorball-io integration tests: one binary, one module per concern.
 mod cube;
 mod flat;
+mod hostile;
+mod mutate;
 mod openexr;
 mod records;

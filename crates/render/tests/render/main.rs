@@ -4,6 +4,7 @@ mod analytic;
 mod capture;
 mod features;
 mod golden;
+mod hostile;
 mod meshes;
 mod rasterizer;
 mod util;

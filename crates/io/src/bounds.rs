@@ -1,0 +1,92 @@
+//! Declared sizes against the file's real length.
+//!
+//! [`crate::Limits`] bound what any file may declare; these checks bound what *this* file
+//! can hold, so that a few kilobytes cannot make a reader allocate gigabytes. Each format
+//! packs at most so many texels into a byte of its file (deflate expands at most 1032:1,
+//! every JPEG block costs at least a bit, every Radiance scan line at least 4 bytes); a
+//! file declaring more is corrupt, and is refused before anything is allocated. Where a
+//! rare but valid coding can pack more (Radiance's old-style chained runs), the bound is
+//! set well above the common coding's (64 texels a byte where new-style runs reach 16), and
+//! every file may declare [`FLOOR_TEXELS`]. Formats
+//! whose coding has no such bound (DWA's DCT with deflated DC values, WebP's arithmetic
+//! and backward-reference coding) are left to the limits.
+
+use crate::Error;
+use std::path::Path;
+
+/// Texels any file may declare whatever its length: tiny files of a constant colour are
+/// fine up to this (16 MiB as `f32` RGBA).
+pub(crate) const FLOOR_TEXELS: u64 = 1 << 20;
+
+/// The file's length in bytes.
+fn file_len(path: &Path) -> Result<u64, Error> {
+    std::fs::metadata(path)
+        .map(|m| m.len())
+        .map_err(|e| Error::io(path, e))
+}
+
+/// Refuses a `width × height` image declared by a `format` file when the file is too short
+/// to hold it: more than `per_byte` texels for each of its bytes (and more than
+/// [`FLOOR_TEXELS`]).
+pub(crate) fn check_texels_fit(
+    path: &Path,
+    width: u64,
+    height: u64,
+    per_byte: u64,
+    format: &str,
+) -> Result<(), Error> {
+    let len = file_len(path)?;
+    let most = len.saturating_mul(per_byte).max(FLOOR_TEXELS);
+    let texels = width.saturating_mul(height);
+    if texels > most {
+        return Err(Error::input(
+            path,
+            format!(
+                "declares a {width}×{height} image ({texels} texels), but a {format} file of \
+                 {len} bytes holds at most {most}: the file is corrupt or truncated"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses an image whose raw samples (`raw_bytes`, as the file's header declares them)
+/// are more than `ratio` times the file's length (and more than [`FLOOR_TEXELS`] × 16
+/// bytes): for a compression that expands a byte into at most `ratio`.
+pub(crate) fn check_raw_bytes_fit(
+    path: &Path,
+    raw_bytes: u64,
+    ratio: u64,
+    what: &str,
+) -> Result<(), Error> {
+    let len = file_len(path)?;
+    let most = len.saturating_mul(ratio).max(FLOOR_TEXELS * 16);
+    if raw_bytes > most {
+        return Err(Error::input(
+            path,
+            format!(
+                "declares {raw_bytes} bytes of samples, but {what} expands a file of {len} \
+                 bytes to at most {most}: the file is corrupt or truncated"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a Radiance file declaring more scan lines than it has room for: every scan
+/// line takes at least 4 bytes (a flat or old-style run-length line starts with a whole
+/// RGBE texel; a new-style one with its 4-byte marker).
+pub(crate) fn check_lines_fit(path: &Path, height: u64) -> Result<(), Error> {
+    let len = file_len(path)?;
+    if height > len / 4 {
+        return Err(Error::input(
+            path,
+            format!(
+                "declares {height} scan lines, but a file of {len} bytes holds at most {} (each \
+                 takes at least 4 bytes): the file is corrupt or truncated",
+                len / 4
+            ),
+        ));
+    }
+    Ok(())
+}
