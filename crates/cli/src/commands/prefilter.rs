@@ -208,9 +208,9 @@ impl Plan {
             )));
         }
         if let Some(c) = a.cube_size {
-            if c == 0 || c > 2048 {
+            if c == 0 || c > 4096 {
                 return Err(CliError::request(format!(
-                    "--cube-size: {c} is outside 1..=2048"
+                    "--cube-size: {c} is outside 1..=4096"
                 )));
             }
         }
@@ -382,20 +382,29 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
     let sh9 = sh::project(&env);
     let chain: Vec<EnvMap> = with_progress("prefilter", rows, a.quiet, |counter| {
         plan.opts.progress = Some(counter);
-        let pf = Prefilterer::new(&env, plan.opts.clone());
+        // The working cube is made as fine as the levels rendered need (no finer than the
+        // source), unless --cube-size says otherwise.
         match (plan.kind, plan.irradiance) {
             (LobeKind::Lambert, method) => {
                 // One irradiance map; the further levels are its solid-angle-weighted box
                 // mips (the irradiance is smooth, and engines read any level).
                 let top = match method {
-                    IrradianceMethod::Exact => pf.render(&Lobe::Lambert, out_proj, size),
+                    IrradianceMethod::Exact => Prefilterer::for_chain(
+                        &env,
+                        &[Lobe::Lambert],
+                        out_proj,
+                        size,
+                        plan.opts.clone(),
+                    )
+                    .render(&Lobe::Lambert, out_proj, size),
                     IrradianceMethod::Sh => {
                         irradiance::irradiance_map_sh(&sh9, plan.window, out_proj, size)
                     }
                 };
                 MipChain::build_levels(&top, MipFilter::Box, levels).into_levels()
             }
-            _ => pf.render_chain(&lobes, out_proj, size),
+            _ => Prefilterer::for_chain(&env, &lobes, out_proj, size, plan.opts.clone())
+                .render_chain(&lobes, out_proj, size),
         }
     });
     let t_filter = t1.elapsed();
