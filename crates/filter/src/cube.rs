@@ -68,6 +68,16 @@ fn pad_level(faces: &[Image], out: &mut [Vec4]) {
         });
 }
 
+/// One level of a [`SeamlessCube`].
+pub(crate) struct Level {
+    /// Face size.
+    pub size: f32,
+    /// Bordered row stride, `size + 2`.
+    pub stride: usize,
+    /// Where each of the six bordered faces starts in the texel buffer.
+    pub face: [usize; 6],
+}
+
 /// A cube map with its seamless, solid-angle-weighted box pyramid, for fast lookups: every
 /// level's six bordered faces in one buffer.
 ///
@@ -79,12 +89,8 @@ fn pad_level(faces: &[Image], out: &mut [Vec4]) {
 /// under 0.1%; the largest working cube is 4096² ([`MAX_CUBE`]).
 pub(crate) struct SeamlessCube {
     texels: Vec<Vec4>,
-    /// Per level: face size and bordered stride as `f32`, and where each of its six faces
-    /// starts in `texels`.
-    size: Vec<f32>,
-    stride: Vec<f32>,
-    stride_index: Vec<usize>,
-    face_offset: Vec<[usize; 6]>,
+    /// Per level, finest first.
+    levels: Vec<Level>,
     /// `0.5·log₂(4/size₀²)`: half the log₂ of a level-0 texel's solid angle per `|ma|³`.
     half_log2_texel0: f32,
     /// The coarsest level, as a float.
@@ -97,17 +103,15 @@ impl SeamlessCube {
     /// made from exist besides the bordered buffer.
     pub fn new(cube: &EnvMap) -> SeamlessCube {
         let s0 = cube.width() as usize;
-        let mut size = Vec::new();
-        let mut stride = Vec::new();
-        let mut face_offset = Vec::new();
-        let mut stride_index = Vec::new();
+        let mut levels = Vec::new();
         let mut total = 0usize;
         let mut s = s0;
         loop {
-            size.push(s as f32);
-            stride.push((s + 2) as f32);
-            face_offset.push(std::array::from_fn(|f| total + f * (s + 2) * (s + 2)));
-            stride_index.push(s + 2);
+            levels.push(Level {
+                size: s as f32,
+                stride: s + 2,
+                face: std::array::from_fn(|f| total + f * (s + 2) * (s + 2)),
+            });
             total += 6 * (s + 2) * (s + 2);
             if s == 1 {
                 break;
@@ -117,24 +121,21 @@ impl SeamlessCube {
         let mut texels = vec![Vec4::ZERO; total];
         let mut rest = texels.as_mut_slice();
         let mut level: Option<EnvMap> = None;
-        for l in 0..size.len() {
+        for l in 0..levels.len() {
             if l > 0 {
                 level = Some(downsample(level.as_ref().unwrap_or(cube), MipFilter::Box));
             }
             let cur = level.as_ref().unwrap_or(cube);
-            let st = stride_index[l];
+            let st = levels[l].stride;
             let (head, tail) = rest.split_at_mut(6 * st * st);
             pad_level(cur.layers(), head);
             rest = tail;
         }
-        let s0 = size[0];
-        let last_lod = (size.len() - 1) as f32;
+        let s0 = s0 as f32;
+        let last_lod = (levels.len() - 1) as f32;
         SeamlessCube {
             texels,
-            size,
-            stride,
-            stride_index,
-            face_offset,
+            levels,
             half_log2_texel0: 0.5 * (4.0 / (s0 * s0)).log2(),
             last_lod,
         }
@@ -152,22 +153,10 @@ impl SeamlessCube {
         self.last_lod
     }
 
-    /// Level `l`'s `(size, stride)`.
+    /// Level `l`'s size, stride and face starts together.
     #[inline(always)]
-    pub fn level_params(&self, l: usize) -> (f32, f32) {
-        (self.size[l], self.stride[l])
-    }
-
-    /// Level `l`'s bordered stride, as an index.
-    #[inline(always)]
-    pub fn stride_index(&self, l: usize) -> usize {
-        self.stride_index[l]
-    }
-
-    /// Where face `face` of level `l` starts in the texel buffer.
-    #[inline(always)]
-    pub fn face_offset(&self, l: usize, face: usize) -> usize {
-        self.face_offset[l][face]
+    pub fn level(&self, l: usize) -> &Level {
+        &self.levels[l]
     }
 
     /// The four texels of a bilinear footprint: `[i, i + 1, i + stride, i + stride + 1]`.
@@ -184,14 +173,14 @@ impl SeamlessCube {
         // Bordered texel i + 1 has its centre at u = (i + ½)/size, so the bordered
         // continuous coordinate is u·size + ½ ∈ [½, size + ½]; clamping below size + ½ keeps
         // x0 + 1 ≤ size + 1 and lets a truncating conversion act as floor.
-        let (size, stride) = self.level_params(l);
-        let max = size + 0.499_9;
-        let x = (u * size + 0.5).max(0.5).min(max);
-        let y = (v * size + 0.5).max(0.5).min(max);
+        let lv = self.level(l);
+        let max = lv.size + 0.499_9;
+        let x = (u * lv.size + 0.5).max(0.5).min(max);
+        let y = (v * lv.size + 0.5).max(0.5).min(max);
         let (x0, y0) = (x as u32, y as u32);
         let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        let st = stride as usize;
-        let i = self.face_offset(l, face) + y0 as usize * st + x0 as usize;
+        let st = lv.stride;
+        let i = lv.face[face] + y0 as usize * st + x0 as usize;
         let [a, b, c, d] = self.quad(i, st);
         a.lerp(b, fx).lerp(c.lerp(d, fx), fy)
     }
@@ -219,7 +208,7 @@ impl SeamlessCube {
         if f <= 0.0 {
             return a;
         }
-        let b = self.bilinear((l0 + 1).min(self.size.len() - 1), face, u, v);
+        let b = self.bilinear((l0 + 1).min(self.levels.len() - 1), face, u, v);
         a.lerp(b, f)
     }
 }

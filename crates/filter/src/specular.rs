@@ -352,26 +352,26 @@ pub(crate) fn fis(cube: &SeamlessCube, set: &SampleSet, n: Vec3, floor: f32) -> 
         let f = lod - l0;
         let l0 = (l0 + MAGIC).to_array();
         let faces = (face + MAGIC).to_array();
-        // Level parameters per lane, for the level below and above the sample's lod:
-        // size, where the lane's face starts, and the stride.
-        let mut pa = ([0.0f32; 4], [0usize; 4], [0usize; 4]);
-        let mut pb = ([0.0f32; 4], [0usize; 4], [0usize; 4]);
-        for k in 0..4 {
-            let l = lane_index(l0[k]);
-            let l1 = (l + 1).min(top);
-            let f = lane_index(faces[k]);
-            pa.0[k] = cube.level_params(l).0;
-            pb.0[k] = cube.level_params(l1).0;
-            pa.1[k] = cube.face_offset(l, f);
-            pb.1[k] = cube.face_offset(l1, f);
-            pa.2[k] = cube.stride_index(l);
-            pb.2[k] = cube.stride_index(l1);
-        }
+        // Level parameters per lane (size, where the lane's face starts, the stride), for
+        // the level below the sample's lod, and above it only when some lane blends in.
+        let lanes_l0 = l0.map(lane_index);
+        let lanes_face = faces.map(lane_index);
+        let params = |level: [usize; 4]| {
+            let mut p = ([0.0f32; 4], [0usize; 4], [0usize; 4]);
+            for k in 0..4 {
+                let lv = cube.level(level[k]);
+                p.0[k] = lv.size;
+                p.1[k] = lv.face[lanes_face[k]];
+                p.2[k] = lv.stride;
+            }
+            p
+        };
         let wb = w * f;
         let wa = w - wb;
-        acc += gather4(cube, &pa, u, v, wa);
+        acc += gather4(cube, &params(lanes_l0), u, v, wa);
         if f.cmpgt(zero).any() {
-            acc += gather4(cube, &pb, u, v, wb);
+            let up = lanes_l0.map(|l| (l + 1).min(top));
+            acc += gather4(cube, &params(up), u, v, wb);
         }
     }
     acc / set.weight_sum
@@ -425,8 +425,8 @@ mod tests {
         for face in [0usize, 5] {
             let p = (
                 [n as f32; 4],
-                [cube.face_offset(0, face); 4],
-                [cube.stride_index(0); 4],
+                [cube.level(0).face[face]; 4],
+                [cube.level(0).stride; 4],
             );
             let u = Vec4::from_array(lanes.map(|l| at(l.0)));
             let v = Vec4::from_array(lanes.map(|l| at(l.1)));

@@ -15,7 +15,7 @@ use crate::spec::{bad, ProjSpec};
 use crate::{load, PrefilterArgs};
 use mirrorball_core::glam::DVec2;
 use mirrorball_core::{EnvMap, Image, Layout, Projection, ProjectionKind, WorldProjection};
-use mirrorball_filter::mip::level_count;
+use mirrorball_filter::mip::{level_count, texel_solid_angles};
 use mirrorball_filter::sh::{self, Window};
 use mirrorball_filter::{
     chain_lobes, compress, irradiance, BrdfLut, Compression, EnergyReport, Lobe, LobeKind,
@@ -551,10 +551,7 @@ fn preview_sheet(chain: &[EnvMap], exposure: f32) -> Image {
     let cols = chain.len().clamp(1, 4) as u32;
     let rows = (chain.len() as u32).div_ceil(cols).max(1);
     let mut sheet = Image::new(cols * (tw + gap) - gap, rows * (th + gap) - gap, 3);
-    let mean = chain.first().map_or(1.0, |l| {
-        let m = l.stats().mean;
-        (m[0] + m[1] + m[2]) / 3.0
-    });
+    let mean = chain.first().map_or(1.0, mean_rgb);
     let scale = if mean > 0.0 && mean.is_finite() {
         (0.18 / mean) as f32 * 2f32.powf(exposure)
     } else {
@@ -578,4 +575,27 @@ fn preview_sheet(chain: &[EnvMap], exposure: f32) -> Image {
         }
     }
     sheet
+}
+
+/// The mean of R, G and B over the sphere, weighted by exact texel solid angle (one table
+/// for all six faces of a cube).
+fn mean_rgb(env: &EnvMap) -> f64 {
+    let omega = texel_solid_angles(env.projection(), env.width(), env.height());
+    let c = env.channels();
+    let (mut sum, mut total) = (0.0f64, 0.0f64);
+    for (layer, img) in env.layers().iter().enumerate() {
+        let om = &omega[layer.min(omega.len() - 1)];
+        for (px, &w) in img.data().chunks_exact(c).zip(om) {
+            let v = (px[0] + px[1] + px[2]) as f64 / 3.0;
+            if v.is_finite() && w > 0.0 {
+                sum += v * w;
+                total += w;
+            }
+        }
+    }
+    if total > 0.0 {
+        sum / total
+    } else {
+        0.0
+    }
 }
