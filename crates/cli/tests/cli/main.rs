@@ -4,6 +4,7 @@ mod analyze;
 mod bad_input;
 mod commands;
 mod prefilter;
+mod production;
 mod quality;
 mod render;
 mod util;
