@@ -121,12 +121,12 @@ impl SeamlessCube {
         let mut texels = vec![Vec4::ZERO; total];
         let mut rest = texels.as_mut_slice();
         let mut level: Option<EnvMap> = None;
-        for l in 0..levels.len() {
+        for (l, lv) in levels.iter().enumerate() {
             if l > 0 {
                 level = Some(downsample(level.as_ref().unwrap_or(cube), MipFilter::Box));
             }
             let cur = level.as_ref().unwrap_or(cube);
-            let st = levels[l].stride;
+            let st = lv.stride;
             let (head, tail) = rest.split_at_mut(6 * st * st);
             pad_level(cur.layers(), head);
             rest = tail;
