@@ -293,7 +293,8 @@ fn lambert_from_4k_keeps_the_mean_and_a_constant_stays_constant() {
 
 #[test]
 fn explicit_large_working_cubes_are_honoured() {
-    // --cube-size 2048 from a 4096×2048 source: once refused by an f32-index assertion.
+    // --cube-size 2048 from a 4096×2048 source: a working cube whose pyramid holds more
+    // than 2²⁴ texels.
     let src = sky_4k();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("big.ktx2");
