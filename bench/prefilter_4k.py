@@ -14,8 +14,9 @@ Standard library only (no virtual environment needed).
 3. Times the whole command as a user runs it, reading the file included:
    `mirrorball prefilter bench/data/INPUT-4k.exr OUT.ktx2 --lobe ggx --size 512 -q`
    (ten levels 512²…1², linear roughness, with the SH JSON and preview written as by
-   default). One untimed warm-up, then --reps timed runs; prints each, the best and the
-   median, and the load around them (the development machine is shared).
+   default). One untimed warm-up, then --reps timed runs; prints each (wall and CPU time,
+   peak memory), the best and the median, and the load around them (the development
+   machine is shared).
 4. Writes bench/results/prefilter-4k.json (or --json PATH).
 
 Target: under 2 s (best) on the 2-core development machine.
@@ -85,26 +86,37 @@ def main() -> int:
                  "OUT.ktx2", *cmd[4:]]
         log(f"command: {' '.join(shown)}")
         subprocess.run(cmd, check=True)  # warm-up (page cache, CPU frequency)
-        runs, load = [], []
+        runs, cpu, rss, load = [], [], [], []
         for i in range(args.reps):
             load.append({"rustc": rustc_count(), "loadavg_1m": round(os.getloadavg()[0], 2)})
             t = time.perf_counter()
-            subprocess.run(cmd, check=True)
+            proc = subprocess.Popen(cmd)
+            _, status, usage = os.wait4(proc.pid, 0)
             runs.append(time.perf_counter() - t)
-            log(f"  run {i + 1}: {runs[-1]:.3f} s")
+            proc.returncode = os.waitstatus_to_exitcode(status)
+            if proc.returncode != 0:
+                raise SystemExit(f"{shown[0]} failed ({proc.returncode})")
+            # CPU time (user + system, all threads) moves less with the load than wall time.
+            cpu.append(usage.ru_utime + usage.ru_stime)
+            rss.append(usage.ru_maxrss / 1024)  # KiB on Linux → MiB
+            log(f"  run {i + 1}: {runs[-1]:.3f} s wall, {cpu[-1]:.3f} s CPU, "
+                f"{rss[-1]:.0f} MiB peak")
         size = out.stat().st_size
     best, median = min(runs), statistics.median(runs)
     print(f"GGX 6×512² chain from a 4096×2048 float EXR ({args.input}), end to end: "
           f"best {best:.3f} s, median {median:.3f} s over {len(runs)} runs "
-          f"(target < {TARGET_S:.0f} s; load average {min(l['loadavg_1m'] for l in load)}–"
-          f"{max(l['loadavg_1m'] for l in load)}, up to {max(l['rustc'] for l in load)} "
-          f"rustc running)")
+          f"(target < {TARGET_S:.0f} s); CPU best {min(cpu):.3f} s, median "
+          f"{statistics.median(cpu):.3f} s; peak memory {max(rss):.0f} MiB; load average "
+          f"{min(l['loadavg_1m'] for l in load)}–{max(l['loadavg_1m'] for l in load)}, up "
+          f"to {max(l['rustc'] for l in load)} rustc running")
     doc = {
         "what": "mirrorball prefilter INPUT-4k.exr out.ktx2 --lobe ggx --size 512 -q",
         "input": args.input,
         "runs_s": [round(r, 4) for r in runs],
         "best_s": round(best, 4),
         "median_s": round(median, 4),
+        "cpu_s": [round(c, 4) for c in cpu],
+        "peak_rss_mib": round(max(rss)),
         "target_s": TARGET_S,
         "output_bytes": size,
         "load": load,
