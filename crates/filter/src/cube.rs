@@ -47,23 +47,33 @@ fn pad_level(faces: &[Image], out: &mut [Vec4]) {
         let t = faces[l].get(tx, ty);
         Vec4::new(t[0], t[1], t[2], if t.len() > 3 { t[3] } else { 1.0 })
     };
-    out.par_chunks_mut(stride * stride)
+    let c = faces[0].channels();
+    // Row by row (`6·stride` rows): a face's own rows straight from the image, with their
+    // two border texels through the wrap; the border rows above and below through the wrap.
+    out.par_chunks_mut(stride)
         .enumerate()
-        .for_each(|(f, face)| {
-            for py in 0..stride {
-                for px in 0..stride {
-                    let (x, y) = (px as i64 - 1, py as i64 - 1);
-                    let outside_x = x < 0 || x >= size as i64;
-                    let outside_y = y < 0 || y >= size as i64;
-                    face[py * stride + px] = if outside_x && outside_y {
-                        // A corner: the mean of the three texels that meet there.
-                        let cx = x.clamp(0, size as i64 - 1);
-                        let cy = y.clamp(0, size as i64 - 1);
-                        (texel(f, cx, cy) + texel(f, x, cy) + texel(f, cx, y)) / 3.0
-                    } else {
-                        texel(f, x, y)
-                    };
+        .for_each(|(row, line)| {
+            let (f, py) = (row / stride, row % stride);
+            let y = py as i64 - 1;
+            if (0..size as i64).contains(&y) {
+                let src = faces[f].row(y as u32);
+                for (o, t) in line[1..=size].iter_mut().zip(src.chunks_exact(c)) {
+                    *o = Vec4::new(t[0], t[1], t[2], if c > 3 { t[3] } else { 1.0 });
                 }
+                line[0] = texel(f, -1, y);
+                line[size + 1] = texel(f, size as i64, y);
+                return;
+            }
+            for (px, o) in line.iter_mut().enumerate() {
+                let x = px as i64 - 1;
+                *o = if x < 0 || x >= size as i64 {
+                    // A corner: the mean of the three texels that meet there.
+                    let cx = x.clamp(0, size as i64 - 1);
+                    let cy = y.clamp(0, size as i64 - 1);
+                    (texel(f, cx, cy) + texel(f, x, cy) + texel(f, cx, y)) / 3.0
+                } else {
+                    texel(f, x, y)
+                };
             }
         });
 }
