@@ -342,8 +342,8 @@ pub struct PrefilterArgs {
     /// Importance samples per texel for the sharpest lobes (wider lobes take more).
     #[arg(long, default_value_t = 128)]
     samples: u32,
-    /// Face size of the working cube the source is filtered from (default: the source's
-    /// resolution).
+    /// Face size of the working cube the source is filtered from, 1..=4096 (default: as
+    /// fine as the levels need, at most the source's resolution).
     #[arg(long)]
     cube_size: Option<u32>,
     /// Tame extreme texels first: none, clamp:MAX, soft:MAX, soft:KNEE:MAX (luminance);

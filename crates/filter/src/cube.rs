@@ -5,7 +5,8 @@
 //! missing texel is the mean of the three that meet there) without any branch in the inner
 //! loop. `f32`, four channels (RGB and a spare), in `glam::Vec4` for SIMD.
 
-use crate::mip::{MipChain, MipFilter};
+use crate::lobe::Lobe;
+use crate::mip::{downsample, MipFilter};
 use glam::{Vec3, Vec4};
 use mirrorball_core::{
     resample, CubeMap, EnvMap, Image, Projection, ResampleOptions, WorldProjection,
@@ -46,38 +47,60 @@ fn pad_level(faces: &[Image], out: &mut [Vec4]) {
         let t = faces[l].get(tx, ty);
         Vec4::new(t[0], t[1], t[2], if t.len() > 3 { t[3] } else { 1.0 })
     };
-    out.par_chunks_mut(stride * stride)
+    let c = faces[0].channels();
+    // Row by row (`6·stride` rows): a face's own rows straight from the image, with their
+    // two border texels through the wrap; the border rows above and below through the wrap.
+    out.par_chunks_mut(stride)
         .enumerate()
-        .for_each(|(f, face)| {
-            for py in 0..stride {
-                for px in 0..stride {
-                    let (x, y) = (px as i64 - 1, py as i64 - 1);
-                    let outside_x = x < 0 || x >= size as i64;
-                    let outside_y = y < 0 || y >= size as i64;
-                    face[py * stride + px] = if outside_x && outside_y {
-                        // A corner: the mean of the three texels that meet there.
-                        let cx = x.clamp(0, size as i64 - 1);
-                        let cy = y.clamp(0, size as i64 - 1);
-                        (texel(f, cx, cy) + texel(f, x, cy) + texel(f, cx, y)) / 3.0
-                    } else {
-                        texel(f, x, y)
-                    };
+        .for_each(|(row, line)| {
+            let (f, py) = (row / stride, row % stride);
+            let y = py as i64 - 1;
+            if (0..size as i64).contains(&y) {
+                let src = faces[f].row(y as u32);
+                for (o, t) in line[1..=size].iter_mut().zip(src.chunks_exact(c)) {
+                    *o = Vec4::new(t[0], t[1], t[2], if c > 3 { t[3] } else { 1.0 });
                 }
+                line[0] = texel(f, -1, y);
+                line[size + 1] = texel(f, size as i64, y);
+                return;
+            }
+            for (px, o) in line.iter_mut().enumerate() {
+                let x = px as i64 - 1;
+                *o = if x < 0 || x >= size as i64 {
+                    // A corner: the mean of the three texels that meet there.
+                    let cx = x.clamp(0, size as i64 - 1);
+                    let cy = y.clamp(0, size as i64 - 1);
+                    (texel(f, cx, cy) + texel(f, x, cy) + texel(f, cx, y)) / 3.0
+                } else {
+                    texel(f, x, y)
+                };
             }
         });
 }
 
+/// One level of a [`SeamlessCube`].
+pub(crate) struct Level {
+    /// Face size.
+    pub size: f32,
+    /// Bordered row stride, `size + 2`.
+    pub stride: usize,
+    /// Where each of the six bordered faces starts in the texel buffer.
+    pub face: [usize; 6],
+}
+
 /// A cube map with its seamless, solid-angle-weighted box pyramid, for fast lookups: every
 /// level's six bordered faces in one buffer.
+///
+/// Addresses are integers: a face's start (`usize`) plus `y·stride + x` within the face,
+/// with `x` and `y` converted from `f32` each on their own (both below 2²³, so exact). Only
+/// the continuous coordinate `u·size + ½` is `f32`: for faces up to 4096² its rounding
+/// error is at most about `2⁻¹¹` texel (the `f32` spacing near 4096, plus `u`'s own
+/// relative error of a few `2⁻²⁴` from the face division), which moves a bilinear weight by
+/// under 0.1%; the largest working cube is 4096² ([`MAX_CUBE`]).
 pub(crate) struct SeamlessCube {
     texels: Vec<Vec4>,
-    /// Per level: face size and bordered stride as `f32`, and where each of its six faces
-    /// starts in `texels`. Within a face, texel indices are computed in `f32`, exact below
-    /// 2²⁴ (faces up to 2048² are made, checked at build).
-    size: Vec<f32>,
-    stride: Vec<f32>,
-    stride_index: Vec<usize>,
-    face_offset: Vec<[usize; 6]>,
+    /// Per level, finest first.
+    levels: Vec<Level>,
     /// `0.5·log₂(4/size₀²)`: half the log₂ of a level-0 texel's solid angle per `|ma|³`.
     half_log2_texel0: f32,
     /// The coarsest level, as a float.
@@ -85,41 +108,44 @@ pub(crate) struct SeamlessCube {
 }
 
 impl SeamlessCube {
-    /// From a cube map's mip chain (box filter: energy-exact).
-    pub fn from_chain(chain: &MipChain) -> SeamlessCube {
-        let mut size = Vec::new();
-        let mut stride = Vec::new();
-        let mut face_offset = Vec::new();
-        let mut stride_index = Vec::new();
+    /// The seamless box pyramid of a cube map with square power-of-two faces (box filter:
+    /// energy-exact), made a level at a time: only the level being padded and the one it is
+    /// made from exist besides the bordered buffer.
+    pub fn new(cube: &EnvMap) -> SeamlessCube {
+        let s0 = cube.width() as usize;
+        let mut levels = Vec::new();
         let mut total = 0usize;
-        for l in chain.levels() {
-            let s = l.width() as usize;
-            size.push(s as f32);
-            stride.push((s + 2) as f32);
-            face_offset.push(std::array::from_fn(|f| total + f * (s + 2) * (s + 2)));
-            stride_index.push(s + 2);
+        let mut s = s0;
+        loop {
+            levels.push(Level {
+                size: s as f32,
+                stride: s + 2,
+                face: std::array::from_fn(|f| total + f * (s + 2) * (s + 2)),
+            });
             total += 6 * (s + 2) * (s + 2);
+            if s == 1 {
+                break;
+            }
+            s = (s / 2).max(1);
         }
-        assert!(
-            total < 1 << 24,
-            "working cube too large for f32 texel indices"
-        );
         let mut texels = vec![Vec4::ZERO; total];
         let mut rest = texels.as_mut_slice();
-        for l in chain.levels() {
-            let s = l.width() as usize + 2;
-            let (head, tail) = rest.split_at_mut(6 * s * s);
-            pad_level(l.layers(), head);
+        let mut level: Option<EnvMap> = None;
+        for (l, lv) in levels.iter().enumerate() {
+            if l > 0 {
+                level = Some(downsample(level.as_ref().unwrap_or(cube), MipFilter::Box));
+            }
+            let cur = level.as_ref().unwrap_or(cube);
+            let st = lv.stride;
+            let (head, tail) = rest.split_at_mut(6 * st * st);
+            pad_level(cur.layers(), head);
             rest = tail;
         }
-        let s0 = size[0];
-        let last_lod = (size.len() - 1) as f32;
+        let s0 = s0 as f32;
+        let last_lod = (levels.len() - 1) as f32;
         SeamlessCube {
             texels,
-            size,
-            stride,
-            stride_index,
-            face_offset,
+            levels,
             half_log2_texel0: 0.5 * (4.0 / (s0 * s0)).log2(),
             last_lod,
         }
@@ -137,22 +163,10 @@ impl SeamlessCube {
         self.last_lod
     }
 
-    /// Level `l`'s `(size, stride)`.
+    /// Level `l`'s size, stride and face starts together.
     #[inline(always)]
-    pub fn level_params(&self, l: usize) -> (f32, f32) {
-        (self.size[l], self.stride[l])
-    }
-
-    /// Level `l`'s bordered stride, as an index.
-    #[inline(always)]
-    pub fn stride_index(&self, l: usize) -> usize {
-        self.stride_index[l]
-    }
-
-    /// Where face `face` of level `l` starts in the texel buffer.
-    #[inline(always)]
-    pub fn face_offset(&self, l: usize, face: usize) -> usize {
-        self.face_offset[l][face]
+    pub fn level(&self, l: usize) -> &Level {
+        &self.levels[l]
     }
 
     /// The four texels of a bilinear footprint: `[i, i + 1, i + stride, i + stride + 1]`.
@@ -169,14 +183,14 @@ impl SeamlessCube {
         // Bordered texel i + 1 has its centre at u = (i + ½)/size, so the bordered
         // continuous coordinate is u·size + ½ ∈ [½, size + ½]; clamping below size + ½ keeps
         // x0 + 1 ≤ size + 1 and lets a truncating conversion act as floor.
-        let (size, stride) = self.level_params(l);
-        let max = size + 0.499_9;
-        let x = (u * size + 0.5).max(0.5).min(max);
-        let y = (v * size + 0.5).max(0.5).min(max);
-        let (x0, y0) = (x as i32, y as i32);
+        let lv = self.level(l);
+        let max = lv.size + 0.499_9;
+        let x = (u * lv.size + 0.5).max(0.5).min(max);
+        let y = (v * lv.size + 0.5).max(0.5).min(max);
+        let (x0, y0) = (x as u32, y as u32);
         let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        let st = stride as usize;
-        let i = self.face_offset(l, face) + y0 as usize * st + x0 as usize;
+        let st = lv.stride;
+        let i = lv.face[face] + y0 as usize * st + x0 as usize;
         let [a, b, c, d] = self.quad(i, st);
         a.lerp(b, fx).lerp(c.lerp(d, fx), fy)
     }
@@ -204,38 +218,103 @@ impl SeamlessCube {
         if f <= 0.0 {
             return a;
         }
-        let b = self.bilinear((l0 + 1).min(self.size.len() - 1), face, u, v);
+        let b = self.bilinear((l0 + 1).min(self.levels.len() - 1), face, u, v);
         a.lerp(b, f)
     }
 }
 
-/// A power-of-two cube at least as fine as `src`, for use as the prefilterers' working map:
-/// `src` itself when it already is one, otherwise an antialiased conversion at about the
-/// source's texel density (rounded up to a power of two, at most `max_size`).
-pub(crate) fn working_cube(src: &EnvMap, size: Option<u32>, max_size: u32) -> EnvMap {
+/// The largest working cube face. Six 4096² faces of `Vec4` are 1.6 GB, and the bordered
+/// pyramid of the body (bright texels capped) as much again plus a third; with the pyramid
+/// of the whole map (made when bright texels were split off) a 4096² working cube holds
+/// about 5.9 GB, and building it briefly about 1.6 GB more.
+pub(crate) const MAX_CUBE: u32 = 4096;
+
+/// The coarsest working cube chosen for a lobe: 256² faces (a texel's centre is at most
+/// 0.0055 rad from any point it stands for, so a point source's share of the widest
+/// lobe, Lambert's, moves by at most about 0.5%).
+pub(crate) const MIN_CUBE: u32 = 256;
+
+/// The working-cube face size that rendering `lobe` into `w×h` layers of `out` needs.
+///
+/// The result can resolve nothing finer than the larger of the output's texels and the
+/// lobe's own blur, so the working cube's texels need only be as small as that:
+///
+/// * `t_out`: the output's mean texel side, `√(Ω_covered/texels)` (a cube output of face
+///   `N`: `1.447/N`);
+/// * `t_lobe`: half the lobe's half-maximum radius ([`Lobe::angular_scale`]; 0 for a
+///   mirror). Samples that stand for less than a working texel read level 0, whose
+///   bilinear tent (variance `t²/6` per axis) then widens the lobe: for a texel of side
+///   `t_lobe`, a Gaussian of that half-maximum radius by about 3% (GGX's heavier tails, by
+///   less);
+/// * the face size whose mean texel side is `max(t_out, t_lobe)`: `s = √(4π/6)/t`, at
+///   least [`MIN_CUBE`] (the caller rounds up to a power of two and caps at the source's
+///   own density).
+///
+/// A chain whose level 0 is `N²` (`N` a power of two, any lobes) so needs an `N²` working
+/// cube: level `m` has `N/2ᵐ` faces and needs at most that. Its mirror level is then the
+/// working cube itself, the antialiased conversion of the source at `N`, which is what a
+/// mirror level should hold; reading a `2N` cube's level 1 instead would add a box over
+/// its bilinear samples. Rough lobes need little whatever the output: GGX roughness 1/9
+/// (level 1 of the linear mapping on ten levels) needs 183, roughness ½ needs 10 (so
+/// [`MIN_CUBE`]).
+pub(crate) fn needed_face(lobe: &Lobe, out: &Projection, w: u32, h: u32) -> u32 {
+    let texels = w.max(1) as f64 * h.max(1) as f64 * out.layer_count() as f64;
+    let t_out = (out.covered_solid_angle() / texels).sqrt();
+    let t_lobe = if lobe.is_mirror() {
+        0.0
+    } else {
+        0.5 * lobe.angular_scale()
+    };
+    let s = (4.0 * std::f64::consts::PI / 6.0).sqrt() / t_out.max(t_lobe);
+    // A cube output of face N gives s = N up to rounding, which must not round up to N + 1.
+    ((s * (1.0 - 1e-9)).ceil().min(MAX_CUBE as f64) as u32).max(MIN_CUBE)
+}
+
+/// The face size of a cube with the same mean texel density (texels per steradian) as
+/// `src` (a cube's own face size).
+fn source_face(src: &EnvMap) -> u32 {
+    if src.projection().kind() == mirrorball_core::ProjectionKind::Cube {
+        return src.width();
+    }
+    let n = src.width() as f64 * src.height() as f64 * src.layers().len() as f64;
+    let per_face = n * (4.0 * std::f64::consts::PI / src.projection().covered_solid_angle()) / 6.0;
+    (per_face.sqrt().ceil() as u32).clamp(1, MAX_CUBE)
+}
+
+/// The largest power of two not above `x` (≥ 1).
+fn floor_pow2(x: u32) -> u32 {
+    1 << (31 - x.max(1).leading_zeros())
+}
+
+/// The face size of the working cube: `size` when given (rounded up to a power of two, at
+/// most [`MAX_CUBE`]); otherwise `need` (see [`needed_face`]; `None`: no limit) rounded up
+/// to a power of two but no finer than the source's own density rounded up to one, and at
+/// most `max_size`.
+pub(crate) fn working_face(
+    src: &EnvMap,
+    size: Option<u32>,
+    need: Option<u32>,
+    max_size: u32,
+) -> u32 {
+    if let Some(s) = size {
+        return s.clamp(1, MAX_CUBE).next_power_of_two();
+    }
+    let density = source_face(src).next_power_of_two();
+    let s = need.map_or(density, |n| n.next_power_of_two().min(density));
+    s.min(floor_pow2(max_size.clamp(1, MAX_CUBE)))
+}
+
+/// The prefilterers' working map: a cube of `face²` faces with four channels, `src` itself
+/// when it already is one, otherwise an antialiased conversion.
+pub(crate) fn working_cube(src: &EnvMap, face: u32) -> EnvMap {
     let is_cube = src.projection().kind() == mirrorball_core::ProjectionKind::Cube;
-    let want = size.unwrap_or_else(|| {
-        if is_cube {
-            src.width()
-        } else {
-            // Same texels per steradian as the source's mean.
-            let n = src.width() as f64 * src.height() as f64 * src.layers().len() as f64;
-            let per_face =
-                n * (4.0 * std::f64::consts::PI / src.projection().covered_solid_angle()) / 6.0;
-            per_face.sqrt().ceil() as u32
-        }
-    });
-    // f32 texel indices within a face are exact up to 2048² faces (see SeamlessCube).
-    let max_size = max_size.clamp(1, 2048);
-    let p = want.clamp(1, max_size).next_power_of_two();
-    let s = if p > max_size { p / 2 } else { p };
-    if is_cube && src.width() == s {
+    if is_cube && src.width() == face {
         return with_four_channels(src.clone());
     }
     let out = resample(
         src,
         Projection::Cube(CubeMap),
-        s,
+        face,
         &ResampleOptions::default(),
     );
     with_four_channels(out)
@@ -252,7 +331,7 @@ fn with_four_channels(env: EnvMap) -> EnvMap {
 
 /// Builds the seamless pyramid of a cube map.
 pub(crate) fn seamless_pyramid(cube: &EnvMap) -> SeamlessCube {
-    SeamlessCube::from_chain(&MipChain::build(cube, MipFilter::Box))
+    SeamlessCube::new(cube)
 }
 
 /// Face-local geometry shared by the six faces of a `size²` cube: for texel `(x, y)`,
@@ -388,6 +467,55 @@ mod tests {
             let w = face_to_world(f, Vec3::new(sc / ma, tc / ma, 1.0) * ma);
             assert!((w.as_dvec3() - d).length() < 1e-5);
         }
+    }
+
+    #[test]
+    fn working_cube_follows_the_outputs() {
+        use crate::prefilter::{chain_lobes, LobeKind};
+        use crate::specular::RoughnessMapping;
+        let cube = Projection::Cube(CubeMap);
+        let ll = mirrorball_core::ProjectionKind::LatLong.default_projection();
+        let mirror = Lobe::Phong {
+            exponent: f64::INFINITY,
+        };
+        // A mirror into a cube of face N needs N; small outputs get the least cube.
+        assert_eq!(needed_face(&mirror, &cube, 512, 512), 512);
+        assert_eq!(needed_face(&mirror, &cube, 2048, 2048), 2048);
+        assert_eq!(needed_face(&mirror, &cube, 64, 64), MIN_CUBE);
+        // Lambert's blur (π/3) is far wider than a 512² output's texels.
+        assert_eq!(needed_face(&Lobe::Lambert, &cube, 512, 512), MIN_CUBE);
+        // Rough lobes need less than their output: GGX roughness 1/9 needs 183.
+        let r9 = Lobe::Ggx {
+            roughness: 1.0 / 9.0,
+        };
+        assert_eq!(needed_face(&r9, &cube, 4096, 4096), MIN_CUBE);
+        // Every level of a GGX chain of edge N needs at most N, level 0 exactly N.
+        for n in [256u32, 512, 1024] {
+            let lobes = chain_lobes(LobeKind::Ggx, &RoughnessMapping::Linear, 10);
+            let need: Vec<u32> = lobes
+                .iter()
+                .enumerate()
+                .map(|(i, l)| needed_face(l, &cube, (n >> i).max(1), (n >> i).max(1)))
+                .collect();
+            assert_eq!(need[0], n);
+            assert!(need.iter().all(|&s| s <= n), "{need:?}");
+        }
+        // A 1024×512 lat-long output: mean texel 0.0049 rad, so 512² faces.
+        assert_eq!(
+            needed_face(&mirror, &ll, 1024, 512).next_power_of_two(),
+            512
+        );
+        // The source bounds the choice; an explicit size is honoured up to MAX_CUBE.
+        let src = EnvMap::new(ll, vec![Image::new(4096, 2048, 3)]).unwrap();
+        assert_eq!(working_face(&src, None, None, 2048), 2048);
+        assert_eq!(working_face(&src, None, Some(512), 2048), 512);
+        assert_eq!(working_face(&src, None, Some(MAX_CUBE), 2048), 2048);
+        assert_eq!(working_face(&src, None, Some(MAX_CUBE), 4096), 2048);
+        assert_eq!(working_face(&src, Some(4096), Some(512), 2048), 4096);
+        assert_eq!(working_face(&src, Some(3000), None, 2048), 4096);
+        assert_eq!(working_face(&src, Some(9000), None, 2048), MAX_CUBE);
+        let small = EnvMap::new(ll, vec![Image::new(512, 256, 3)]).unwrap();
+        assert_eq!(working_face(&small, None, Some(1024), 2048), 256);
     }
 
     #[test]

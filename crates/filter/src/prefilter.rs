@@ -1,8 +1,10 @@
 //! Prefiltered environment maps in any projection: the entry point.
 //!
 //! A [`Prefilterer`] is built once from a source map of any projection. It keeps a working
-//! cube (the source itself when it is a power-of-two cube, an antialiased conversion at the
-//! source's texel density otherwise) and makes, each on first use: for Phong and GGX, the
+//! cube (the source itself when it is a power-of-two cube of the size chosen, an
+//! antialiased conversion otherwise; as fine as the outputs need when they are known,
+//! [`Prefilterer::for_outputs`], else at the source's texel density) and makes, each on
+//! first use: for Phong and GGX, the
 //! split into a bounded body (its seamless solid-angle-weighted pyramid is what importance
 //! sampling reads) and the bright texels summed exactly as point sources; for Lambert, the
 //! moment quadtree; for mirror lobes, the pyramid of the whole cube. Every output texel is
@@ -13,7 +15,7 @@
 //! The work is parallel over output rows (rayon); the per-texel loops allocate nothing.
 
 use crate::bright::{split, BrightKernel, BrightSet, BrightWalk};
-use crate::cube::{seamless_pyramid, working_cube, SeamlessCube};
+use crate::cube::{needed_face, seamless_pyramid, working_cube, working_face, SeamlessCube};
 use crate::irradiance::MomentPyramid;
 use crate::lobe::Lobe;
 use crate::specular::{fis, sample_count, RoughnessMapping, SampleSet};
@@ -32,10 +34,13 @@ pub struct PrefilterOptions {
     /// Added to every sample's mip level (Křivánek & Colbert use +1, which blurs; the
     /// default −0.5 was the most accurate against brute force on the bundled HDRs).
     pub lod_bias: f32,
-    /// Face size of the working cube (default: the source's own texel density, rounded up
-    /// to a power of two).
+    /// Face size of the working cube, rounded up to a power of two, at most 4096. Default:
+    /// what the outputs need ([`Prefilterer::for_outputs`], [`Prefilterer::for_chain`]),
+    /// never finer than the source's own texel density rounded up to a power of two
+    /// ([`Prefilterer::new`]: that density).
     pub cube_size: Option<u32>,
-    /// Largest working cube face (default and most: 2048).
+    /// Largest working cube face chosen when [`cube_size`](Self::cube_size) is not given
+    /// (default 2048; at most 4096).
     pub max_cube_size: u32,
     /// Tolerance of the Lambert moment hierarchy, relative to the map's total energy per
     /// horizon-cut node (default 1e-5; 0 makes it the exact brute-force sum).
@@ -99,9 +104,49 @@ enum Eval<'a> {
 }
 
 impl Prefilterer {
-    /// Prepares `src` (any projection).
+    /// Prepares `src` (any projection) for any output: unless
+    /// [`PrefilterOptions::cube_size`] is given, the working cube has the source's own
+    /// texel density (rounded up to a power of two, at most
+    /// [`PrefilterOptions::max_cube_size`]). When the outputs are known,
+    /// [`for_outputs`](Self::for_outputs) makes a working cube no finer than they need.
     pub fn new(src: &EnvMap, opts: PrefilterOptions) -> Prefilterer {
-        let cube = working_cube(src, opts.cube_size, opts.max_cube_size);
+        let face = working_face(src, opts.cube_size, None, opts.max_cube_size);
+        Prefilterer::with_face(src, face, opts)
+    }
+
+    /// Prepares `src` for rendering each `(lobe, projection, w, h)` of `outputs` (`w×h`
+    /// layers): the working cube is the finest any of them needs (the rule is in
+    /// `cube.rs`, `needed_face`: the larger of the output's texel and half the lobe's
+    /// radius, as a cube face, at least 256²), never finer than the source's own density,
+    /// unless [`PrefilterOptions::cube_size`] is given. Other outputs may still be
+    /// rendered; finer ones are then limited by the working cube.
+    pub fn for_outputs(
+        src: &EnvMap,
+        outputs: &[(Lobe, Projection, u32, u32)],
+        opts: PrefilterOptions,
+    ) -> Prefilterer {
+        let need = outputs
+            .iter()
+            .map(|(lobe, out, w, h)| needed_face(lobe, out, *w, *h))
+            .max();
+        let face = working_face(src, opts.cube_size, need, opts.max_cube_size);
+        Prefilterer::with_face(src, face, opts)
+    }
+
+    /// Prepares `src` for [`render_chain`](Self::render_chain)`(lobes, out, size)`: as
+    /// [`for_outputs`](Self::for_outputs) with each level's lobe and extent.
+    pub fn for_chain(
+        src: &EnvMap,
+        lobes: &[Lobe],
+        out: Projection,
+        size: u32,
+        opts: PrefilterOptions,
+    ) -> Prefilterer {
+        Prefilterer::for_outputs(src, &chain_outputs(lobes, out, size), opts)
+    }
+
+    fn with_face(src: &EnvMap, face: u32, opts: PrefilterOptions) -> Prefilterer {
+        let cube = working_cube(src, face);
         Prefilterer {
             cube,
             full: OnceLock::new(),
@@ -304,16 +349,22 @@ impl Prefilterer {
     /// A prefiltered chain: level `i` holds `lobes[i]` at half the size of level `i − 1`
     /// (level 0 at edge `size`).
     pub fn render_chain(&self, lobes: &[Lobe], out: Projection, size: u32) -> Vec<EnvMap> {
-        let (w0, h0) = out.layer_extent(size.max(1));
-        lobes
+        chain_outputs(lobes, out, size)
             .iter()
-            .enumerate()
-            .map(|(i, lobe)| {
-                let (w, h) = ((w0 >> i).max(1), (h0 >> i).max(1));
-                self.render_extent(lobe, out, w, h)
-            })
+            .map(|(lobe, out, w, h)| self.render_extent(lobe, *out, *w, *h))
             .collect()
     }
+}
+
+/// Each level of a chain as `(lobe, projection, w, h)`: level `i` at half the size of level
+/// `i − 1`, level 0 at edge `size`.
+fn chain_outputs(lobes: &[Lobe], out: Projection, size: u32) -> Vec<(Lobe, Projection, u32, u32)> {
+    let (w0, h0) = out.layer_extent(size.max(1));
+    lobes
+        .iter()
+        .enumerate()
+        .map(|(i, lobe)| (*lobe, out, (w0 >> i).max(1), (h0 >> i).max(1)))
+        .collect()
 }
 
 /// Rows a [`Prefilterer::render_chain`] call will report through

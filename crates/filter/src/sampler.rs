@@ -31,12 +31,14 @@
 //!   Heckbert 1989 §3.5.8): with the ellipse's conjugate radii `(u_x, v_x)`, `(u_y, v_y)`
 //!   in texels, `A = v_x² + v_y² + δ`, `B = −2(u_x v_x + u_y v_y)`, `C = u_x² + u_y² + δ`,
 //!   `F = AC − B²/4`; each texel within `Q = A Δu² + B Δu Δv + C Δv² < F` gets weight
-//!   `exp(−2Q/F)` times its exact solid angle, so the average is over the sphere, not over
-//!   texels. Heckbert's `δ = 1` adds a reconstruction filter; here `δ` adds up to one texel
-//!   only when the minor semi-axis is under a texel, and otherwise takes off the `1/12`
-//!   texel² variance per axis that the box-averaged texels add (`δ = −1/3`, as the
-//!   Gaussian's covariance is `S/4`), so the filter on the sphere does not depend on the
-//!   texel size. The ellipse's eccentricity is limited to [`Sampler::max_anisotropy`], and
+//!   `exp(−2Q/F) − exp(−2)` (pbrt's: zero on the ellipse, so no jump as texels enter it)
+//!   times its exact solid angle, so the average is over the sphere, not over texels.
+//!   Heckbert's `δ = 1` adds a reconstruction filter; here `δ` (along the level's texel
+//!   axes) adds up to one texel only when the minor semi-axis is under a texel, so a
+//!   magnified map is a smooth interpolation of its texel centres, as bilinear's, and
+//!   otherwise takes off the `1/12` texel² variance per axis that the box-averaged texels
+//!   add (`δ = −1/3`, as the Gaussian's covariance is `S/4`), so the filter on the sphere
+//!   does not depend on the texel size. The ellipse's eccentricity is limited to [`Sampler::max_anisotropy`], and
 //!   the level is chosen so that its minor semi-axis spans about four texels (the two
 //!   nearest levels are blended), bounding the cost at about `π·8·8·max_anisotropy`
 //!   texels. Texels beyond a layer's edge come from
@@ -354,9 +356,9 @@ impl Sampler {
             .min((self.chain.len() - 1) as f64);
         let l0 = lod.floor() as usize;
         let f = lod - l0 as f64;
-        let mut acc = self.ewa_level(e, fp, major, minor, l0, c);
+        let mut acc = self.ewa_level(e, fp, minor, l0, c);
         if f > 1e-6 && l0 + 1 < self.chain.len() {
-            let hi = self.ewa_level(e, fp, major, minor, l0 + 1, c);
+            let hi = self.ewa_level(e, fp, minor, l0 + 1, c);
             for k in 0..4 {
                 acc[k] = acc[k] * (1.0 - f) + hi[k] * f;
             }
@@ -368,40 +370,63 @@ impl Sampler {
         out
     }
 
-    /// EWA on level `l`: every texel within the footprint's bounding box in this level
-    /// (from the Jacobian; `major`, `minor` in level-0 texels) is weighted by
-    /// `exp(−2r²)·Ω`, with `r` its elliptical radius measured on the sphere.
-    fn ewa_level(
-        &self,
-        e: &UvEllipse,
-        fp: &Tangent,
-        major: f64,
-        minor: f64,
-        l: usize,
-        c: usize,
-    ) -> [f64; 4] {
+    /// EWA on level `l`: every texel within the footprint's reach in this level (`minor`,
+    /// the minor semi-axis, in level-0 texels) is weighted by `(exp(−2r²) − exp(−2))·Ω` (zero at the
+    /// ellipse, so the result is continuous as texels enter and leave it), with `r` its
+    /// elliptical radius measured on the sphere about the texel's centre direction.
+    fn ewa_level(&self, e: &UvEllipse, fp: &Tangent, minor: f64, l: usize, c: usize) -> [f64; 4] {
         let lv = self.chain.level(l);
         let proj = lv.projection();
         let (w, h) = (lv.width(), lv.height());
         let base = self.chain.level(0);
         let scale = w as f64 / base.width() as f64;
-        // This level's texel, in the tangent plane: its box adds `texel²/12` of variance
-        // per axis, which the footprint's covariance (`S/4` for `exp(−2r²)`) gives back
-        // once the footprint spans a few texels (`δ`, in units of the footprint).
-        let texel = fp.radius / (major * scale).max(1e-300); // radians per texel, roughly
+        // The reconstruction filter, `δ` texel² added to the footprint's covariance along
+        // both texel axes of this level: up to one texel when the minor semi-axis is under
+        // a texel (magnification: the filter is then at least one texel in radius, a smooth
+        // interpolation of the texel centres as in Heckbert's and pbrt's EWA), and once the
+        // footprint spans a few texels, minus the `texel²/12` of variance per axis that the
+        // box-averaged texels add (the footprint's covariance is `S/4` for `exp(−2r²)`).
         let minor_t = minor * scale;
         let delta = if minor_t < 1.0 {
             1.0 - minor_t * minor_t
         } else {
             -(minor_t * minor_t - 1.0).min(1.0) / 3.0
         };
-        let q = fp.quadratic_form(delta * texel * texel);
-        // Bounding box in this level's texels, a little generous (the map is not linear).
-        let ext = |v: DVec2| v * DVec2::new(w as f64, h as f64);
-        let (a, b) = (ext(e.a), ext(e.b));
-        let grow = 1.25 + (delta.max(0.0)).sqrt();
-        let ru = (a.x * a.x + b.x * b.x).sqrt() * grow + 1.0;
-        let rv = (a.y * a.y + b.y * b.y).sqrt() * grow + 1.0;
+        // This level's texel steps in the tangent plane (`M`'s columns over `w`, `h`), and
+        // the footprint in its texels (`M⁻¹` of the tangent semi-diameters, so widened as
+        // `fp` was).
+        let (cu, cv) = match uv_derivatives(proj, e.layer, e.uv) {
+            Some((du, dv)) => (
+                DVec2::new(fp.t1.dot(du), fp.t2.dot(du)) / w as f64,
+                DVec2::new(fp.t1.dot(dv), fp.t2.dot(dv)) / h as f64,
+            ),
+            None => (DVec2::ZERO, DVec2::ZERO),
+        };
+        let det_c = cu.x * cv.y - cv.x * cu.y;
+        let (a, b) = if det_c.abs() > 1e-300 {
+            let to_texels =
+                |t: DVec2| DVec2::new(cv.y * t.x - cv.x * t.y, -cu.y * t.x + cu.x * t.y) / det_c;
+            (to_texels(fp.p), to_texels(fp.q))
+        } else {
+            (
+                e.a * DVec2::new(w as f64, h as f64),
+                e.b * DVec2::new(w as f64, h as f64),
+            )
+        };
+        let q = fp.quadratic_form([
+            delta * (cu.x * cu.x + cv.x * cv.x),
+            delta * (cu.x * cu.y + cv.x * cv.y),
+            delta * (cu.y * cu.y + cv.y * cv.y),
+        ]);
+        // The same ellipse in this level's texels, `S = a aᵀ + b bᵀ + δ I`, grown a little
+        // (the map is not linear across the footprint): its bounding box, and per row the
+        // span inside it plus a texel of margin each side.
+        let grow2 = 1.25f64 * 1.25;
+        let s00 = (a.x * a.x + b.x * b.x + delta) * grow2;
+        let s01 = (a.x * a.y + b.x * b.y) * grow2;
+        let s11 = (a.y * a.y + b.y * b.y + delta) * grow2;
+        let ru = s00.max(0.0).sqrt() + 1.0;
+        let rv = s11.max(0.0).sqrt() + 1.0;
         let (cx, cy) = (e.uv.x * w as f64 - 0.5, e.uv.y * h as f64 - 0.5);
         let (mut x0, mut x1) = ((cx - ru).ceil() as i64, (cx + ru).floor() as i64);
         let (y0, y1) = ((cy - rv).ceil() as i64, (cy + rv).floor() as i64);
@@ -412,32 +437,30 @@ impl Sampler {
             x1 = w as i64 - 1;
             whole_rows = true;
         }
-        // Each row visits only the span of the (grown) ellipse, not its whole bounding box:
-        // with `M = [a b]·grow`, a point `p` from the centre is inside when
-        // `|M⁻¹p|² ≤ 1`, i.e. `A·px² + B·px + C ≤ 0` for the row's `py`, plus a texel of
-        // margin each side (a thin diagonal ellipse covers a small part of its box). Only
-        // where the map is smooth inside a layer (cube faces, lat-long): the disk and
-        // octahedral maps fold their parametrisation, and a footprint across a fold reaches
-        // texels far from its linearised ellipse, which the whole box keeps.
+        // Each row visits only the span of the ellipse, not its whole bounding box: a point
+        // `p` from the centre is inside when `pᵀ S⁻¹ p ≤ 1`, i.e. for the row's `py`,
+        // `s11·px² − 2 s01 py·px + s00 py² − det S ≤ 0`, plus a texel of margin each side (a
+        // thin diagonal ellipse covers a small part of its box). Only where the map is
+        // smooth inside a layer (cube faces, lat-long): the disk and octahedral maps fold
+        // their parametrisation, and a footprint across a fold reaches texels far from its
+        // linearised ellipse, which the whole box keeps.
         let smooth = matches!(proj, Projection::Cube(_) | Projection::LatLong(_));
-        let (ga, gb) = (a * grow, b * grow);
-        let det = ga.x * gb.y - ga.y * gb.x;
-        let qa = ga.y * ga.y + gb.y * gb.y;
+        let det_s = s00 * s11 - s01 * s01;
         let span = |ty: i64| -> (i64, i64) {
-            if !smooth || whole_rows || det.abs() < 1e-9 || qa < 1e-18 {
+            if !smooth || whole_rows || det_s < 1e-18 || s11 < 1e-18 {
                 return (x0, x1);
             }
             let py = ty as f64 - cy;
-            let qb = -2.0 * py * (ga.x * ga.y + gb.x * gb.y);
-            let qc = py * py * (ga.x * ga.x + gb.x * gb.x) - det * det;
-            let disc = qb * qb - 4.0 * qa * qc;
+            let qb = -2.0 * py * s01;
+            let qc = py * py * s00 - det_s;
+            let disc = qb * qb - 4.0 * s11 * qc;
             if disc < 0.0 {
                 // The row passes beyond the ellipse: only the margin's texel.
-                let m = (-qb / (2.0 * qa) + cx).round() as i64;
+                let m = (-qb / (2.0 * s11) + cx).round() as i64;
                 return (m.max(x0), m.min(x1));
             }
             let r = disc.sqrt();
-            let (lo, hi) = ((-qb - r) / (2.0 * qa) + cx, (-qb + r) / (2.0 * qa) + cx);
+            let (lo, hi) = ((-qb - r) / (2.0 * s11) + cx, (-qb + r) / (2.0 * s11) + cx);
             (
                 ((lo - 1.0).ceil() as i64).max(x0),
                 ((hi + 1.0).floor() as i64).min(x1),
@@ -459,7 +482,7 @@ impl Sampler {
             if r2 >= 1.0 {
                 return;
             }
-            let wt = (-2.0 * r2).exp() * om;
+            let wt = ((-2.0 * r2).exp() - EXP_M2) * om;
             let t = lv.layers()[layer].get(px, py);
             for k in 0..c.min(4) {
                 acc[k] += wt * t[k] as f64;
@@ -509,6 +532,9 @@ impl Sampler {
         }
     }
 }
+
+/// `exp(−2)`: the EWA weight at the ellipse, subtracted so that weights fall to zero there.
+const EXP_M2: f64 = 0.135_335_283_236_612_7;
 
 thread_local! {
     /// Per-thread scratch of [`Sampler::ewa_level`]: the texels a footprint reaches beyond
@@ -575,13 +601,13 @@ impl Tangent {
         DVec2::new(x, y) * (theta / s)
     }
 
-    /// The quadratic form of the footprint ellipse (`r = 1` on it), with `extra` added to
-    /// both axes of `S = P Pᵀ` (radians²), widened to the sampler's largest anisotropy.
-    fn quadratic_form(&self, extra: f64) -> Quadratic {
+    /// The quadratic form of the footprint ellipse (`r = 1` on it), `S = P Pᵀ + extra`
+    /// (`extra = [e₀₀, e₀₁, e₁₁]`, radians², symmetric).
+    fn quadratic_form(&self, extra: [f64; 3]) -> Quadratic {
         let (p, q) = (self.p, self.q);
-        let s00 = p.x * p.x + q.x * q.x + extra;
-        let s01 = p.x * p.y + q.x * q.y;
-        let s11 = p.y * p.y + q.y * q.y + extra;
+        let s00 = p.x * p.x + q.x * q.x + extra[0];
+        let s01 = p.x * p.y + q.x * q.y + extra[1];
+        let s11 = p.y * p.y + q.y * q.y + extra[2];
         // Keep S positive definite: at least a thousandth of the major axis.
         let floor = (1e-3 * self.radius).powi(2) + 1e-300;
         let det = (s00 * s11 - s01 * s01).max(floor * (s00 + s11));

@@ -290,12 +290,17 @@ pub fn project(env: &EnvMap) -> Sh9 {
                     p.row_dirs(layer, y as u32, w as u32, h as u32, dirs);
                     let data = env.layers()[layer].row(y as u32);
                     let mut acc = [[0.0f64; 3]; 9];
+                    // A lat-long row's texels all cover the same solid angle.
+                    let row_omega = (p.kind() == ProjectionKind::LatLong)
+                        .then(|| p.texel_solid_angle(layer, 0, y as u32, w as u32, h as u32));
                     for (x, (px, d)) in data.chunks_exact(c).zip(dirs.iter()).enumerate() {
                         let Some((d, dens)) = *d else { continue };
                         if dens <= 0.0 {
                             continue;
                         }
-                        let om = p.texel_solid_angle(layer, x as u32, y as u32, w as u32, h as u32);
+                        let om = row_omega.unwrap_or_else(|| {
+                            p.texel_solid_angle(layer, x as u32, y as u32, w as u32, h as u32)
+                        });
                         let b = basis(d);
                         for (a, bi) in acc.iter_mut().zip(b) {
                             for k in 0..3 {

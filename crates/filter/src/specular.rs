@@ -261,27 +261,29 @@ fn lane_index(x: f32) -> usize {
     (x.to_bits() & 0x007f_ffff) as usize
 }
 
-/// Four bilinear lookups (one per lane) on the levels described by `p` (size and stride as
-/// `f32`, face start, stride as an index, per lane), weighted by `w`: addresses and bilinear weights in SIMD lanes, then
-/// four texel quads.
+/// Four bilinear lookups (one per lane) on the levels described by `p` (per lane: face
+/// size as `f32`, where the face starts, its bordered stride), weighted by `w`: coordinates
+/// and bilinear weights in SIMD lanes, then four texel quads.
 #[inline(always)]
 fn gather4(
     cube: &SeamlessCube,
-    p: &([f32; 4], [f32; 4], [usize; 4], [usize; 4]),
+    p: &([f32; 4], [usize; 4], [usize; 4]),
     u: Vec4,
     v: Vec4,
     w: Vec4,
 ) -> Vec4 {
     let size = Vec4::from_array(p.0);
-    let stride = Vec4::from_array(p.1);
     let half = Vec4::splat(0.5);
     let max = size + 0.499_9;
     let x = (u * size + half).max(half).min(max);
     let y = (v * size + half).max(half).min(max);
     let (x0, y0) = (x.trunc(), y.trunc());
     let (fx, fy) = (x - x0, y - y0);
-    // Within a face: exact in f32 (faces hold fewer than 2²³ texels).
-    let idx = (y0 * stride + x0 + MAGIC).to_array();
+    // Column and row each below 2²³ (faces up to 4096²), so exact as integers; the address
+    // within the face is made in integer arithmetic (a 4096² face's bordered texels number
+    // more than 2²⁴, past what f32 holds exactly).
+    let xi = (x0 + MAGIC).to_array();
+    let yi = (y0 + MAGIC).to_array();
     let (gx, gy) = (Vec4::ONE - fx, Vec4::ONE - fy);
     let w00 = (w * gx * gy).to_array();
     let w10 = (w * fx * gy).to_array();
@@ -289,7 +291,8 @@ fn gather4(
     let w11 = (w * fx * fy).to_array();
     let mut acc = Vec4::ZERO;
     for k in 0..4 {
-        let [a, b, c, d] = cube.quad(p.2[k] + lane_index(idx[k]), p.3[k]);
+        let i = p.1[k] + lane_index(yi[k]) * p.2[k] + lane_index(xi[k]);
+        let [a, b, c, d] = cube.quad(i, p.2[k]);
         acc += a * w00[k] + b * w10[k] + c * w01[k] + d * w11[k];
     }
     acc
@@ -349,26 +352,26 @@ pub(crate) fn fis(cube: &SeamlessCube, set: &SampleSet, n: Vec3, floor: f32) -> 
         let f = lod - l0;
         let l0 = (l0 + MAGIC).to_array();
         let faces = (face + MAGIC).to_array();
-        // Level parameters per lane, for the level below and above the sample's lod:
-        // size, stride, and where the lane's face starts.
-        let mut pa = ([0.0f32; 4], [0.0f32; 4], [0usize; 4], [0usize; 4]);
-        let mut pb = ([0.0f32; 4], [0.0f32; 4], [0usize; 4], [0usize; 4]);
-        for k in 0..4 {
-            let l = lane_index(l0[k]);
-            let l1 = (l + 1).min(top);
-            let f = lane_index(faces[k]);
-            (pa.0[k], pa.1[k]) = cube.level_params(l);
-            (pb.0[k], pb.1[k]) = cube.level_params(l1);
-            pa.2[k] = cube.face_offset(l, f);
-            pb.2[k] = cube.face_offset(l1, f);
-            pa.3[k] = cube.stride_index(l);
-            pb.3[k] = cube.stride_index(l1);
-        }
+        // Level parameters per lane (size, where the lane's face starts, the stride), for
+        // the level below the sample's lod, and above it only when some lane blends in.
+        let lanes_l0 = l0.map(lane_index);
+        let lanes_face = faces.map(lane_index);
+        let params = |level: [usize; 4]| {
+            let mut p = ([0.0f32; 4], [0usize; 4], [0usize; 4]);
+            for k in 0..4 {
+                let lv = cube.level(level[k]);
+                p.0[k] = lv.size;
+                p.1[k] = lv.face[lanes_face[k]];
+                p.2[k] = lv.stride;
+            }
+            p
+        };
         let wb = w * f;
         let wa = w - wb;
-        acc += gather4(cube, &pa, u, v, wa);
+        acc += gather4(cube, &params(lanes_l0), u, v, wa);
         if f.cmpgt(zero).any() {
-            acc += gather4(cube, &pb, u, v, wb);
+            let up = lanes_l0.map(|l| (l + 1).min(top));
+            acc += gather4(cube, &params(up), u, v, wb);
         }
     }
     acc / set.weight_sum
@@ -387,6 +390,63 @@ pub(crate) fn sample_count(base: u32, lobe: &Lobe) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lookups_address_every_texel_of_a_4096_face() {
+        // Each texel holds (x, y, face): every lookup at a texel centre must return its own
+        // texel, and halfway between two texels their mean, on the largest working cube,
+        // whose bordered texels past the first 2²⁴ of a face f32 could not address.
+        use mirrorball_core::{EnvMap, Image, ProjectionKind};
+        use rayon::prelude::*;
+        let n = 4096u32;
+        let faces: Vec<Image> = (0..6)
+            .map(|f| {
+                let mut data = vec![0.0f32; (n * n * 3) as usize];
+                data.par_chunks_mut(3 * n as usize)
+                    .enumerate()
+                    .for_each(|(y, row)| {
+                        for (x, t) in row.chunks_exact_mut(3).enumerate() {
+                            t.copy_from_slice(&[x as f32, y as f32, f as f32]);
+                        }
+                    });
+                Image::from_vec(n, n, 3, data).unwrap()
+            })
+            .collect();
+        let env = EnvMap::new(ProjectionKind::Cube.default_projection(), faces).unwrap();
+        let cube = SeamlessCube::new(&env);
+        drop(env);
+        let at = |x: f32| (x + 0.5) / n as f32;
+        let lanes = [
+            (4095.0f32, 4095.0f32),
+            (4000.0, 4090.0),
+            (0.0, 4095.0),
+            (4095.0, 0.0),
+        ];
+        for face in [0usize, 5] {
+            let p = (
+                [n as f32; 4],
+                [cube.level(0).face[face]; 4],
+                [cube.level(0).stride; 4],
+            );
+            let u = Vec4::from_array(lanes.map(|l| at(l.0)));
+            let v = Vec4::from_array(lanes.map(|l| at(l.1)));
+            for (k, &(x, y)) in lanes.iter().enumerate() {
+                let mut w = [0.0f32; 4];
+                w[k] = 1.0;
+                let got = gather4(&cube, &p, u, v, Vec4::from_array(w));
+                assert_eq!(
+                    got.truncate(),
+                    Vec3::new(x, y, face as f32),
+                    "{face} {x} {y}"
+                );
+                let one = cube.bilinear(0, face, at(x), at(y));
+                assert_eq!(one, got, "{face} {x} {y}");
+            }
+            // Halfway between columns 4093 and 4094 of row 4094.
+            let mid = cube.bilinear(0, face, 4094.0 / n as f32, at(4094.0));
+            assert_eq!(mid.truncate(), Vec3::new(4093.5, 4094.0, face as f32));
+        }
+    }
 
     #[test]
     fn mappings_invert() {

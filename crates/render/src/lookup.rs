@@ -9,7 +9,9 @@
 //!   at the corners for the background.
 //! * **Greene's material** ([`crate::Material::Greene`]): the diffuse illumination map
 //!   (Lambert, `E/π`) and the specular map of each lobe, made by
-//!   [`mirrorball_filter::Prefilterer`] in the environment's own projection.
+//!   [`mirrorball_filter::Prefilterer`] in the environment's own projection (at most 512
+//!   texels along a side, so from a working cube no finer than such a map needs, whatever
+//!   the environment's size).
 //!
 //! The cache is keyed by the environment map's `Arc`: replacing `Environment::map` makes it
 //! start again; clones of the environment share it, so a turntable's frames build nothing.
@@ -142,7 +144,17 @@ impl EnvCache {
         let pf = match &g.prefilterer {
             Some(p) => p.clone(),
             None => {
-                let p = Arc::new(Prefilterer::new(map, PrefilterOptions::default()));
+                // One working cube serves every lobe asked for later: it is made as fine as
+                // the finest map this cache makes needs, a mirror at the largest extent.
+                let (w, h) = extent_for(map, 0.0);
+                let mirror = Lobe::Phong {
+                    exponent: f64::INFINITY,
+                };
+                let p = Arc::new(Prefilterer::for_outputs(
+                    map,
+                    &[(mirror, *map.projection(), w, h)],
+                    PrefilterOptions::default(),
+                ));
                 g.prefilterer = Some(p.clone());
                 p
             }

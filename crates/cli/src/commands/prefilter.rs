@@ -16,7 +16,7 @@ use crate::spec::{bad, ProjSpec};
 use crate::{load, PrefilterArgs};
 use mirrorball_core::glam::DVec2;
 use mirrorball_core::{EnvMap, Image, Layout, Projection, ProjectionKind, WorldProjection};
-use mirrorball_filter::mip::level_count;
+use mirrorball_filter::mip::{level_count, texel_solid_angles};
 use mirrorball_filter::sh::{self, Window};
 use mirrorball_filter::{
     chain_lobes, compress, irradiance, BrdfLut, Compression, EnergyReport, Lobe, LobeKind,
@@ -209,9 +209,9 @@ impl Plan {
             )));
         }
         if let Some(c) = a.cube_size {
-            if c == 0 || c > 2048 {
+            if c == 0 || c > 4096 {
                 return Err(CliError::request(format!(
-                    "--cube-size: {c} is outside 1..=2048"
+                    "--cube-size: {c} is outside 1..=4096"
                 )));
             }
         }
@@ -406,20 +406,29 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
     let sh9 = sh::project(&env);
     let chain: Vec<EnvMap> = with_progress("prefilter", rows, a.quiet, |counter| {
         plan.opts.progress = Some(counter);
-        let pf = Prefilterer::new(&env, plan.opts.clone());
+        // The working cube is made as fine as the levels rendered need (no finer than the
+        // source), unless --cube-size says otherwise.
         match (plan.kind, plan.irradiance) {
             (LobeKind::Lambert, method) => {
                 // One irradiance map; the further levels are its solid-angle-weighted box
                 // mips (the irradiance is smooth, and engines read any level).
                 let top = match method {
-                    IrradianceMethod::Exact => pf.render(&Lobe::Lambert, out_proj, size),
+                    IrradianceMethod::Exact => Prefilterer::for_chain(
+                        &env,
+                        &[Lobe::Lambert],
+                        out_proj,
+                        size,
+                        plan.opts.clone(),
+                    )
+                    .render(&Lobe::Lambert, out_proj, size),
                     IrradianceMethod::Sh => {
                         irradiance::irradiance_map_sh(&sh9, plan.window, out_proj, size)
                     }
                 };
                 MipChain::build_levels(&top, MipFilter::Box, levels).into_levels()
             }
-            _ => pf.render_chain(&lobes, out_proj, size),
+            _ => Prefilterer::for_chain(&env, &lobes, out_proj, size, plan.opts.clone())
+                .render_chain(&lobes, out_proj, size),
         }
     });
     let t_filter = t1.elapsed();
@@ -566,10 +575,7 @@ fn preview_sheet(chain: &[EnvMap], exposure: f32) -> Image {
     let cols = chain.len().clamp(1, 4) as u32;
     let rows = (chain.len() as u32).div_ceil(cols).max(1);
     let mut sheet = Image::new(cols * (tw + gap) - gap, rows * (th + gap) - gap, 3);
-    let mean = chain.first().map_or(1.0, |l| {
-        let m = l.stats().mean;
-        (m[0] + m[1] + m[2]) / 3.0
-    });
+    let mean = chain.first().map_or(1.0, mean_rgb);
     let scale = if mean > 0.0 && mean.is_finite() {
         (0.18 / mean) as f32 * 2f32.powf(exposure)
     } else {
@@ -593,4 +599,27 @@ fn preview_sheet(chain: &[EnvMap], exposure: f32) -> Image {
         }
     }
     sheet
+}
+
+/// The mean of R, G and B over the sphere, weighted by exact texel solid angle (one table
+/// for all six faces of a cube).
+fn mean_rgb(env: &EnvMap) -> f64 {
+    let omega = texel_solid_angles(env.projection(), env.width(), env.height());
+    let c = env.channels();
+    let (mut sum, mut total) = (0.0f64, 0.0f64);
+    for (layer, img) in env.layers().iter().enumerate() {
+        let om = &omega[layer.min(omega.len() - 1)];
+        for (px, &w) in img.data().chunks_exact(c).zip(om) {
+            let v = (px[0] + px[1] + px[2]) as f64 / 3.0;
+            if v.is_finite() && w > 0.0 {
+                sum += v * w;
+                total += w;
+            }
+        }
+    }
+    if total > 0.0 {
+        sum / total
+    } else {
+        0.0
+    }
 }

@@ -6,8 +6,8 @@ use mirrorball_core::{EnvMap, ProjectionKind, WorldProjection};
 use mirrorball_filter::sampler::{footprint_ellipse, semi_axes, uv_derivatives};
 use mirrorball_filter::{directions, Filter, Footprint, Sampler, SummedAreaTable};
 
-/// The exact EWA target on the sphere: `∫ L exp(−2θ²/β²) [θ < β] dω / ∫ …`, by dense
-/// quadrature over the cap (tangent-plane polar grid mapped by the exponential map).
+/// The exact EWA target on the sphere: `∫ L (exp(−2θ²/β²) − exp(−2)) [θ < β] dω / ∫ …`, by
+/// dense quadrature over the cap (tangent-plane polar grid mapped by the exponential map).
 fn gaussian_cone(d: DVec3, beta: f64) -> [f64; 3] {
     let t1 = DVec3::new(d.z, 0.0, -d.x).normalize();
     let t2 = d.cross(t1);
@@ -18,7 +18,7 @@ fn gaussian_cone(d: DVec3, beta: f64) -> [f64; 3] {
         for j in 0..na {
             let a = (j as f64 + 0.5) / na as f64 * std::f64::consts::TAU;
             let l = d * r.cos() + (t1 * a.cos() + t2 * a.sin()) * r.sin();
-            let w = (-2.0 * r * r / (beta * beta)).exp() * r.sin();
+            let w = ((-2.0 * r * r / (beta * beta)).exp() - (-2.0f64).exp()) * r.sin();
             let v = analytic(l);
             for k in 0..3 {
                 acc[k] += w * v[k] as f64;
@@ -225,4 +225,74 @@ fn nearest_and_bilinear() {
     let got = n.sample(d, &Footprint::Cone(0.3));
     assert_eq!(&got[..3], &t[..3]);
     assert_eq!(b.sample(d, &Footprint::Point), env.sample(d));
+}
+
+#[test]
+fn ewa_magnifies_smoothly() {
+    // Lat-long maps of 45° and 5.6° texels read along dense lines of directions with
+    // footprints far smaller than a texel: EWA must interpolate as smoothly as bilinear (no
+    // step between neighbouring directions much larger than bilinear's largest) and stay
+    // close to it, rather than hold texels as blocks. "Close": the two kernels differ at
+    // most where a lookup sits a quarter texel from a centre on both axes (bilinear weights
+    // 9/16, 3/16, 3/16, 1/16; the Gaussian of one texel's radius, 0.712, 0.144, 0.144, 0),
+    // by 0.15 of the texels' range; on 45° texels the sphere's curvature across a texel
+    // (the Gaussian is measured on the sphere) adds a little.
+    let proj = ProjectionKind::LatLong.default_projection();
+    for (w, h, close) in [(8u32, 4u32, 0.2f32), (64, 32, 0.15)] {
+        let mut img = mirrorball_core::Image::new(w, h, 3);
+        for y in 0..h {
+            for x in 0..w {
+                let v = ((x * 7 + y * 3) % 5) as f32 / 4.0;
+                img.set(x, y, &[v, 1.0 - v, 0.5 * v]);
+            }
+        }
+        let env = EnvMap::new(proj, vec![img]).unwrap();
+        let ewa = Sampler::new(&env, Filter::Ewa);
+        let n = 8000;
+        let lines: [Box<dyn Fn(f64) -> DVec3>; 2] = [
+            // Along a parallel.
+            Box::new(|t: f64| {
+                let (lon, lat) = (t * std::f64::consts::TAU, 0.3f64);
+                DVec3::new(lon.sin() * lat.cos(), lat.sin(), -lon.cos() * lat.cos())
+            }),
+            // Across rows and columns at once.
+            Box::new(|t: f64| {
+                let lon = t * std::f64::consts::TAU;
+                let lat = 0.9 * (3.0 * lon).sin();
+                DVec3::new(lon.sin() * lat.cos(), lat.sin(), -lon.cos() * lat.cos())
+            }),
+        ];
+        for (li, line) in lines.iter().enumerate() {
+            let (mut step_b, mut step_e, mut diff) = (0.0f32, 0.0f32, 0.0f32);
+            let mut prev: Option<([f32; 4], [f32; 4])> = None;
+            for i in 0..=n {
+                let d = line(i as f64 / n as f64);
+                let b = env.sample(d);
+                let e = ewa.sample(d, &Footprint::Cone(1e-5));
+                for k in 0..3 {
+                    diff = diff.max((e[k] - b[k]).abs());
+                }
+                if let Some((pb, pe)) = prev {
+                    for k in 0..3 {
+                        step_b = step_b.max((b[k] - pb[k]).abs());
+                        step_e = step_e.max((e[k] - pe[k]).abs());
+                    }
+                }
+                prev = Some((b, e));
+            }
+            assert!(
+                step_b > 0.0 && step_b < 0.1,
+                "{w}×{h} line {li}: bilinear step {step_b}"
+            );
+            assert!(
+                step_e < 2.0 * step_b,
+                "{w}×{h} line {li}: EWA steps by {step_e}, bilinear by at most {step_b}"
+            );
+            // Values span [0, 1].
+            assert!(
+                diff < close,
+                "{w}×{h} line {li}: EWA is {diff} from bilinear"
+            );
+        }
+    }
 }
