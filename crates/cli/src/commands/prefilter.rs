@@ -7,6 +7,7 @@
 //! per level → SH JSON → preview PNG`.
 
 use super::InputPlan;
+use crate::budget;
 use crate::commands::convert::parse_precision;
 use crate::error::CliError;
 use crate::guard::Files;
@@ -392,7 +393,46 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
     let (w0, h0) = out_proj.layer_extent(size);
     let full = level_count(w0, h0);
     let levels = plan.levels.unwrap_or(full).min(full);
+    // A list of values per level must say every level: padding would be a silent guess.
+    let listed = match (&plan.mapping, &plan.exponents) {
+        (_, Some(e)) => Some(("--exponents", "exponents", e.len())),
+        (RoughnessMapping::Custom(r), None) if plan.kind != LobeKind::Lambert => {
+            Some(("--mapping", "roughness values", r.len()))
+        }
+        _ => None,
+    };
+    if let Some((flag, what, n)) = listed.filter(|&(_, _, n)| n != levels) {
+        return Err(CliError::request(format!(
+            "{flag} lists {n} {what} but the chain has {levels} levels ({w0}x{h0} down to {}); give {levels}, or --levels {n}",
+            if plan.levels.is_some() { "--levels" } else { "1x1" }
+        )));
+    }
     let lobes = lobes(&plan, levels);
+    {
+        // The working cube (bordered, with its pyramid, twice when bright texels are split
+        // off) is about as fine as level 0 needs, at least 256² and at most 4096², unless
+        // --cube-size says; the chain is four channels with its mips.
+        let face = plan.opts.cube_size.unwrap_or(size.clamp(256, 4096)) as u64;
+        let working = budget::f32_texels(6 * (face + 2) * (face + 2) * 4 / 3, 4) * 2;
+        let chain = budget::f32_texels(
+            w0 as u64 * h0 as u64 * out_proj.layer_count() as u64 * 4 / 3,
+            4,
+        );
+        let held = budget::f32_texels(
+            env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
+            env.channels() as u64,
+        );
+        budget::check(
+            &format!(
+                "prefiltering into {} {w0}x{h0}x{} (working cube {face}²)",
+                out_proj.name(),
+                out_proj.layer_count()
+            ),
+            held,
+            working.saturating_add(chain),
+            "a smaller --size or --cube-size",
+        )?;
+    }
 
     // Prefilter.
     let t1 = Instant::now();
@@ -491,7 +531,7 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
             "projection": out_proj.name(),
             "levels": level_info,
             "energy_removed": energy.map(|r| json!({
-                "operator": format!("{:?}", plan.compression),
+                "operator": a.compress,
                 "texels": r.texels,
                 "fraction": r.fraction_removed,
                 "energy_before_rgb": r.before,

@@ -729,9 +729,14 @@ fn material_of(e: &MaterialEntry) -> Result<Material, String> {
                 other => return Err(format!("lobe '{other}' is not phong or ggx")),
             };
             if !lobe.is_valid() {
-                return Err(format!(
-                    "{lobe:?}: the exponent must be ≥ 0 and the roughness in [0, 1]"
-                ));
+                return Err(match lobe {
+                    SpecularLobe::Phong { exponent } => {
+                        format!("phong exponent {exponent} must be a number ≥ 0")
+                    }
+                    SpecularLobe::Ggx { roughness } => {
+                        format!("ggx roughness {roughness} is outside [0, 1]")
+                    }
+                });
             }
             Material::Greene {
                 dc: colour("dc", e.dc.unwrap_or([0.2; 3]))?,
@@ -1021,6 +1026,15 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                         .build(None)
                         .map_err(|e| CliError::request(format!("--env-as: {e}")))?;
                     let (w, h) = p.layer_extent(*size);
+                    budget::check(
+                        &format!("--env-as {} {w}x{h}x{}", p.name(), p.layer_count()),
+                        0,
+                        budget::f32_texels(
+                            w as u64 * h as u64 * p.layer_count() as u64,
+                            env.channels() as u64,
+                        ),
+                        "a smaller --env-size",
+                    )?;
                     if !plan.quiet {
                         eprintln!("environment converted to {} {w}x{h}", p.name());
                     }

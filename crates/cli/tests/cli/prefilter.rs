@@ -198,6 +198,19 @@ fn bad_requests_fail_before_work() {
         (vec!["--lobe", "ggx", "--size", "30"], "power of two"),
         (vec!["--lobe", "ggx", "--mapping", "2,3"], "--mapping"),
         (vec!["--lobe", "ggx", "--exponents", "10"], "--exponents"),
+        // A list shorter than the chain is refused, not padded.
+        (
+            vec!["--lobe", "ggx", "--size", "8", "--mapping", "0,0.5"],
+            "--mapping lists 2 roughness values but the chain has 4 levels",
+        ),
+        (
+            vec!["--lobe", "phong", "--size", "8", "--exponents", "inf,10"],
+            "--exponents lists 2 exponents but the chain has 4 levels",
+        ),
+        (
+            vec!["--lobe", "ggx", "--size", "4096", "--max-memory", "100M"],
+            "of --max-memory",
+        ),
         (
             vec!["--lobe", "ggx", "--compress", "soft:10:5"],
             "--compress",

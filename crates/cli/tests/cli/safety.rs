@@ -389,3 +389,47 @@ fn a_face_placeholder_where_there_is_one_layer_is_refused() {
     }
     assert!(files(dir.path()).is_empty());
 }
+
+/// Messages name values as the user spells them, never in Rust's debug form
+/// (`Ggx { roughness: 2.0 }`, `Half`).
+#[test]
+fn messages_speak_the_users_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let city = asset("city.exr");
+    let c = city.to_str().unwrap();
+    let png = dir.path().join("o.png");
+    for (args, expect) in [
+        (
+            vec![
+                "render",
+                "--env",
+                c,
+                "--material",
+                "greene:ggx=2",
+                "-o",
+                png.to_str().unwrap(),
+            ],
+            "ggx roughness 2 is outside [0, 1]",
+        ),
+        (
+            vec![
+                "convert",
+                c,
+                png.to_str().unwrap(),
+                "--to",
+                "latlong",
+                "--precision",
+                "half",
+            ],
+            "--precision half does not fit",
+        ),
+    ] {
+        let r = run(&args);
+        let e = stderr(&r);
+        assert_eq!(r.status.code(), Some(2), "{e}");
+        assert!(
+            e.contains(expect) && !e.contains(" { ") && !e.contains("Half"),
+            "{e}"
+        );
+    }
+}
