@@ -1077,7 +1077,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                     motion_from: plan.pan_blur.map(|p| cam.panned(p)),
                     ..plan.settings
                 };
-                let f = match plan.fisheye {
+                match plan.fisheye {
                     Some((lens, fov)) => mirrorball_render::capture::render_fisheye(
                         &scene,
                         cam.eye,
@@ -1100,8 +1100,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                         mirrorball_render::render_with_progress(&scene, &cam, &settings, &counter)
                     }
                 }
-                .map_err(|e| CliError::request(e.to_string()));
-                f
+                .map_err(|e| CliError::request(e.to_string()))
             })
             .collect::<Vec<_>>()
     });
