@@ -66,7 +66,11 @@ pub fn check_read(path: &Path, limits: &Limits, tally: &mut Tally) {
             if e.problem().contains("decoder failed") {
                 // Tagged with the compression the file declares (a mutation can turn a
                 // DWAB seed into a B44 file), for the known-panic rule of `assert_tally`.
-                let b44 = if declares_b44(path) { " [declares b44]" } else { "" };
+                let b44 = if declares_b44(path) {
+                    " [declares b44]"
+                } else {
+                    ""
+                };
                 tally.caught_panics.push(format!("{e}{b44}"));
             }
         }
