@@ -499,18 +499,28 @@ fn grid(title: &str, panels: &[(String, u32, u32, Vec<u8>)], scale: Option<&Colo
 }
 
 fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> {
-    let mut out = Vec::new();
-    let size_note = |p: &Projection, _f: &[LayerField]| p.name().to_string();
-    let stats_of = |i: usize| &r.projections[i].stats;
-    let at = |t: &TexelStats| {
-        if t.width == t.height {
-            format!("{}×{}²", t.layers, t.width)
-        } else {
-            format!("{}×{}×{}", t.layers, t.width, t.height)
-        }
-    };
+    vec![
+        solid_angle_figure(r, fields),
+        anisotropy_figure(r, fields),
+        zimmons_figure(r),
+        cone_figure(r, fields),
+        indexing_line_figure(r),
+        indexing_quad_sphere_figure(r),
+        singularities_figure(r),
+    ]
+}
 
-    // Solid angle per texel.
+/// "4×512²", or "1×1024×512" where the layers are not square.
+fn size_label(t: &TexelStats) -> String {
+    if t.width == t.height {
+        format!("{}×{}²", t.layers, t.width)
+    } else {
+        format!("{}×{}×{}", t.layers, t.width, t.height)
+    }
+}
+
+/// Solid angle per texel.
+fn solid_angle_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Figure {
     let sa = ColorScale {
         lo: 1.0 / 64.0,
         hi: 8.0,
@@ -521,7 +531,7 @@ fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> 
         .iter()
         .enumerate()
         .map(|(i, (p, f))| {
-            let t = stats_of(i);
+            let t = &r.projections[i].stats;
             let total: u64 = f.iter().map(|l| (l.width * l.height) as u64).sum();
             let share = equal_share(total);
             let layers = f
@@ -535,14 +545,14 @@ fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> 
             let (w, h, px) = pack(p, layers);
             let title = format!(
                 "{}\nmax/min {:.4} at {}",
-                size_note(p, f),
+                p.name(),
                 t.full.ratio,
-                at(t)
+                size_label(t)
             );
             (title, w, h, px)
         })
         .collect();
-    out.push(Figure {
+    Figure {
         id: "analysis-solid-angle-heatmaps".into(),
         title: "Solid angle per texel".into(),
         caption: format!(
@@ -559,9 +569,11 @@ fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> 
             &panels,
             Some(&sa),
         ),
-    });
+    }
+}
 
-    // Anisotropy.
+/// Anisotropy.
+fn anisotropy_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Figure {
     let an = ColorScale {
         lo: 1.0,
         hi: 16.0,
@@ -572,7 +584,7 @@ fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> 
         .iter()
         .enumerate()
         .map(|(k, (p, f))| {
-            let t = stats_of(k);
+            let t = &r.projections[k].stats;
             let layers = f
                 .iter()
                 .map(|l| {
@@ -586,15 +598,15 @@ fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> 
             let (w, h, px) = pack(p, layers);
             let title = format!(
                 "{}\nmax {:.4}, mean {:.4} at {}",
-                size_note(p, f),
+                p.name(),
                 t.anisotropy_max.value,
                 t.anisotropy_mean,
-                at(t)
+                size_label(t)
             );
             (title, w, h, px)
         })
         .collect();
-    out.push(Figure {
+    Figure {
         id: "analysis-anisotropy-heatmaps".into(),
         title: "Anisotropy".into(),
         caption: "Ratio of the largest to the smallest angle one pixel step subtends (singular \
@@ -605,109 +617,111 @@ fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> 
                   numbers under each name are at the analysed size."
             .into(),
         svg: grid("Anisotropy of each texel", &panels, Some(&an)),
-    });
+    }
+}
 
-    // Zimmons' one-dimensional measure.
+/// Zimmons' one-dimensional measure.
+fn zimmons_figure(r: &Report) -> Figure {
+    let n = r.projections.len();
+    let cols = 5usize.min(n.max(1));
+    let rows = n.div_ceil(cols);
+    let (pw, ph) = (300.0, 240.0);
+    let w = cols as f64 * pw;
+    let h = 36.0 + rows as f64 * ph;
+    let h = h + 22.0;
+    let mut body = plot::text(
+        w / 2.0,
+        22.0,
+        "Angle subtended by each pixel, from the layer centre outwards (Zimmons' figs. 13, 30, 48)",
+        15.0,
+        "middle",
+        "font-weight=\"bold\"",
+    );
+    // One legend for all panels.
+    for (k, name) in ["horizontal axis (h)", "vertical axis (v)", "diagonal (d)"]
+        .iter()
+        .enumerate()
     {
-        let n = r.projections.len();
-        let cols = 5usize.min(n.max(1));
-        let rows = n.div_ceil(cols);
-        let (pw, ph) = (300.0, 240.0);
-        let w = cols as f64 * pw;
-        let h = 36.0 + rows as f64 * ph;
-        let h = h + 22.0;
-        let mut body = plot::text(
-            w / 2.0,
-            22.0,
-            "Angle subtended by each pixel, from the layer centre outwards (Zimmons' figs. 13, 30, 48)",
-            15.0,
-            "middle",
-            "font-weight=\"bold\"",
+        let lx = w / 2.0 - 270.0 + 190.0 * k as f64;
+        let dash = if k == 1 {
+            " stroke-dasharray=\"6 3\""
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            body,
+            "<line x1=\"{lx:.1}\" y1=\"40\" x2=\"{:.1}\" y2=\"40\" stroke=\"{}\" stroke-width=\"2\"{dash}/>",
+            lx + 24.0,
+            plot::PALETTE[k]
         );
-        // One legend for all panels.
-        for (k, name) in ["horizontal axis (h)", "vertical axis (v)", "diagonal (d)"]
+        body += &plot::text(lx + 30.0, 44.0, name, 12.0, "start", "");
+    }
+    for (i, e) in r.projections.iter().enumerate() {
+        let (c, row) = (i % cols, i / cols);
+        let pr = &e.profile;
+        let series = pr
+            .walks
             .iter()
             .enumerate()
-        {
-            let lx = w / 2.0 - 270.0 + 190.0 * k as f64;
-            let dash = if k == 1 {
-                " stroke-dasharray=\"6 3\""
-            } else {
-                ""
-            };
-            let _ = writeln!(
-                body,
-                "<line x1=\"{lx:.1}\" y1=\"40\" x2=\"{:.1}\" y2=\"40\" stroke=\"{}\" stroke-width=\"2\"{dash}/>",
-                lx + 24.0,
-                plot::PALETTE[k]
-            );
-            body += &plot::text(lx + 30.0, 44.0, name, 12.0, "start", "");
-        }
-        for (i, e) in r.projections.iter().enumerate() {
-            let (c, row) = (i % cols, i / cols);
-            let pr = &e.profile;
-            let series = pr
-                .walks
-                .iter()
-                .enumerate()
-                .map(|(k, wk)| {
-                    // A last step cut short by the rim or an odd edge is not a whole pixel.
-                    let full = if wk.last_fraction < 1.0 {
-                        wk.degrees.len() - 1
-                    } else {
-                        wk.degrees.len()
-                    };
-                    let pts = wk.degrees[..full]
-                        .iter()
-                        .enumerate()
-                        .map(|(j, d)| [j as f64, *d])
-                        .collect();
-                    let s = Series::new(&wk.name, pts, k);
-                    if k == 1 {
-                        s.dashed()
-                    } else {
-                        s
-                    }
-                })
-                .collect();
-            let ratios: Vec<String> = pr
-                .walks
-                .iter()
-                .map(|w| format!("{} {:.3}", &w.name[..1], w.ratio))
-                .collect();
-            let chart = LineChart {
-                title: if e.stats.layers > 1 {
-                    format!(
-                        "{} (layer {}, {}×{})",
-                        pr.projection, pr.layer, pr.width, pr.height
-                    )
+            .map(|(k, wk)| {
+                // A last step cut short by the rim or an odd edge is not a whole pixel.
+                let full = if wk.last_fraction < 1.0 {
+                    wk.degrees.len() - 1
                 } else {
-                    format!("{} ({}×{})", pr.projection, pr.width, pr.height)
-                },
-                subtitle: format!("max/min: {}", ratios.join(", ")),
-                x_label: "pixel from the centre".into(),
-                y_label: "degrees per pixel".into(),
-                series,
-                legend: Legend::None,
-                ..Default::default()
-            };
-            body += &chart.draw(c as f64 * pw, 58.0 + row as f64 * ph, pw, ph);
-        }
-        out.push(Figure {
-            id: "analysis-zimmons-1d".into(),
-            title: "Zimmons' one-dimensional measure".into(),
-            caption: "For each projection at the analysed size: the angle between the directions \
-                      at the two ends of each pixel, walking from the centre of the layer that \
-                      looks along −Z to its edge, along the horizontal axis, the vertical axis \
-                      (dashed) and the diagonal (one pixel in each direction per step). A \
-                      rising curve (sphere map, angular map) means texels see more of the world \
-                      towards the edge; the sphere map's last pixel is its rim singularity."
-                .into(),
-            svg: plot::document(w, h, &body),
-        });
+                    wk.degrees.len()
+                };
+                let pts = wk.degrees[..full]
+                    .iter()
+                    .enumerate()
+                    .map(|(j, d)| [j as f64, *d])
+                    .collect();
+                let s = Series::new(&wk.name, pts, k);
+                if k == 1 {
+                    s.dashed()
+                } else {
+                    s
+                }
+            })
+            .collect();
+        let ratios: Vec<String> = pr
+            .walks
+            .iter()
+            .map(|w| format!("{} {:.3}", &w.name[..1], w.ratio))
+            .collect();
+        let chart = LineChart {
+            title: if e.stats.layers > 1 {
+                format!(
+                    "{} (layer {}, {}×{})",
+                    pr.projection, pr.layer, pr.width, pr.height
+                )
+            } else {
+                format!("{} ({}×{})", pr.projection, pr.width, pr.height)
+            },
+            subtitle: format!("max/min: {}", ratios.join(", ")),
+            x_label: "pixel from the centre".into(),
+            y_label: "degrees per pixel".into(),
+            series,
+            legend: Legend::None,
+            ..Default::default()
+        };
+        body += &chart.draw(c as f64 * pw, 58.0 + row as f64 * ph, pw, ph);
     }
+    Figure {
+        id: "analysis-zimmons-1d".into(),
+        title: "Zimmons' one-dimensional measure".into(),
+        caption: "For each projection at the analysed size: the angle between the directions \
+                  at the two ends of each pixel, walking from the centre of the layer that \
+                  looks along −Z to its edge, along the horizontal axis, the vertical axis \
+                  (dashed) and the diagonal (one pixel in each direction per step). A \
+                  rising curve (sphere map, angular map) means texels see more of the world \
+                  towards the edge; the sphere map's last pixel is its rim singularity."
+            .into(),
+        svg: plot::document(w, h, &body),
+    }
+}
 
-    // The reflection cone.
+/// The reflection cone.
+fn cone_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Figure {
     let panels: Vec<_> = r
         .projections
         .iter()
@@ -746,7 +760,7 @@ fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> 
             )
         })
         .collect();
-    out.push(Figure {
+    Figure {
         id: "analysis-reflection-cone".into(),
         title: "One reflection cone on every projection (Greene's fig. 2)".into(),
         caption: format!(
@@ -765,271 +779,270 @@ fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> 
             &panels,
             None,
         ),
-    });
-
-    // Indexing: the line.
-    {
-        let ix = &r.indexing;
-        let (w, h) = (1100.0, 380.0);
-        let s35: Vec<Series> = ix
-            .line_runs
-            .iter()
-            .enumerate()
-            .map(|(i, run)| {
-                Series::new(
-                    &format!(
-                        "{} segment{}",
-                        run.segments,
-                        if run.segments == 1 { "" } else { "s" }
-                    ),
-                    run.errors.clone(),
-                    i,
-                )
-            })
-            .collect();
-        let c35 = LineChart {
-            title: format!(
-                "Fig. 35 set-up: viewer at ({}, {}, 0)",
-                ix.line_viewer, ix.line.height
-            ),
-            x_label: "x on the mirror".into(),
-            y_label: "interpolated vs exact reflection (°)".into(),
-            series: s35,
-            log_y: true,
-            y_range: Some([1e-3, 300.0]),
-            markers: vec![Marker {
-                at: [-4.5, 2.61],
-                label: "Zimmons: 2.61° at −4.5".into(),
-            }],
-            ..Default::default()
-        };
-        let s36: Vec<Series> = ix
-            .line_runs
-            .iter()
-            .enumerate()
-            .map(|(i, run)| {
-                Series::new(
-                    &format!(
-                        "{} seg.: worst {:.2}° (viewer {:.2})",
-                        run.segments, run.worst_viewer.worst.degrees, run.worst_viewer.viewer
-                    ),
-                    run.sweep
-                        .iter()
-                        .map(|s| [s.viewer, s.worst.degrees])
-                        .collect(),
-                    i,
-                )
-            })
-            .collect();
-        let c36 = LineChart {
-            title: "Fig. 36 set-up: worst error for each viewer position".into(),
-            x_label: "viewer x (one unit above the mirror)".into(),
-            y_label: "largest error along the mirror (°)".into(),
-            series: s36,
-            log_y: true,
-            y_range: Some([1e-1, 300.0]),
-            markers: vec![Marker {
-                at: [-8.3, 2.60751],
-                label: "Zimmons: 2.60751° at −8.3".into(),
-            }],
-            ..Default::default()
-        };
-        let body = c35.draw(0.0, 0.0, w / 2.0, h) + &c36.draw(w / 2.0, 0.0, w / 2.0, h);
-        out.push(Figure {
-            id: "analysis-indexing-line".into(),
-            title: "Per-vertex reflection on a mirror line (Zimmons' figs. 34–36)".into(),
-            caption: "A flat mirror along x from −10 to 10 (normal +y), the viewer one unit \
-                      above it. Reflected vectors are computed exactly at the segment ends and \
-                      interpolated linearly in between (object space, i.e. perspective-correct) \
-                      and compared with the exact reflection at each point. One segment is \
-                      Zimmons' stated set-up; the circles mark his printed values, which no \
-                      segment count reproduces."
-                .into(),
-            svg: plot::document(w, h, &body),
-        });
     }
+}
 
-    // Indexing: quad and sphere.
-    {
-        let ix = &r.indexing;
-        let (w, h) = (1260.0, 720.0);
-        let (cw, chh) = (w / 3.0, h / 2.0);
-        let mut body = String::new();
-        let map_series = |res: &[ViewResult]| -> Vec<Series> {
-            (0..res.first().map_or(0, |v| v.maps.len()))
-                .map(|k| {
-                    let m = &res[0].maps[k];
-                    Series::new(
-                        &format!(
-                            "{} {} ({}²)",
-                            m.projection,
-                            m.indexing.to_lowercase(),
-                            m.size
-                        ),
-                        res.iter()
-                            .map(|v| [v.viewer, v.maps[k].max_texels])
-                            .collect(),
-                        k + 1,
-                    )
-                })
-                .collect()
-        };
-        let angle_series = |res: &[ViewResult]| {
-            vec![
-                Series::new(
-                    "worst, vector interpolation",
-                    res.iter().map(|v| [v.viewer, v.worst.degrees]).collect(),
-                    0,
+/// Indexing: the line.
+fn indexing_line_figure(r: &Report) -> Figure {
+    let ix = &r.indexing;
+    let (w, h) = (1100.0, 380.0);
+    let s35: Vec<Series> = ix
+        .line_runs
+        .iter()
+        .enumerate()
+        .map(|(i, run)| {
+            Series::new(
+                &format!(
+                    "{} segment{}",
+                    run.segments,
+                    if run.segments == 1 { "" } else { "s" }
                 ),
+                run.errors.clone(),
+                i,
+            )
+        })
+        .collect();
+    let c35 = LineChart {
+        title: format!(
+            "Fig. 35 set-up: viewer at ({}, {}, 0)",
+            ix.line_viewer, ix.line.height
+        ),
+        x_label: "x on the mirror".into(),
+        y_label: "interpolated vs exact reflection (°)".into(),
+        series: s35,
+        log_y: true,
+        y_range: Some([1e-3, 300.0]),
+        markers: vec![Marker {
+            at: [-4.5, 2.61],
+            label: "Zimmons: 2.61° at −4.5".into(),
+        }],
+        ..Default::default()
+    };
+    let s36: Vec<Series> = ix
+        .line_runs
+        .iter()
+        .enumerate()
+        .map(|(i, run)| {
+            Series::new(
+                &format!(
+                    "{} seg.: worst {:.2}° (viewer {:.2})",
+                    run.segments, run.worst_viewer.worst.degrees, run.worst_viewer.viewer
+                ),
+                run.sweep
+                    .iter()
+                    .map(|s| [s.viewer, s.worst.degrees])
+                    .collect(),
+                i,
+            )
+        })
+        .collect();
+    let c36 = LineChart {
+        title: "Fig. 36 set-up: worst error for each viewer position".into(),
+        x_label: "viewer x (one unit above the mirror)".into(),
+        y_label: "largest error along the mirror (°)".into(),
+        series: s36,
+        log_y: true,
+        y_range: Some([1e-1, 300.0]),
+        markers: vec![Marker {
+            at: [-8.3, 2.60751],
+            label: "Zimmons: 2.60751° at −8.3".into(),
+        }],
+        ..Default::default()
+    };
+    let body = c35.draw(0.0, 0.0, w / 2.0, h) + &c36.draw(w / 2.0, 0.0, w / 2.0, h);
+    Figure {
+        id: "analysis-indexing-line".into(),
+        title: "Per-vertex reflection on a mirror line (Zimmons' figs. 34–36)".into(),
+        caption: "A flat mirror along x from −10 to 10 (normal +y), the viewer one unit \
+                  above it. Reflected vectors are computed exactly at the segment ends and \
+                  interpolated linearly in between (object space, i.e. perspective-correct) \
+                  and compared with the exact reflection at each point. One segment is \
+                  Zimmons' stated set-up; the circles mark his printed values, which no \
+                  segment count reproduces."
+            .into(),
+        svg: plot::document(w, h, &body),
+    }
+}
+
+/// Indexing: quad and sphere.
+fn indexing_quad_sphere_figure(r: &Report) -> Figure {
+    let ix = &r.indexing;
+    let (w, h) = (1260.0, 720.0);
+    let (cw, chh) = (w / 3.0, h / 2.0);
+    let mut body = String::new();
+    let map_series = |res: &[ViewResult]| -> Vec<Series> {
+        (0..res.first().map_or(0, |v| v.maps.len()))
+            .map(|k| {
+                let m = &res[0].maps[k];
                 Series::new(
-                    "mean, vector interpolation",
-                    res.iter().map(|v| [v.viewer, v.mean_degrees]).collect(),
-                    0,
-                )
-                .dashed(),
-                Series::new(
-                    "worst, sphere-map texgen (looked-up direction)",
+                    &format!(
+                        "{} {} ({}²)",
+                        m.projection,
+                        m.indexing.to_lowercase(),
+                        m.size
+                    ),
                     res.iter()
-                        .map(|v| [v.viewer, v.maps[0].max_degrees])
+                        .map(|v| [v.viewer, v.maps[k].max_texels])
                         .collect(),
-                    1,
-                ),
-            ]
-        };
-        let by_inc = |bins: &[f64]| -> Vec<[f64; 2]> {
-            bins.iter()
-                .enumerate()
-                .map(|(i, e)| [i as f64 + 0.5, if *e > 0.0 { *e } else { f64::NAN }])
-                .collect()
-        };
-        type Row<'a> = (&'a str, String, &'a str, &'a [ViewResult], &'a [f64]);
-        let rows: [Row; 2] = [
-            (
-                "Mirror quad",
-                format!(
-                    "[−{0},{0}]² at y = 0, {1}×{1} cell(s) of 2 triangles, viewer at (x, {2}, 0)",
-                    ix.quad.half, ix.quad.cells, ix.quad.height
-                ),
-                "viewer x",
-                &ix.quad_results,
-                &ix.quad_worst_by_incidence,
+                    k + 1,
+                )
+            })
+            .collect()
+    };
+    let angle_series = |res: &[ViewResult]| {
+        vec![
+            Series::new(
+                "worst, vector interpolation",
+                res.iter().map(|v| [v.viewer, v.worst.degrees]).collect(),
+                0,
             ),
-            (
-                "UV sphere",
-                format!(
-                    "{} stacks × {} slices, radius 1, viewer {} radii from the centre",
-                    ix.sphere.stacks, ix.sphere.slices, ix.sphere.distance
-                ),
-                "viewer elevation (°)",
-                &ix.sphere_results,
-                &ix.sphere_worst_by_incidence,
+            Series::new(
+                "mean, vector interpolation",
+                res.iter().map(|v| [v.viewer, v.mean_degrees]).collect(),
+                0,
+            )
+            .dashed(),
+            Series::new(
+                "worst, sphere-map texgen (looked-up direction)",
+                res.iter()
+                    .map(|v| [v.viewer, v.maps[0].max_degrees])
+                    .collect(),
+                1,
             ),
-        ];
-        for (i, (title, sub, xl, res, bins)) in rows.iter().enumerate() {
-            let y = i as f64 * chh;
-            let a = LineChart {
-                title: format!("{title}: reflected-vector error"),
-                subtitle: sub.clone(),
-                x_label: xl.to_string(),
-                y_label: "degrees".into(),
-                series: angle_series(res),
-                ..Default::default()
-            };
-            body += &a.draw(0.0, y, cw, chh);
-            let t = LineChart {
-                title: format!("{title}: worst texture-coordinate error"),
-                subtitle: "each map at its analysed size".into(),
-                x_label: xl.to_string(),
-                y_label: "texels".into(),
-                series: map_series(res),
-                log_y: true,
-                y_range: Some([1e-2, 1e3]),
-                legend: Legend::BottomRight,
-                ..Default::default()
-            };
-            body += &t.draw(cw, y, cw, chh);
-            let b = LineChart {
-                title: format!("{title}: worst vector error by incidence"),
-                subtitle: "all viewer positions together".into(),
-                x_label: "angle between view ray and normal (°)".into(),
-                y_label: "degrees".into(),
-                series: vec![Series::new("", by_inc(bins), 2)],
-                x_range: Some([0.0, 90.0]),
-                legend: Legend::None,
-                ..Default::default()
-            };
-            body += &b.draw(2.0 * cw, y, cw, chh);
-        }
-        out.push(Figure {
-            id: "analysis-indexing-meshes".into(),
-            title: "Per-vertex indexing on a mirror quad and a tessellated sphere".into(),
-            caption: "Exact per-point reflection (interpolated normal, exact view ray) against \
-                      reflected vectors computed at the vertices and interpolated. Vector \
-                      indexing (cube, paraboloid) looks the interpolated vector up per pixel; \
-                      texgen indexing (GL_SPHERE_MAP in the camera's eye space, lat-long) \
-                      interpolates per-vertex texture coordinates. Texel errors are measured on \
-                      each map at the analysed size; samples whose two lookups fall on \
-                      different faces (or across the lat-long seam) are left out of the texel \
-                      error and counted in the JSON."
-                .into(),
-            svg: plot::document(w, h, &body),
-        });
-    }
-
-    // Singularities.
-    {
-        let s = &r.singularities;
-        let (w, h) = (1100.0, 360.0);
-        let lg = |rows: &[RimRow], f: fn(&RimRow) -> f64| -> Vec<[f64; 2]> {
-            rows.iter()
-                .map(|r| [(r.size as f64).log2(), f(r)])
-                .collect()
-        };
+        ]
+    };
+    let by_inc = |bins: &[f64]| -> Vec<[f64; 2]> {
+        bins.iter()
+            .enumerate()
+            .map(|(i, e)| [i as f64 + 0.5, if *e > 0.0 { *e } else { f64::NAN }])
+            .collect()
+    };
+    type Row<'a> = (&'a str, String, &'a str, &'a [ViewResult], &'a [f64]);
+    let rows: [Row; 2] = [
+        (
+            "Mirror quad",
+            format!(
+                "[−{0},{0}]² at y = 0, {1}×{1} cell(s) of 2 triangles, viewer at (x, {2}, 0)",
+                ix.quad.half, ix.quad.cells, ix.quad.height
+            ),
+            "viewer x",
+            &ix.quad_results,
+            &ix.quad_worst_by_incidence,
+        ),
+        (
+            "UV sphere",
+            format!(
+                "{} stacks × {} slices, radius 1, viewer {} radii from the centre",
+                ix.sphere.stacks, ix.sphere.slices, ix.sphere.distance
+            ),
+            "viewer elevation (°)",
+            &ix.sphere_results,
+            &ix.sphere_worst_by_incidence,
+        ),
+    ];
+    for (i, (title, sub, xl, res, bins)) in rows.iter().enumerate() {
+        let y = i as f64 * chh;
         let a = LineChart {
-            title: "Largest / smallest pixel angle along the axis".into(),
-            x_label: "log₂ of the edge size".into(),
-            y_label: "ratio".into(),
-            series: vec![
-                Series::new("sphere map", lg(&s.sphere, |r| r.ratio), 0),
-                Series::new("paraboloid half", lg(&s.paraboloid, |r| r.ratio), 1),
-                Series::new("cube face", lg(&s.cube, |r| r.ratio), 2),
-            ],
-            log_y: true,
-            legend: Legend::TopLeft,
+            title: format!("{title}: reflected-vector error"),
+            subtitle: sub.clone(),
+            x_label: xl.to_string(),
+            y_label: "degrees".into(),
+            series: angle_series(res),
             ..Default::default()
         };
+        body += &a.draw(0.0, y, cw, chh);
+        let t = LineChart {
+            title: format!("{title}: worst texture-coordinate error"),
+            subtitle: "each map at its analysed size".into(),
+            x_label: xl.to_string(),
+            y_label: "texels".into(),
+            series: map_series(res),
+            log_y: true,
+            y_range: Some([1e-2, 1e3]),
+            legend: Legend::BottomRight,
+            ..Default::default()
+        };
+        body += &t.draw(cw, y, cw, chh);
         let b = LineChart {
-            title: "Anisotropy of the outermost texel of the centre row".into(),
-            x_label: "log₂ of the edge size".into(),
-            y_label: "σ₁/σ₂".into(),
-            series: vec![
-                Series::new("sphere map", lg(&s.sphere, |r| r.outermost_anisotropy), 0),
-                Series::new(
-                    "paraboloid half",
-                    lg(&s.paraboloid, |r| r.outermost_anisotropy),
-                    1,
-                ),
-                Series::new("cube face", lg(&s.cube, |r| r.outermost_anisotropy), 2),
-            ],
-            log_y: true,
-            legend: Legend::TopLeft,
+            title: format!("{title}: worst vector error by incidence"),
+            subtitle: "all viewer positions together".into(),
+            x_label: "angle between view ray and normal (°)".into(),
+            y_label: "degrees".into(),
+            series: vec![Series::new("", by_inc(bins), 2)],
+            x_range: Some([0.0, 90.0]),
+            legend: Legend::None,
             ..Default::default()
         };
-        let body = a.draw(0.0, 0.0, w / 2.0, h) + &b.draw(w / 2.0, 0.0, w / 2.0, h);
-        out.push(Figure {
-            id: "analysis-rims".into(),
-            title: "The sphere map's rim singularity and the paraboloid's rim".into(),
-            caption: "As the map grows the sphere map's one-dimensional ratio grows like √n \
-                      (its rim is a single direction) and its rim texels become arbitrarily \
-                      anisotropic (1/(1 − ρ²)), although every full texel has the same solid \
-                      angle. The paraboloid's ratio tends to 2 and it stays isotropic; the \
-                      cube's tends to 2 along an axis (the two curves coincide: both are atan \
-                      maps), with anisotropy √2 at an edge midpoint."
-                .into(),
-            svg: plot::document(w, h, &body),
-        });
+        body += &b.draw(2.0 * cw, y, cw, chh);
     }
-    out
+    Figure {
+        id: "analysis-indexing-meshes".into(),
+        title: "Per-vertex indexing on a mirror quad and a tessellated sphere".into(),
+        caption: "Exact per-point reflection (interpolated normal, exact view ray) against \
+                  reflected vectors computed at the vertices and interpolated. Vector \
+                  indexing (cube, paraboloid) looks the interpolated vector up per pixel; \
+                  texgen indexing (GL_SPHERE_MAP in the camera's eye space, lat-long) \
+                  interpolates per-vertex texture coordinates. Texel errors are measured on \
+                  each map at the analysed size; samples whose two lookups fall on \
+                  different faces (or across the lat-long seam) are left out of the texel \
+                  error and counted in the JSON."
+            .into(),
+        svg: plot::document(w, h, &body),
+    }
+}
+
+/// Singularities.
+fn singularities_figure(r: &Report) -> Figure {
+    let s = &r.singularities;
+    let (w, h) = (1100.0, 360.0);
+    let lg = |rows: &[RimRow], f: fn(&RimRow) -> f64| -> Vec<[f64; 2]> {
+        rows.iter()
+            .map(|r| [(r.size as f64).log2(), f(r)])
+            .collect()
+    };
+    let a = LineChart {
+        title: "Largest / smallest pixel angle along the axis".into(),
+        x_label: "log₂ of the edge size".into(),
+        y_label: "ratio".into(),
+        series: vec![
+            Series::new("sphere map", lg(&s.sphere, |r| r.ratio), 0),
+            Series::new("paraboloid half", lg(&s.paraboloid, |r| r.ratio), 1),
+            Series::new("cube face", lg(&s.cube, |r| r.ratio), 2),
+        ],
+        log_y: true,
+        legend: Legend::TopLeft,
+        ..Default::default()
+    };
+    let b = LineChart {
+        title: "Anisotropy of the outermost texel of the centre row".into(),
+        x_label: "log₂ of the edge size".into(),
+        y_label: "σ₁/σ₂".into(),
+        series: vec![
+            Series::new("sphere map", lg(&s.sphere, |r| r.outermost_anisotropy), 0),
+            Series::new(
+                "paraboloid half",
+                lg(&s.paraboloid, |r| r.outermost_anisotropy),
+                1,
+            ),
+            Series::new("cube face", lg(&s.cube, |r| r.outermost_anisotropy), 2),
+        ],
+        log_y: true,
+        legend: Legend::TopLeft,
+        ..Default::default()
+    };
+    let body = a.draw(0.0, 0.0, w / 2.0, h) + &b.draw(w / 2.0, 0.0, w / 2.0, h);
+    Figure {
+        id: "analysis-rims".into(),
+        title: "The sphere map's rim singularity and the paraboloid's rim".into(),
+        caption: "As the map grows the sphere map's one-dimensional ratio grows like √n \
+                  (its rim is a single direction) and its rim texels become arbitrarily \
+                  anisotropic (1/(1 − ρ²)), although every full texel has the same solid \
+                  angle. The paraboloid's ratio tends to 2 and it stays isotropic; the \
+                  cube's tends to 2 along an axis (the two curves coincide: both are atan \
+                  maps), with anisotropy √2 at an edge midpoint."
+            .into(),
+        svg: plot::document(w, h, &body),
+    }
 }
 
 fn pct(x: f64) -> String {
