@@ -21,9 +21,9 @@ use crate::frustum::{frustum_share, Frustum};
 use crate::indexing::LineStudy;
 use crate::jacobian;
 use crate::profile::{profile, Profile, Walk};
-use crate::texels::{crossover, texel_stats, used_area_fraction};
+use crate::texels::{crossover, texel_stats, used_area_fraction, Crossover};
 use glam::DVec2;
-use mirrorball_core::{ProjectionKind, WorldProjection};
+use mirrorball_core::{Projection, ProjectionKind, WorldProjection};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -133,13 +133,48 @@ const G: &str = "Greene 1986";
 
 /// Every claim checked, in document order.
 pub fn claims() -> Vec<Claim> {
-    let sphere = ProjectionKind::Sphere.default_projection();
-    let cube = ProjectionKind::Cube.default_projection();
-    let para = ProjectionKind::Paraboloid.default_projection();
+    let k = Known::new();
     let mut out = Vec::new();
+    zimmons_sphere_map(&k, &mut out);
+    zimmons_cube_map(&k, &mut out);
+    zimmons_paraboloid(&k, &mut out);
+    zimmons_indexing(&k, &mut out);
+    greene(&k, &mut out);
+    textbook(&k, &mut out);
+    grimm_niebruegge(&k, &mut out);
+    out
+}
 
-    // --- Zimmons: sphere map.
-    let c = crossover(&sphere, 512).expect("the sphere map has a crossover");
+/// What several documents' claims are checked against, computed once.
+struct Known {
+    sphere: Projection,
+    cube: Projection,
+    para: Projection,
+    /// The sphere map's front/back crossover.
+    c: Crossover,
+    /// The sphere map's and the cube map's 1-D profiles at 512 texels.
+    ps: Profile,
+    pc: Profile,
+}
+
+impl Known {
+    fn new() -> Self {
+        let sphere = ProjectionKind::Sphere.default_projection();
+        let cube = ProjectionKind::Cube.default_projection();
+        Known {
+            sphere,
+            cube,
+            para: ProjectionKind::Paraboloid.default_projection(),
+            c: crossover(&sphere, 512).expect("the sphere map has a crossover"),
+            ps: profile(&sphere, 512),
+            pc: profile(&cube, 512),
+        }
+    }
+}
+
+/// Zimmons: sphere map.
+fn zimmons_sphere_map(k: &Known, out: &mut Vec<Claim>) {
+    let Known { sphere, c, ps, .. } = k;
     out.push(num(
         &format!("{Z}, fig. 9–10"),
         "sphere map: front/back crossover radius, texture units (1/(2√2))",
@@ -150,7 +185,7 @@ pub fn claims() -> Vec<Claim> {
         "The reflected vector is perpendicular to the view at θ = 90° from the centre direction; \
          the sphere map puts θ at radius sin(θ/2)/2 in texture units: 1/(2√2).",
     ));
-    let used = used_area_fraction(&sphere);
+    let used = used_area_fraction(sphere);
     out.push(num(
         &format!("{Z}, sphere-map properties"),
         "sphere map: share of the texture wasted (1 − π/4)",
@@ -171,8 +206,7 @@ pub fn claims() -> Vec<Claim> {
          'forward facing') π r² with r = 1/(2√2); the ring outside it holds the same area. \
          Equal areas because the sphere map is an equal-area (Lambert azimuthal) projection.",
     ));
-    let ps = profile(&sphere, 512);
-    let sh = walk(&ps, "horizontal");
+    let sh = walk(ps, "horizontal");
     out.push(num(
         &format!("{Z}, fig. 12"),
         "sphere map 512²: angle of the centre pixel (0 → 1)",
@@ -221,7 +255,7 @@ pub fn claims() -> Vec<Claim> {
         3,
         "He divides rounded values (4.2/0.45); unrounded, 9.39.",
     ));
-    let j0 = jacobian::anisotropy(&sphere, 0, DVec2::new(0.5 + 1e-9, 0.5 + 1e-9), 512, 512)
+    let j0 = jacobian::anisotropy(sphere, 0, DVec2::new(0.5 + 1e-9, 0.5 + 1e-9), 512, 512)
         .unwrap_or(f64::NAN);
     out.push(said(
         &format!("{Z}, fig. 14 and 'Problems with sphere mapping'"),
@@ -235,10 +269,13 @@ pub fn claims() -> Vec<Claim> {
          projection is smooth and isotropic there (Jacobian 2·I in disk units). The real \
          trouble is the rim, where the anisotropy 1/(1 − ρ²) grows without bound.",
     ));
+}
 
-    // --- Zimmons: cube map.
-    let pc = profile(&cube, 512);
-    let (ch, cd) = (walk(&pc, "horizontal"), walk(&pc, "diagonal"));
+/// Zimmons: cube map.
+fn zimmons_cube_map(k: &Known, out: &mut Vec<Claim>) {
+    let Known { cube, ps, pc, .. } = k;
+    let sh = walk(ps, "horizontal");
+    let (ch, cd) = (walk(pc, "horizontal"), walk(pc, "diagonal"));
     out.push(num(
         &format!("{Z}, fig. 29"),
         "cube 512²: angle of the centre pixel along an axis",
@@ -324,8 +361,8 @@ pub fn claims() -> Vec<Claim> {
         3,
         "√(512²/6).",
     ));
-    let d209 = profile(&cube, 209);
-    let d418 = profile(&cube, 418);
+    let d209 = profile(cube, 209);
+    let d418 = profile(cube, 418);
     out.push(num(
         &format!("{Z}, equal-space comparison"),
         "cube 209² (equal budget): centre / corner pixel angle along the diagonal",
@@ -343,8 +380,8 @@ pub fn claims() -> Vec<Claim> {
         ),
     ));
     let useful_face = (512.0f64 * 512.0 * PI / 4.0 / 6.0).sqrt();
-    let d185 = profile(&cube, useful_face.round() as u32);
-    let d370 = profile(&cube, 2 * useful_face.round() as u32);
+    let d185 = profile(cube, useful_face.round() as u32);
+    let d370 = profile(cube, 2 * useful_face.round() as u32);
     out.push(num(
         &format!("{Z}, equal-space comparison"),
         "cube 185² (budget of the sphere map's useful texels): diagonal ratio",
@@ -399,18 +436,22 @@ pub fn claims() -> Vec<Claim> {
              area) vs cube → 5.196",
             ch.ratio,
             sphere_1d / ch.ratio,
-            walk(&ps, "diagonal").ratio,
+            walk(ps, "diagonal").ratio,
             cd.ratio,
-            walk(&ps, "diagonal").ratio / cd.ratio
+            walk(ps, "diagonal").ratio / cd.ratio
         ),
         Verdict::Partly,
         "True of his one-dimensional, radial measure; false of solid angle per texel, where the \
          sphere map is perfectly uniform and the cube is not. The sphere map's fault is \
          anisotropy (unbounded at the rim), not area.",
     ));
+}
 
-    // --- Zimmons: paraboloid.
-    let used_p = used_area_fraction(&para);
+/// Zimmons: paraboloid.
+fn zimmons_paraboloid(k: &Known, out: &mut Vec<Claim>) {
+    let Known { para, pc, .. } = k;
+    let ch = walk(pc, "horizontal");
+    let used_p = used_area_fraction(para);
     out.push(num(
         &format!("{Z}, paraboloid properties"),
         "dual paraboloid: share of texels unused",
@@ -422,7 +463,7 @@ pub fn claims() -> Vec<Claim> {
          first step, '1 − 2(π/2)²', is mis-typed for 2 − 2π(1/2)²). 'Almost 25%' later is the \
          same number.",
     ));
-    let pp = profile(&para, 512);
+    let pp = profile(para, 512);
     let (ph, pd) = (walk(&pp, "horizontal"), walk(&pp, "diagonal"));
     out.push(num(
         &format!("{Z}, fig. 47"),
@@ -481,8 +522,10 @@ pub fn claims() -> Vec<Claim> {
         3,
         "2 atan(1/256) / atan(1/256).",
     ));
+}
 
-    // --- Zimmons: the indexing study (figures 35, 36).
+/// Zimmons: the indexing study (figures 35, 36).
+fn zimmons_indexing(_: &Known, out: &mut Vec<Claim>) {
     let line = LineStudy::ZIMMONS;
     let w83 = line.worst(-8.3);
     let viewers: Vec<f64> = (0..=1000).map(|i| -10.0 + 0.01 * i as f64).collect();
@@ -523,8 +566,11 @@ pub fn claims() -> Vec<Claim> {
             worst.at[0].abs()
         ),
     ));
+}
 
-    // --- Greene.
+/// Greene.
+fn greene(k: &Known, out: &mut Vec<Claim>) {
+    let Known { cube, .. } = k;
     let f = frustum_share(Frustum::GREENE, &[]);
     out.push(num(
         &format!("{G}, §9"),
@@ -540,7 +586,7 @@ pub fn claims() -> Vec<Claim> {
         ),
     ));
     let cone = greene_cone();
-    let on_cube = cone_region(&cube, 64, &cone);
+    let on_cube = cone_region(cube, 64, &cone);
     let on_merc = cone_region(&ProjectionKind::Mercator.default_projection(), 128, &cone);
     out.push(said(
         &format!("{G}, fig. 2"),
@@ -564,8 +610,11 @@ pub fn claims() -> Vec<Claim> {
          (gnomonic projection). Five is a property of his example: a convex region of 3/8 of \
          the sphere needs at least three faces and can touch up to five.",
     ));
+}
 
-    // --- The OpenGL textbook, §13.6.
+/// The OpenGL textbook, §13.6.
+fn textbook(k: &Known, out: &mut Vec<Claim>) {
+    let Known { sphere, c, .. } = k;
     out.push(num(
         "OpenGL textbook §13.6, eq. (13.8)",
         "sphere map: the equator (Z = 0) maps to the circle R² = (1 − Z²)/(2 + 2Z), i.e. \
@@ -595,10 +644,13 @@ pub fn claims() -> Vec<Claim> {
         Verdict::Confirmed,
         "ρ = sin(θ/2) reaches 1 only at θ = 180°.",
     ));
+}
 
-    // --- Grimm & Niebruegge.
+/// Grimm & Niebruegge.
+fn grimm_niebruegge(k: &Known, out: &mut Vec<Claim>) {
+    let Known { cube, .. } = k;
     let cc = ProjectionKind::ContinuousCube.default_projection();
-    let (sc, scc) = (texel_stats(&cube, 128), texel_stats(&cc, 128));
+    let (sc, scc) = (texel_stats(cube, 128), texel_stats(&cc, 128));
     out.push(said(
         "Grimm & Niebruegge, §3",
         "continuous cube mapping is a better parameterisation than the cube",
@@ -617,7 +669,6 @@ pub fn claims() -> Vec<Claim> {
         "Its angular parameterisation spreads the solid angle more evenly (see the heat maps); \
          its anisotropy is about the cube's.",
     ));
-    out
 }
 
 impl LineStudy {
