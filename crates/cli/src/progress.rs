@@ -23,8 +23,8 @@ pub fn with_progress<T: Send>(
             .progress_chars("=> "),
     );
     bar.set_message(label.to_string());
-    // The updater waits on a channel rather than sleeping, so that it ends the moment the
-    // work does (a plain 50 ms sleep kept every command up to 50 ms past its work).
+    // The updater waits on a channel with a timeout rather than sleeping, so that it ends
+    // the moment the work does.
     let (done, wait) = std::sync::mpsc::channel::<()>();
     std::thread::scope(|s| {
         let (c, b) = (counter.clone(), bar.clone());

@@ -1,12 +1,10 @@
 //! OpenEXR's ZIP and ZIPS block compression, done with libdeflate on all cores.
 //!
-//! The `exr` crate reads these blocks with `zune-inflate` and writes them with `miniz_oxide`
-//! at level 4; for float data (which hardly compresses) a 4096×2048 float read spent 0.35 s
-//! of processor time inflating, and writing a 6×1024² float cube took 1.9 s. libdeflate
-//! inflates the same blocks 1.3–1.5× faster (0.245 s against 0.32–0.37 s for that file's
-//! 128 blocks on one core), and the cube is written in 0.73 s (see BENCHMARKS.md). The
-//! `exr` crate still reads and writes everything around the blocks: headers, offset
-//! tables, chunk order. Files come out the size OpenEXR's own ZIP makes them.
+//! The `exr` crate would read these blocks with `zune-inflate` and write them with
+//! `miniz_oxide`; libdeflate inflates and deflates them faster, and here every block is its
+//! own task on all cores (BENCHMARKS.md has the end-to-end figures). The `exr` crate still
+//! reads and writes everything around the blocks: headers, offset tables, chunk order.
+//! Files come out the size OpenEXR's own ZIP makes them.
 //!
 //! The block format (OpenEXR's `ImfZip.cpp`): a block's lines, each line its channels in
 //! the header's (alphabetical) order, each channel its samples in little-endian order; then
