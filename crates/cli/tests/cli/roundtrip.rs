@@ -9,6 +9,9 @@ use mirrorball_core::{Image, LatLong, WorldProjection};
 use std::f64::consts::PI;
 use std::path::Path;
 
+#[path = "../../../io/tests/io/imf_envmap.rs"]
+mod imf_envmap;
+
 /// Every projection, the disk maps with parameters other than their defaults, and the
 /// `--size` to write it at.
 const SPECS: [(&str, &str); 10] = [
@@ -158,61 +161,14 @@ fn reading_a_recorded_map_as_another_projection_is_what_the_record_prevents() {
 // are a port of OpenEXR's src/lib/OpenEXR/ImfEnvmap.cpp (`LatLongMap::direction`,
 // `CubeMap::direction` and `CubeMap::pixelPosition`), stored as (d + 1)/2.
 
-/// `LatLongMap::direction(dataWindow, pixelPosition)`, data window `(0, 0)–(w−1, h−1)`.
-fn imf_latlong_direction(w: u32, h: u32, x: f64, y: f64) -> DVec3 {
-    let latitude = -PI * (y / (h as f64 - 1.0) - 0.5);
-    let longitude = -2.0 * PI * (x / (w as f64 - 1.0) - 0.5);
-    DVec3::new(
-        longitude.sin() * latitude.cos(),
-        latitude.sin(),
-        longitude.cos() * latitude.cos(),
-    )
-}
-
 /// `CubeMap::direction(face, …)` and `CubeMap::pixelPosition(face, …)` of the pixel at
 /// `positionInFace` `(i, j)` of faces of edge `s`.
 fn imf_cube_pixel(face: usize, s: u32, i: f64, j: f64) -> (DVec3, DVec2) {
-    let k = s as f64 - 1.0;
-    let (a, b) = (i / k * 2.0 - 1.0, j / k * 2.0 - 1.0);
-    let dir = match face {
-        0 => DVec3::new(1.0, a, b),
-        1 => DVec3::new(-1.0, a, b),
-        2 => DVec3::new(a, 1.0, b),
-        3 => DVec3::new(a, -1.0, b),
-        4 => DVec3::new(a, b, 1.0),
-        _ => DVec3::new(a, b, -1.0),
-    };
-    let (min_y, max_y) = (face as f64 * s as f64, face as f64 * s as f64 + k);
-    let pos = match face {
-        0 => DVec2::new(j, max_y - i),
-        1 => DVec2::new(k - j, max_y - i),
-        2 => DVec2::new(i, max_y - j),
-        3 => DVec2::new(i, min_y + j),
-        4 => DVec2::new(k - i, max_y - j),
-        _ => DVec2::new(i, max_y - j),
-    };
-    (dir, pos)
-}
-
-/// Writes a float RGB OpenEXR file tagged `envmap`.
-fn write_tagged(path: &Path, img: &Image, envmap: exr::meta::attribute::EnvironmentMap) {
-    use exr::prelude::*;
-    let attributes = LayerAttributes {
-        environment_map: Some(envmap),
-        ..LayerAttributes::default()
-    };
-    let w = img.width() as usize;
-    let data = img.data().to_vec();
-    let channels = SpecificChannels::rgb(move |p: Vec2<usize>| {
-        let i = (p.y() * w + p.x()) * 3;
-        (data[i], data[i + 1], data[i + 2])
-    });
-    let size = (img.width() as usize, img.height() as usize);
-    let layer = Layer::new(size, attributes, Encoding::SMALL_LOSSLESS, channels);
-    exr::image::Image::from_layer(layer)
-        .write()
-        .to_file(path)
-        .unwrap();
+    let pif = DVec2::new(i, j);
+    (
+        imf_envmap::imf_cube_direction(face, s, pif),
+        imf_envmap::imf_cube_pixel_position(face, s, pif),
+    )
 }
 
 fn coded(d: DVec3) -> [f32; 3] {
@@ -282,12 +238,12 @@ fn openexr_tagged_maps_are_read_in_openexr_conventions() {
             ll.set(
                 x,
                 y,
-                &coded(imf_latlong_direction(w, h, x as f64, y as f64)),
+                &coded(imf_envmap::imf_latlong_direction(w, h, x as f64, y as f64)),
             );
         }
     }
     let path = dir.path().join("latlong.exr");
-    write_tagged(
+    imf_envmap::write_tagged(
         &path,
         &ll,
         exr::meta::attribute::EnvironmentMap::LatitudeLongitude,
@@ -318,7 +274,7 @@ fn openexr_tagged_maps_are_read_in_openexr_conventions() {
         }
     }
     let path = dir.path().join("cube.exr");
-    write_tagged(&path, &strip, exr::meta::attribute::EnvironmentMap::Cube);
+    imf_envmap::write_tagged(&path, &strip, exr::meta::attribute::EnvironmentMap::Cube);
     // Measured: worst 0.14 texel (the resampler's antialiasing across the cube's edges),
     // median 0.018.
     let (worst, median, said) = latlong_direction_errors(dir.path(), &path, w, &[]);

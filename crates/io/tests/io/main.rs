@@ -2,6 +2,7 @@
 mod cube;
 mod flat;
 mod hostile;
+mod imf_envmap;
 mod mutate;
 mod openexr;
 mod records;
