@@ -7,9 +7,9 @@
 //! file declaring more is corrupt, and is refused before anything is allocated. Where a
 //! rare but valid coding can pack more (Radiance's old-style chained runs), the bound is
 //! set well above the common coding's (64 texels a byte where new-style runs reach 16), and
-//! every file may declare [`FLOOR_TEXELS`]. Formats
-//! whose coding has no such bound (DWA's DCT with deflated DC values, WebP's arithmetic
-//! and backward-reference coding) are left to the limits.
+//! every file may declare [`FLOOR_TEXELS`]. WebP's coding has no such bound, so it is held
+//! to a plausible density instead ([`check_texels_plausible`]); DWA's DCT with deflated DC
+//! values is bounded by checking each block's counters (`exr_io`).
 
 use crate::Error;
 use std::path::Path;
@@ -44,6 +44,34 @@ pub(crate) fn check_texels_fit(
             format!(
                 "declares a {width}×{height} image ({texels} texels), but a {format} file of \
                  {len} bytes holds at most {most}: the file is corrupt or truncated"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a `width × height` image declared by a `format` file whose coding has no hard
+/// bound on texels a byte, when it declares more than `per_byte` texels for each byte (and
+/// more than [`FLOOR_TEXELS`]): a far denser picture than any real file, which would make a
+/// few bytes allocate gigabytes.
+pub(crate) fn check_texels_plausible(
+    path: &Path,
+    width: u64,
+    height: u64,
+    per_byte: u64,
+    format: &str,
+) -> Result<(), Error> {
+    let len = file_len(path)?;
+    let most = len.saturating_mul(per_byte).max(FLOOR_TEXELS);
+    let texels = width.saturating_mul(height);
+    if texels > most {
+        return Err(Error::input(
+            path,
+            format!(
+                "declares a {width}×{height} image ({texels} texels) in {len} bytes: more \
+                 than {per_byte} texels a byte, which no real {format} picture reaches \
+                 (mirrorball reads {format} files up to {most} texels at this length); the \
+                 file is corrupt or hostile"
             ),
         ));
     }

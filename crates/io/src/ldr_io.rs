@@ -132,12 +132,17 @@ fn decode<R: BufRead + Seek>(
     })
 }
 
-/// Refuses a PNG or JPEG whose declared size its length cannot hold (see
+/// Refuses a PNG, JPEG or WebP whose declared size its length cannot hold (see
 /// [`crate::bounds`]). PNG: deflate expands a byte to at most 1032, and a 1-bit grey texel
 /// takes an eighth of a raw byte, so at most 8 × 1032 (plus slack) texels a byte. JPEG
 /// (Huffman-coded, as the decoder reads it): every 8×8 block of the fullest component costs
-/// at least a bit for its DC value, so at most 512 texels a byte (doubled for slack). WebP's
-/// coding has no such bound: it is left to the limits.
+/// at least a bit for its DC value, so at most 512 texels a byte (doubled for slack).
+///
+/// WebP's coding has no such bound: lossless VP8L codes a picture whose every Huffman
+/// group has one symbol in zero bits a texel, and lossy VP8's arithmetic-coded skip flags
+/// cost a small fraction of a bit per 16×16 macroblock. So a WebP file is held to a
+/// *plausible* density instead: 4096 texels a byte (real pictures, lossy or lossless, come
+/// to well under 100), and every file may still declare [`crate::bounds::FLOOR_TEXELS`].
 fn check_fits_file(
     path: &Path,
     format: Format,
@@ -145,12 +150,13 @@ fn check_fits_file(
     width: u32,
     height: u32,
 ) -> Result<(), Error> {
-    let per_byte = match format {
-        Format::Png => 8 * 1040,
-        Format::Jpeg => 1024,
-        _ => return Ok(()),
-    };
-    crate::bounds::check_texels_fit(path, width as u64, height as u64, per_byte, name)
+    let (w, h) = (width as u64, height as u64);
+    match format {
+        Format::Png => crate::bounds::check_texels_fit(path, w, h, 8 * 1040, name),
+        Format::Jpeg => crate::bounds::check_texels_fit(path, w, h, 1024, name),
+        Format::Webp => crate::bounds::check_texels_plausible(path, w, h, 4096, name),
+        _ => Ok(()),
+    }
 }
 
 /// Whether the last scan of a JPEG stream is followed by an end-of-image marker. Marker

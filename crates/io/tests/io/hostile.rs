@@ -305,6 +305,28 @@ fn dwaa_file() -> (Vec<u8>, usize) {
     (bytes, table + 16)
 }
 
+/// Found by the coverage-guided campaign: a 76-byte lossless WebP declaring 15120×14342
+/// texels (a valid header; VP8L can code a picture in zero bits a texel) made the decoder
+/// take 2.2 GB. WebP is held to a plausible density (`ldr_io::check_fits_file`).
+#[test]
+fn a_tiny_webp_declaring_a_huge_picture_is_refused_before_decoding() {
+    let path = corpus().join("webp/crashes/vp8l-15120x14342-in-76-bytes.webp");
+    let start = Instant::now();
+    let e = read(&path, &Limits::default()).expect_err("refused");
+    assert!(
+        start.elapsed() < Duration::from_millis(200),
+        "{:?}",
+        start.elapsed()
+    );
+    assert_eq!(e.fault(), Fault::Input, "{e}");
+    assert!(
+        e.to_string().contains("15120×14342") && e.to_string().contains("texels a byte"),
+        "{e}"
+    );
+    // The seed, a real picture, still reads.
+    read(&corpus().join("webp/lossless.webp"), &Limits::default()).unwrap();
+}
+
 #[test]
 fn dwa_counters_beyond_the_block_are_refused_before_decoding() {
     let dir = tempfile::tempdir().unwrap();
