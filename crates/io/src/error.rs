@@ -3,16 +3,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-/// Whose fault an [`Error`] is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Fault {
-    /// The input file is missing, truncated, corrupt, or uses something we do not decode.
-    Input,
-    /// The request cannot be met (wrong extension for the data, unsupported option).
-    Request,
-    /// The system failed (permissions, disk full).
-    System,
-}
+pub use mirrorball_core::Fault;
 
 /// A file problem, naming the file.
 #[derive(Debug)]

@@ -532,7 +532,7 @@ impl Prepared<'_> {
         }
         let out = match env.filter {
             // Footprint filters without a footprint (motion-blur sweeps) read bilinearly.
-            Filter::Bilinear | Filter::Trilinear | Filter::Ewa => {
+            Filter::Bilinear | Filter::Trilinear | Filter::Ewa | Filter::SummedArea => {
                 crate::fast::bilinear(&env.map, layer, u, v)
             }
             Filter::Nearest => {
