@@ -476,7 +476,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("mirrorball: error: {e}");
-            ExitCode::from(e.code as u8)
+            ExitCode::from(e.code())
         }
     }
 }

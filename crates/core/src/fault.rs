@@ -13,3 +13,15 @@ pub enum Fault {
     /// The system failed (permissions, disk full, a reader's own failure).
     System,
 }
+
+impl Fault {
+    /// Whose fault a failed read of a file is, from the I/O error's kind: a file that is
+    /// not there, or ends early, is the input's; one that is there but cannot be read
+    /// (permissions, a device error) is the system's.
+    pub fn of_io(kind: std::io::ErrorKind) -> Fault {
+        match kind {
+            std::io::ErrorKind::NotFound | std::io::ErrorKind::UnexpectedEof => Fault::Input,
+            _ => Fault::System,
+        }
+    }
+}

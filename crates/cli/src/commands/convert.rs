@@ -296,7 +296,7 @@ fn write_while_converting(
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(rayon::current_num_threads())
                 .build()
-                .map_err(|e| CliError::input(format!("cannot start writer threads: {e}")))?;
+                .map_err(|e| CliError::system(format!("cannot start writer threads: {e}")))?;
             let mut staged = Vec::with_capacity(paths.len());
             for (path, img) in rx {
                 staged.push(pool.install(|| mirrorball_io::write_image_staged(path, &img, opts))?);

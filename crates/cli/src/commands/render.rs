@@ -14,7 +14,7 @@ use crate::spec::{bad, parse_dir, ProjSpec};
 use crate::{load, RenderArgs};
 use mirrorball_core::glam::{Mat4, Vec3};
 use mirrorball_core::{resample, EnvMap, Image, ResampleOptions, WorldProjection};
-use mirrorball_core::{Choice, UnknownName};
+use mirrorball_core::{Choice, Fault, UnknownName};
 use mirrorball_io::{Format, Precision, WriteOptions};
 use mirrorball_render::mesh::MAX_TRIANGLES;
 use mirrorball_render::tone::{self, Tone};
@@ -767,7 +767,7 @@ fn material_of(e: &MaterialEntry) -> Result<Material, String> {
 fn apply_scene_file(plan: &mut RenderPlan, path: &Path) -> Result<(), CliError> {
     let name = path.display();
     let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::input(format!("{name}: cannot read: {e}")))?;
+        .map_err(|e| CliError::new(Fault::of_io(e.kind()), format!("{name}: cannot read: {e}")))?;
     let is_toml = path
         .extension()
         .and_then(|e| e.to_str())
@@ -900,7 +900,7 @@ fn load_object(o: &ObjectPlan) -> Result<Object, CliError> {
     let (mesh, fit) = match &o.source {
         MeshSource::Builtin(b, l) => (b.mesh(*l), Mat4::IDENTITY),
         MeshSource::File(p) => {
-            let m: Mesh = mirrorball_render::load::load_mesh(p).map_err(CliError::input)?;
+            let m: Mesh = mirrorball_render::load::load_mesh(p)?;
             let fit = if o.normalize {
                 m.normalizing_transform()
             } else {
@@ -1092,7 +1092,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                         mirrorball_render::render_with_progress(&scene, &cam, &settings, &counter)
                     }
                 }
-                .map_err(|e| CliError::request(e.to_string()))
+                .map_err(CliError::from)
             })
             .collect::<Vec<_>>()
     });
@@ -1116,7 +1116,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
             let angle = std::f32::consts::TAU * i as f32 / frames as f32;
             let cam = plan.camera.orbited(angle);
             let d = mirrorball_render::texture_space_diagram(&scene, &cam, &plan.settings, &f, 512)
-                .map_err(|e| CliError::request(format!("--diagnostics: {e}")))?;
+                .map_err(|e| CliError::from(e).context("--diagnostics"))?;
             let p = sibling(&path, "diag", "png");
             mirrorball_io::write_image(&p, &d, &WriteOptions::default())?;
             if !plan.quiet {
