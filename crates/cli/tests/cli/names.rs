@@ -141,30 +141,25 @@ fn failures_exit_with_the_status_of_whose_fault_they_are() {
     // A malformed mesh: the input's fault.
     let bad = dir.path().join("bad.obj");
     std::fs::write(&bad, "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-    let o = run(&[
-        "render",
-        "--object",
-        bad.to_str().unwrap(),
-        "--material",
-        "diffuse",
-        "--no-background",
-        "-o",
-        out,
-    ]);
+    let render_mesh = |mesh: &std::path::Path| {
+        let m = mesh.to_str().unwrap();
+        run(&[
+            "render",
+            "--object",
+            m,
+            "--material",
+            "diffuse",
+            "--no-background",
+            "-o",
+            out,
+        ])
+    };
+    let o = render_mesh(&bad);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("bad.obj"), "{}", stderr(&o));
     // A missing mesh: the input's fault too.
     let gone = dir.path().join("gone.glb");
-    let o = run(&[
-        "render",
-        "--object",
-        gone.to_str().unwrap(),
-        "--material",
-        "diffuse",
-        "--no-background",
-        "-o",
-        out,
-    ]);
+    let o = render_mesh(&gone);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     // Flags that do not go together: the request's fault.
     let env = crate::util::asset("city.exr");
