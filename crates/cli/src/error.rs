@@ -1,43 +1,70 @@
-//! The CLI's error: a message for people and an exit status.
+//! The CLI's error: a message for people and whose fault it is, which picks the exit
+//! status.
 
+use mirrorball_core::Fault;
 use std::fmt;
 
-/// What went wrong, and the exit status it earns.
+/// What went wrong, and whose fault it is.
 #[derive(Debug)]
 pub struct CliError {
     /// The message, naming the file and the problem.
     pub message: String,
-    /// 1: the input or the system failed; 2: the request cannot be met.
-    pub code: i32,
+    /// Whose fault: the exit status follows ([`CliError::code`]).
+    pub fault: Fault,
 }
 
 impl CliError {
     /// The request's fault (exit status 2).
     pub fn request(message: impl Into<String>) -> CliError {
+        CliError::new(Fault::Request, message)
+    }
+    /// The input's fault (exit status 1).
+    pub fn input(message: impl Into<String>) -> CliError {
+        CliError::new(Fault::Input, message)
+    }
+    /// The system's fault (exit status 1).
+    pub fn system(message: impl Into<String>) -> CliError {
+        CliError::new(Fault::System, message)
+    }
+    /// `message`, `fault`'s.
+    pub fn new(fault: Fault, message: impl Into<String>) -> CliError {
         CliError {
             message: message.into(),
-            code: 2,
+            fault,
         }
     }
-    /// The input's or the system's fault (exit status 1).
-    pub fn input(message: impl Into<String>) -> CliError {
+    /// The exit status: 2 when the request cannot be met, 1 when the input or the system
+    /// failed.
+    pub fn code(&self) -> u8 {
+        match self.fault {
+            Fault::Request => 2,
+            Fault::Input | Fault::System => 1,
+        }
+    }
+    /// The same fault, with `context` before the message.
+    pub fn context(self, context: impl fmt::Display) -> CliError {
         CliError {
-            message: message.into(),
-            code: 1,
+            message: format!("{context}: {}", self.message),
+            fault: self.fault,
         }
     }
 }
 
 impl From<mirrorball_io::Error> for CliError {
     fn from(e: mirrorball_io::Error) -> CliError {
-        let code = match e.fault() {
-            mirrorball_io::Fault::Request => 2,
-            _ => 1,
-        };
-        CliError {
-            message: e.to_string(),
-            code,
-        }
+        CliError::new(e.fault(), e.to_string())
+    }
+}
+
+impl From<mirrorball_render::RenderError> for CliError {
+    fn from(e: mirrorball_render::RenderError) -> CliError {
+        CliError::new(e.fault(), e.to_string())
+    }
+}
+
+impl From<mirrorball_render::load::MeshError> for CliError {
+    fn from(e: mirrorball_render::load::MeshError) -> CliError {
+        CliError::new(e.fault(), e.to_string())
     }
 }
 

@@ -119,7 +119,7 @@ mod tests {
             let mut f = Files::new();
             f.input("the input", &input).output("the output", &out);
             let e = f.check().expect_err(&out.display().to_string());
-            assert_eq!(e.code, 2);
+            assert_eq!(e.fault, mirrorball_core::Fault::Request);
             assert!(
                 e.message.contains("would overwrite the input"),
                 "{}",

@@ -4,6 +4,7 @@
 //! layout checked, folders checked) before any file is read or any work starts.
 
 mod budget;
+mod choice;
 mod commands;
 mod error;
 mod guard;
@@ -12,9 +13,14 @@ mod progress;
 mod save;
 mod spec;
 
+use choice::{names, names_of};
 use clap::parser::ValueSource;
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use error::CliError;
+use mirrorball_core::{Layout, Lens};
+use mirrorball_io::{ExrCompression, Precision};
+use mirrorball_render::tone::Tone;
+use mirrorball_render::{Attach, Indexing, ENVIRONMENT_FILTERS};
 use std::process::ExitCode;
 
 /// Environment (reflection) maps: convert between world projections, inspect them.
@@ -61,8 +67,8 @@ pub struct InputArgs {
     /// max-lat=DEG.
     #[arg(long, value_name = "PROJECTION")]
     from: Option<String>,
-    /// Layout of the input's layers: separate, hcross, vcross, hstrip, vstrip.
-    #[arg(long = "in-layout", value_name = "LAYOUT")]
+    /// Layout of the input's layers.
+    #[arg(long = "in-layout", value_name = "LAYOUT", value_parser = names::<Layout>())]
     in_layout: Option<String>,
     /// Keep NaN, infinite and negative texels instead of replacing them by 0.
     #[arg(long)]
@@ -84,8 +90,8 @@ pub struct ConvertArgs {
     /// Default: about the source's resolution.
     #[arg(long)]
     size: Option<u32>,
-    /// Layout of the output's layers: separate, hcross, vcross, hstrip, vstrip.
-    #[arg(long, value_name = "LAYOUT")]
+    /// Layout of the output's layers.
+    #[arg(long, value_name = "LAYOUT", value_parser = names::<Layout>())]
     layout: Option<String>,
     #[command(flatten)]
     input_args: InputArgs,
@@ -106,10 +112,10 @@ pub struct ConvertArgs {
     #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
     /// Texel precision: half, float (EXR/KTX2/DDS) or 8, 16 (PNG).
-    #[arg(long)]
+    #[arg(long, value_parser = names::<Precision>())]
     precision: Option<String>,
-    /// EXR compression: none, rle, zips, zip, piz, pxr24.
-    #[arg(long, default_value = "zip")]
+    /// EXR compression.
+    #[arg(long, default_value = "zip", value_parser = names::<ExrCompression>())]
     compression: String,
     /// Write the full mip chain (KTX2/DDS).
     #[arg(long)]
@@ -195,14 +201,14 @@ pub struct RenderArgs {
     #[arg(long)]
     env_size: Option<u32>,
     /// Indexing mode: 1|texgen, 2|vertex, 3|pixel, 4|cone.
-    #[arg(long, default_value = "pixel")]
+    #[arg(long, default_value = "pixel", value_parser = names::<Indexing>())]
     mode: String,
     /// What the environment is attached to: world (view-independent) or eye.
-    #[arg(long, default_value = "world")]
+    #[arg(long, default_value = "world", value_parser = names::<Attach>())]
     attach: String,
     /// Lookup filter: nearest, bilinear, trilinear or ewa (the last two filter each pixel's
     /// footprint, objects and background; mode 4 always filters: EWA unless trilinear).
-    #[arg(long, default_value = "bilinear")]
+    #[arg(long, default_value = "bilinear", value_parser = names_of(&ENVIRONMENT_FILTERS))]
     filter: String,
     // The help is an attribute, not a doc comment: rustdoc would read its brackets as links.
     #[arg(
@@ -240,8 +246,8 @@ pub struct RenderArgs {
     /// scene is captured as a cube at --eye and resampled to a WIDTHxWIDTH fisheye picture.
     #[arg(long, value_parser = finite_f64)]
     fisheye: Option<f64>,
-    /// Lens of --fisheye: equidistant, equisolid, stereographic, orthographic.
-    #[arg(long, default_value = "equidistant")]
+    /// Lens of --fisheye.
+    #[arg(long, default_value = "equidistant", value_parser = names::<Lens>())]
     fisheye_lens: String,
     /// Near clipping distance.
     #[arg(long, value_parser = finite_f32, default_value_t = 0.05)]
@@ -258,8 +264,8 @@ pub struct RenderArgs {
     /// Exposure in stops.
     #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
-    /// Tone curve for PNG/JPEG: aces, reinhard, clamp.
-    #[arg(long, default_value = "aces")]
+    /// Tone curve for PNG/JPEG.
+    #[arg(long, default_value = "aces", value_parser = names::<Tone>())]
     tone: String,
     /// Draw objects over transparent black instead of the environment.
     #[arg(long)]
@@ -359,7 +365,11 @@ pub struct PrefilterArgs {
     sh_window: String,
     /// How lambert maps are computed: exact (the brute-force sum, fast) or sh (nine
     /// coefficients, windowed by --sh-window).
-    #[arg(long, default_value = "exact")]
+    #[arg(
+        long,
+        default_value = "exact",
+        value_parser = names::<commands::prefilter::IrradianceMethod>()
+    )]
     irradiance: String,
     /// Where to write the spherical-harmonic JSON (default: beside OUTPUT, .sh.json).
     #[arg(long)]
@@ -382,12 +392,11 @@ pub struct PrefilterArgs {
     /// Edge of the BRDF table.
     #[arg(long, default_value_t = 128)]
     lut_size: u32,
-    /// Layout of flat outputs of multi-layer projections: separate, hcross, vcross,
-    /// hstrip, vstrip.
-    #[arg(long, value_name = "LAYOUT")]
+    /// Layout of flat outputs of multi-layer projections.
+    #[arg(long, value_name = "LAYOUT", value_parser = names::<Layout>())]
     layout: Option<String>,
     /// Texel precision: half (default) or float.
-    #[arg(long)]
+    #[arg(long, value_parser = names::<Precision>())]
     precision: Option<String>,
     #[command(flatten)]
     input_args: InputArgs,
@@ -467,7 +476,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("mirrorball: error: {e}");
-            ExitCode::from(e.code as u8)
+            ExitCode::from(e.code())
         }
     }
 }

@@ -14,7 +14,7 @@
 //! ```
 
 use crate::projection::{Projection, ProjectionKind, WorldProjection};
-use crate::{EnvMap, Image};
+use crate::{Choice, EnvMap, Image};
 use std::fmt;
 use std::str::FromStr;
 
@@ -61,17 +61,6 @@ impl Layout {
         Layout::HorizontalStrip,
         Layout::VerticalStrip,
     ];
-
-    /// The command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Layout::Separate => "separate",
-            Layout::HorizontalCross => "hcross",
-            Layout::VerticalCross => "vcross",
-            Layout::HorizontalStrip => "hstrip",
-            Layout::VerticalStrip => "vstrip",
-        }
-    }
 
     /// Whether a projection with `layers` layers can use this layout packed in one picture.
     pub fn fits(self, layers: usize) -> bool {
@@ -199,6 +188,35 @@ impl Layout {
     }
 }
 
+impl Choice for Layout {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (Layout::Separate, &["separate", "faces", "files"]),
+        (
+            Layout::HorizontalCross,
+            &["hcross", "horizontal-cross", "cross"],
+        ),
+        (Layout::VerticalCross, &["vcross", "vertical-cross"]),
+        (
+            Layout::HorizontalStrip,
+            &[
+                "hstrip",
+                "horizontal-strip",
+                "strip",
+                "side-by-side",
+                "sidebyside",
+            ],
+        ),
+        (Layout::VerticalStrip, &["vstrip", "vertical-strip"]),
+    ];
+}
+
+impl Layout {
+    /// The command-line name (the canonical name of [`Choice`]).
+    pub fn name(self) -> &'static str {
+        Choice::name(self)
+    }
+}
+
 impl fmt::Display for Layout {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -208,20 +226,7 @@ impl fmt::Display for Layout {
 impl FromStr for Layout {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Ok(match s.to_ascii_lowercase().replace('_', "-").as_str() {
-            "separate" | "faces" | "files" => Layout::Separate,
-            "hcross" | "horizontal-cross" | "cross" => Layout::HorizontalCross,
-            "vcross" | "vertical-cross" => Layout::VerticalCross,
-            "hstrip" | "horizontal-strip" | "strip" | "side-by-side" | "sidebyside" => {
-                Layout::HorizontalStrip
-            }
-            "vstrip" | "vertical-strip" => Layout::VerticalStrip,
-            _ => {
-                return Err(format!(
-                    "unknown layout '{s}' (known: separate, hcross, vcross, hstrip, vstrip)"
-                ))
-            }
-        })
+        Layout::parse_name(s).map_err(|e| format!("unknown layout '{s}' (known: {})", e.list()))
     }
 }
 

@@ -16,7 +16,9 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod choice;
 mod envmap;
+mod fault;
 mod image;
 pub mod layout;
 pub mod metrics;
@@ -24,7 +26,9 @@ pub mod projection;
 mod remap;
 mod resample;
 
+pub use choice::{Choice, UnknownName};
 pub use envmap::{bilinear_corner, count_invalid, EnvMap, EnvMapError, Stats};
+pub use fault::Fault;
 pub use image::Image;
 pub use layout::{guess, Guess, Layout};
 pub use projection::{

@@ -68,12 +68,13 @@ pub enum Footprint {
     },
 }
 
-/// The filter of a [`Sampler`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The filter of a [`Sampler`] (and of the renderer's environment lookups).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Filter {
     /// The texel the direction falls in.
     Nearest,
     /// Bilinear interpolation, seamless.
+    #[default]
     Bilinear,
     /// Two bilinear lookups in the mip pyramid, blended.
     Trilinear,
@@ -83,17 +84,21 @@ pub enum Filter {
     SummedArea,
 }
 
+impl mirrorball_core::Choice for Filter {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (Filter::Nearest, &["nearest", "point"]),
+        (Filter::Bilinear, &["bilinear", "linear"]),
+        (Filter::Trilinear, &["trilinear", "mip", "mipmap"]),
+        (Filter::Ewa, &["ewa", "anisotropic"]),
+        (Filter::SummedArea, &["sat", "summed-area", "box"]),
+    ];
+}
+mirrorball_core::choice_traits!(Filter);
+
 impl Filter {
-    /// Parses `nearest`, `bilinear`, `trilinear`, `ewa`, `sat`.
-    pub fn parse(s: &str) -> Option<Filter> {
-        Some(match s.trim().to_ascii_lowercase().as_str() {
-            "nearest" | "point" => Filter::Nearest,
-            "bilinear" | "linear" => Filter::Bilinear,
-            "trilinear" | "mip" | "mipmap" => Filter::Trilinear,
-            "ewa" | "anisotropic" => Filter::Ewa,
-            "sat" | "summed-area" | "box" => Filter::SummedArea,
-            _ => return None,
-        })
+    /// Whether the filter reads the footprint (and so needs a mip pyramid or a table).
+    pub fn uses_footprint(self) -> bool {
+        matches!(self, Filter::Trilinear | Filter::Ewa | Filter::SummedArea)
     }
 }
 

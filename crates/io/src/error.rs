@@ -3,16 +3,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-/// Whose fault an [`Error`] is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Fault {
-    /// The input file is missing, truncated, corrupt, or uses something we do not decode.
-    Input,
-    /// The request cannot be met (wrong extension for the data, unsupported option).
-    Request,
-    /// The system failed (permissions, disk full).
-    System,
-}
+pub use mirrorball_core::Fault;
 
 /// A file problem, naming the file.
 #[derive(Debug)]
@@ -44,15 +35,15 @@ impl Error {
     }
     /// The system's fault, from an I/O error. A missing input file is the input's fault.
     pub fn io(path: &Path, e: std::io::Error) -> Error {
-        let (fault, problem) = match e.kind() {
-            std::io::ErrorKind::NotFound => (Fault::Input, "no such file".to_string()),
-            std::io::ErrorKind::UnexpectedEof => (
-                Fault::Input,
-                "file is truncated (unexpected end of file)".to_string(),
-            ),
-            std::io::ErrorKind::PermissionDenied => (Fault::System, "permission denied".into()),
-            _ => (Fault::System, e.to_string()),
+        let problem = match e.kind() {
+            std::io::ErrorKind::NotFound => "no such file".to_string(),
+            std::io::ErrorKind::UnexpectedEof => {
+                "file is truncated (unexpected end of file)".to_string()
+            }
+            std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+            _ => e.to_string(),
         };
+        let fault = Fault::of_io(e.kind());
         Error {
             path: path.to_path_buf(),
             fault,

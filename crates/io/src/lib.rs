@@ -179,6 +179,28 @@ pub enum ExrCompression {
     Pxr24,
 }
 
+impl mirrorball_core::Choice for Precision {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (Precision::Half, &["half", "f16", "16f"]),
+        (Precision::Float, &["float", "f32", "32f", "full"]),
+        (Precision::U8, &["8", "u8", "8bit"]),
+        (Precision::U16, &["16", "u16", "16bit"]),
+    ];
+}
+mirrorball_core::choice_traits!(Precision);
+
+impl mirrorball_core::Choice for ExrCompression {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (ExrCompression::None, &["none", "uncompressed"]),
+        (ExrCompression::Rle, &["rle"]),
+        (ExrCompression::Zips, &["zips"]),
+        (ExrCompression::Zip, &["zip"]),
+        (ExrCompression::Piz, &["piz"]),
+        (ExrCompression::Pxr24, &["pxr24"]),
+    ];
+}
+mirrorball_core::choice_traits!(ExrCompression);
+
 /// How to write a file.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct WriteOptions {

@@ -30,14 +30,14 @@ pub fn capture_cube(
     settings: &Settings,
 ) -> Result<EnvMap, RenderError> {
     if face == 0 {
-        return Err(RenderError(
-            "the cube's faces need at least one texel".into(),
+        return Err(RenderError::request(
+            "the cube's faces need at least one texel",
         ));
     }
     let mut s = scene.clone();
     if let Some(k) = exclude {
         if k >= s.objects.len() {
-            return Err(RenderError(format!("no object {k} to leave out")));
+            return Err(RenderError::request(format!("no object {k} to leave out")));
         }
         s.objects.remove(k);
     }
@@ -88,7 +88,7 @@ pub fn capture_cube(
         }
         layers.push(img);
     }
-    EnvMap::new(Projection::Cube(CubeMap), layers).map_err(|e| RenderError(e.to_string()))
+    EnvMap::new(Projection::Cube(CubeMap), layers).map_err(|e| RenderError::system(e.to_string()))
 }
 
 /// Greene's Omnimax frames (§10): the scene is captured as a cube map at the eye and the
@@ -111,18 +111,18 @@ pub fn render_fisheye(
     let f = (target - eye).as_dvec3();
     let fwd = f
         .try_normalize()
-        .ok_or_else(|| RenderError("eye and target must differ".into()))?;
+        .ok_or_else(|| RenderError::request("eye and target must differ"))?;
     let right = fwd
         .cross(up.as_dvec3())
         .try_normalize()
-        .ok_or_else(|| RenderError("up must not be parallel to the view direction".into()))?;
+        .ok_or_else(|| RenderError::request("up must not be parallel to the view direction"))?;
     let frame = mirrorball_core::Frame {
         right,
         up: right.cross(fwd),
         forward: fwd,
     };
     let fish = mirrorball_core::Fisheye::new(frame, lens, fov_deg).ok_or_else(|| {
-        RenderError(format!(
+        RenderError::request(format!(
             "a {lens:?} lens cannot cover a {fov_deg}° field of view"
         ))
     })?;

@@ -55,4 +55,7 @@ pub use render::{
     render, render_into, render_with_progress, sphere_map_texcoords, texture_space_diagram, Aovs,
     Frame, RenderError,
 };
-pub use scene::{Attach, Environment, Filter, Indexing, Material, Object, Ramp, Scene, Settings};
+pub use scene::{
+    environment_filter, Attach, Environment, Filter, Indexing, Material, Object, Ramp, Scene,
+    Settings, ENVIRONMENT_FILTERS,
+};

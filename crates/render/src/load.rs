@@ -9,10 +9,58 @@
 
 use crate::mesh::Mesh;
 use glam::{Mat4, Vec2, Vec3};
-use std::path::Path;
+use mirrorball_core::Fault;
+use std::path::{Path, PathBuf};
+
+/// Why a mesh file cannot be loaded, naming the file, and whose fault it is: the file's
+/// (missing, malformed, no triangles, Draco-compressed), the request's (not a mesh
+/// format) or the system's (it cannot be read).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{}: {problem}", path.display())]
+pub struct MeshError {
+    path: PathBuf,
+    fault: Fault,
+    problem: String,
+}
+
+impl MeshError {
+    fn new(path: &Path, fault: Fault, problem: impl Into<String>) -> MeshError {
+        MeshError {
+            path: path.to_path_buf(),
+            fault,
+            problem: problem.into(),
+        }
+    }
+    fn input(path: &Path, problem: impl Into<String>) -> MeshError {
+        MeshError::new(path, Fault::Input, problem)
+    }
+    /// Whose fault it is.
+    pub fn fault(&self) -> Fault {
+        self.fault
+    }
+    /// The file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+    /// What went wrong, without the file's name.
+    pub fn problem(&self) -> &str {
+        &self.problem
+    }
+}
+
+/// Whose fault it is that a parser could not open `path` or a file it refers to (glTF
+/// buffers): the main file's own failure to open ([`Fault::of_io`]: missing is the
+/// input's fault, unreadable the system's); when it opens, the fault is in what it refers
+/// to, the input's.
+fn open_fault(path: &Path) -> Fault {
+    match std::fs::File::open(path) {
+        Err(e) => Fault::of_io(e.kind()),
+        Ok(_) => Fault::Input,
+    }
+}
 
 /// Reads a mesh from a `.glb`, `.gltf` or `.obj` file.
-pub fn load_mesh(path: &Path) -> Result<Mesh, String> {
+pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -23,25 +71,27 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, String> {
     let parse = || match ext.as_str() {
         "glb" | "gltf" => load_gltf(path),
         "obj" => load_obj(path),
-        _ => Err(format!(
-            "{}: unknown mesh format (known: .glb .gltf .obj)",
-            path.display()
+        _ => Err(MeshError::new(
+            path,
+            Fault::Request,
+            "unknown mesh format (known: .glb .gltf .obj)",
         )),
     };
     let mesh =
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse)).unwrap_or_else(|_| {
-            Err(format!(
-                "{}: the {} reader failed on malformed data",
-                path.display(),
-                if ext == "obj" { "OBJ" } else { "glTF" }
+            Err(MeshError::input(
+                path,
+                format!(
+                    "the {} reader failed on malformed data",
+                    if ext == "obj" { "OBJ" } else { "glTF" }
+                ),
             ))
         })?;
     if mesh.triangles.is_empty() {
-        return Err(format!("{}: no triangles", path.display()));
+        return Err(MeshError::input(path, "no triangles"));
     }
-    mesh.validate()
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    check_extent(&mesh).map_err(|e| format!("{}: {e}", path.display()))?;
+    mesh.validate().map_err(|e| MeshError::input(path, e))?;
+    check_extent(&mesh).map_err(|e| MeshError::input(path, e))?;
     Ok(mesh)
 }
 
@@ -73,26 +123,34 @@ fn check_extent(mesh: &Mesh) -> Result<(), String> {
     Ok(())
 }
 
-fn load_gltf(path: &Path) -> Result<Mesh, String> {
-    let name = path.display();
+fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
+    const DRACO: &str =
+        "Draco-compressed glTF (KHR_draco_mesh_compression) is not supported; decompress it first";
     let (doc, buffers, _images) = gltf::import(path).map_err(|e| {
         let msg = e.to_string();
         if msg.contains("draco") || msg.contains("KHR_draco") {
-            format!("{name}: Draco-compressed glTF (KHR_draco_mesh_compression) is not supported; decompress it first (e.g. gltf-transform, or the OBJ in assets/meshes)")
+            MeshError::input(
+                path,
+                format!("{DRACO} (e.g. gltf-transform, or the OBJ in assets/meshes)"),
+            )
         } else {
-            format!("{name}: {msg}")
+            let fault = match e {
+                gltf::Error::Io(_) => open_fault(path),
+                _ => Fault::Input,
+            };
+            MeshError::new(path, fault, msg)
         }
     })?;
     if doc
         .extensions_required()
         .any(|e| e == "KHR_draco_mesh_compression")
     {
-        return Err(format!("{name}: Draco-compressed glTF (KHR_draco_mesh_compression) is not supported; decompress it first"));
+        return Err(MeshError::input(path, DRACO));
     }
     let scene = doc
         .default_scene()
         .or_else(|| doc.scenes().next())
-        .ok_or_else(|| format!("{name}: no scene"))?;
+        .ok_or_else(|| MeshError::input(path, "no scene"))?;
     let mut out = Mesh::default();
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     while let Some((node, parent)) = stack.pop() {
@@ -115,10 +173,13 @@ fn load_gltf(path: &Path) -> Result<Mesh, String> {
                 if let Some(a) = prim.indices() {
                     use gltf::accessor::DataType;
                     if !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32) {
-                        return Err(format!(
-                            "{name}: mesh {}: the indices are {:?}, not unsigned integers",
-                            mesh.index(),
-                            a.data_type()
+                        return Err(MeshError::input(
+                            path,
+                            format!(
+                                "mesh {}: the indices are {:?}, not unsigned integers",
+                                mesh.index(),
+                                a.data_type()
+                            ),
                         ));
                     }
                 }
@@ -134,7 +195,7 @@ fn load_gltf(path: &Path) -> Result<Mesh, String> {
                 if let Some(tc) = reader.read_tex_coords(0) {
                     part.uvs = tc.into_f32().map(Vec2::from_array).collect();
                 }
-                part.validate().map_err(|e| format!("{name}: {e}"))?;
+                part.validate().map_err(|e| MeshError::input(path, e))?;
                 out.append(&part.transformed(m));
             }
         }
@@ -143,14 +204,21 @@ fn load_gltf(path: &Path) -> Result<Mesh, String> {
     Ok(out)
 }
 
-fn load_obj(path: &Path) -> Result<Mesh, String> {
-    let name = path.display();
+fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
-    let (models, _mtl) = tobj::load_obj(path, &opts).map_err(|e| format!("{name}: {e}"))?;
+    let (models, _mtl) = tobj::load_obj(path, &opts).map_err(|e| {
+        // tobj keeps no I/O error kind. Its read error is, on a file that opened, a line
+        // that is not UTF-8: the content, as is every other error.
+        let fault = match e {
+            tobj::LoadError::OpenFileFailed => open_fault(path),
+            _ => Fault::Input,
+        };
+        MeshError::new(path, fault, e.to_string())
+    })?;
     let mut out = Mesh::default();
     for m in models {
         let mm = m.mesh;
@@ -183,7 +251,7 @@ fn load_obj(path: &Path) -> Result<Mesh, String> {
                 .map(|p| Vec2::new(p[0], 1.0 - p[1]))
                 .collect();
         }
-        part.validate().map_err(|e| format!("{name}: {e}"))?;
+        part.validate().map_err(|e| MeshError::input(path, e))?;
         out.append(&part);
     }
     Ok(out)

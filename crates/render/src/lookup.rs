@@ -126,13 +126,7 @@ impl EnvCache {
         if let Some((_, s)) = g.samplers.iter().find(|(f, _)| *f == filter) {
             return s.clone();
         }
-        let f = match filter {
-            Filter::Trilinear => mirrorball_filter::Filter::Trilinear,
-            Filter::Ewa => mirrorball_filter::Filter::Ewa,
-            Filter::Nearest => mirrorball_filter::Filter::Nearest,
-            Filter::Bilinear => mirrorball_filter::Filter::Bilinear,
-        };
-        let s = Arc::new(Sampler::new(map, f));
+        let s = Arc::new(Sampler::new(map, filter));
         g.samplers.push((filter, s.clone()));
         g.builds += 1;
         s

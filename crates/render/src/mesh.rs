@@ -9,6 +9,7 @@
 //! in the `z = 0` plane facing +Z, a cube of edge 2), with outward unit normals.
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
+use mirrorball_core::Choice;
 
 /// An indexed triangle mesh with per-vertex unit normals (and optional texture coordinates).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -468,6 +469,17 @@ pub enum Builtin {
 /// memory.
 pub const MAX_TRIANGLES: u64 = 1 << 24;
 
+impl Choice for Builtin {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (Builtin::Sphere, &["sphere", "ball"]),
+        (Builtin::Torus, &["torus", "donut"]),
+        (Builtin::Cube, &["cube", "box"]),
+        (Builtin::Quad, &["quad", "plane", "door"]),
+        (Builtin::Teapot, &["teapot", "utah"]),
+    ];
+}
+mirrorball_core::choice_traits!(Builtin);
+
 impl Builtin {
     /// Every built-in.
     pub const ALL: [Builtin; 5] = [
@@ -478,27 +490,9 @@ impl Builtin {
         Builtin::Teapot,
     ];
 
-    /// Parses `sphere`, `torus`, `cube`, `quad` (or `plane`, `door`), `teapot`.
-    pub fn from_name(s: &str) -> Option<Builtin> {
-        Some(match s.to_ascii_lowercase().as_str() {
-            "sphere" | "ball" => Builtin::Sphere,
-            "torus" | "donut" => Builtin::Torus,
-            "cube" | "box" => Builtin::Cube,
-            "quad" | "plane" | "door" => Builtin::Quad,
-            "teapot" | "utah" => Builtin::Teapot,
-            _ => return None,
-        })
-    }
-
-    /// The name `from_name` accepts.
+    /// The canonical name (see [`Choice`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Builtin::Sphere => "sphere",
-            Builtin::Torus => "torus",
-            Builtin::Cube => "cube",
-            Builtin::Quad => "quad",
-            Builtin::Teapot => "teapot",
-        }
+        Choice::name(self)
     }
 
     /// A sensible default tessellation: sphere and torus segments, quad and cube cells per

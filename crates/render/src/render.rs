@@ -12,7 +12,7 @@ use crate::camera::Rays;
 use crate::raster::{Binned, Cull, NO_HIT};
 use crate::scene::{Attach, Filter, Indexing, Material, Scene, Settings};
 use glam::{DVec2, DVec3, Mat3, Mat4, Vec2, Vec3, Vec3A, Vec4};
-use mirrorball_core::{Image, Projection, SphereMap, WorldProjection};
+use mirrorball_core::{Fault, Image, Projection, SphereMap, WorldProjection};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -44,17 +44,46 @@ pub struct Aovs {
     pub depth: Image,
 }
 
-/// Why a scene cannot be rendered.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderError(pub String);
-
-impl std::fmt::Display for RenderError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
+/// Why a scene cannot be rendered, and whose fault it is: the request's (the camera, the
+/// settings, what is asked of the scene) or the input's (the scene's meshes and matrices).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{message}")]
+pub struct RenderError {
+    fault: Fault,
+    message: String,
 }
 
-impl std::error::Error for RenderError {}
+impl RenderError {
+    /// The request's fault.
+    pub fn request(message: impl Into<String>) -> RenderError {
+        RenderError {
+            fault: Fault::Request,
+            message: message.into(),
+        }
+    }
+    /// The input's fault (the scene's data).
+    pub fn input(message: impl Into<String>) -> RenderError {
+        RenderError {
+            fault: Fault::Input,
+            message: message.into(),
+        }
+    }
+    /// The system's fault (a failure of the renderer itself).
+    pub fn system(message: impl Into<String>) -> RenderError {
+        RenderError {
+            fault: Fault::System,
+            message: message.into(),
+        }
+    }
+    /// Whose fault it is.
+    pub fn fault(&self) -> Fault {
+        self.fault
+    }
+    /// What went wrong.
+    pub fn message(&self) -> &str {
+        &self.message
+    }
+}
 
 /// What mode 1 generates per vertex for the environment's projection.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -176,29 +205,29 @@ fn render_counting(
     frame: &mut Frame,
     rows_done: Option<&AtomicU64>,
 ) -> Result<(), RenderError> {
-    cam.validate().map_err(RenderError)?;
+    cam.validate().map_err(RenderError::request)?;
     if let Some(prev) = &settings.motion_from {
         prev.validate()
-            .map_err(|e| RenderError(format!("the previous frame's camera: {e}")))?;
+            .map_err(|e| RenderError::request(format!("the previous frame's camera: {e}")))?;
     }
     if !(1..=16).contains(&settings.supersample) {
-        return Err(RenderError(format!(
+        return Err(RenderError::request(format!(
             "supersampling {} is outside 1..=16",
             settings.supersample
         )));
     }
     let needs_env = scene.background || scene.objects.iter().any(|o| o.material.uses_environment());
     if needs_env && scene.environment.is_none() {
-        return Err(RenderError(
-            "the scene reflects or shows an environment but has none".into(),
+        return Err(RenderError::request(
+            "the scene reflects or shows an environment but has none",
         ));
     }
     for (i, o) in scene.objects.iter().enumerate() {
         o.mesh
             .validate()
-            .map_err(|e| RenderError(format!("object {i}: {e}")))?;
+            .map_err(|e| RenderError::input(format!("object {i}: {e}")))?;
         if !o.model.is_finite() || o.model.determinant() == 0.0 {
-            return Err(RenderError(format!(
+            return Err(RenderError::input(format!(
                 "object {i}: the model matrix is singular or not finite"
             )));
         }
@@ -532,7 +561,7 @@ impl Prepared<'_> {
         }
         let out = match env.filter {
             // Footprint filters without a footprint (motion-blur sweeps) read bilinearly.
-            Filter::Bilinear | Filter::Trilinear | Filter::Ewa => {
+            Filter::Bilinear | Filter::Trilinear | Filter::Ewa | Filter::SummedArea => {
                 crate::fast::bilinear(&env.map, layer, u, v)
             }
             Filter::Nearest => {
@@ -1174,11 +1203,11 @@ pub fn texture_space_diagram(
     let env = scene
         .environment
         .as_ref()
-        .ok_or_else(|| RenderError("the diagram needs an environment".into()))?;
+        .ok_or_else(|| RenderError::request("the diagram needs an environment"))?;
     let aovs = frame
         .aovs
         .as_ref()
-        .ok_or_else(|| RenderError("the diagram needs a frame rendered with aovs".into()))?;
+        .ok_or_else(|| RenderError::request("the diagram needs a frame rendered with aovs"))?;
     let map = &env.map;
     let layers = map.layers().len() as u32;
     let cw = cell.max(8);

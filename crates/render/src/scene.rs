@@ -4,7 +4,8 @@
 use crate::lookup::{EnvCache, SpecularLobe};
 use crate::mesh::Mesh;
 use glam::Mat4;
-use mirrorball_core::EnvMap;
+use mirrorball_core::{Choice, EnvMap, UnknownName};
+pub use mirrorball_filter::Filter;
 use std::sync::Arc;
 
 /// How the environment is indexed: the four ways environment mapping has been done. Their
@@ -47,31 +48,32 @@ impl Indexing {
         Indexing::Cone,
     ];
 
-    /// Parses `1`/`texgen`/`gl`, `2`/`vertex`, `3`/`pixel`, `4`/`cone`/`greene`.
-    pub fn from_name(s: &str) -> Option<Indexing> {
-        Some(match s.to_ascii_lowercase().as_str() {
-            "1" | "texgen" | "gl" | "fixed-function" | "per-vertex-texgen" => {
-                Indexing::PerVertexTexgen
-            }
-            "2" | "vertex" | "per-vertex" | "per-vertex-reflection" => {
-                Indexing::PerVertexReflection
-            }
-            "3" | "pixel" | "per-pixel" => Indexing::PerPixel,
-            "4" | "cone" | "greene" | "pixel-cone" => Indexing::Cone,
-            _ => return None,
-        })
+    /// The mode's number, 1 to 4.
+    pub fn number(self) -> usize {
+        Indexing::ALL.iter().position(|&m| m == self).unwrap_or(0) + 1
     }
 
     /// Canonical name.
     pub fn name(self) -> &'static str {
-        match self {
-            Indexing::PerVertexTexgen => "texgen",
-            Indexing::PerVertexReflection => "vertex",
-            Indexing::PerPixel => "pixel",
-            Indexing::Cone => "cone",
-        }
+        Choice::name(self)
     }
 }
+
+impl Choice for Indexing {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (
+            Indexing::PerVertexTexgen,
+            &["texgen", "1", "gl", "fixed-function", "per-vertex-texgen"],
+        ),
+        (
+            Indexing::PerVertexReflection,
+            &["vertex", "2", "per-vertex", "per-vertex-reflection"],
+        ),
+        (Indexing::PerPixel, &["pixel", "3", "per-pixel"]),
+        (Indexing::Cone, &["cone", "4", "greene", "pixel-cone"]),
+    ];
+}
+mirrorball_core::choice_traits!(Indexing);
 
 /// What the environment is attached to (Zimmons, figure 18).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -86,60 +88,27 @@ pub enum Attach {
     Eye,
 }
 
-impl Attach {
-    /// Parses `world` or `eye` (`view`, `camera`).
-    pub fn from_name(s: &str) -> Option<Attach> {
-        match s.to_ascii_lowercase().as_str() {
-            "world" | "scene" => Some(Attach::World),
-            "eye" | "view" | "camera" => Some(Attach::Eye),
-            _ => None,
-        }
-    }
+impl Choice for Attach {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (Attach::World, &["world", "scene"]),
+        (Attach::Eye, &["eye", "view", "camera"]),
+    ];
 }
+mirrorball_core::choice_traits!(Attach);
 
-/// Texture filter for environment lookups.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
-pub enum Filter {
-    /// The texel containing the coordinates.
-    Nearest,
-    /// Bilinear, seamless across the projection's seams.
-    #[default]
-    Bilinear,
-    /// Two bilinear lookups in `mirrorball_filter`'s solid-angle-weighted mip pyramid, at
-    /// the level of the pixel's footprint (the ray differentials of the reflected ray, or
-    /// of the camera ray on the background), blended.
-    Trilinear,
-    /// Heckbert's elliptical weighted average over the pixel's footprint
-    /// (`mirrorball_filter::sampler`), weighted by exact texel solid angle.
-    Ewa,
-}
+/// The filters an [`Environment`] can be read with, in the order they are offered.
+pub const ENVIRONMENT_FILTERS: [Filter; 4] = [
+    Filter::Nearest,
+    Filter::Bilinear,
+    Filter::Trilinear,
+    Filter::Ewa,
+];
 
-impl Filter {
-    /// Parses `nearest`, `bilinear`, `trilinear` (`mip`) or `ewa` (`anisotropic`).
-    pub fn from_name(s: &str) -> Option<Filter> {
-        match s.to_ascii_lowercase().as_str() {
-            "nearest" | "point" => Some(Filter::Nearest),
-            "bilinear" | "linear" => Some(Filter::Bilinear),
-            "trilinear" | "mip" | "mipmap" => Some(Filter::Trilinear),
-            "ewa" | "anisotropic" => Some(Filter::Ewa),
-            _ => None,
-        }
-    }
-
-    /// Canonical name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Filter::Nearest => "nearest",
-            Filter::Bilinear => "bilinear",
-            Filter::Trilinear => "trilinear",
-            Filter::Ewa => "ewa",
-        }
-    }
-
-    /// Whether the filter uses the pixel's footprint (and so a mip pyramid).
-    pub fn uses_footprint(self) -> bool {
-        matches!(self, Filter::Trilinear | Filter::Ewa)
-    }
+/// Parses the name of one of the [`ENVIRONMENT_FILTERS`]; the error lists them.
+pub fn environment_filter(s: &str) -> Result<Filter, UnknownName> {
+    Filter::from_name(s)
+        .filter(|f| ENVIRONMENT_FILTERS.contains(f))
+        .ok_or_else(|| UnknownName::among(s, ENVIRONMENT_FILTERS.map(Filter::name)))
 }
 
 /// The world projection the objects reflect, and how.

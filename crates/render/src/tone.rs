@@ -2,7 +2,7 @@
 //! light in `[0, 1]`; `mirrorball-io` applies the sRGB encoding when it writes 8- or 16-bit
 //! files. EXR output skips this and keeps the linear radiance.
 
-use mirrorball_core::Image;
+use mirrorball_core::{Choice, Image};
 
 /// How linear radiance is squeezed into `[0, 1]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -17,17 +17,16 @@ pub enum Tone {
     Aces,
 }
 
-impl Tone {
-    /// Parses `clamp` (`none`, `linear`), `reinhard`, `aces` (`filmic`).
-    pub fn from_name(s: &str) -> Option<Tone> {
-        Some(match s.to_ascii_lowercase().as_str() {
-            "clamp" | "none" | "linear" | "clip" => Tone::Clamp,
-            "reinhard" => Tone::Reinhard,
-            "aces" | "filmic" => Tone::Aces,
-            _ => return None,
-        })
-    }
+impl Choice for Tone {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (Tone::Aces, &["aces", "filmic"]),
+        (Tone::Reinhard, &["reinhard"]),
+        (Tone::Clamp, &["clamp", "none", "linear", "clip"]),
+    ];
+}
+mirrorball_core::choice_traits!(Tone);
 
+impl Tone {
     /// The curve at `x ≥ 0`.
     #[inline]
     pub fn apply(self, x: f32) -> f32 {

@@ -80,7 +80,7 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
 pub fn run(a: AnalyzeArgs) -> Result<(), CliError> {
     let plan = plan(&a)?;
     std::fs::create_dir_all(&plan.out).map_err(|e| {
-        CliError::input(format!(
+        CliError::system(format!(
             "{}: cannot create the folder: {e}",
             plan.out.display()
         ))

@@ -9,7 +9,8 @@ use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
 use mirrorball_core::{
-    resample, Image, Layout, Projection, ResampleOptions, Resampler, Rotation, WorldProjection,
+    resample, Choice, Image, Layout, Projection, ResampleOptions, Resampler, Rotation,
+    WorldProjection,
 };
 use mirrorball_io::{ExrCompression, Format, Precision, WriteOptions};
 use std::path::PathBuf;
@@ -26,33 +27,25 @@ struct Plan {
 }
 
 pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
-    let Some(p) = p else { return Ok(None) };
-    Ok(Some(match p.to_ascii_lowercase().as_str() {
-        "half" | "f16" | "16f" => Precision::Half,
-        "float" | "f32" | "32f" | "full" => Precision::Float,
-        "8" | "u8" | "8bit" => Precision::U8,
-        "16" | "u16" | "16bit" => Precision::U16,
-        other => {
-            return Err(CliError::request(format!(
-                "--precision: unknown '{other}' (half, float, 8, 16)"
-            )))
-        }
-    }))
+    p.map(|p| {
+        Precision::parse_name(p).map_err(|e| {
+            CliError::request(format!(
+                "--precision: unknown '{}' ({})",
+                e.given.to_ascii_lowercase(),
+                e.list()
+            ))
+        })
+    })
+    .transpose()
 }
 
 fn parse_compression(c: &str) -> Result<ExrCompression, CliError> {
-    Ok(match c.to_ascii_lowercase().as_str() {
-        "none" | "uncompressed" => ExrCompression::None,
-        "rle" => ExrCompression::Rle,
-        "zips" => ExrCompression::Zips,
-        "zip" => ExrCompression::Zip,
-        "piz" => ExrCompression::Piz,
-        "pxr24" => ExrCompression::Pxr24,
-        other => {
-            return Err(CliError::request(format!(
-                "--compression: unknown '{other}' (none, rle, zips, zip, piz, pxr24)"
-            )))
-        }
+    ExrCompression::parse_name(c).map_err(|e| {
+        CliError::request(format!(
+            "--compression: unknown '{}' ({})",
+            e.given.to_ascii_lowercase(),
+            e.list()
+        ))
     })
 }
 
@@ -303,7 +296,7 @@ fn write_while_converting(
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(rayon::current_num_threads())
                 .build()
-                .map_err(|e| CliError::input(format!("cannot start writer threads: {e}")))?;
+                .map_err(|e| CliError::system(format!("cannot start writer threads: {e}")))?;
             let mut staged = Vec::with_capacity(paths.len());
             for (path, img) in rx {
                 staged.push(pool.install(|| mirrorball_io::write_image_staged(path, &img, opts))?);

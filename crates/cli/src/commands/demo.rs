@@ -76,11 +76,11 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
     }
     let dir = Path::new(&a.out);
     std::fs::create_dir_all(dir).map_err(|e| {
-        CliError::input(format!("{}: cannot create the folder: {e}", dir.display()))
+        CliError::system(format!("{}: cannot create the folder: {e}", dir.display()))
     })?;
     let src_path = dir.join("source-city.exr");
     std::fs::write(&src_path, CITY_EXR)
-        .map_err(|e| CliError::input(format!("{}: {e}", src_path.display())))?;
+        .map_err(|e| CliError::system(format!("{}: {e}", src_path.display())))?;
     let t0 = Instant::now();
     let src_str = src_path.display().to_string();
     let mut src = load::load(&src_str, None, None, &mirrorball_io::Limits::default())?;
@@ -218,9 +218,9 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
     html.push_str("<p>cube.ktx2 and cube.dds hold the cube with its full mip chain, faces in OpenGL/Vulkan/Direct3D order.</p>");
     let index = dir.join("index.html");
     std::fs::write(&index, html)
-        .map_err(|e| CliError::input(format!("{}: {e}", index.display())))?;
+        .map_err(|e| CliError::system(format!("{}: {e}", index.display())))?;
     std::fs::write(dir.join("summary.txt"), table)
-        .map_err(|e| CliError::input(format!("{}: {e}", dir.display())))?;
+        .map_err(|e| CliError::system(format!("{}: {e}", dir.display())))?;
     eprintln!(
         "done in {:.1}s: open {}",
         t0.elapsed().as_secs_f64(),

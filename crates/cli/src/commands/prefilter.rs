@@ -16,7 +16,7 @@ use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, PrefilterArgs};
 use mirrorball_core::glam::DVec2;
-use mirrorball_core::{EnvMap, Image, Layout, Projection, ProjectionKind, WorldProjection};
+use mirrorball_core::{Choice, EnvMap, Image, Layout, Projection, ProjectionKind, WorldProjection};
 use mirrorball_filter::mip::{level_count, texel_solid_angles};
 use mirrorball_filter::sh::{self, Window};
 use mirrorball_filter::{
@@ -30,11 +30,18 @@ use std::time::Instant;
 
 /// How Lambert maps are computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum IrradianceMethod {
+pub(crate) enum IrradianceMethod {
     /// The moment hierarchy: the brute-force sum to a tolerance.
     Exact,
     /// Nine spherical-harmonic coefficients.
     Sh,
+}
+
+impl Choice for IrradianceMethod {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (IrradianceMethod::Exact, &["exact", "convolve", "brute"]),
+        (IrradianceMethod::Sh, &["sh", "sh9"]),
+    ];
 }
 
 /// Everything `prefilter` will do, checked before any file is read.
@@ -194,15 +201,13 @@ impl Plan {
                 a.sh_window
             ))
         })?;
-        let irradiance = match a.irradiance.to_ascii_lowercase().as_str() {
-            "exact" | "convolve" | "brute" => IrradianceMethod::Exact,
-            "sh" | "sh9" => IrradianceMethod::Sh,
-            other => {
-                return Err(CliError::request(format!(
-                    "--irradiance: unknown '{other}' (exact, sh)"
-                )))
-            }
-        };
+        let irradiance = IrradianceMethod::parse_name(&a.irradiance).map_err(|e| {
+            CliError::request(format!(
+                "--irradiance: unknown '{}' ({})",
+                e.given.to_ascii_lowercase(),
+                e.list()
+            ))
+        })?;
         if a.samples == 0 || a.samples > 65536 {
             return Err(CliError::request(format!(
                 "--samples: {} is outside 1..=65536",

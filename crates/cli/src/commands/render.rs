@@ -14,12 +14,13 @@ use crate::spec::{bad, parse_dir, ProjSpec};
 use crate::{load, RenderArgs};
 use mirrorball_core::glam::{Mat4, Vec3};
 use mirrorball_core::{resample, EnvMap, Image, ResampleOptions, WorldProjection};
+use mirrorball_core::{Choice, Fault, UnknownName};
 use mirrorball_io::{Format, Precision, WriteOptions};
 use mirrorball_render::mesh::MAX_TRIANGLES;
 use mirrorball_render::tone::{self, Tone};
 use mirrorball_render::{
-    Attach, Builtin, Camera, Environment, Filter, Indexing, Lens, Material, Mesh, Object, Ramp,
-    Scene, Settings, SpecularLobe,
+    environment_filter, Attach, Builtin, Camera, Environment, Filter, Indexing, Lens, Material,
+    Mesh, Object, Ramp, Scene, Settings, SpecularLobe,
 };
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -174,7 +175,7 @@ fn parse_material(spec: &str, tint: [f32; 3], f0: f32) -> Result<Material, Strin
 }
 
 fn parse_object(s: &str, level: Option<u32>) -> Result<MeshSource, CliError> {
-    if let Some(b) = Builtin::from_name(s) {
+    if let Ok(b) = s.parse::<Builtin>() {
         let l = level.unwrap_or(b.default_tessellation());
         if !(1..=4096).contains(&l) {
             return Err(bad("--tessellation", format!("{l} is outside 1..=4096")));
@@ -203,7 +204,10 @@ fn parse_object(s: &str, level: Option<u32>) -> Result<MeshSource, CliError> {
         Some("glb" | "gltf" | "obj") => Ok(MeshSource::File(p)),
         _ => Err(bad(
             "--object",
-            format!("'{s}' is neither a built-in (sphere, torus, cube, quad, teapot) nor a .glb/.gltf/.obj file"),
+            format!(
+                "'{s}' is neither a built-in ({}) nor a .glb/.gltf/.obj file",
+                UnknownName::new::<Builtin>(s).list()
+            ),
         )),
     }
 }
@@ -212,28 +216,24 @@ impl RenderPlan {
     fn new(a: &RenderArgs) -> Result<RenderPlan, CliError> {
         let input = InputPlan::new(&a.input_args)?;
         let indexing = Indexing::from_name(&a.mode).ok_or_else(|| {
+            let known: Vec<String> = Indexing::all()
+                .map(|m| format!("{}|{}", m.number(), m.name()))
+                .collect();
+            let known = known.join(", ");
             bad(
                 "--mode",
-                format!(
-                    "unknown mode '{}' (known: 1|texgen, 2|vertex, 3|pixel, 4|cone)",
-                    a.mode
-                ),
+                format!("unknown mode '{}' (known: {known})", a.mode),
             )
         })?;
-        let attach = Attach::from_name(&a.attach)
-            .ok_or_else(|| bad("--attach", format!("'{}' is not world or eye", a.attach)))?;
-        let filter = Filter::from_name(&a.filter).ok_or_else(|| {
-            bad(
-                "--filter",
-                format!("'{}' is not nearest, bilinear, trilinear or ewa", a.filter),
-            )
-        })?;
-        let tone = Tone::from_name(&a.tone).ok_or_else(|| {
-            bad(
-                "--tone",
-                format!("'{}' is not aces, reinhard or clamp", a.tone),
-            )
-        })?;
+        let attach = a
+            .attach
+            .parse::<Attach>()
+            .map_err(|e| bad("--attach", e.to_string()))?;
+        let filter = environment_filter(&a.filter).map_err(|e| bad("--filter", e.to_string()))?;
+        let tone = a
+            .tone
+            .parse::<Tone>()
+            .map_err(|e| bad("--tone", e.to_string()))?;
         let tint = parse_colour("--tint", &a.tint)?;
         if !(0.0..=1.0).contains(&a.f0) {
             return Err(bad("--f0", format!("{} is outside [0, 1]", a.f0)));
@@ -335,16 +335,10 @@ impl RenderPlan {
             diagnostics: a.diagnostics,
             fisheye: match a.fisheye {
                 Some(fov) => {
-                    let lens =
-                        mirrorball_core::Lens::from_name(&a.fisheye_lens).ok_or_else(|| {
-                            bad(
-                                "--fisheye-lens",
-                                format!(
-                                "'{}' is not equidistant, equisolid, stereographic or orthographic",
-                                a.fisheye_lens
-                            ),
-                            )
-                        })?;
+                    let lens = a
+                        .fisheye_lens
+                        .parse::<mirrorball_core::Lens>()
+                        .map_err(|e| bad("--fisheye-lens", e.to_string()))?;
                     if !(fov.is_finite()
                         && fov > 0.0
                         && fov.to_radians() / 2.0 <= lens.max_half_fov())
@@ -773,7 +767,7 @@ fn material_of(e: &MaterialEntry) -> Result<Material, String> {
 fn apply_scene_file(plan: &mut RenderPlan, path: &Path) -> Result<(), CliError> {
     let name = path.display();
     let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::input(format!("{name}: cannot read: {e}")))?;
+        .map_err(|e| CliError::new(Fault::of_io(e.kind()), format!("{name}: cannot read: {e}")))?;
     let is_toml = path
         .extension()
         .and_then(|e| e.to_str())
@@ -868,15 +862,13 @@ fn apply_scene_file(plan: &mut RenderPlan, path: &Path) -> Result<(), CliError> 
                 Some(ProjSpec::parse(p).map_err(|x| err(format!("environment.projection: {x}")))?);
         }
         if let Some(a) = &e.attach {
-            plan.attach = Attach::from_name(a)
-                .ok_or_else(|| err(format!("environment.attach: '{a}' is not world or eye")))?;
+            plan.attach = a
+                .parse::<Attach>()
+                .map_err(|e| err(format!("environment.attach: {e}")))?;
         }
         if let Some(f) = &e.filter {
-            plan.filter = Filter::from_name(f).ok_or_else(|| {
-                err(format!(
-                    "environment.filter: '{f}' is not nearest, bilinear, trilinear or ewa"
-                ))
-            })?;
+            plan.filter =
+                environment_filter(f).map_err(|e| err(format!("environment.filter: {e}")))?;
         }
         if let Some(i) = e.intensity {
             if !(i.is_finite() && i >= 0.0) {
@@ -908,7 +900,7 @@ fn load_object(o: &ObjectPlan) -> Result<Object, CliError> {
     let (mesh, fit) = match &o.source {
         MeshSource::Builtin(b, l) => (b.mesh(*l), Mat4::IDENTITY),
         MeshSource::File(p) => {
-            let m: Mesh = mirrorball_render::load::load_mesh(p).map_err(CliError::input)?;
+            let m: Mesh = mirrorball_render::load::load_mesh(p)?;
             let fit = if o.normalize {
                 m.normalizing_transform()
             } else {
@@ -1100,7 +1092,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                         mirrorball_render::render_with_progress(&scene, &cam, &settings, &counter)
                     }
                 }
-                .map_err(|e| CliError::request(e.to_string()))
+                .map_err(CliError::from)
             })
             .collect::<Vec<_>>()
     });
@@ -1124,7 +1116,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
             let angle = std::f32::consts::TAU * i as f32 / frames as f32;
             let cam = plan.camera.orbited(angle);
             let d = mirrorball_render::texture_space_diagram(&scene, &cam, &plan.settings, &f, 512)
-                .map_err(|e| CliError::request(format!("--diagnostics: {e}")))?;
+                .map_err(|e| CliError::from(e).context("--diagnostics"))?;
             let p = sibling(&path, "diag", "png");
             mirrorball_io::write_image(&p, &d, &WriteOptions::default())?;
             if !plan.quiet {

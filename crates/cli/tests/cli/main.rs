@@ -4,6 +4,7 @@ mod analyze;
 mod bad_input;
 mod commands;
 mod hostile;
+mod names;
 mod prefilter;
 mod production;
 mod quality;

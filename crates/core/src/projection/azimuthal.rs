@@ -111,26 +111,27 @@ pub enum Lens {
     Orthographic,
 }
 
-impl Lens {
-    /// Parses `equidistant`, `equisolid`, `stereographic`, `orthographic`.
-    pub fn from_name(s: &str) -> Option<Lens> {
-        Some(match s.to_ascii_lowercase().as_str() {
-            "equidistant" | "f-theta" | "ftheta" | "linear" => Lens::Equidistant,
-            "equisolid" | "equal-area" | "equisolid-angle" => Lens::Equisolid,
-            "stereographic" | "conformal" => Lens::Stereographic,
-            "orthographic" => Lens::Orthographic,
-            _ => return None,
-        })
-    }
+impl crate::Choice for Lens {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (
+            Lens::Equidistant,
+            &["equidistant", "f-theta", "ftheta", "linear"],
+        ),
+        (
+            Lens::Equisolid,
+            &["equisolid", "equal-area", "equisolid-angle"],
+        ),
+        (Lens::Stereographic, &["stereographic", "conformal"]),
+        (Lens::Orthographic, &["orthographic"]),
+    ];
+}
 
-    /// The canonical name, as [`Lens::from_name`] reads it.
+crate::choice_traits!(Lens);
+
+impl Lens {
+    /// The canonical name (see [`crate::Choice`]).
     pub fn name(self) -> &'static str {
-        match self {
-            Lens::Equidistant => "equidistant",
-            Lens::Equisolid => "equisolid",
-            Lens::Stereographic => "stereographic",
-            Lens::Orthographic => "orthographic",
-        }
+        crate::Choice::name(self)
     }
 
     /// The largest half field of view the lens supports.

@@ -27,6 +27,7 @@ pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
 pub use spec::{parse_dir, ProjectionSpec};
 
+use crate::{Choice, UnknownName};
 use glam::{DVec2, DVec3};
 use std::fmt;
 use std::str::FromStr;
@@ -269,20 +270,9 @@ impl ProjectionKind {
         ProjectionKind::EqualAreaOctahedral,
     ];
 
-    /// The canonical command-line name.
+    /// The canonical command-line name (the canonical name of [`Choice`]).
     pub fn name(self) -> &'static str {
-        match self {
-            ProjectionKind::LatLong => "latlong",
-            ProjectionKind::Cube => "cube",
-            ProjectionKind::Sphere => "sphere",
-            ProjectionKind::Paraboloid => "paraboloid",
-            ProjectionKind::ContinuousCube => "continuous-cube",
-            ProjectionKind::Mercator => "mercator",
-            ProjectionKind::Angular => "angular",
-            ProjectionKind::Fisheye => "fisheye",
-            ProjectionKind::Octahedral => "octahedral",
-            ProjectionKind::EqualAreaOctahedral => "equal-area-octahedral",
-        }
+        Choice::name(self)
     }
 
     /// The projection with its documented default parameters.
@@ -304,6 +294,63 @@ impl ProjectionKind {
     }
 }
 
+impl Choice for ProjectionKind {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (
+            ProjectionKind::LatLong,
+            &[
+                "latlong",
+                "lat-long",
+                "latlon",
+                "equirect",
+                "equirectangular",
+                "longlat",
+                "spherical",
+            ],
+        ),
+        (ProjectionKind::Cube, &["cube", "cubemap", "cube-map"]),
+        (
+            ProjectionKind::Sphere,
+            &[
+                "sphere",
+                "spheremap",
+                "sphere-map",
+                "matcap",
+                "mirrorball",
+                "mirror-ball",
+            ],
+        ),
+        (
+            ProjectionKind::Paraboloid,
+            &["paraboloid", "dual-paraboloid", "parabolic", "dp"],
+        ),
+        (
+            ProjectionKind::ContinuousCube,
+            &["continuous-cube", "continuouscube", "ccube"],
+        ),
+        (ProjectionKind::Mercator, &["mercator"]),
+        (
+            ProjectionKind::Angular,
+            &[
+                "angular",
+                "angular-map",
+                "lightprobe",
+                "light-probe",
+                "probe",
+            ],
+        ),
+        (ProjectionKind::Fisheye, &["fisheye", "omnimax", "dome"]),
+        (
+            ProjectionKind::Octahedral,
+            &["octahedral", "octahedron", "oct"],
+        ),
+        (
+            ProjectionKind::EqualAreaOctahedral,
+            &["equal-area-octahedral", "eao", "clarberg", "equal-area-oct"],
+        ),
+    ];
+}
+
 impl fmt::Display for ProjectionKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -316,12 +363,12 @@ pub struct UnknownProjection(pub String);
 
 impl fmt::Display for UnknownProjection {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let names: Vec<&str> = ProjectionKind::ALL.iter().map(|k| k.name()).collect();
+        let known = UnknownName::new::<ProjectionKind>(&self.0);
         write!(
             f,
             "unknown projection '{}' (known: {})",
             self.0,
-            names.join(", ")
+            known.list()
         )
     }
 }
@@ -339,27 +386,7 @@ impl FromStr for ProjectionKind {
     /// assert!("banana".parse::<ProjectionKind>().is_err());
     /// ```
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let k = s.trim().to_ascii_lowercase().replace('_', "-");
-        Ok(match k.as_str() {
-            "latlong" | "lat-long" | "latlon" | "equirect" | "equirectangular" | "longlat"
-            | "spherical" => ProjectionKind::LatLong,
-            "cube" | "cubemap" | "cube-map" => ProjectionKind::Cube,
-            "sphere" | "spheremap" | "sphere-map" | "matcap" | "mirrorball" | "mirror-ball" => {
-                ProjectionKind::Sphere
-            }
-            "paraboloid" | "dual-paraboloid" | "parabolic" | "dp" => ProjectionKind::Paraboloid,
-            "continuous-cube" | "continuouscube" | "ccube" => ProjectionKind::ContinuousCube,
-            "mercator" => ProjectionKind::Mercator,
-            "angular" | "angular-map" | "lightprobe" | "light-probe" | "probe" => {
-                ProjectionKind::Angular
-            }
-            "fisheye" | "omnimax" | "dome" => ProjectionKind::Fisheye,
-            "octahedral" | "octahedron" | "oct" => ProjectionKind::Octahedral,
-            "equal-area-octahedral" | "eao" | "clarberg" | "equal-area-oct" => {
-                ProjectionKind::EqualAreaOctahedral
-            }
-            _ => return Err(UnknownProjection(s.to_string())),
-        })
+        ProjectionKind::from_name(s).ok_or_else(|| UnknownProjection(s.to_string()))
     }
 }
 

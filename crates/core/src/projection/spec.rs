@@ -17,6 +17,7 @@ use super::{
     AngularMap, DualParaboloid, Fisheye, Frame, Lens, Mercator, Projection, ProjectionKind,
     SphereMap, UnknownProjection,
 };
+use crate::Choice;
 use glam::DVec3;
 use std::fmt;
 
@@ -96,12 +97,17 @@ impl ProjectionSpec {
                 "up" => spec.up = Some(parse_dir(v)?),
                 "fov" => spec.fov = Some(num(v)?),
                 "lens" => {
-                    spec.lens = Some(Lens::from_name(v).ok_or_else(|| {
-                        format!("unknown lens '{v}' (known: equidistant, equisolid, stereographic, orthographic)")
-                    })?)
+                    spec.lens = Some(
+                        Lens::parse_name(v)
+                            .map_err(|e| format!("unknown lens '{v}' (known: {})", e.list()))?,
+                    )
                 }
                 "max-lat" | "maxlat" | "lat" => spec.max_lat = Some(num(v)?),
-                other => return Err(format!("unknown option '{other}' in '{s}' (known: look, up, fov, lens, max-lat)")),
+                other => {
+                    return Err(format!(
+                        "unknown option '{other}' in '{s}' (known: look, up, fov, lens, max-lat)"
+                    ))
+                }
             }
         }
         let applies = |ok: bool, key: &str| {

@@ -41,6 +41,8 @@ fn check_load(path: &Path) -> Duration {
     let took = start.elapsed();
     match result {
         Err(e) => {
+            assert_eq!(e.fault(), mirrorball_core::Fault::Input, "{e}");
+            let e = e.to_string();
             assert!(
                 e.starts_with(&path.display().to_string()) && e.len() > path.as_os_str().len() + 2,
                 "{e}"
@@ -132,6 +134,8 @@ fn vertices_that_are_not_finite_or_too_far_apart_are_named() {
     let nan = dir.path().join("nan.obj");
     std::fs::write(&nan, "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let e = load_mesh(&nan).unwrap_err();
+    assert_eq!(e.fault(), mirrorball_core::Fault::Input);
+    let e = e.to_string();
     assert!(
         e.starts_with(&nan.display().to_string())
             && e.contains("vertex 1")
@@ -141,6 +145,8 @@ fn vertices_that_are_not_finite_or_too_far_apart_are_named() {
     let huge = dir.path().join("huge.obj");
     std::fs::write(&huge, "v -3e38 0 0\nv 3e38 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let e = load_mesh(&huge).unwrap_err();
+    assert_eq!(e.fault(), mirrorball_core::Fault::Input);
+    let e = e.to_string();
     assert!(
         e.starts_with(&huge.display().to_string()) && e.contains("span") && e.contains("inf"),
         "{e}"
@@ -148,6 +154,8 @@ fn vertices_that_are_not_finite_or_too_far_apart_are_named() {
     let far = dir.path().join("far.obj");
     std::fs::write(&far, "v 0 0 0\nv 1e20 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let e = load_mesh(&far).unwrap_err();
+    assert_eq!(e.fault(), mirrorball_core::Fault::Input);
+    let e = e.to_string();
     assert!(e.contains("1e20") && e.contains("vertex 1"), "{e}");
     // Large but within what can be framed: loads.
     let big = dir.path().join("big.obj");

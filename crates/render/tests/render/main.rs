@@ -6,5 +6,6 @@ mod features;
 mod golden;
 mod hostile;
 mod meshes;
+mod names;
 mod rasterizer;
 mod util;

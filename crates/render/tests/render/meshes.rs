@@ -1,6 +1,7 @@
 //! Built-in meshes, the teapot, and loading files.
 
 use glam::{Mat4, Vec3};
+use mirrorball_core::Fault;
 use mirrorball_render::{load::load_mesh, mesh, teapot, Builtin};
 use std::path::Path;
 
@@ -121,12 +122,29 @@ fn refuses_draco_and_unknown_files_with_a_reason() {
     let draco = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/bunny.glb");
     if draco.exists() {
         let e = load_mesh(&draco).unwrap_err();
+        assert_eq!(e.fault(), Fault::Input, "{e}");
+        let e = e.to_string();
         assert!(e.to_lowercase().contains("draco"), "{e}");
     }
     let e = load_mesh(Path::new("x.stl")).unwrap_err();
+    assert_eq!(e.fault(), Fault::Request, "{e}");
+    let e = e.to_string();
     assert!(e.contains("unknown mesh format"), "{e}");
-    let e = load_mesh(Path::new("/nonexistent/x.obj")).unwrap_err();
-    assert!(e.contains("x.obj"), "{e}");
+    for missing in ["/nonexistent/x.obj", "/nonexistent/x.glb"] {
+        let e = load_mesh(Path::new(missing)).unwrap_err();
+        assert_eq!(e.fault(), Fault::Input, "{e}");
+        assert_eq!(e.path(), Path::new(missing));
+        let e = e.to_string();
+        assert!(e.contains(&missing[12..]), "{e}");
+    }
+    // A file that is there but malformed is the input's fault.
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in [("bad.obj", "v 0 0\nf 1 2 3\n"), ("bad.gltf", "{ not json")] {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        let e = load_mesh(&p).unwrap_err();
+        assert_eq!(e.fault(), Fault::Input, "{e}");
+    }
 }
 
 #[test]
