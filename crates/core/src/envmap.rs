@@ -3,6 +3,7 @@
 use crate::projection::{Projection, WorldProjection};
 use crate::Image;
 use glam::{DVec2, DVec3};
+use mirrorball_simd::{trunc_i32, F32x4, F32x8, I32x4, I32x8, M32x4, M32x8, X8};
 use rayon::prelude::*;
 use std::fmt;
 
@@ -266,39 +267,25 @@ fn valid(i: usize, x: f32, rgba: bool) -> bool {
     (0.0..f32::INFINITY).contains(&x) || (rgba && i % 4 == 3)
 }
 
-/// [`count_invalid`] of one block of whole texels, four values a step with SSE2 masks on
-/// x86-64 (a per-texel loop over three colours does not vectorise and ran ten times slower).
+/// [`count_invalid`] of one block of whole texels, four values a step with lane masks (a
+/// per-texel loop over three colours does not vectorise).
 fn count_block(block: &[f32], rgba: bool) -> u32 {
-    let scalar = |run: &[f32]| {
-        run.iter()
-            .enumerate()
-            .filter(|&(i, &x)| !valid(i, x, rgba))
-            .count() as u32
-    };
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        let quads = block.chunks_exact(4);
-        // Only RGB blocks leave a remainder, and it holds no alpha.
-        let mut n = scalar(quads.remainder());
-        // SAFETY: SSE2 is part of x86-64; each load is of the four floats of `quad`.
-        unsafe {
-            let (zero, inf) = (_mm_setzero_ps(), _mm_set1_ps(f32::INFINITY));
-            // RGBA: the fourth lane (alpha) always passes.
-            let keep = _mm_castsi128_ps(_mm_set_epi32(-(rgba as i32), 0, 0, 0));
-            for quad in quads {
-                let v = _mm_loadu_ps(quad.as_ptr());
-                let ok = _mm_or_ps(
-                    _mm_and_ps(_mm_cmpge_ps(v, zero), _mm_cmplt_ps(v, inf)),
-                    keep,
-                );
-                n += (_mm_movemask_ps(ok) ^ 0xF).count_ones();
-            }
-        }
-        n
+    let quads = block.chunks_exact(4);
+    // Only RGB blocks leave a remainder, and it holds no alpha.
+    let mut n = quads
+        .remainder()
+        .iter()
+        .filter(|&&x| !valid(0, x, rgba))
+        .count() as u32;
+    let (zero, inf) = (F32x4::splat(0.0), F32x4::splat(f32::INFINITY));
+    // RGBA: the fourth lane (alpha) always passes.
+    let keep = M32x4::from_bools([false, false, false, rgba]);
+    for quad in quads {
+        let v = F32x4::load(quad);
+        let ok = (v.ge(zero) & v.lt(inf)) | keep;
+        n += (ok.bitmask() ^ 0xF).count_ones();
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    scalar(block)
+    n
 }
 
 /// [`EnvMap::sanitize`] of one block of whole texels: counted first, read only, so that a
@@ -338,21 +325,79 @@ pub fn bilinear_corner(u: f32, v: f32, w: u32, h: u32) -> (i32, i32, f32, f32) {
     (x0, y0, x - x0 as f32, y - y0 as f32)
 }
 
-/// `x` truncated towards zero, as one instruction on x86-64 (`cvttss2si`, which gives
-/// `i32::MIN` for NaN and values outside the `i32` range, where Rust's saturating `as`
-/// needs four more); elsewhere `as`. The same for every `x` in the `i32` range.
+/// [`bilinear_corner`] of lanes of `(u, v)`, and which lanes' 2×2 texels lie inside the
+/// layer (`0 ≤ x0 < w − 1`, `0 ≤ y0 < h − 1`).
+#[derive(Clone, Copy, Debug)]
+pub struct CornerLanes<F, I, M> {
+    /// The top-left texels' columns.
+    pub x0: I,
+    /// The top-left texels' rows.
+    pub y0: I,
+    /// The fractions towards `+x`.
+    pub fx: F,
+    /// The fractions towards `+y`.
+    pub fy: F,
+    /// The lanes whose four texels are inside the layer.
+    pub inside: M,
+}
+
+/// [`bilinear_corner`]'s operations on lanes (the step down is the comparison's mask, −1
+/// where set, added), written once for four and eight lanes.
+macro_rules! corner_lanes {
+    ($u:expr, $v:expr, $w:expr, $h:expr, $splat:expr, $splat_i:expr, $f:ty) => {{
+        let (w, h) = ($w as i32, $h as i32);
+        let floor = |t: $f, n: i32| {
+            let c = t * $splat(n as f32) - $splat(0.5);
+            let ti = c.trunc_i32();
+            let t0 = ti + ti.to_f32().gt(c).to_i32();
+            (t0, c - t0.to_f32())
+        };
+        let ((x0, fx), (y0, fy)) = (floor($u, w), floor($v, h));
+        let lo = $splat_i(-1);
+        let inside = x0.gt(lo) & x0.lt($splat_i(w - 1)) & y0.gt(lo) & y0.lt($splat_i(h - 1));
+        CornerLanes {
+            x0,
+            y0,
+            fx,
+            fy,
+            inside,
+        }
+    }};
+}
+
+/// [`bilinear_corner`] of four lookups, lane by lane to the bit (tested).
 #[inline(always)]
-fn trunc_i32(x: f32) -> i32 {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: SSE2 is part of x86-64; the conversion is defined for every input.
-    unsafe {
-        use std::arch::x86_64::*;
-        _mm_cvttss_si32(_mm_set_ss(x))
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        x as i32
-    }
+pub fn bilinear_corner4(u: F32x4, v: F32x4, w: u32, h: u32) -> CornerLanes<F32x4, I32x4, M32x4> {
+    corner_lanes!(u, v, w, h, F32x4::splat, I32x4::splat, F32x4)
+}
+
+/// [`bilinear_corner`] of eight lookups, lane by lane to the bit (tested).
+#[inline(always)]
+pub fn bilinear_corner8(
+    x8: X8,
+    u: F32x8,
+    v: F32x8,
+    w: u32,
+    h: u32,
+) -> CornerLanes<F32x8, I32x8, M32x8> {
+    corner_lanes!(u, v, w, h, |t| x8.splat(t), |t| x8.splat_i32(t), F32x8)
+}
+
+/// The bilinear blend of four lanes each of the 2×2 texels `a b / c d` (`a` top left):
+/// `top = a + fx·(b − a)`, `bottom = c + fx·(d − c)`, `top + fy·(bottom − top)`, the
+/// arithmetic of every bilinear read in the workspace ([`lerp4`] is its scalar form, to the
+/// bit). `p` holds the first texel's channels from `p[0]`, the second's from `p[c]`, the
+/// row below `stride` floats on; four floats are read from each, so `p` must hold
+/// `stride + c + 4` (panics otherwise).
+#[inline(always)]
+pub fn bilinear_blend(p: &[f32], stride: usize, c: usize, fx: f32, fy: f32) -> F32x4 {
+    let p = &p[..stride + c + 4];
+    let (a, b) = (F32x4::load(p), F32x4::load(&p[c..]));
+    let (e, f) = (F32x4::load(&p[stride..]), F32x4::load(&p[stride + c..]));
+    let (vx, vy) = (F32x4::splat(fx), F32x4::splat(fy));
+    let top = a + vx * (b - a);
+    let bot = e + vx * (f - e);
+    top + vy * (bot - top)
 }
 
 /// `floor` as an integer without a libm call.
@@ -449,9 +494,8 @@ pub(crate) fn bilinear32_quad<const C: usize>(
 /// Bilinear blend of the 2×2 texels of `C` channels whose top-left texel starts at float
 /// `i` of `data` (rows `stride` floats apart), as four lanes: the `C` channels, then (for
 /// `C = 3`) a lane to ignore. `None` when a four-float read would pass the end of `data`
-/// (the last texels of an image), where [`lerp4`] serves. Same arithmetic as [`lerp4`],
-/// `a + f·(b − a)`, so results agree to the bit; on x86-64 one SSE2 operation per step
-/// instead of `C`.
+/// (the last texels of an image), where [`lerp4`] serves. [`bilinear_blend`]: the same
+/// arithmetic as [`lerp4`], so results agree to the bit.
 #[inline(always)]
 pub(crate) fn lerp_quad<const C: usize>(
     data: &[f32],
@@ -460,39 +504,8 @@ pub(crate) fn lerp_quad<const C: usize>(
     fx: f32,
     fy: f32,
 ) -> Option<[f32; 4]> {
-    if i + stride + C + 4 > data.len() {
-        return None;
-    }
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        // SAFETY: SSE2 is part of x86-64; the four unaligned 4-float reads end at
-        // `i + stride + C + 4 <= data.len()`, checked above.
-        unsafe {
-            let p = data.as_ptr().add(i);
-            let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(C)));
-            let (c, d) = (_mm_loadu_ps(p.add(stride)), _mm_loadu_ps(p.add(stride + C)));
-            let (vx, vy) = (_mm_set1_ps(fx), _mm_set1_ps(fy));
-            let top = _mm_add_ps(a, _mm_mul_ps(vx, _mm_sub_ps(b, a)));
-            let bot = _mm_add_ps(c, _mm_mul_ps(vx, _mm_sub_ps(d, c)));
-            let v = _mm_add_ps(top, _mm_mul_ps(vy, _mm_sub_ps(bot, top)));
-            let mut out = [0.0f32; 4];
-            _mm_storeu_ps(out.as_mut_ptr(), v);
-            Some(out)
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let mut out = [0.0f32; 4];
-        lerp4::<C>(
-            &data[i..i + 2 * C],
-            &data[i + stride..i + stride + 2 * C],
-            fx,
-            fy,
-            &mut out,
-        );
-        Some(out)
-    }
+    let p = data.get(i..i.checked_add(stride + C + 4)?)?;
+    Some(bilinear_blend(p, stride, C, fx, fy).to_array())
 }
 
 /// Bilinear blend of two rows of two `C`-channel texels.

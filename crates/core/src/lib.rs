@@ -27,17 +27,22 @@ mod remap;
 mod resample;
 
 pub use choice::{Choice, UnknownName};
-pub use envmap::{bilinear_corner, count_invalid, EnvMap, EnvMapError, Stats};
+pub use envmap::{
+    bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, count_invalid,
+    CornerLanes, EnvMap, EnvMapError, Stats,
+};
 pub use fault::Fault;
 pub use image::Image;
 pub use layout::{guess, Guess, Layout};
 pub use projection::{
     AngularMap, ContinuousCube, CubeFace, CubeMap, DirRun, DualParaboloid, EqualAreaOctahedral,
-    Fisheye, Frame, LatLong, Lens, Lookup, Mercator, Octahedral, Projection, ProjectionKind,
-    RadialMap, SphereMap, UnknownProjection, WorldProjection,
+    FaceLanes, Fisheye, Frame, LatLong, Lens, Lookup, Mercator, Octahedral, Projection,
+    ProjectionKind, RadialMap, SphereMap, UnknownProjection, WorldProjection,
 };
 pub use remap::{Remap, RemapError};
 pub use resample::{resample, resample_to_extent, ResampleOptions, Resampler, Rotation};
 
 pub use glam;
+/// The SIMD lanes the fast variants are written on.
+pub use mirrorball_simd as simd;
 pub use projection::quadrature;

@@ -17,10 +17,11 @@
 //! Memory: 8 bytes per output texel, plus 16 bytes per tap of the few texels that are
 //! integrated or straddle a seam (a 6×1024² cube from a 4096×2048 lat-long: about 60 MB).
 
-use crate::envmap::{lerp4, seam_taps};
+use crate::envmap::{bilinear_blend, lerp4, seam_taps};
 use crate::projection::{Projection, WorldProjection};
 use crate::resample::{Job, PointScratch, Pyramid, RowScratch};
 use crate::{EnvMap, Image, ResampleOptions};
+use mirrorball_simd::{prefetch, F32x4};
 use rayon::prelude::*;
 use std::fmt;
 
@@ -382,27 +383,15 @@ fn gather_row<const C: usize>(
     stride: usize,
     row: &mut [f32],
 ) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        // SAFETY: SSE2 is part of x86-64; `gather_row_sse` checks every read and write.
-        unsafe {
-            if single {
-                gather_row_sse::<C, true>(entries, planes, stride, row)
-            } else {
-                gather_row_sse::<C, false>(entries, planes, stride, row)
-            }
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let _ = single;
-        for (x, t) in entries.iter().enumerate() {
-            gather_one::<C>(t, planes, stride, &mut row[x * C..(x + 1) * C]);
-        }
+    if single {
+        gather_row_lanes::<C, true>(entries, planes, stride, row)
+    } else {
+        gather_row_lanes::<C, false>(entries, planes, stride, row)
     }
 }
 
-/// One texel of the bilinear pass, in plain arithmetic (the reference for the SSE2 loop).
+/// One texel of the bilinear pass, in plain arithmetic (the reference for the four-lane
+/// loop).
 #[inline(always)]
 fn gather_one<const C: usize>(
     t: &Texel,
@@ -426,49 +415,42 @@ fn gather_one<const C: usize>(
     }
 }
 
-/// Entries ahead of the current one whose source texels [`gather_row_sse`] prefetches.
-#[cfg(target_arch = "x86_64")]
+/// Entries ahead of the current one whose source texels [`gather_row_lanes`] prefetches.
 const AHEAD: usize = 24;
 
-/// The bilinear pass with SSE2: each texel's fractions decoded from its packed entry in
-/// one vector, its four source texels blended four channels at a time (`lerp4`'s
-/// arithmetic, so the same bits). `SINGLE`: the source has one layer, so the entry's layer
-/// bits are not decoded.
-#[cfg(target_arch = "x86_64")]
+/// The bilinear pass four channels at a time: each texel's four source texels blended with
+/// [`bilinear_blend`] (`lerp4`'s arithmetic, so the same bits). `SINGLE`: the source has
+/// one layer, so the entry's layer bits are not decoded.
 #[inline(always)]
-unsafe fn gather_row_sse<const C: usize, const SINGLE: bool>(
+fn gather_row_lanes<const C: usize, const SINGLE: bool>(
     entries: &[Texel],
     planes: &[&[f32]; MAX_LAYERS],
     stride: usize,
     row: &mut [f32],
 ) {
-    use std::arch::x86_64::*;
-    let q = _mm_set1_ps(1.0 / 65536.0);
-    let zero = _mm_setzero_si128();
+    const Q: f32 = 1.0 / 65536.0;
     let n = row.len();
-    let out = row.as_mut_ptr();
+    let plane = |idx: u32| {
+        if SINGLE {
+            planes[0]
+        } else {
+            planes[(idx >> INDEX_BITS) as usize & (MAX_LAYERS - 1)]
+        }
+    };
     for (x, t) in entries.iter().enumerate() {
         // The source texels of the entry a few ahead, asked for now (a hint: the lookups
         // of an output row wander over source rows, which the hardware does not foresee).
         if let Some(a) = entries.get(x + AHEAD) {
-            let data = if SINGLE {
-                planes[0]
-            } else {
-                planes[(a.idx >> INDEX_BITS) as usize & (MAX_LAYERS - 1)]
-            };
+            let data = plane(a.idx);
             let i = (a.idx & INDEX_MASK) as usize * C;
             if a.idx != NO_TEXEL && i + stride < data.len() {
-                let p = data.as_ptr().add(i) as *const i8;
-                _mm_prefetch::<_MM_HINT_T0>(p);
-                _mm_prefetch::<_MM_HINT_T0>(p.add(stride * 4));
+                let p = data.as_ptr().wrapping_add(i);
+                prefetch(p);
+                prefetch(p.wrapping_add(stride));
             }
         }
         let o = x * C;
-        let data = if SINGLE {
-            planes[0]
-        } else {
-            planes[(t.idx >> INDEX_BITS) as usize & (MAX_LAYERS - 1)]
-        };
+        let data = plane(t.idx);
         let i = (t.idx & INDEX_MASK) as usize * C;
         // An empty entry (NO_TEXEL) fails this test, as do the last texels of a row or an
         // image, where a four-float read or write would pass the end.
@@ -476,70 +458,33 @@ unsafe fn gather_row_sse<const C: usize, const SINGLE: bool>(
             gather_one::<C>(t, planes, stride, &mut row[o..o + C]);
             continue;
         }
-        // The entry's fractions: bytes 4..8 of the (repr(C)) entry are fx, fy as u16.
-        let e = _mm_loadl_epi64(t as *const Texel as *const __m128i);
-        let f = _mm_mul_ps(
-            _mm_cvtepi32_ps(_mm_unpacklo_epi16(_mm_srli_si128::<4>(e), zero)),
-            q,
-        );
-        let (vx, vy) = (_mm_shuffle_ps::<0x00>(f, f), _mm_shuffle_ps::<0x55>(f, f));
-        let p = data.as_ptr().add(i);
-        let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(C)));
-        let (c, d) = (_mm_loadu_ps(p.add(stride)), _mm_loadu_ps(p.add(stride + C)));
-        let top = _mm_add_ps(a, _mm_mul_ps(vx, _mm_sub_ps(b, a)));
-        let bot = _mm_add_ps(c, _mm_mul_ps(vx, _mm_sub_ps(d, c)));
+        let (fx, fy) = (t.fx as f32 * Q, t.fy as f32 * Q);
         // Four lanes; for C = 3 the fourth lands on the next texel's first channel, which
         // that texel (or the zero of an empty one) overwrites next.
-        _mm_storeu_ps(
-            out.add(o),
-            _mm_add_ps(top, _mm_mul_ps(vy, _mm_sub_ps(bot, top))),
-        );
+        bilinear_blend(&data[i..], stride, C, fx, fy).store(&mut row[o..]);
     }
 }
 
-/// The weighted sum of `taps` over the layers of one mip level, into `out`.
+/// The weighted sum of `taps` over the layers of one mip level, into `out`: four channels
+/// at once wherever a four-float read fits.
 #[inline(always)]
 fn sum_taps<const C: usize>(taps: &[Tap], level: &[Image], out: &mut [f32]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        // SSE2 (part of x86-64): four channels at once wherever a four-float read fits.
-        // SAFETY: each read is checked against its layer's length first.
-        unsafe {
-            let mut acc = _mm_setzero_ps();
-            let mut tail = [0.0f32; C];
-            for t in taps {
-                let data = level[(t.idx >> INDEX_BITS) as usize].data();
-                let i = (t.idx & INDEX_MASK) as usize * C;
-                if i + 4 <= data.len() {
-                    let v = _mm_loadu_ps(data.as_ptr().add(i));
-                    acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(t.w), v));
-                } else if let Some(v) = data.get(i..i + C) {
-                    for c in 0..C {
-                        tail[c] += t.w * v[c];
-                    }
-                }
-            }
-            let mut lanes = [0.0f32; 4];
-            _mm_storeu_ps(lanes.as_mut_ptr(), acc);
+    let mut acc = F32x4::splat(0.0);
+    let mut tail = [0.0f32; C];
+    for t in taps {
+        let data = level[(t.idx >> INDEX_BITS) as usize].data();
+        let i = (t.idx & INDEX_MASK) as usize * C;
+        if i + 4 <= data.len() {
+            acc = acc + F32x4::splat(t.w) * F32x4::load(&data[i..]);
+        } else if let Some(v) = data.get(i..i + C) {
             for c in 0..C {
-                out[c] = lanes[c] + tail[c];
+                tail[c] += t.w * v[c];
             }
         }
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let mut acc = [0.0f32; C];
-        for t in taps {
-            let data = level[(t.idx >> INDEX_BITS) as usize].data();
-            let i = (t.idx & INDEX_MASK) as usize * C;
-            if let Some(v) = data.get(i..i + C) {
-                for c in 0..C {
-                    acc[c] += t.w * v[c];
-                }
-            }
-        }
-        out.copy_from_slice(&acc);
+    let lanes = acc.to_array();
+    for c in 0..C {
+        out[c] = lanes[c] + tail[c];
     }
 }
 

@@ -15,10 +15,11 @@
 //!
 //! The work runs in parallel over rows with rayon and allocates nothing per texel.
 
-use crate::envmap::{bilinear32, bilinear32_quad, bilinear_corner, lerp_quad};
+use crate::envmap::{bilinear32, bilinear32_quad, bilinear_corner, bilinear_corner4, lerp_quad};
 use crate::projection::{DirRun, Lookup, Projection, WorldProjection};
 use crate::{EnvMap, Image};
 use glam::{DMat3, DVec3};
+use mirrorball_simd::{prefetch as prefetch_line, F32x4, M32x4};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -399,97 +400,51 @@ fn one_layer<'a>(layers: &'a [Image], look: &[Lookup]) -> Option<(u32, &'a Image
     Some((layer, layers.get(layer as usize)?))
 }
 
-/// Four [`Lookup`]s as four lanes each of layer (bits), `u`, `v` and density.
-///
-/// # Safety
-/// `look` holds at least four lookups.
-#[cfg(target_arch = "x86_64")]
+/// One field of the first four [`Lookup`]s of `look` as lanes.
 #[inline(always)]
-unsafe fn load4(
-    look: &[Lookup],
-) -> (
-    std::arch::x86_64::__m128,
-    std::arch::x86_64::__m128,
-    std::arch::x86_64::__m128,
-    std::arch::x86_64::__m128,
-) {
-    use std::arch::x86_64::*;
-    debug_assert!(look.len() >= 4);
-    // `Lookup` is `repr(C)`: four 4-byte fields; four lookups are sixteen floats' bytes.
-    let p = look.as_ptr() as *const f32;
-    let (mut l, mut u, mut v, mut d) = (
-        _mm_loadu_ps(p),
-        _mm_loadu_ps(p.add(4)),
-        _mm_loadu_ps(p.add(8)),
-        _mm_loadu_ps(p.add(12)),
-    );
-    _MM_TRANSPOSE4_PS(&mut l, &mut u, &mut v, &mut d);
-    (l, u, v, d)
+fn lanes(look: &[Lookup], f: impl Fn(&Lookup) -> f32) -> F32x4 {
+    let look = &look[..4];
+    F32x4::from_array([f(&look[0]), f(&look[1]), f(&look[2]), f(&look[3])])
 }
 
 /// The [`Tap`]s of four lookups at `(u, v)` on `img` (layer `layer`), when all four lanes
-/// of `ok` are set and every lookup is what [`inner_tap`] makes a tap of: [`bilinear_corner`]
-/// four lanes at once (the same operations, so the same corners and fractions to the bit),
-/// the bounds as `inner_tap` has them. Else `None`.
-#[cfg(target_arch = "x86_64")]
+/// of `ok` are set and every lookup is what [`inner_tap`] makes a tap of:
+/// [`bilinear_corner4`] (so the same corners and fractions to the bit), the bounds as
+/// `inner_tap` has them. Else `None`.
 #[inline(always)]
 fn corner_taps4<const C: usize>(
     img: &Image,
     layer: u32,
-    u: std::arch::x86_64::__m128,
-    v: std::arch::x86_64::__m128,
-    ok: std::arch::x86_64::__m128,
+    u: F32x4,
+    v: F32x4,
+    ok: M32x4,
 ) -> Option<[Tap; 4]> {
-    use std::arch::x86_64::*;
-    // SAFETY: SSE2 is part of x86-64; the stores go to local arrays of four lanes.
-    unsafe {
-        let (w, h) = (img.width() as i32, img.height() as i32);
-        let half = _mm_set1_ps(0.5);
-        let x = _mm_sub_ps(_mm_mul_ps(u, _mm_set1_ps(w as f32)), half);
-        let y = _mm_sub_ps(_mm_mul_ps(v, _mm_set1_ps(h as f32)), half);
-        let floor = |x: __m128| {
-            let xi = _mm_cvttps_epi32(x);
-            // −1 (all ones) where truncation went up: below zero.
-            let up = _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(xi), x));
-            _mm_add_epi32(xi, up)
-        };
-        let (x0, y0) = (floor(x), floor(y));
-        let fx = _mm_sub_ps(x, _mm_cvtepi32_ps(x0));
-        let fy = _mm_sub_ps(y, _mm_cvtepi32_ps(y0));
-        // Inside: 0 ≤ x0 < w − 1 and 0 ≤ y0 < h − 1.
-        let minus1 = _mm_set1_epi32(-1);
-        let inside = _mm_and_si128(
-            _mm_and_si128(_mm_cmpgt_epi32(x0, minus1), _mm_cmpgt_epi32(y0, minus1)),
-            _mm_and_si128(
-                _mm_cmplt_epi32(x0, _mm_set1_epi32(w - 1)),
-                _mm_cmplt_epi32(y0, _mm_set1_epi32(h - 1)),
-            ),
-        );
-        if _mm_movemask_ps(_mm_and_ps(ok, _mm_castsi128_ps(inside))) != 0xF {
+    let c = bilinear_corner4(u, v, img.width(), img.height());
+    if !(ok & c.inside).all() {
+        return None;
+    }
+    let (xs, ys, fxs, fys) = (
+        c.x0.to_array(),
+        c.y0.to_array(),
+        c.fx.to_array(),
+        c.fy.to_array(),
+    );
+    // As inner_tap: the start, and the reads' end inside the layer.
+    let (stride, len) = (img.width() as usize * C, img.data().len());
+    let mut taps = [NO_TAP; 4];
+    for (k, t) in taps.iter_mut().enumerate() {
+        let at = ys[k] as usize * stride + xs[k] as usize * C;
+        if at + stride + C + 4 > len {
             return None;
         }
-        let (mut xs, mut ys, mut fxs, mut fys) = ([0i32; 4], [0i32; 4], [0f32; 4], [0f32; 4]);
-        _mm_storeu_si128(xs.as_mut_ptr() as *mut __m128i, x0);
-        _mm_storeu_si128(ys.as_mut_ptr() as *mut __m128i, y0);
-        _mm_storeu_ps(fxs.as_mut_ptr(), fx);
-        _mm_storeu_ps(fys.as_mut_ptr(), fy);
-        // As inner_tap: the start, and the reads' end inside the layer.
-        let (stride, len) = (w as usize * C, img.data().len());
-        let mut taps = [NO_TAP; 4];
-        for (k, t) in taps.iter_mut().enumerate() {
-            let at = ys[k] as usize * stride + xs[k] as usize * C;
-            if at + stride + C + 4 > len {
-                return None;
-            }
-            *t = Tap {
-                layer,
-                at: u32::try_from(at).ok()?,
-                fx: fxs[k],
-                fy: fys[k],
-            };
-        }
-        Some(taps)
+        *t = Tap {
+            layer,
+            at: u32::try_from(at).ok()?,
+            fx: fxs[k],
+            fy: fys[k],
+        };
     }
+    Some(taps)
 }
 
 /// In [`PointScratch::staps`]: a point that adds nothing (no weight, or no direction).
@@ -519,15 +474,11 @@ fn point_taps<const C: usize>(lv: &[Image], weight: &[f32], look: &[Lookup], tap
         }
     };
     let mut k = 0;
-    #[cfg(target_arch = "x86_64")]
     while k + 4 <= look.len() {
         let (w4, l4) = (&weight[k..k + 4], &look[k..k + 4]);
-        // SAFETY: SSE2 is part of x86-64; `l4` and `w4` hold four values each.
-        let four = one_layer(lv, l4).and_then(|(layer, img)| unsafe {
-            use std::arch::x86_64::*;
-            let (_, u, v, _) = load4(l4);
-            let ok = _mm_cmpgt_ps(_mm_loadu_ps(w4.as_ptr()), _mm_setzero_ps());
-            corner_taps4::<C>(img, layer, u, v, ok)
+        let four = one_layer(lv, l4).and_then(|(layer, img)| {
+            let ok = F32x4::load(w4).gt(F32x4::splat(0.0));
+            corner_taps4::<C>(img, layer, lanes(l4, |l| l.u), lanes(l4, |l| l.v), ok)
         });
         match four {
             Some(t) => taps[k..k + 4].copy_from_slice(&t),
@@ -547,24 +498,15 @@ fn point_taps<const C: usize>(lv: &[Image], weight: &[f32], look: &[Lookup], tap
 /// Taps ahead of the current one whose source texels [`gather`] asks for.
 const AHEAD: usize = 24;
 
-/// Asks for the source texels of `tap` ahead of reading them (a hint: nothing off x86-64,
-/// or for [`NO_TAP`]).
+/// Asks for the source texels of `tap` (its two rows) ahead of reading them (a hint:
+/// nothing for [`NO_TAP`]).
 #[inline(always)]
 fn prefetch<const C: usize>(tap: &Tap, layers: &[Image]) {
-    #[cfg(target_arch = "x86_64")]
     if let Some(img) = layers.get(tap.layer as usize) {
-        // SAFETY: a prefetch never faults; `inner_tap` put both addresses (the tap's two
-        // rows) inside the layer.
-        unsafe {
-            use std::arch::x86_64::*;
-            let p = img.data().as_ptr().add(tap.at as usize);
-            let stride = img.width() as usize * C;
-            _mm_prefetch::<_MM_HINT_T0>(p as *const i8);
-            _mm_prefetch::<_MM_HINT_T0>(p.add(stride) as *const i8);
-        }
+        let p = img.data().as_ptr().wrapping_add(tap.at as usize);
+        prefetch_line(p);
+        prefetch_line(p.wrapping_add(img.width() as usize * C));
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (tap, layers);
 }
 
 /// Writes every texel of `row`: its [`Tap`]'s bilinear blend, or zero for [`NO_TAP`].
@@ -815,8 +757,8 @@ impl Job {
     /// makes a plain inner lookup of (a direction, one bilinear lookup, its 2×2 texels
     /// inside one layer), all on the same layer; else `None`, and they are sorted one at a
     /// time. The same arithmetic as [`bilinear_corner`] and
-    /// [`integration_ratio`](Self::integration_ratio), four lanes at once with SSE2, so the
-    /// same taps to the bit (tested); elsewhere always `None`.
+    /// [`integration_ratio`](Self::integration_ratio), four lanes at once, so the same taps
+    /// to the bit (tested).
     #[inline(always)]
     fn inner_taps4<const C: usize>(
         &self,
@@ -825,31 +767,18 @@ impl Job {
         look: &[Lookup],
     ) -> Option<[Tap; 4]> {
         let (layer, img) = one_layer(base, look)?;
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: SSE2 is part of x86-64; `look` holds four lookups (its layers read above).
-        unsafe {
-            use std::arch::x86_64::*;
-            let (_, u, v, d) = load4(look);
-            let dd = _mm_loadu_ps(dens.as_ptr());
-            let zero = _mm_setzero_ps();
-            // A direction (ddens ≥ 0; NaN fails) and one bilinear lookup: ratio < 4, where
-            // ratio = ddens·area/density (∞ where density ≤ 0), or max_n = 1, or ddens = 0.
-            let mut ok = _mm_cmpge_ps(dd, zero);
-            if self.max_n != 1 {
-                let ratio = _mm_div_ps(_mm_mul_ps(dd, _mm_set1_ps(self.area)), d);
-                let small = _mm_and_ps(
-                    _mm_cmpgt_ps(d, zero),
-                    _mm_cmplt_ps(ratio, _mm_set1_ps(BILINEAR_MAX_RATIO as f32)),
-                );
-                ok = _mm_and_ps(ok, _mm_or_ps(small, _mm_cmpeq_ps(dd, zero)));
-            }
-            corner_taps4::<C>(img, layer, u, v, ok)
+        let dd = F32x4::from_array(*dens);
+        let d = lanes(look, |l| l.density);
+        let zero = F32x4::splat(0.0);
+        // A direction (ddens ≥ 0; NaN fails) and one bilinear lookup: ratio < 4, where
+        // ratio = ddens·area/density (∞ where density ≤ 0), or max_n = 1, or ddens = 0.
+        let mut ok = dd.ge(zero);
+        if self.max_n != 1 {
+            let ratio = dd * F32x4::splat(self.area) / d;
+            let small = d.gt(zero) & ratio.lt(F32x4::splat(BILINEAR_MAX_RATIO as f32));
+            ok = ok & (small | dd.eq(zero));
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            let _ = (img, dens);
-            None
-        }
+        corner_taps4::<C>(img, layer, lanes(look, |l| l.u), lanes(look, |l| l.v), ok)
     }
 
     /// Integrates the output texels `xs` of row `y`, which share a `(level, n)` grid: their

@@ -18,8 +18,9 @@
 //! larger); placing each at its centroid leaves an error of second order in the node's size
 //! over the lobe's scale.
 
-use crate::cube::{face_to_world, FaceGeometry};
+use crate::cube::FaceGeometry;
 use glam::{Vec3, Vec4};
+use mirrorball_core::CubeFace;
 use mirrorball_core::EnvMap;
 
 /// Bright clusters at one level, structure-of-arrays; each cluster of level `m ≥ 1` owns a
@@ -138,7 +139,7 @@ pub(crate) fn split(cube: &mut EnvMap, k: f32, max_texels: usize) -> Option<Brig
             for v in &mut p[..3] {
                 *v *= s;
             }
-            let d = face_to_world(f, Vec3::new(g[0], g[1], g[2]));
+            let d = CubeFace::from_face(f, Vec3::new(g[0], g[1], g[2]));
             level.push(d, ex * g[3], (0, 0));
             level
                 .texel
@@ -290,7 +291,7 @@ impl BrightWalk {
                 let r2 = 1.0 + a * a + b * b;
                 let inv = r2.sqrt().recip();
                 let w = inv * inv * inv;
-                let d = face_to_world(t[0] as usize, Vec3::new(a, b, 1.0) * inv);
+                let d = CubeFace::from_face(t[0] as usize, Vec3::new(a, b, 1.0) * inv);
                 let c = n.dot(d);
                 if c > 0.0 {
                     kw += w * self.kernel.eval(c);

@@ -9,16 +9,9 @@ use crate::lobe::Lobe;
 use crate::mip::{downsample, MipFilter};
 use glam::{Vec3, Vec4};
 use mirrorball_core::{
-    resample, CubeMap, EnvMap, Image, Projection, ResampleOptions, WorldProjection,
+    resample, CubeFace, CubeMap, EnvMap, Image, Projection, ResampleOptions, WorldProjection,
 };
 use rayon::prelude::*;
-
-/// The face OpenGL selects for `d` and `(sc, tc, |ma|)` (OpenGL 4.6 table 8.19), in `f32`,
-/// with the same tie rules as [`mirrorball_core::CubeFace::select`] (x, then y).
-#[inline(always)]
-pub(crate) fn select(d: Vec3) -> (usize, f32, f32, f32) {
-    mirrorball_core::CubeFace::select_f32(d)
-}
 
 /// `log₂ x` for positive normal `x`, to about 2e-4 (exponent plus a quartic in the
 /// mantissa, least-squares fit on `[1, 2)` with `p(1) = 0`). Mip level selection needs no
@@ -201,7 +194,7 @@ impl SeamlessCube {
     /// the texel's `uv` area, and `1 + a² + b² = 1/ma²` for a unit direction).
     #[inline(always)]
     pub fn lookup(&self, d: Vec3, half_log2_omega: f32) -> Vec4 {
-        let (face, sc, tc, ma) = select(d);
+        let (face, sc, tc, ma) = CubeFace::select_f32(d);
         let inv = 0.5 / ma;
         let (u, v) = (sc * inv + 0.5, tc * inv + 0.5);
         let lod = half_log2_omega - self.half_log2_texel0 - 1.5 * fast_log2(ma);
@@ -432,20 +425,6 @@ impl FaceGeometry {
     }
 }
 
-/// The world direction of a face-local vector `(x, y, z)` = `(a, b, 1)·s` on `face`: the
-/// same map as [`mirrorball_core::CubeFace::point`], linear in its arguments.
-#[inline(always)]
-pub(crate) fn face_to_world(face: usize, l: Vec3) -> Vec3 {
-    match face {
-        0 => Vec3::new(l.z, -l.y, -l.x),
-        1 => Vec3::new(-l.z, -l.y, l.x),
-        2 => Vec3::new(l.x, l.z, l.y),
-        3 => Vec3::new(l.x, -l.z, -l.y),
-        4 => Vec3::new(l.x, -l.y, l.z),
-        _ => Vec3::new(-l.x, -l.y, -l.z),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -460,11 +439,11 @@ mod tests {
             let a = t * std::f64::consts::TAU;
             let d = DVec3::new(r * a.cos(), z, r * a.sin());
             let (f, uv) = CubeMap.dir_to_uv(d).unwrap();
-            let (g, sc, tc, ma) = select(d.as_vec3());
+            let (g, sc, tc, ma) = CubeFace::select_f32(d.as_vec3());
             assert_eq!(f, g);
             assert!(((sc / ma * 0.5 + 0.5) as f64 - uv.x).abs() < 1e-5);
             assert!(((tc / ma * 0.5 + 0.5) as f64 - uv.y).abs() < 1e-5);
-            let w = face_to_world(f, Vec3::new(sc / ma, tc / ma, 1.0) * ma);
+            let w = CubeFace::from_face(f, Vec3::new(sc / ma, tc / ma, 1.0) * ma);
             assert!((w.as_dvec3() - d).length() < 1e-5);
         }
     }

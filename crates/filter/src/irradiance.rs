@@ -22,9 +22,10 @@
 //! * Spherical harmonics ([`crate::sh`]): nine numbers, evaluated anywhere in a few
 //!   nanoseconds; exact only for environments of bands 0–2 (Ramamoorthi & Hanrahan 2001).
 
-use crate::cube::{face_to_world, FaceGeometry};
+use crate::cube::FaceGeometry;
 use crate::sh::{Sh9, Window};
 use glam::{Vec3, Vec4};
+use mirrorball_core::CubeFace;
 use mirrorball_core::{EnvMap, Image, Projection};
 use rayon::prelude::*;
 
@@ -38,19 +39,6 @@ pub(crate) struct MomentPyramid {
     levels: Vec<Vec<[Vec4; 4]>>,
     /// `1/Σ E` per channel (and `1/4π`).
     inv_total: Vec4,
-}
-
-/// World → face-local coordinates: the transpose of [`face_to_world`].
-#[inline(always)]
-pub(crate) fn world_to_face(face: usize, w: Vec3) -> Vec3 {
-    match face {
-        0 => Vec3::new(-w.z, -w.y, w.x),
-        1 => Vec3::new(w.z, -w.y, -w.x),
-        2 => Vec3::new(w.x, w.z, w.y),
-        3 => Vec3::new(w.x, -w.z, -w.y),
-        4 => Vec3::new(w.x, -w.y, w.z),
-        _ => Vec3::new(-w.x, -w.y, -w.z),
-    }
 }
 
 impl MomentPyramid {
@@ -95,7 +83,7 @@ impl MomentPyramid {
                                 None => {
                                     let i = cy * s2 + cx;
                                     let g = geom.texels[i];
-                                    let d = face_to_world(f, Vec3::new(g[0], g[1], g[2]));
+                                    let d = CubeFace::from_face(f, Vec3::new(g[0], g[1], g[2]));
                                     let e = base[f * s2 * s2 + i] * g[3];
                                     [e, e * d.x, e * d.y, e * d.z]
                                 }
@@ -143,7 +131,7 @@ impl MomentPyramid {
         let mut sp = 0usize;
         let mut nl = [Vec3::ZERO; 6];
         for (f, nlf) in nl.iter_mut().enumerate() {
-            *nlf = world_to_face(f, n);
+            *nlf = CubeFace::to_face(f, n);
             stack[sp] = (top as u8, f as u8, 0, 0);
             sp += 1;
         }
@@ -230,18 +218,4 @@ pub fn irradiance_map_sh(sh: &Sh9, window: Window, out: Projection, size: u32) -
         let v = conv.eval(d);
         [v[0] as f32, v[1] as f32, v[2] as f32, 1.0]
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::cube::face_to_world;
-
-    #[test]
-    fn world_to_face_inverts() {
-        let v = Vec3::new(0.3, -0.7, 0.2);
-        for f in 0..6 {
-            assert!((face_to_world(f, world_to_face(f, v)) - v).length() < 1e-6);
-        }
-    }
 }

@@ -42,8 +42,9 @@
 //! irradiance non-negative everywhere (found by bisection on `1/w`; `w = 1` keeps band 0
 //! only, which is always non-negative).
 
-use crate::cube::{face_to_world, FaceGeometry};
+use crate::cube::FaceGeometry;
 use glam::{DVec2, DVec3, Vec3};
+use mirrorball_core::CubeFace;
 use mirrorball_core::{EnvMap, ProjectionKind, WorldProjection};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -267,7 +268,7 @@ pub fn project(env: &EnvMap) -> Sh9 {
                 let g = &geom.texels[y * w..(y + 1) * w];
                 let mut acc = [[0.0f32; 3]; 9];
                 for (px, g) in data.chunks_exact(c).zip(g) {
-                    let d = face_to_world(f, Vec3::new(g[0], g[1], g[2]));
+                    let d = CubeFace::from_face(f, Vec3::new(g[0], g[1], g[2]));
                     let b = basis_f32(d);
                     let l = [px[0] * g[3], px[1] * g[3], px[2] * g[3]];
                     for (a, bi) in acc.iter_mut().zip(b) {

@@ -44,6 +44,8 @@
 use crate::cube::SeamlessCube;
 use crate::lobe::Lobe;
 use glam::{DVec3, Vec3, Vec4};
+use mirrorball_core::simd::F32x4;
+use mirrorball_core::CubeMap;
 use std::f64::consts::PI;
 
 /// Which roughness each mip level of a prefiltered chain holds.
@@ -301,9 +303,9 @@ fn gather4(
 /// The filtered-importance-sampling estimate of the lobe about `n`, with `floor` the
 /// `½ log₂` of the least solid angle a sample may stand for (the output texel's).
 ///
-/// Four samples at a time: rotation into the frame, OpenGL face selection (table 8.19, the
-/// same ties as [`CubeFace::select`](mirrorball_core::CubeFace::select)), face coordinates
-/// and mip level are computed in SIMD lanes; the four trilinear fetches follow.
+/// Four samples at a time: rotation into the frame, OpenGL face selection and face
+/// coordinates ([`CubeMap::uv4`]) and mip level are computed in SIMD lanes; the four
+/// trilinear fetches follow.
 #[inline]
 pub(crate) fn fis(cube: &SeamlessCube, set: &SampleSet, n: Vec3, floor: f32) -> Vec4 {
     let (t, b) = frame(n);
@@ -313,7 +315,6 @@ pub(crate) fn fis(cube: &SeamlessCube, set: &SampleSet, n: Vec3, floor: f32) -> 
     let floor4 = Vec4::splat(floor);
     let c0 = Vec4::splat(cube.half_log2_texel0());
     let zero = Vec4::ZERO;
-    let half = Vec4::splat(0.5);
     let last = Vec4::splat(cube.last_lod());
     let top = cube.last_lod() as usize;
     let mut acc = Vec4::ZERO;
@@ -322,40 +323,24 @@ pub(crate) fn fis(cube: &SeamlessCube, set: &SampleSet, n: Vec3, floor: f32) -> 
         let lx = tx * sx + bx * sy + nx * sz;
         let ly = ty * sx + by * sy + ny * sz;
         let lz = tz * sx + bz * sy + nz * sz;
-        let (ax, ay, az) = (lx.abs(), ly.abs(), lz.abs());
-        let is_x = ax.cmpge(ay) & ax.cmpge(az);
-        let is_y = !is_x & ay.cmpge(az);
-        let (neg_x, neg_y, neg_z) = (lx.cmplt(zero), ly.cmplt(zero), lz.cmplt(zero));
-        let ma = Vec4::select(is_x, ax, Vec4::select(is_y, ay, az));
-        let sc = Vec4::select(
-            is_x,
-            Vec4::select(neg_x, lz, -lz),
-            Vec4::select(is_y, lx, Vec4::select(neg_z, -lx, lx)),
+        // OpenGL's face and (u, v) of the four directions: core's table, four lanes.
+        let lanes = |v: Vec4| F32x4::from_array(v.to_array());
+        let at = CubeMap::uv4(lanes(lx), lanes(ly), lanes(lz));
+        let (u, v) = (
+            Vec4::from_array(at.sc.to_array()),
+            Vec4::from_array(at.tc.to_array()),
         );
-        let tc = Vec4::select(is_y, Vec4::select(neg_y, -lz, lz), -ly);
-        let face = Vec4::select(
-            is_x,
-            Vec4::select(neg_x, Vec4::ONE, zero),
-            Vec4::select(
-                is_y,
-                Vec4::select(neg_y, Vec4::splat(3.0), Vec4::splat(2.0)),
-                Vec4::select(neg_z, Vec4::splat(5.0), Vec4::splat(4.0)),
-            ),
-        );
-        let inv = half / ma;
-        let u = sc * inv + half;
-        let v = tc * inv + half;
+        let ma = Vec4::from_array(at.ma.to_array());
         let lod = (hl.max(floor4) - c0 - log2_major(ma) * 1.5)
             .max(zero)
             .min(last);
         let l0 = lod.trunc();
         let f = lod - l0;
         let l0 = (l0 + MAGIC).to_array();
-        let faces = (face + MAGIC).to_array();
         // Level parameters per lane (size, where the lane's face starts, the stride), for
         // the level below the sample's lod, and above it only when some lane blends in.
         let lanes_l0 = l0.map(lane_index);
-        let lanes_face = faces.map(lane_index);
+        let lanes_face = at.layer.to_array().map(|l| l as usize);
         let params = |level: [usize; 4]| {
             let mut p = ([0.0f32; 4], [0usize; 4], [0usize; 4]);
             for k in 0..4 {

@@ -19,6 +19,7 @@ use exr::prelude::{
     ChannelDescription, Compression, Encoding, LayerAttributes, LineOrder, ReadChannels,
     ReadLayers, SampleType, SpecificChannels, Vec2, WritableImage,
 };
+use mirrorball_core::simd::F32x4;
 use mirrorball_core::{Image, ProjectionKind};
 use std::fs::File;
 use std::io::BufReader;
@@ -918,8 +919,8 @@ fn read_zip_file(
 }
 
 /// [`pack_lines`] for float channels (`layout` all [`SampleType::F32`], `c` 3 or 4): each
-/// texel's samples stored straight into their channels' planes, on x86-64 four texels a
-/// step (an SSE2 transpose of RGB(A) into R, G, B (and A) lanes), the rest one at a time.
+/// texel's samples stored straight into their channels' planes, four texels a step (a
+/// transpose of RGB(A) into R, G, B (and A) lanes), the rest one at a time.
 fn pack_float_lines(
     rows: &[f32],
     w: usize,
@@ -937,52 +938,27 @@ fn pack_float_lines(
         .zip(out.chunks_exact_mut(c * 4 * w))
     {
         let mut x = 0;
-        #[cfg(target_arch = "x86_64")]
         if line.len() == c * 4 * w && row.len() == w * c {
-            use std::arch::x86_64::*;
-            // SAFETY: SSE2 is part of x86-64. Reads: `c` × 4 floats from texel x with
-            // x + 4 <= w, inside `row` (w·c floats). Writes: 16 bytes at plane[k] + 4x,
-            // inside the line's c planes of 4w bytes (checked above).
-            unsafe {
-                let (src, dst) = (row.as_ptr(), line.as_mut_ptr());
-                let put = |k: usize, x: usize, v: __m128| {
-                    _mm_storeu_ps(dst.add(plane[k] + 4 * x) as *mut f32, v);
-                };
-                while x + 4 <= w {
-                    let p = src.add(x * c);
-                    if c == 4 {
-                        let (mut r, mut g, mut b, mut a) = (
-                            _mm_loadu_ps(p),
-                            _mm_loadu_ps(p.add(4)),
-                            _mm_loadu_ps(p.add(8)),
-                            _mm_loadu_ps(p.add(12)),
-                        );
-                        _MM_TRANSPOSE4_PS(&mut r, &mut g, &mut b, &mut a);
-                        put(3, x, a);
-                        put(0, x, r);
-                        put(1, x, g);
-                        put(2, x, b);
-                    } else {
-                        // [r0 g0 b0 r1] [g1 b1 r2 g2] [b2 r3 g3 b3] (the scatter's inverse)
-                        let (o0, o1, o2) = (
-                            _mm_loadu_ps(p),
-                            _mm_loadu_ps(p.add(4)),
-                            _mm_loadu_ps(p.add(8)),
-                        );
-                        let rr = _mm_shuffle_ps::<0b01_01_10_10>(o1, o2); // r2 r2 r3 r3
-                        let r = _mm_shuffle_ps::<0b10_00_11_00>(o0, rr); // r0 r1 r2 r3
-                        let g01 = _mm_shuffle_ps::<0b00_00_01_01>(o0, o1); // g0 g0 g1 g1
-                        let g23 = _mm_shuffle_ps::<0b10_10_11_11>(o1, o2); // g2 g2 g3 g3
-                        let g = _mm_shuffle_ps::<0b10_00_10_00>(g01, g23); // g0 g1 g2 g3
-                        let b01 = _mm_shuffle_ps::<0b01_01_10_10>(o0, o1); // b0 b0 b1 b1
-                        let b23 = _mm_shuffle_ps::<0b11_11_00_00>(o2, o2); // b2 b2 b3 b3
-                        let b = _mm_shuffle_ps::<0b10_00_10_00>(b01, b23); // b0 b1 b2 b3
-                        put(0, x, r);
-                        put(1, x, g);
-                        put(2, x, b);
-                    }
-                    x += 4;
+            let mut put = |k: usize, x: usize, v: F32x4| {
+                v.store_le_bytes(&mut line[plane[k] + 4 * x..]);
+            };
+            while x + 4 <= w {
+                let p = &row[x * c..];
+                if c == 4 {
+                    let [r, g, b, a] =
+                        F32x4::transpose(std::array::from_fn(|k| F32x4::load(&p[4 * k..])));
+                    put(3, x, a);
+                    put(0, x, r);
+                    put(1, x, g);
+                    put(2, x, b);
+                } else {
+                    let [r, g, b] =
+                        F32x4::deinterleave3(std::array::from_fn(|k| F32x4::load(&p[4 * k..])));
+                    put(0, x, r);
+                    put(1, x, g);
+                    put(2, x, b);
                 }
+                x += 4;
             }
         }
         for x in x..w {
@@ -1002,8 +978,8 @@ fn all_float(layout: &[(usize, SampleType)]) -> bool {
 /// [`scatter`] for a ZIP block of float lines (`layout` all [`SampleType::F32`], 3 or 4
 /// channels) still split into even- and odd-offset bytes ([`crate::exr_zip::Lines`]):
 /// each float is put together from the two halves as it is stored, so the raw bytes are
-/// never written out. On x86-64 four texels a step: each channel's four floats from one
-/// SSE2 byte interleave, then transposed into RGB(A) order.
+/// never written out. Four texels a step: each channel's four floats from one byte
+/// interleave, then transposed into RGB(A) order.
 fn scatter_split_f32(
     evens: &[u8],
     odds: &[u8],
@@ -1031,55 +1007,31 @@ fn scatter_split_f32(
         let base = y * half_line;
         let p = plane.map(|o| base + o);
         let mut x = 0;
-        #[cfg(target_arch = "x86_64")]
         if evens.len() >= base + half_line && odds.len() >= base + half_line {
-            use std::arch::x86_64::*;
-            // SAFETY: SSE2 is part of x86-64. Reads: 8 bytes from offset p[c] + 2x with
-            // x + 4 <= w, inside the line's n planes of 2w bytes, which both halves hold
-            // (checked above). Writes: n·4 floats from texel x, inside `row` (w·n floats).
-            unsafe {
-                let four = |c: usize, x: usize| {
-                    let at = p[c] + 2 * x;
-                    let e = _mm_loadl_epi64(evens.as_ptr().add(at) as *const __m128i);
-                    let o = _mm_loadl_epi64(odds.as_ptr().add(at) as *const __m128i);
-                    _mm_castsi128_ps(_mm_unpacklo_epi8(e, o))
-                };
-                let out = row.as_mut_ptr();
-                let (zero, inf) = (_mm_setzero_ps(), _mm_set1_ps(f32::INFINITY));
-                // Lanes of `v` that are NaN, infinite or negative (`v ≥ 0` fails for NaN).
-                let bad = |v: __m128| {
-                    let ok = _mm_and_ps(_mm_cmpge_ps(v, zero), _mm_cmplt_ps(v, inf));
-                    (_mm_movemask_ps(ok) ^ 0xF).count_ones() as u64
-                };
-                while x + 4 <= w {
-                    let (r, g, b) = (four(0, x), four(1, x), four(2, x));
-                    invalid += bad(r) + bad(g) + bad(b);
-                    let dst = out.add(x * n);
-                    if n == 4 {
-                        let mut a = four(3, x);
-                        let (mut r, mut g, mut b) = (r, g, b);
-                        _MM_TRANSPOSE4_PS(&mut r, &mut g, &mut b, &mut a);
-                        _mm_storeu_ps(dst, r);
-                        _mm_storeu_ps(dst.add(4), g);
-                        _mm_storeu_ps(dst.add(8), b);
-                        _mm_storeu_ps(dst.add(12), a);
-                    } else {
-                        // [r0 g0 b0 r1] [g1 b1 r2 g2] [b2 r3 g3 b3]
-                        let lo = _mm_unpacklo_ps(r, g); // r0 g0 r1 g1
-                        let hi = _mm_unpackhi_ps(r, g); // r2 g2 r3 g3
-                        let t0 = _mm_shuffle_ps::<0b10_10_00_00>(b, lo); // b0 b0 r1 r1
-                        let o0 = _mm_shuffle_ps::<0b10_00_01_00>(lo, t0); // r0 g0 b0 r1
-                        let t1 = _mm_shuffle_ps::<0b01_01_11_11>(lo, b); // g1 g1 b1 b1
-                        let o1 = _mm_shuffle_ps::<0b01_00_10_00>(t1, hi); // g1 b1 r2 g2
-                        let t2 = _mm_shuffle_ps::<0b10_10_10_10>(b, hi); // b2 b2 r3 r3
-                        let t3 = _mm_shuffle_ps::<0b11_11_11_11>(hi, b); // g3 g3 b3 b3
-                        let o2 = _mm_shuffle_ps::<0b10_00_10_00>(t2, t3); // b2 r3 g3 b3
-                        _mm_storeu_ps(dst, o0);
-                        _mm_storeu_ps(dst.add(4), o1);
-                        _mm_storeu_ps(dst.add(8), o2);
+            let four = |c: usize, x: usize| {
+                let at = p[c] + 2 * x;
+                let e: &[u8; 8] = evens[at..at + 8].try_into().unwrap();
+                let o: &[u8; 8] = odds[at..at + 8].try_into().unwrap();
+                F32x4::from_split_bytes(e, o)
+            };
+            let (zero, inf) = (F32x4::splat(0.0), F32x4::splat(f32::INFINITY));
+            // Lanes of `v` that are NaN, infinite or negative (`v ≥ 0` fails for NaN).
+            let bad = |v: F32x4| u64::from(((v.ge(zero) & v.lt(inf)).bitmask() ^ 0xF).count_ones());
+            while x + 4 <= w {
+                let (r, g, b) = (four(0, x), four(1, x), four(2, x));
+                invalid += bad(r) + bad(g) + bad(b);
+                let dst = &mut row[x * n..];
+                if n == 4 {
+                    let t = F32x4::transpose([r, g, b, four(3, x)]);
+                    for (k, v) in t.into_iter().enumerate() {
+                        v.store(&mut dst[4 * k..]);
                     }
-                    x += 4;
+                } else {
+                    for (k, v) in F32x4::interleave3([r, g, b]).into_iter().enumerate() {
+                        v.store(&mut dst[4 * k..]);
+                    }
                 }
+                x += 4;
             }
         }
         for x in x..w {

@@ -121,50 +121,10 @@ pub(crate) fn inflate<'a>(
     Ok(Lines::Split { evens, odds })
 }
 
-/// `b[i] = b[i − 1] + b[i] − 128` for every byte but the first (modulo 256): a prefix sum of
-/// `b[i] − 128`, sixteen bytes a step (SSE2: the sum within the sixteen in four
-/// shift-and-add steps, then the carry of the bytes before, kept in a vector register: its
-/// last byte broadcast in three shuffles. Taking the carry out to a general register and
-/// back, as this did before, made a chain of about 12 cycles a step; now 4.)
+/// `b[i] = b[i − 1] + b[i] − 128` for every byte but the first (modulo 256): the running
+/// sum that undoes OpenEXR's ZIP predictor.
 fn running_sum(b: &mut [u8]) {
-    if b.len() < 2 {
-        return;
-    }
-    let mut prev = b[0];
-    let mut i = 1;
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        // SAFETY: SSE2 is part of x86-64's baseline; every load and store covers
-        // `b[i..i + 16]`, inside the slice by the loop condition.
-        unsafe {
-            let bias = _mm_set1_epi8(-128i8);
-            // Every byte: the running value before the step.
-            let mut carry = _mm_set1_epi8(prev as i8);
-            while i + 16 <= b.len() {
-                let p = b.as_mut_ptr().add(i) as *mut __m128i;
-                let mut x = _mm_add_epi8(_mm_loadu_si128(p), bias);
-                x = _mm_add_epi8(x, _mm_slli_si128::<1>(x));
-                x = _mm_add_epi8(x, _mm_slli_si128::<2>(x));
-                x = _mm_add_epi8(x, _mm_slli_si128::<4>(x));
-                x = _mm_add_epi8(x, _mm_slli_si128::<8>(x));
-                x = _mm_add_epi8(x, carry);
-                _mm_storeu_si128(p, x);
-                // Byte 15 to all sixteen: bytes 8..16 doubled into words 4..8, word 7 to
-                // words 4..8, then dword 3 to all four.
-                let hi = _mm_unpackhi_epi8(x, x);
-                carry = _mm_shuffle_epi32::<0xFF>(_mm_shufflehi_epi16::<0xFF>(hi));
-                i += 16;
-            }
-            if i > 1 {
-                prev = b[i - 1];
-            }
-        }
-    }
-    for v in &mut b[i..] {
-        prev = prev.wrapping_add(*v).wrapping_sub(128);
-        *v = prev;
-    }
+    mirrorball_core::simd::prefix_sum_biased(b, 128);
 }
 
 /// `out[2k] = evens[k]`, `out[2k + 1] = odds[k]` (`evens` may be one longer).

@@ -1,22 +1,26 @@
-//! Which vectorised paths run: those that need more than the target's baseline (AVX2 on
-//! x86-64) are chosen at run time, once the processor has said it has the feature, and
-//! give the same bits as the portable paths they replace (tested by switching them off
-//! with [`set_portable`]).
+//! Which vectorised paths run: the eight-lane paths (depth pass, mirror rows) run where
+//! [`X8::get`] hands out its token (on x86-64, a processor with AVX2, chosen at run time)
+//! and give the same bits as the per-sample paths they replace (tested by switching them
+//! off with [`set_portable`]).
 
-/// Whether the AVX2 path runs: the processor has AVX2 and [`set_portable`] has not turned
-/// it off.
-#[cfg(target_arch = "x86_64")]
+use mirrorball_core::simd::X8;
+
+/// The eight-lane token, unless [`set_portable`] has turned the eight-lane paths off or the
+/// processor lacks them.
 #[inline]
-pub(crate) fn avx2() -> bool {
-    !PORTABLE.load(std::sync::atomic::Ordering::Relaxed) && std::is_x86_feature_detected!("avx2")
+pub(crate) fn x8() -> Option<X8> {
+    if PORTABLE.load(std::sync::atomic::Ordering::Relaxed) {
+        return None;
+    }
+    X8::get()
 }
 
 static PORTABLE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
-/// Makes the renderer's vectorised paths that depend on the processor (AVX2) step aside for
-/// the portable ones (`true`), or use them again where the processor has them (`false`,
-/// the default). The pictures are the same to the bit either way; tests and benchmarks
-/// use this to show it and to measure the difference.
+/// Makes the renderer's eight-lane paths (AVX2 on x86-64, chosen at run time) step aside
+/// for the per-sample ones (`true`), or use them again where the processor has them
+/// (`false`, the default). The pictures are the same to the bit either way; tests and
+/// benchmarks use this to show it and to measure the difference.
 pub fn set_portable(portable: bool) {
     PORTABLE.store(portable, std::sync::atomic::Ordering::Relaxed);
 }

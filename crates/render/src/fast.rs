@@ -4,20 +4,21 @@
 //! [`EnvMap::bilinear_at`], which joins faces and wraps longitude.
 
 use glam::{DVec2, DVec3, Vec3};
-use mirrorball_core::{EnvMap, Projection, WorldProjection};
+use mirrorball_core::simd::{prefetch, F32x4};
+use mirrorball_core::{
+    bilinear_blend, bilinear_corner4, CubeMap, EnvMap, Projection, WorldProjection,
+};
 
 /// `(layer, u, v)` of direction `d` (not necessarily unit length for the cube).
 #[inline]
 pub fn dir_to_uv(map: &EnvMap, d: Vec3) -> Option<(usize, f32, f32)> {
     match map.projection() {
         Projection::Cube(_) => {
-            // OpenGL 4.6 table 8.19; ties go to x, then y, as CubeFace::select.
-            let (layer, sc, tc, ma) = mirrorball_core::CubeFace::select_f32(d);
+            let (layer, u, v, ma) = CubeMap::uv_f32(d);
             if ma <= 0.0 || ma.is_nan() {
                 return None;
             }
-            let k = 0.5 / ma;
-            Some((layer, sc * k + 0.5, tc * k + 0.5))
+            Some((layer, u, v))
         }
         Projection::LatLong(_) => {
             let n = d.normalize_or_zero();
@@ -110,12 +111,10 @@ impl<'a> CubeFaces<'a> {
     /// together before [`CubeFaces::fetch`] reads them.
     #[inline(always)]
     pub fn locate(&self, d: Vec3) -> CubeLoc {
-        let (layer, sc, tc, ma) = mirrorball_core::CubeFace::select_f32(d);
+        let (layer, u, v, ma) = CubeMap::uv_f32(d);
         if ma <= 0.0 || ma.is_nan() {
             return CubeLoc::NONE;
         }
-        let k = 0.5 / ma;
-        let (u, v) = (sc * k + 0.5, tc * k + 0.5);
         if !(u.is_finite() && v.is_finite()) {
             return CubeLoc::NONE;
         }
@@ -124,8 +123,8 @@ impl<'a> CubeFaces<'a> {
         if x0 >= 0 && y0 >= 0 && x0 + 1 < n && y0 + 1 < n {
             let stride = n as usize * self.c;
             let i = y0 as usize * stride + x0 as usize * self.c;
-            prefetch(&self.faces[layer][i..]);
-            prefetch(&self.faces[layer][i + stride..]);
+            prefetch(self.faces[layer][i..].as_ptr());
+            prefetch(self.faces[layer][i + stride..].as_ptr());
             return CubeLoc {
                 layer: layer as u32,
                 i: i as u32,
@@ -143,125 +142,54 @@ impl<'a> CubeFaces<'a> {
     }
 
     /// [`CubeFaces::locate`] of four directions at once, given as component arrays,
-    /// branch-free (SSE2 on x86-64): lane `k` gives exactly what `locate(Vec3::new(x[k],
-    /// y[k], z[k]))` gives, bit for bit (the same operations
-    /// in the same order, face chosen by masks instead of branches).
+    /// branch-free ([`CubeMap::uv4`], [`bilinear_corner4`]): lane `k` gives exactly what
+    /// `locate(Vec3::new(x[k], y[k], z[k]))` gives, bit for bit (the same operations in the
+    /// same order, face chosen by masks instead of branches).
     #[inline(always)]
     pub fn locate4(&self, x: &[f32; 4], y: &[f32; 4], z: &[f32; 4]) -> [CubeLoc; 4] {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: SSE2 is part of x86-64's baseline; the intrinsics only read and write
-        // local arrays.
-        unsafe {
-            use std::arch::x86_64::*;
-            let sel =
-                |m: __m128, a: __m128, b: __m128| _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b));
-            let (x, y, z) = (
-                _mm_loadu_ps(x.as_ptr()),
-                _mm_loadu_ps(y.as_ptr()),
-                _mm_loadu_ps(z.as_ptr()),
-            );
-            let sign = _mm_set1_ps(-0.0);
-            let (ax, ay, az) = (
-                _mm_andnot_ps(sign, x),
-                _mm_andnot_ps(sign, y),
-                _mm_andnot_ps(sign, z),
-            );
-            let (nx, ny, nz) = (
-                _mm_xor_ps(sign, x),
-                _mm_xor_ps(sign, y),
-                _mm_xor_ps(sign, z),
-            );
-            // CubeFace::select_f32's branches as masks: x major, else y major, else z.
-            let is_x = _mm_and_ps(_mm_cmpge_ps(ax, ay), _mm_cmpge_ps(ax, az));
-            let is_y = _mm_andnot_ps(is_x, _mm_cmpge_ps(ay, az));
-            let zero = _mm_setzero_ps();
-            let (px, py, pz) = (
-                _mm_cmpge_ps(x, zero),
-                _mm_cmpge_ps(y, zero),
-                _mm_cmpge_ps(z, zero),
-            );
-            let sc = sel(is_x, sel(px, nz, z), sel(is_y, x, sel(pz, x, nx)));
-            let tc = sel(is_x, ny, sel(is_y, sel(py, z, nz), ny));
-            let ma = sel(is_x, ax, sel(is_y, ay, az));
-            let pos = sel(is_x, px, sel(is_y, py, pz));
-            // Layer: 0, 2 or 4 by the major axis, plus 1 on its negative side.
-            let layer = _mm_add_epi32(
-                _mm_or_si128(
-                    _mm_and_si128(_mm_castps_si128(is_y), _mm_set1_epi32(2)),
-                    _mm_andnot_si128(_mm_castps_si128(_mm_or_ps(is_x, is_y)), _mm_set1_epi32(4)),
-                ),
-                _mm_andnot_si128(_mm_castps_si128(pos), _mm_set1_epi32(1)),
-            );
-            let valid = _mm_cmpgt_ps(ma, zero); // false for NaN
-            let k = _mm_div_ps(_mm_set1_ps(0.5), ma);
-            let half = _mm_set1_ps(0.5);
-            let u = _mm_add_ps(_mm_mul_ps(sc, k), half);
-            let v = _mm_add_ps(_mm_mul_ps(tc, k), half);
-            let inf = _mm_set1_ps(f32::INFINITY);
-            let finite = _mm_and_ps(
-                _mm_cmplt_ps(_mm_andnot_ps(sign, u), inf),
-                _mm_cmplt_ps(_mm_andnot_ps(sign, v), inf),
-            );
-            let ok = _mm_movemask_ps(_mm_and_ps(valid, finite));
-            // bilinear_corner, four lanes: truncate, then step down where that rounded up.
-            let nf = _mm_set1_ps(self.n as f32);
-            let fxy = |t: __m128| {
-                let c = _mm_sub_ps(_mm_mul_ps(t, nf), half);
-                let ti = _mm_cvttps_epi32(c);
-                let t0 = _mm_add_epi32(ti, _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(ti), c)));
-                (t0, _mm_sub_ps(c, _mm_cvtepi32_ps(t0)))
-            };
-            let (x0, fx) = fxy(u);
-            let (y0, fy) = fxy(v);
-            let lo = _mm_set1_epi32(-1);
-            let hi = _mm_set1_epi32(self.n - 1);
-            let inside = _mm_movemask_ps(_mm_castsi128_ps(_mm_and_si128(
-                _mm_and_si128(_mm_cmpgt_epi32(x0, lo), _mm_cmplt_epi32(x0, hi)),
-                _mm_and_si128(_mm_cmpgt_epi32(y0, lo), _mm_cmplt_epi32(y0, hi)),
-            )));
-            let mut a = [[0i32; 4]; 3];
-            let mut f = [[0f32; 4]; 4];
-            _mm_storeu_si128(a[0].as_mut_ptr() as *mut __m128i, layer);
-            _mm_storeu_si128(a[1].as_mut_ptr() as *mut __m128i, x0);
-            _mm_storeu_si128(a[2].as_mut_ptr() as *mut __m128i, y0);
-            for (o, t) in f.iter_mut().zip([fx, fy, u, v]) {
-                _mm_storeu_ps(o.as_mut_ptr(), t);
+        let f = CubeMap::uv4(
+            F32x4::from_array(*x),
+            F32x4::from_array(*y),
+            F32x4::from_array(*z),
+        );
+        let (u, v) = (f.sc, f.tc);
+        let inf = F32x4::splat(f32::INFINITY);
+        let ok = (f.ma.gt(F32x4::splat(0.0)) & u.abs().lt(inf) & v.abs().lt(inf)).bitmask();
+        let c = bilinear_corner4(u, v, self.n as u32, self.n as u32);
+        let inside = c.inside.bitmask();
+        let (layers, x0, y0) = (f.layer.to_array(), c.x0.to_array(), c.y0.to_array());
+        let (fx, fy, u, v) = (c.fx.to_array(), c.fy.to_array(), u.to_array(), v.to_array());
+        let stride = self.n as usize * self.c;
+        std::array::from_fn(|lane| {
+            if ok & (1 << lane) == 0 {
+                return CubeLoc::NONE;
             }
-            let stride = self.n as usize * self.c;
-            std::array::from_fn(|lane| {
-                if ok & (1 << lane) == 0 {
-                    return CubeLoc::NONE;
-                }
-                let layer = a[0][lane] as usize;
-                if inside & (1 << lane) == 0 {
-                    return CubeLoc {
-                        layer: layer as u32,
-                        i: SEAM,
-                        a: f[2][lane],
-                        b: f[3][lane],
-                    };
-                }
-                let i = a[2][lane] as usize * stride + a[1][lane] as usize * self.c;
-                prefetch(&self.faces[layer][i..]);
-                prefetch(&self.faces[layer][i + stride..]);
-                CubeLoc {
+            let layer = layers[lane] as usize;
+            if inside & (1 << lane) == 0 {
+                return CubeLoc {
                     layer: layer as u32,
-                    i: i as u32,
-                    a: f[0][lane],
-                    b: f[1][lane],
-                }
-            })
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        std::array::from_fn(|k| self.locate(Vec3::new(x[k], y[k], z[k])))
+                    i: SEAM,
+                    a: u[lane],
+                    b: v[lane],
+                };
+            }
+            let i = y0[lane] as usize * stride + x0[lane] as usize * self.c;
+            prefetch(self.faces[layer][i..].as_ptr());
+            prefetch(self.faces[layer][i + stride..].as_ptr());
+            CubeLoc {
+                layer: layer as u32,
+                i: i as u32,
+                a: fx[lane],
+                b: fy[lane],
+            }
+        })
     }
 
     /// [`CubeFaces::fetch`] as `[r, g, b, 1]` times `[t0, t1, t2, 1]` (the tint): inside a
-    /// face, the two rows of the footprint are read as four-lane vectors (SSE2 on x86-64)
-    /// with the scalar read's operations lane by lane, so the colour is the same to the bit.
+    /// face, the two rows of the footprint are read as four-lane vectors with the scalar
+    /// read's operations lane by lane, so the colour is the same to the bit.
     #[inline(always)]
     pub fn fetch_tinted(&self, l: &CubeLoc, t: [f32; 4]) -> [f32; 4] {
-        #[cfg(target_arch = "x86_64")]
         if (l.layer as usize) < 6 && l.i != SEAM {
             let data = self.faces[l.layer as usize];
             let stride = self.n as usize * self.c;
@@ -321,13 +249,12 @@ impl<'a> CubeFaces<'a> {
     }
 }
 
-/// The bilinear blend inside a face, four lanes (SSE2): the texels at `p[0]`, `p[c]` and a
-/// row below (`stride` floats), weights `fx`, `fy` (`CubeFaces::footprint`'s arithmetic, lane
-/// by lane, so the same bits), times the tint `t`, alpha 1, into `o[..4]`. For three
-/// channels the second texel is read as four lanes, one float past it, so `p` must hold
-/// `stride + c + 4` floats (asserted). The one copy of this blend: [`CubeFaces::fetch_tinted`]
-/// calls it, and the renderer's AVX2 mirror rows its unchecked form.
-#[cfg(target_arch = "x86_64")]
+/// The bilinear blend inside a face, four lanes ([`bilinear_blend`]): the texels at `p[0]`,
+/// `p[c]` and a row below (`stride` floats), weights `fx`, `fy` (`CubeFaces::footprint`'s
+/// arithmetic, lane by lane, so the same bits), times the tint `t`, alpha 1, into `o[..4]`.
+/// For three channels the second texel is read as four lanes, one float past it, so `p`
+/// must hold `stride + c + 4` floats (panics otherwise). [`CubeFaces::fetch_tinted`] and
+/// the renderer's eight-lane mirror rows call it.
 #[inline(always)]
 pub(crate) fn bilinear_tinted(
     p: &[f32],
@@ -338,39 +265,9 @@ pub(crate) fn bilinear_tinted(
     t: &[f32; 4],
     o: &mut [f32],
 ) {
-    assert!(p.len() >= stride + c + 4 && o.len() >= 4);
-    // SAFETY: the reads stay within `p` and the write within `o` (asserted above).
-    unsafe { bilinear_tinted_unchecked(p.as_ptr(), stride, c, fx, fy, t, o.as_mut_ptr()) }
-}
-
-/// [`bilinear_tinted`] on raw pointers, for callers that have established the bounds for
-/// eight lanes at once.
-///
-/// # Safety
-/// `p` must be valid for reads of `stride + c + 4` floats and `o` for writes of four.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-pub(crate) unsafe fn bilinear_tinted_unchecked(
-    p: *const f32,
-    stride: usize,
-    c: usize,
-    fx: f32,
-    fy: f32,
-    t: &[f32; 4],
-    o: *mut f32,
-) {
-    use std::arch::x86_64::*;
-    // SAFETY: SSE2 is part of x86-64's baseline; the caller vouches for the pointers.
-    unsafe {
-        let (a, b) = (_mm_loadu_ps(p), _mm_loadu_ps(p.add(c)));
-        let (e, f) = (_mm_loadu_ps(p.add(stride)), _mm_loadu_ps(p.add(stride + c)));
-        let fx = _mm_set1_ps(fx);
-        let top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
-        let bot = _mm_add_ps(e, _mm_mul_ps(fx, _mm_sub_ps(f, e)));
-        let v = _mm_add_ps(top, _mm_mul_ps(_mm_set1_ps(fy), _mm_sub_ps(bot, top)));
-        _mm_storeu_ps(o, _mm_mul_ps(v, _mm_loadu_ps(t.as_ptr())));
-        *o.add(3) = 1.0;
-    }
+    let o = &mut o[..4];
+    (bilinear_blend(p, stride, c, fx, fy) * F32x4::from_array(*t)).store(o);
+    o[3] = 1.0;
 }
 
 /// `CubeLoc::i` of a lookup whose footprint crosses a seam.
@@ -394,20 +291,6 @@ impl CubeLoc {
         a: 0.0,
         b: 0.0,
     };
-}
-
-/// Asks for the cache line holding `s[0]` (a hint; does nothing where unsupported).
-#[inline(always)]
-fn prefetch(s: &[f32]) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch is only a hint and cannot fault; the pointer is in bounds anyway.
-    #[allow(unused_unsafe)]
-    unsafe {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        _mm_prefetch::<_MM_HINT_T0>(s.as_ptr() as *const i8);
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = s;
 }
 
 /// Bilinear lookup in direction `d`; zero where the projection does not cover `d`.

@@ -1,6 +1,6 @@
 //! The per-pixel mirror's reflected direction, the renderer's commonest and hottest case,
 //! computed from per-setup corner attributes: one pixel at a time ([`mirror_dir`]), or
-//! eight at a time with AVX2 where the processor has it ([`mirror_dirs`]), to the same bits.
+//! eight at a time (AVX2 where the processor has it: [`mirror_dirs`]), to the same bits.
 //!
 //! **Why no division and no square root.** At a sample inside a setup (a clipped, projected
 //! triangle) with edge values `fₖ` (twice the areas of the sub-triangles opposite corner
@@ -15,6 +15,7 @@
 //! all drop out.
 
 use glam::{Mat3, Vec3, Vec3A};
+use mirrorball_core::simd::{F32x8, X8};
 
 /// What the per-pixel mirror needs of one setup, prepared once a frame: `n = Σ fₖ·nₖ` and
 /// `v = Σ fₖ·vₖ` (see the module documentation) as planes over the sample grid. The edge
@@ -123,10 +124,8 @@ pub(crate) fn mirror_dirs(
     dirs: &mut [[f32; SPAN]; 3],
 ) {
     debug_assert!(ids.len() <= SPAN);
-    #[cfg(target_arch = "x86_64")]
-    if crate::cpu::avx2() {
-        // SAFETY: the processor has AVX2 (checked just above).
-        unsafe { mirror_dirs_avx2(ids, lanes, x0, fy, setups, view, dirs) };
+    if let Some(x8) = crate::cpu::x8() {
+        x8.run(|| mirror_dirs_x8(x8, ids, lanes, x0, fy, setups, view, dirs));
         return;
     }
     mirror_dirs_portable(ids, lanes, x0, fy, setups, view, dirs);
@@ -153,9 +152,10 @@ pub(crate) fn mirror_dirs_portable(
 }
 
 /// [`mirror_dirs`] eight pixels a step ([`v8::reflect`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn mirror_dirs_avx2(
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn mirror_dirs_x8(
+    x8: X8,
     ids: &[u32],
     lanes: u32,
     x0: usize,
@@ -164,7 +164,6 @@ unsafe fn mirror_dirs_avx2(
     view: &MirrorView,
     dirs: &mut [[f32; SPAN]; 3],
 ) {
-    use std::arch::x86_64::*;
     let n = ids.len().min(SPAN);
     let mut g = 0;
     while g < n {
@@ -176,24 +175,26 @@ unsafe fn mirror_dirs_avx2(
         let cnt = (n - g).min(8);
         let mut idb = [crate::raster::NO_HIT; 8];
         idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
-        let ev = v8::reflect(&idb, glanes, x0 + g, fy, setups, view);
-        let keep = v8::lane_mask(glanes);
+        let ev = v8::reflect(x8, &idb, glanes, x0 + g, fy, setups, view);
+        let keep = x8.mask(glanes);
         for (d, r) in dirs.iter_mut().zip(ev.r) {
             // g + 8 ≤ SPAN: the eight entries are in the array whatever `cnt` is.
-            let p = d[g..g + 8].as_mut_ptr();
-            _mm256_storeu_ps(p, _mm256_blendv_ps(_mm256_loadu_ps(p), r, keep));
+            let d = &mut d[g..g + 8];
+            keep.select(r, x8.load(d)).store(d);
         }
         g += 8;
     }
 }
 
 /// The whole per-pixel mirror of a row segment of a frame without background, eight pixels
-/// a step (AVX2): reflected directions ([`mirror_dirs`]'s arithmetic), the cube face and
-/// texel of each ([`CubeFaces::locate`](crate::fast::CubeFaces::locate)'s arithmetic, face chosen by masks), then each
-/// pixel's bilinear read ([`CubeFaces::fetch_tinted`](crate::fast::CubeFaces::fetch_tinted))
-/// written to `out` (four floats a pixel). Pixels that see nothing are written transparent black. Returns
+/// a step: reflected directions ([`mirror_dirs`]'s arithmetic), the cube face and texel of
+/// each ([`CubeFaces::locate`](crate::fast::CubeFaces::locate)'s arithmetic, face chosen by
+/// masks), then each pixel's bilinear read
+/// ([`CubeFaces::fetch_tinted`](crate::fast::CubeFaces::fetch_tinted)) written to `out`
+/// (four floats a pixel). Pixels that see nothing are written transparent black. Returns
 /// the lanes whose setup is not a mirror, left for the caller to shade; `None` where the
-/// processor lacks AVX2 (or [`set_portable`](crate::set_portable) said so), having done nothing.
+/// eight-lane paths are off (no AVX2, or [`set_portable`](crate::set_portable) said so),
+/// having done nothing.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mirror_row(
     ids: &[u32],
@@ -204,18 +205,14 @@ pub(crate) fn mirror_row(
     cf: &crate::fast::CubeFaces,
     out: &mut [f32],
 ) -> Option<u32> {
-    #[cfg(target_arch = "x86_64")]
-    if crate::cpu::avx2() {
-        // SAFETY: the processor has AVX2 (checked just above).
-        return Some(unsafe { mirror_row_avx2(ids, x0, fy, setups, view, cf, out) });
-    }
-    let _ = (ids, x0, fy, setups, view, cf, out);
-    None
+    let x8 = crate::cpu::x8()?;
+    Some(x8.run(|| mirror_row_x8(x8, ids, x0, fy, setups, view, cf, out)))
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn mirror_row_avx2(
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn mirror_row_x8(
+    x8: X8,
     ids: &[u32],
     x0: usize,
     fy: f32,
@@ -234,17 +231,17 @@ unsafe fn mirror_row_avx2(
         let mut idb = [NO_HIT; 8];
         idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
         let orow = &mut out[g * 4..(g + cnt) * 4];
-        let none = v8::equal_lanes(&idb, NO_HIT);
+        let none = x8.u32s(&idb).eq(x8.splat_i32(NO_HIT as i32)).bitmask();
         let hit = !none & ((1u32 << cnt) - 1);
         if hit == 0 {
             orow.fill(0.0);
             g += 8;
             continue;
         }
-        let ev = v8::reflect(&idb, hit, x0 + g, fy, setups, view);
+        let ev = v8::reflect(x8, &idb, hit, x0 + g, fy, setups, view);
         left |= ev.left << g;
-        let at = v8::locate(&ev.r, cf);
-        let tint = v8::pixels(&ev.tint);
+        let at = v8::locate(x8, &ev.r, cf);
+        let tint = F32x8::interleave4([ev.tint[0], ev.tint[1], ev.tint[2], x8.splat(1.0)]);
         let stride = cf.n as usize * cf.c;
         // Mirror lanes whose four texels lie inside one face and within reach of four-lane
         // reads: straight to the blend, no further test.
@@ -254,19 +251,17 @@ unsafe fn mirror_row_avx2(
             let lane = m.trailing_zeros() as usize;
             m &= m - 1;
             let data = cf.faces[at.layer[lane] as usize];
-            // SAFETY: `reach` says `index + stride + c + 4 ≤ data.len()`; lane < cnt, so the
+            // `reach` says `index + stride + c + 4 ≤ data.len()`; lane < cnt, so the
             // pixel's four floats are in `orow`.
-            unsafe {
-                crate::fast::bilinear_tinted_unchecked(
-                    data.as_ptr().add(at.index[lane] as usize),
-                    stride,
-                    cf.c,
-                    at.fx[lane],
-                    at.fy[lane],
-                    &tint[lane],
-                    orow.as_mut_ptr().add(4 * lane),
-                );
-            }
+            crate::fast::bilinear_tinted(
+                &data[at.index[lane] as usize..],
+                stride,
+                cf.c,
+                at.fx[lane],
+                at.fy[lane],
+                &tint[lane],
+                &mut orow[4 * lane..],
+            );
         }
         let mut rest = ((1u32 << cnt) - 1) & !direct;
         while rest != 0 {
@@ -307,21 +302,19 @@ unsafe fn mirror_row_avx2(
     left
 }
 
-/// Eight-lane building blocks (AVX2), each lane doing the scalar code's operations in its
-/// order (no fused multiply-add), so that every result is the scalar result to the bit.
-/// Functions rather than closures, so that they inherit the caller's target feature and
-/// inline.
-#[cfg(target_arch = "x86_64")]
+/// Eight-lane building blocks, each lane doing the scalar code's operations in its order
+/// (no fused multiply-add), so that every result is the scalar result to the bit.
 mod v8 {
     use super::{MirrorSetup, MirrorView};
     use crate::fast::CubeFaces;
     use glam::Vec3A;
-    use std::arch::x86_64::*;
+    use mirrorball_core::simd::{F32x8, X8};
+    use mirrorball_core::{bilinear_corner8, CubeMap};
 
     /// Reflected directions and tints of eight pixels.
     pub struct Reflected {
-        pub r: [__m256; 3],
-        pub tint: [__m256; 3],
+        pub r: [F32x8; 3],
+        pub tint: [F32x8; 3],
         /// Lanes whose setup is a mirror (directions and tints set).
         pub mirror: u32,
         /// Lanes whose setup is not a mirror.
@@ -343,82 +336,17 @@ mod v8 {
         pub v: [f32; 8],
     }
 
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn splat(v: f32) -> __m256 {
-        _mm256_set1_ps(v)
-    }
-
     /// `(x·x' + y·y') + z·z'`, as glam's `Vec3A::dot`.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn dot(a: &[__m256; 3], b: &[__m256; 3]) -> __m256 {
-        _mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(a[0], b[0]), _mm256_mul_ps(a[1], b[1])),
-            _mm256_mul_ps(a[2], b[2]),
-        )
-    }
-
-    /// `m ? a : b`, lane by lane.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn sel(m: __m256, a: __m256, b: __m256) -> __m256 {
-        _mm256_blendv_ps(b, a, m)
-    }
-
-    /// All-ones in the lanes whose bit is set in `bits`.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub fn lane_mask(bits: u32) -> __m256 {
-        let b = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-        _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-            _mm256_and_si256(_mm256_set1_epi32(bits as i32), b),
-            b,
-        ))
-    }
-
-    /// The lanes of `ids` equal to `id`, as bits.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub fn equal_lanes(ids: &[u32; 8], id: u32) -> u32 {
-        // SAFETY: `ids` holds eight u32, read unaligned.
-        let v = unsafe { _mm256_loadu_si256(ids.as_ptr() as *const __m256i) };
-        let eq = _mm256_cmpeq_epi32(v, _mm256_set1_epi32(id as i32));
-        _mm256_movemask_ps(_mm256_castsi256_ps(eq)) as u32
-    }
-
-    /// Eight `(r, g, b, 1)` of three vectors of lanes `r`, `g`, `b`.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub fn pixels(v: &[__m256; 3]) -> [[f32; 4]; 8] {
-        let one = splat(1.0);
-        let (rg_lo, rg_hi) = (
-            _mm256_unpacklo_ps(v[0], v[1]),
-            _mm256_unpackhi_ps(v[0], v[1]),
-        );
-        let (ba_lo, ba_hi) = (_mm256_unpacklo_ps(v[2], one), _mm256_unpackhi_ps(v[2], one));
-        // Pixels 0|4, 1|5, 2|6, 3|7, then their halves put in order.
-        let p04 = _mm256_shuffle_ps::<0x44>(rg_lo, ba_lo);
-        let p15 = _mm256_shuffle_ps::<0xEE>(rg_lo, ba_lo);
-        let p26 = _mm256_shuffle_ps::<0x44>(rg_hi, ba_hi);
-        let p37 = _mm256_shuffle_ps::<0xEE>(rg_hi, ba_hi);
-        let mut out = [[0.0f32; 4]; 8];
-        let o = out.as_mut_ptr() as *mut f32;
-        // SAFETY: `out` holds 32 floats.
-        unsafe {
-            _mm256_storeu_ps(o, _mm256_permute2f128_ps::<0x20>(p04, p15));
-            _mm256_storeu_ps(o.add(8), _mm256_permute2f128_ps::<0x20>(p26, p37));
-            _mm256_storeu_ps(o.add(16), _mm256_permute2f128_ps::<0x31>(p04, p15));
-            _mm256_storeu_ps(o.add(24), _mm256_permute2f128_ps::<0x31>(p26, p37));
-        }
-        out
+    #[inline(always)]
+    fn dot(a: &[F32x8; 3], b: &[F32x8; 3]) -> F32x8 {
+        (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]
     }
 
     /// `mirror_dir` of the pixels at columns `x0 ..` of `idb` whose bit is set in `lanes`,
     /// once per distinct setup among them (its values broadcast, its pixels blended in).
-    #[inline]
-    #[target_feature(enable = "avx2")]
+    #[inline(always)]
     pub fn reflect(
+        x8: X8,
         idb: &[u32; 8],
         lanes: u32,
         x0: usize,
@@ -426,13 +354,9 @@ mod v8 {
         setups: &[MirrorSetup],
         view: &MirrorView,
     ) -> Reflected {
-        // SAFETY: `idb` holds eight u32, read unaligned.
-        let idv = unsafe { _mm256_loadu_si256(idb.as_ptr() as *const __m256i) };
-        let fx = _mm256_add_ps(
-            splat(x0 as f32),
-            _mm256_setr_ps(0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5),
-        );
-        let zero = _mm256_setzero_ps();
+        let idv = x8.u32s(idb);
+        let fx = x8.splat(x0 as f32) + x8.f32s([0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5]);
+        let zero = x8.splat(0.0);
         let mut out = Reflected {
             r: [zero; 3],
             tint: [zero; 3],
@@ -442,8 +366,8 @@ mod v8 {
         let mut todo = lanes;
         while todo != 0 {
             let id = idb[todo.trailing_zeros() as usize];
-            let same = _mm256_castsi256_ps(_mm256_cmpeq_epi32(idv, _mm256_set1_epi32(id as i32)));
-            let bits = _mm256_movemask_ps(same) as u32 & lanes;
+            let same = idv.eq(x8.splat_i32(id as i32));
+            let bits = same.bitmask() & lanes;
             todo &= !bits;
             let m = &setups[id as usize];
             if !m.mirror {
@@ -454,152 +378,64 @@ mod v8 {
             // The planes as `mirror_dir` evaluates them: the row's part once (as a Vec3A),
             // then eight columns.
             let dy = fy - m.origin[1];
-            let dx = _mm256_sub_ps(fx, splat(m.origin[0]));
+            let dx = fx - x8.splat(m.origin[0]);
             let plane = |a: &[Vec3A; 3]| {
                 let row = a[0] + a[2] * dy;
-                [0, 1, 2].map(|c| _mm256_add_ps(splat(row[c]), _mm256_mul_ps(splat(a[1][c]), dx)))
+                [0, 1, 2].map(|c| x8.splat(row[c]) + x8.splat(a[1][c]) * dx)
             };
             let v = if view.persp || view.per_vertex {
                 plane(&m.v)
             } else {
-                [
-                    splat(view.forward.x),
-                    splat(view.forward.y),
-                    splat(view.forward.z),
-                ]
+                view.forward.to_array().map(|c| x8.splat(c))
             };
             let r = if view.per_vertex {
                 v // mode 2: the interpolated reflected vector itself
             } else {
                 let n = plane(&m.n);
                 let nn = dot(&n, &n);
-                let t = _mm256_mul_ps(dot(&n, &v), splat(2.0));
-                let mut r = [zero; 3];
-                for ((rc, vc), nc) in r.iter_mut().zip(v).zip(n) {
-                    *rc = _mm256_sub_ps(_mm256_mul_ps(vc, nn), _mm256_mul_ps(nc, t));
-                }
-                r
+                let t = dot(&n, &v) * x8.splat(2.0);
+                [0, 1, 2].map(|c| v[c] * nn - n[c] * t)
             };
             for (c, rc) in r.into_iter().enumerate() {
-                out.r[c] = sel(same, rc, out.r[c]);
-                out.tint[c] = sel(same, splat(m.tint[c]), out.tint[c]);
+                out.r[c] = same.select(rc, out.r[c]);
+                out.tint[c] = same.select(x8.splat(m.tint[c]), out.tint[c]);
             }
         }
         if let Some(rot) = view.rot {
             let col = [rot.x_axis, rot.y_axis, rot.z_axis];
             let r = out.r;
             for (c, rc) in out.r.iter_mut().enumerate() {
-                *rc = _mm256_add_ps(
-                    _mm256_add_ps(
-                        _mm256_mul_ps(splat(col[0][c]), r[0]),
-                        _mm256_mul_ps(splat(col[1][c]), r[1]),
-                    ),
-                    _mm256_mul_ps(splat(col[2][c]), r[2]),
-                );
+                *rc = (x8.splat(col[0][c]) * r[0] + x8.splat(col[1][c]) * r[1])
+                    + x8.splat(col[2][c]) * r[2];
             }
         }
         out
     }
 
-    /// `bilinear_corner` of one coordinate: the texel below (truncate, then step down
-    /// where that rounded up) and the fraction.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn corner(t: __m256, n: __m256) -> (__m256i, __m256) {
-        let c = _mm256_sub_ps(_mm256_mul_ps(t, n), splat(0.5));
-        let ti = _mm256_cvttps_epi32(c);
-        let up = _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_cvtepi32_ps(ti), c);
-        let t0 = _mm256_add_epi32(ti, _mm256_castps_si256(up));
-        (t0, _mm256_sub_ps(c, _mm256_cvtepi32_ps(t0)))
-    }
-
-    /// `CubeFace::select_f32` and `CubeFaces::locate` of eight directions, the face chosen
-    /// by masks (as `CubeFaces::locate4`).
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    pub fn locate(r: &[__m256; 3], cf: &CubeFaces) -> Located {
-        let [x, y, z] = *r;
-        let sign = splat(-0.0);
-        let zero = _mm256_setzero_ps();
-        let half = splat(0.5);
-        let (ax, ay, az) = (
-            _mm256_andnot_ps(sign, x),
-            _mm256_andnot_ps(sign, y),
-            _mm256_andnot_ps(sign, z),
-        );
-        let (nx, ny, nz) = (
-            _mm256_xor_ps(sign, x),
-            _mm256_xor_ps(sign, y),
-            _mm256_xor_ps(sign, z),
-        );
-        let is_x = _mm256_and_ps(
-            _mm256_cmp_ps::<_CMP_GE_OQ>(ax, ay),
-            _mm256_cmp_ps::<_CMP_GE_OQ>(ax, az),
-        );
-        let is_y = _mm256_andnot_ps(is_x, _mm256_cmp_ps::<_CMP_GE_OQ>(ay, az));
-        let px = _mm256_cmp_ps::<_CMP_GE_OQ>(x, zero);
-        let py = _mm256_cmp_ps::<_CMP_GE_OQ>(y, zero);
-        let pz = _mm256_cmp_ps::<_CMP_GE_OQ>(z, zero);
-        let sc = sel(is_x, sel(px, nz, z), sel(is_y, x, sel(pz, x, nx)));
-        let tc = sel(is_x, ny, sel(is_y, sel(py, z, nz), ny));
-        let ma = sel(is_x, ax, sel(is_y, ay, az));
-        let pos = sel(is_x, px, sel(is_y, py, pz));
-        let layer = _mm256_add_epi32(
-            _mm256_or_si256(
-                _mm256_and_si256(_mm256_castps_si256(is_y), _mm256_set1_epi32(2)),
-                _mm256_andnot_si256(
-                    _mm256_castps_si256(_mm256_or_ps(is_x, is_y)),
-                    _mm256_set1_epi32(4),
-                ),
-            ),
-            _mm256_andnot_si256(_mm256_castps_si256(pos), _mm256_set1_epi32(1)),
-        );
-        let valid = _mm256_cmp_ps::<_CMP_GT_OQ>(ma, zero);
-        let k = _mm256_div_ps(half, ma);
-        let u = _mm256_add_ps(_mm256_mul_ps(sc, k), half);
-        let v = _mm256_add_ps(_mm256_mul_ps(tc, k), half);
-        let inf = splat(f32::INFINITY);
-        let finite = _mm256_and_ps(
-            _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, u), inf),
-            _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, v), inf),
-        );
-        let nf = splat(cf.n as f32);
-        let (x0, fx) = corner(u, nf);
-        let (y0, fy) = corner(v, nf);
-        let lo = _mm256_set1_epi32(-1);
-        let hi = _mm256_set1_epi32(cf.n - 1);
-        let inside = _mm256_and_si256(
-            _mm256_and_si256(_mm256_cmpgt_epi32(x0, lo), _mm256_cmpgt_epi32(hi, x0)),
-            _mm256_and_si256(_mm256_cmpgt_epi32(y0, lo), _mm256_cmpgt_epi32(hi, y0)),
-        );
+    /// `CubeFaces::locate` of eight directions: [`CubeMap::uv8`] and
+    /// [`bilinear_corner8`] (as `CubeFaces::locate4` with four).
+    #[inline(always)]
+    pub fn locate(x8: X8, r: &[F32x8; 3], cf: &CubeFaces) -> Located {
+        let f = CubeMap::uv8(x8, r[0], r[1], r[2]);
+        let (u, v) = (f.sc, f.tc);
+        let inf = x8.splat(f32::INFINITY);
+        let ok = f.ma.gt(x8.splat(0.0)) & u.abs().lt(inf) & v.abs().lt(inf);
+        let c = bilinear_corner8(x8, u, v, cf.n as u32, cf.n as u32);
         let stride = cf.n * cf.c as i32;
-        let index = _mm256_add_epi32(
-            _mm256_mullo_epi32(y0, _mm256_set1_epi32(stride)),
-            _mm256_mullo_epi32(x0, _mm256_set1_epi32(cf.c as i32)),
-        );
-        let mut out = Located {
-            ok: _mm256_movemask_ps(_mm256_and_ps(valid, finite)) as u32,
-            inside: _mm256_movemask_ps(_mm256_castsi256_ps(inside)) as u32,
-            reach: _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(
-                _mm256_set1_epi32(cf.n * stride - stride - cf.c as i32 - 3),
-                index,
-            ))) as u32,
-            layer: [0; 8],
-            index: [0; 8],
-            fx: [0.0; 8],
-            fy: [0.0; 8],
-            u: [0.0; 8],
-            v: [0.0; 8],
-        };
-        // SAFETY: each destination holds eight lanes.
-        unsafe {
-            _mm256_storeu_si256(out.layer.as_mut_ptr() as *mut __m256i, layer);
-            _mm256_storeu_si256(out.index.as_mut_ptr() as *mut __m256i, index);
-            _mm256_storeu_ps(out.fx.as_mut_ptr(), fx);
-            _mm256_storeu_ps(out.fy.as_mut_ptr(), fy);
-            _mm256_storeu_ps(out.u.as_mut_ptr(), u);
-            _mm256_storeu_ps(out.v.as_mut_ptr(), v);
+        let index = c.y0 * x8.splat_i32(stride) + c.x0 * x8.splat_i32(cf.c as i32);
+        let reach = x8
+            .splat_i32(cf.n * stride - stride - cf.c as i32 - 3)
+            .gt(index);
+        Located {
+            ok: ok.bitmask(),
+            inside: c.inside.bitmask(),
+            reach: reach.bitmask(),
+            layer: f.layer.to_array(),
+            index: index.to_array(),
+            fx: c.fx.to_array(),
+            fy: c.fy.to_array(),
+            u: u.to_array(),
+            v: v.to_array(),
         }
-        out
     }
 }

@@ -24,6 +24,7 @@
 //! band walks the triangles binned to it.
 
 use glam::{BVec4A, Vec3, Vec4};
+use mirrorball_core::simd::{I32x4, M32x4, X8};
 use rayon::prelude::*;
 
 /// The triangle index of a sample that sees no triangle.
@@ -230,13 +231,13 @@ impl Binned {
         }
         buf.dirty = cols.clone();
         let (depth, ids) = (&mut buf.depth[..], &mut buf.ids[..]);
-        #[cfg(target_arch = "x86_64")]
-        if crate::cpu::avx2() {
-            for &si in &self.bins[b] {
-                let s = &self.setups[si as usize];
-                // SAFETY: the processor has AVX2 (checked just above).
-                unsafe { scan_avx2(s, si, depth, ids, y_start, self.width) };
-            }
+        if let Some(x8) = crate::cpu::x8() {
+            x8.run(|| {
+                for &si in &self.bins[b] {
+                    let s = &self.setups[si as usize];
+                    scan_x8(x8, s, si, depth, ids, y_start, self.width);
+                }
+            });
             return cols;
         }
         for &si in &self.bins[b] {
@@ -603,11 +604,12 @@ fn row_start(s: &Setup, edges: &[([f32; 2], [f32; 2]); 3], qy: f32) -> u32 {
     xs
 }
 
-/// [`scan`] eight samples a step (AVX2): each lane does the same operations in the same
-/// order, so depths, ids and the fill rule come out the same to the bit.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn scan_avx2(
+/// [`scan`] eight samples a step (AVX2 where the processor has it): each lane does the same
+/// operations in the same order, so depths, ids and the fill rule come out the same to the
+/// bit.
+#[inline(always)]
+fn scan_x8(
+    x8: X8,
     s: &Setup,
     id: u32,
     depth: &mut [f32],
@@ -615,7 +617,6 @@ unsafe fn scan_avx2(
     y_start: u32,
     width: u32,
 ) {
-    use std::arch::x86_64::*;
     let band_rows = depth.len() as u32 / width;
     let ya = s.y0.max(y_start);
     let yb = s.y1.min(y_start + band_rows - 1);
@@ -624,21 +625,14 @@ unsafe fn scan_avx2(
     }
     let [p0, p1, p2] = s.p;
     let edges = [(p1, p2), (p2, p0), (p0, p1)];
-    let mut tl = [_mm256_setzero_ps(); 3];
-    for (t, (a, c)) in tl.iter_mut().zip(edges) {
-        *t = _mm256_castsi256_ps(_mm256_set1_epi32(-(top_left(a, c) as i32)));
-    }
-    let inv_area = _mm256_set1_ps(1.0 / s.area);
-    let z4 = [
-        _mm256_set1_ps(s.z[0]),
-        _mm256_set1_ps(s.z[1]),
-        _mm256_set1_ps(s.z[2]),
-    ];
-    let x_end = _mm256_set1_ps(s.x1 as f32 + 1.0);
-    let lanes = _mm256_setr_ps(0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5);
-    let zero = _mm256_setzero_ps();
-    let idv = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
-    let neg_one = _mm256_set1_ps(-1.0);
+    let tl = edges.map(|(a, c)| x8.mask(if top_left(a, c) { 0xFF } else { 0 }));
+    let inv_area = x8.splat(1.0 / s.area);
+    let z4 = s.z.map(|z| x8.splat(z));
+    let x_end = x8.splat(s.x1 as f32 + 1.0);
+    let lanes = x8.f32s([0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5]);
+    let zero = x8.splat(0.0);
+    let idv = x8.splat_i32(id as i32);
+    let neg_one = x8.splat(-1.0);
     for y in ya..=yb {
         let qy = y as f32 + 0.5;
         let xs = row_start(s, &edges, qy);
@@ -648,73 +642,55 @@ unsafe fn scan_avx2(
         let r0 = ((y - y_start) * width) as usize;
         let drow = &mut depth[r0..r0 + width as usize];
         let irow = &mut ids[r0..r0 + width as usize];
-        let mut ev = [(zero, zero, zero); 3];
-        for (e, (a, c)) in ev.iter_mut().zip(edges) {
-            *e = (
-                _mm256_set1_ps((c[0] - a[0]) * (qy - a[1])),
-                _mm256_set1_ps(c[1] - a[1]),
-                _mm256_set1_ps(a[0]),
-            );
-        }
+        let ev = edges.map(|(a, c)| {
+            (
+                x8.splat((c[0] - a[0]) * (qy - a[1])),
+                x8.splat(c[1] - a[1]),
+                x8.splat(a[0]),
+            )
+        });
         let mut entered = false;
-        let mut x8 = xs;
-        while x8 <= s.x1 {
-            let qx = _mm256_add_ps(_mm256_set1_ps(x8 as f32), lanes);
+        let mut xq = xs;
+        while xq <= s.x1 {
+            let qx = x8.splat(xq as f32) + lanes;
             let mut f = [zero; 3];
-            let mut mask = _mm256_cmp_ps::<_CMP_LT_OQ>(qx, x_end);
+            let mut mask = qx.lt(x_end);
             for k in 0..3 {
                 let (c, d, ax) = ev[k];
-                f[k] = _mm256_sub_ps(c, _mm256_mul_ps(d, _mm256_sub_ps(qx, ax)));
-                let inside = _mm256_or_ps(
-                    _mm256_cmp_ps::<_CMP_GT_OQ>(f[k], zero),
-                    _mm256_and_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(f[k], zero), tl[k]),
-                );
-                mask = _mm256_and_ps(mask, inside);
+                f[k] = c - d * (qx - ax);
+                mask = mask & (f[k].gt(zero) | (f[k].eq(zero) & tl[k]));
             }
-            if _mm256_movemask_ps(mask) == 0 {
+            if !mask.any() {
                 if entered {
                     break;
                 }
-                x8 += 8;
+                xq += 8;
                 continue;
             }
             entered = true;
-            let z = _mm256_add_ps(
-                _mm256_add_ps(
-                    _mm256_mul_ps(_mm256_mul_ps(f[0], inv_area), z4[0]),
-                    _mm256_mul_ps(_mm256_mul_ps(f[1], inv_area), z4[1]),
-                ),
-                _mm256_mul_ps(_mm256_mul_ps(f[2], inv_area), z4[2]),
-            );
-            let x = x8 as usize;
+            let z =
+                ((f[0] * inv_area) * z4[0] + (f[1] * inv_area) * z4[1]) + (f[2] * inv_area) * z4[2];
+            let x = xq as usize;
             if x + 8 <= drow.len() {
-                let dp = drow[x..x + 8].as_mut_ptr();
-                let ip = irow[x..x + 8].as_mut_ptr() as *mut f32;
-                let old = _mm256_loadu_ps(dp);
-                let m = _mm256_and_ps(
-                    mask,
-                    _mm256_and_ps(
-                        _mm256_cmp_ps::<_CMP_LT_OQ>(z, old),
-                        _mm256_cmp_ps::<_CMP_GE_OQ>(z, neg_one),
-                    ),
-                );
-                if _mm256_movemask_ps(m) != 0 {
-                    _mm256_storeu_ps(dp, _mm256_blendv_ps(old, z, m));
-                    _mm256_storeu_ps(ip, _mm256_blendv_ps(_mm256_loadu_ps(ip), idv, m));
+                let old = x8.load(&drow[x..]);
+                let m = mask & z.lt(old) & z.ge(neg_one);
+                if m.any() {
+                    m.select(z, old).store(&mut drow[x..]);
+                    let io: &mut [u32; 8] = (&mut irow[x..x + 8]).try_into().unwrap();
+                    let new = m.select_i32(idv, x8.u32s(io)).to_array();
+                    *io = new.map(|v| v as u32);
                 }
             } else {
-                let (mut zs, mut ms) = ([0.0f32; 8], [0.0f32; 8]);
-                _mm256_storeu_ps(zs.as_mut_ptr(), z);
-                _mm256_storeu_ps(ms.as_mut_ptr(), mask);
+                let (zs, ms) = (z.to_array(), mask.bitmask());
                 for lane in 0..drow.len() - x {
                     let z = zs[lane];
-                    if ms[lane].to_bits() != 0 && z < drow[x + lane] && z >= -1.0 {
+                    if ms & (1 << lane) != 0 && z < drow[x + lane] && z >= -1.0 {
                         drow[x + lane] = z;
                         irow[x + lane] = id;
                     }
                 }
             }
-            x8 += 8;
+            xq += 8;
         }
     }
 }
@@ -722,28 +698,10 @@ unsafe fn scan_avx2(
 /// Sets the lanes of `ids` (four) selected by the low four bits of `keep` to `id`.
 #[inline(always)]
 fn blend_ids(ids: &mut [u32], keep: u32, id: u32) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: SSE2 is part of x86-64's baseline; `ids` holds four u32 (checked by the
-    // slice index below), read and written unaligned.
-    unsafe {
-        use std::arch::x86_64::*;
-        let ids = &mut ids[..4];
-        let p = ids.as_mut_ptr() as *mut __m128i;
-        let bit = _mm_set_epi32(8, 4, 2, 1);
-        let sel = _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(keep as i32), bit), bit);
-        let old = _mm_loadu_si128(p);
-        let new = _mm_or_si128(
-            _mm_and_si128(sel, _mm_set1_epi32(id as i32)),
-            _mm_andnot_si128(sel, old),
-        );
-        _mm_storeu_si128(p, new);
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    for (lane, v) in ids[..4].iter_mut().enumerate() {
-        if keep & (1 << lane) != 0 {
-            *v = id;
-        }
-    }
+    let ids: &mut [u32; 4] = (&mut ids[..4]).try_into().unwrap();
+    let old = I32x4::from_array(ids.map(|v| v as i32));
+    let new = M32x4::from_bitmask(keep).select_i32(I32x4::splat(id as i32), old);
+    *ids = new.to_array().map(|v| v as u32);
 }
 
 /// Offsets of the four samples a SIMD step of [`scan`] tests (sample centres).

@@ -22,7 +22,7 @@ mod spec;
 
 pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap, SphereMap};
 pub use continuous_cube::ContinuousCube;
-pub use cube::{CubeFace, CubeMap};
+pub use cube::{CubeFace, CubeMap, FaceLanes};
 pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
 pub use spec::{parse_dir, ProjectionSpec};

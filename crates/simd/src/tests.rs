@@ -1,0 +1,298 @@
+//! The x86-64 lanes against the portable ones, bit for bit, for every operation, on values
+//! that reach every corner of IEEE arithmetic (signed zeros, subnormals, the `i32` range's
+//! ends, infinities, NaN).
+
+use crate::portable as p;
+
+/// Edge values, then a spread of ordinary ones.
+fn values() -> Vec<f32> {
+    let mut v = vec![
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        0.5,
+        -0.5,
+        1.5,
+        -1.5,
+        2.5,
+        -2.5,
+        1e-40,
+        -1e-40,
+        f32::MIN_POSITIVE,
+        2_147_483_520.0,
+        2_147_483_648.0,
+        -2_147_483_648.0,
+        -2_147_483_904.0,
+        3e9,
+        -3e9,
+        f32::MAX,
+        f32::MIN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        -f32::NAN,
+    ];
+    let mut s = 0x2545_f491_u32;
+    for _ in 0..200 {
+        s ^= s << 13;
+        s ^= s >> 17;
+        s ^= s << 5;
+        v.push((s as f32 / u32::MAX as f32 - 0.5) * 1000.0);
+    }
+    v
+}
+
+/// Groups of `n` lanes drawn from [`values`], shifted so that every value meets every lane.
+fn groups<const N: usize>() -> Vec<([f32; N], [f32; N])> {
+    let v = values();
+    let mut out = Vec::new();
+    for i in 0..v.len() {
+        for shift in [1, 3, 7] {
+            let a = std::array::from_fn(|k| v[(i + k) % v.len()]);
+            let b = std::array::from_fn(|k| v[(i + k * shift + 5) % v.len()]);
+            out.push((a, b));
+        }
+    }
+    out
+}
+
+fn bits<const N: usize>(a: [f32; N]) -> [u32; N] {
+    a.map(f32::to_bits)
+}
+
+#[test]
+fn trunc_matches() {
+    for x in values() {
+        assert_eq!(crate::trunc_i32(x), p::trunc_i32(x), "{x}");
+        #[cfg(target_arch = "x86_64")]
+        assert_eq!(crate::sse2::trunc_i32(x), p::trunc_i32(x), "{x}");
+    }
+}
+
+/// Every four-lane operation of `$q` (SSE2 or whichever is in use) against the portable one.
+macro_rules! check4 {
+    ($q:path) => {{
+        use $q as q;
+        for (a, b) in groups::<4>() {
+            let (pa, pb) = (p::F32x4::from_array(a), p::F32x4::from_array(b));
+            let (qa, qb) = (q::F32x4::from_array(a), q::F32x4::from_array(b));
+            let same = |x: p::F32x4, y: q::F32x4| {
+                assert_eq!(bits(x.to_array()), bits(y.to_array()), "{a:?} {b:?}")
+            };
+            same(pa + pb, qa + qb);
+            same(pa - pb, qa - qb);
+            same(pa * pb, qa * qb);
+            same(pa / pb, qa / qb);
+            same(-pa, -qa);
+            same(pa.abs(), qa.abs());
+            same(p::F32x4::load(&a), q::F32x4::load(&a));
+            same(p::F32x4::splat(a[1]), q::F32x4::splat(a[1]));
+            let mut s = [0.0; 4];
+            qa.store(&mut s);
+            assert_eq!(bits(s), bits(a));
+            let (mut pb16, mut qb16) = ([0u8; 17], [0u8; 17]);
+            pa.store_le_bytes(&mut pb16[1..]);
+            qa.store_le_bytes(&mut qb16[1..]);
+            assert_eq!(pb16, qb16);
+            let pm = [pa.ge(pb), pa.gt(pb), pa.lt(pb), pa.eq(pb)];
+            let qm = [qa.ge(qb), qa.gt(qb), qa.lt(qb), qa.eq(qb)];
+            for (x, y) in pm.iter().zip(&qm) {
+                assert_eq!(x.bitmask(), y.bitmask(), "{a:?} {b:?}");
+                assert_eq!(x.to_i32().to_array(), y.to_i32().to_array());
+                same(x.select(pa, pb), y.select(qa, qb));
+                assert_eq!(x.any(), y.any());
+                assert_eq!(x.all(), y.all());
+                assert_eq!((!*x).bitmask(), (!*y).bitmask());
+                for (x2, y2) in pm.iter().zip(&qm) {
+                    assert_eq!((*x & *x2).bitmask(), (*y & *y2).bitmask());
+                    assert_eq!((*x | *x2).bitmask(), (*y | *y2).bitmask());
+                    assert_eq!(x.and_not(*x2).bitmask(), y.and_not(*y2).bitmask());
+                }
+            }
+            let (pi, qi) = (pa.trunc_i32(), qa.trunc_i32());
+            assert_eq!(pi.to_array(), qi.to_array(), "{a:?}");
+            let (pj, qj) = (pb.to_bits(), qb.to_bits());
+            assert_eq!(pj.to_array(), qj.to_array());
+            same(p::F32x4::from_bits(pj), q::F32x4::from_bits(qj));
+            same(pi.to_f32(), qi.to_f32());
+            assert_eq!((pi + pj).to_array(), (qi + qj).to_array());
+            assert_eq!((pi - pj).to_array(), (qi - qj).to_array());
+            for (x, y) in [
+                (pi.gt(pj), qi.gt(qj)),
+                (pi.lt(pj), qi.lt(qj)),
+                (pi.eq(pi), qi.eq(qi)),
+            ] {
+                assert_eq!(x.bitmask(), y.bitmask());
+                assert_eq!(
+                    x.select_i32(pi, pj).to_array(),
+                    y.select_i32(qi, qj).to_array()
+                );
+            }
+            assert_eq!(
+                q::I32x4::splat(pi.to_array()[2]).to_array(),
+                p::I32x4::splat(pi.to_array()[2]).to_array()
+            );
+            assert_eq!(
+                q::I32x4::from_array(pj.to_array()).to_array(),
+                pj.to_array()
+            );
+            let bools = [a[0] > 0.0, a[1] > 0.0, a[2] < 0.0, b[0] > a[0]];
+            assert_eq!(
+                p::M32x4::from_bools(bools).bitmask(),
+                q::M32x4::from_bools(bools).bitmask()
+            );
+            let c = [a, b, a.map(|x| x * 0.5), b.map(|x| x - 1.0)];
+            let (pt, qt) = (
+                p::F32x4::transpose(c.map(p::F32x4::from_array)),
+                q::F32x4::transpose(c.map(q::F32x4::from_array)),
+            );
+            for (x, y) in pt.into_iter().zip(qt) {
+                same(x, y);
+            }
+            let c3 = [c[0], c[1], c[2]];
+            let (pd, qd) = (
+                p::F32x4::deinterleave3(c3.map(p::F32x4::from_array)),
+                q::F32x4::deinterleave3(c3.map(q::F32x4::from_array)),
+            );
+            let (pe, qe) = (
+                p::F32x4::interleave3(c3.map(p::F32x4::from_array)),
+                q::F32x4::interleave3(c3.map(q::F32x4::from_array)),
+            );
+            for (x, y) in pd.into_iter().zip(qd).chain(pe.into_iter().zip(qe)) {
+                same(x, y);
+            }
+            let (e, o): ([u8; 8], [u8; 8]) = (
+                std::array::from_fn(|k| a[k / 2].to_bits().to_le_bytes()[k % 4]),
+                std::array::from_fn(|k| b[k / 2].to_bits().to_le_bytes()[(k + 1) % 4]),
+            );
+            same(
+                p::F32x4::from_split_bytes(&e, &o),
+                q::F32x4::from_split_bytes(&e, &o),
+            );
+        }
+        for bits in 0..16 {
+            assert_eq!(q::M32x4::from_bitmask(bits).bitmask(), bits);
+            assert_eq!(p::M32x4::from_bitmask(bits).bitmask(), bits);
+        }
+    }};
+}
+
+/// Every eight-lane operation of `$q` against the portable one, inside the token's `run`.
+macro_rules! check8 {
+    ($q:path, $x8:expr) => {{
+        use $q as q;
+        let x8: q::X8 = $x8;
+        let px = p::X8::get().unwrap();
+        x8.run(|| {
+            for (a, b) in groups::<8>() {
+                let (pa, pb) = (px.f32s(a), px.f32s(b));
+                let (qa, qb) = (x8.f32s(a), x8.f32s(b));
+                let same = |x: p::F32x8, y: q::F32x8| {
+                    assert_eq!(bits(x.to_array()), bits(y.to_array()), "{a:?} {b:?}")
+                };
+                same(pa + pb, qa + qb);
+                same(pa - pb, qa - qb);
+                same(pa * pb, qa * qb);
+                same(pa / pb, qa / qb);
+                same(-pa, -qa);
+                same(pa.abs(), qa.abs());
+                same(px.load(&a), x8.load(&a));
+                same(px.splat(a[3]), x8.splat(a[3]));
+                let mut s = [0.0; 8];
+                qa.store(&mut s);
+                assert_eq!(bits(s), bits(a));
+                let pm = [pa.ge(pb), pa.gt(pb), pa.lt(pb), pa.eq(pb)];
+                let qm = [qa.ge(qb), qa.gt(qb), qa.lt(qb), qa.eq(qb)];
+                for (x, y) in pm.iter().zip(&qm) {
+                    assert_eq!(x.bitmask(), y.bitmask(), "{a:?} {b:?}");
+                    assert_eq!(x.to_i32().to_array(), y.to_i32().to_array());
+                    same(x.select(pa, pb), y.select(qa, qb));
+                    assert_eq!((x.any(), x.all()), (y.any(), y.all()));
+                    assert_eq!((!*x).bitmask(), (!*y).bitmask());
+                    for (x2, y2) in pm.iter().zip(&qm) {
+                        assert_eq!((*x & *x2).bitmask(), (*y & *y2).bitmask());
+                        assert_eq!((*x | *x2).bitmask(), (*y | *y2).bitmask());
+                        assert_eq!(x.and_not(*x2).bitmask(), y.and_not(*y2).bitmask());
+                    }
+                }
+                let (pi, qi) = (pa.trunc_i32(), qa.trunc_i32());
+                assert_eq!(pi.to_array(), qi.to_array(), "{a:?}");
+                let (pj, qj) = (pb.to_bits(), qb.to_bits());
+                assert_eq!(pj.to_array(), qj.to_array());
+                same(p::F32x8::from_bits(pj), q::F32x8::from_bits(qj));
+                same(pi.to_f32(), qi.to_f32());
+                assert_eq!((pi + pj).to_array(), (qi + qj).to_array());
+                assert_eq!((pi - pj).to_array(), (qi - qj).to_array());
+                assert_eq!((pi * pj).to_array(), (qi * qj).to_array());
+                for (x, y) in [
+                    (pi.gt(pj), qi.gt(qj)),
+                    (pi.lt(pj), qi.lt(qj)),
+                    (pi.eq(pi), qi.eq(qi)),
+                ] {
+                    assert_eq!(x.bitmask(), y.bitmask());
+                    assert_eq!(
+                        x.select_i32(pi, pj).to_array(),
+                        y.select_i32(qi, qj).to_array()
+                    );
+                }
+                let u: [u32; 8] = pj.to_array().map(|x| x as u32);
+                assert_eq!(px.u32s(&u).to_array(), x8.u32s(&u).to_array());
+                assert_eq!(px.splat_i32(-7).to_array(), x8.splat_i32(-7).to_array());
+                let c = [a, b, a.map(|x| x * 0.5), b.map(|x| x - 1.0)];
+                let (pp, qp) = (
+                    p::F32x8::interleave4(c.map(|v| px.f32s(v))),
+                    q::F32x8::interleave4(c.map(|v| x8.f32s(v))),
+                );
+                assert_eq!(pp.map(bits), qp.map(bits));
+            }
+            for bits in 0..256 {
+                assert_eq!(x8.mask(bits).bitmask(), bits);
+                assert_eq!(px.mask(bits).bitmask(), bits);
+            }
+        });
+    }};
+}
+
+#[test]
+fn lanes4_match_portable() {
+    #[cfg(target_arch = "x86_64")]
+    check4!(crate::sse2);
+    check4!(crate);
+}
+
+#[test]
+fn lanes8_match_portable() {
+    #[cfg(target_arch = "x86_64")]
+    match crate::avx2::X8::get() {
+        Some(x8) => check8!(crate::avx2, x8),
+        None => eprintln!("no AVX2 here: only the portable lanes checked"),
+    }
+    check8!(crate::portable, p::X8::get().unwrap());
+}
+
+#[test]
+fn prefix_sums_match() {
+    let mut s = 7u32;
+    for len in [0, 1, 2, 15, 16, 17, 31, 32, 33, 100, 1000] {
+        let b: Vec<u8> = (0..len)
+            .map(|_| {
+                s = s.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                (s >> 16) as u8
+            })
+            .collect();
+        for bias in [0, 1, 128, 255] {
+            let mut x = b.clone();
+            let mut y = b.clone();
+            p::prefix_sum_biased(&mut x, bias);
+            crate::prefix_sum_biased(&mut y, bias);
+            assert_eq!(x, y, "{len} {bias}");
+            #[cfg(target_arch = "x86_64")]
+            {
+                let mut z = b.clone();
+                crate::sse2::prefix_sum_biased(&mut z, bias);
+                assert_eq!(x, z, "{len} {bias}");
+            }
+        }
+    }
+}
