@@ -344,17 +344,20 @@ pub struct CornerLanes<F, I, M> {
 /// [`bilinear_corner`]'s operations on lanes (the step down is the comparison's mask, −1
 /// where set, added), written once for four and eight lanes.
 macro_rules! corner_lanes {
-    ($u:expr, $v:expr, $w:expr, $h:expr, $splat:expr, $splat_i:expr, $f:ty) => {{
+    // Written without closures: a closure is compiled as a function of its own, without the
+    // eight-lane kernel's AVX2, and its lane operations would stay calls.
+    ($u:expr, $v:expr, $w:expr, $h:expr, [$($splat:tt)+], [$($splat_i:tt)+]) => {{
         let (w, h) = ($w as i32, $h as i32);
-        let floor = |t: $f, n: i32| {
-            let c = t * $splat(n as f32) - $splat(0.5);
-            let ti = c.trunc_i32();
-            let t0 = ti + ti.to_f32().gt(c).to_i32();
-            (t0, c - t0.to_f32())
-        };
-        let ((x0, fx), (y0, fy)) = (floor($u, w), floor($v, h));
-        let lo = $splat_i(-1);
-        let inside = x0.gt(lo) & x0.lt($splat_i(w - 1)) & y0.gt(lo) & y0.lt($splat_i(h - 1));
+        let (cx, cy) = (
+            $u * $($splat)+(w as f32) - $($splat)+(0.5),
+            $v * $($splat)+(h as f32) - $($splat)+(0.5),
+        );
+        let (tx, ty) = (cx.trunc_i32(), cy.trunc_i32());
+        let x0 = tx + tx.to_f32().gt(cx).to_i32();
+        let y0 = ty + ty.to_f32().gt(cy).to_i32();
+        let (fx, fy) = (cx - x0.to_f32(), cy - y0.to_f32());
+        let lo = $($splat_i)+(-1);
+        let inside = x0.gt(lo) & x0.lt($($splat_i)+(w - 1)) & y0.gt(lo) & y0.lt($($splat_i)+(h - 1));
         CornerLanes {
             x0,
             y0,
@@ -368,7 +371,7 @@ macro_rules! corner_lanes {
 /// [`bilinear_corner`] of four lookups, lane by lane to the bit (tested).
 #[inline(always)]
 pub fn bilinear_corner4(u: F32x4, v: F32x4, w: u32, h: u32) -> CornerLanes<F32x4, I32x4, M32x4> {
-    corner_lanes!(u, v, w, h, F32x4::splat, I32x4::splat, F32x4)
+    corner_lanes!(u, v, w, h, [F32x4::splat], [I32x4::splat])
 }
 
 /// [`bilinear_corner`] of eight lookups, lane by lane to the bit (tested).
@@ -380,7 +383,7 @@ pub fn bilinear_corner8(
     w: u32,
     h: u32,
 ) -> CornerLanes<F32x8, I32x8, M32x8> {
-    corner_lanes!(u, v, w, h, |t| x8.splat(t), |t| x8.splat_i32(t), F32x8)
+    corner_lanes!(u, v, w, h, [x8.splat], [x8.splat_i32])
 }
 
 /// The bilinear blend of four lanes each of the 2×2 texels `a b / c d` (`a` top left):

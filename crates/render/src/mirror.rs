@@ -15,7 +15,7 @@
 //! all drop out.
 
 use glam::{Mat3, Vec3, Vec3A};
-use mirrorball_core::simd::{F32x8, X8};
+use mirrorball_core::simd::F32x8;
 
 /// What the per-pixel mirror needs of one setup, prepared once a frame: `n = Σ fₖ·nₖ` and
 /// `v = Σ fₖ·vₖ` (see the module documentation) as planes over the sample grid. The edge
@@ -125,7 +125,7 @@ pub(crate) fn mirror_dirs(
 ) {
     debug_assert!(ids.len() <= SPAN);
     if let Some(x8) = crate::cpu::x8() {
-        x8.run(|| mirror_dirs_x8(x8, ids, lanes, x0, fy, setups, view, dirs));
+        mirror_dirs_x8(x8, ids, lanes, x0, fy, setups, view, dirs);
         return;
     }
     mirror_dirs_portable(ids, lanes, x0, fy, setups, view, dirs);
@@ -151,38 +151,38 @@ pub(crate) fn mirror_dirs_portable(
     }
 }
 
-/// [`mirror_dirs`] eight pixels a step ([`v8::reflect`]).
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn mirror_dirs_x8(
-    x8: X8,
-    ids: &[u32],
-    lanes: u32,
-    x0: usize,
-    fy: f32,
-    setups: &[MirrorSetup],
-    view: &MirrorView,
-    dirs: &mut [[f32; SPAN]; 3],
-) {
-    let n = ids.len().min(SPAN);
-    let mut g = 0;
-    while g < n {
-        let glanes = (lanes >> g) & 0xff;
-        if glanes == 0 {
+mirrorball_core::simd::x8_kernel! {
+    /// [`mirror_dirs`] eight pixels a step ([`v8::reflect`]).
+    fn mirror_dirs_x8(
+        x8: X8,
+        ids: &[u32],
+        lanes: u32,
+        x0: usize,
+        fy: f32,
+        setups: &[MirrorSetup],
+        view: &MirrorView,
+        dirs: &mut [[f32; SPAN]; 3],
+    ) {
+        let n = ids.len().min(SPAN);
+        let mut g = 0;
+        while g < n {
+            let glanes = (lanes >> g) & 0xff;
+            if glanes == 0 {
+                g += 8;
+                continue;
+            }
+            let cnt = (n - g).min(8);
+            let mut idb = [crate::raster::NO_HIT; 8];
+            idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
+            let ev = v8::reflect(x8, &idb, glanes, x0 + g, fy, setups, view);
+            let keep = x8.mask(glanes);
+            for (d, r) in dirs.iter_mut().zip(ev.r) {
+                // g + 8 ≤ SPAN: the eight entries are in the array whatever `cnt` is.
+                let d = &mut d[g..g + 8];
+                keep.select(r, x8.load(d)).store(d);
+            }
             g += 8;
-            continue;
         }
-        let cnt = (n - g).min(8);
-        let mut idb = [crate::raster::NO_HIT; 8];
-        idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
-        let ev = v8::reflect(x8, &idb, glanes, x0 + g, fy, setups, view);
-        let keep = x8.mask(glanes);
-        for (d, r) in dirs.iter_mut().zip(ev.r) {
-            // g + 8 ≤ SPAN: the eight entries are in the array whatever `cnt` is.
-            let d = &mut d[g..g + 8];
-            keep.select(r, x8.load(d)).store(d);
-        }
-        g += 8;
     }
 }
 
@@ -206,100 +206,100 @@ pub(crate) fn mirror_row(
     out: &mut [f32],
 ) -> Option<u32> {
     let x8 = crate::cpu::x8()?;
-    Some(x8.run(|| mirror_row_x8(x8, ids, x0, fy, setups, view, cf, out)))
+    Some(mirror_row_x8(x8, ids, x0, fy, setups, view, cf, out))
 }
 
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn mirror_row_x8(
-    x8: X8,
-    ids: &[u32],
-    x0: usize,
-    fy: f32,
-    setups: &[MirrorSetup],
-    view: &MirrorView,
-    cf: &crate::fast::CubeFaces,
-    out: &mut [f32],
-) -> u32 {
-    use crate::fast::{CubeLoc, SEAM};
-    use crate::raster::NO_HIT;
-    let n = ids.len().min(SPAN);
-    let mut left = 0u32;
-    let mut g = 0;
-    while g < n {
-        let cnt = (n - g).min(8);
-        let mut idb = [NO_HIT; 8];
-        idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
-        let orow = &mut out[g * 4..(g + cnt) * 4];
-        let none = x8.u32s(&idb).eq(x8.splat_i32(NO_HIT as i32)).bitmask();
-        let hit = !none & ((1u32 << cnt) - 1);
-        if hit == 0 {
-            orow.fill(0.0);
-            g += 8;
-            continue;
-        }
-        let ev = v8::reflect(x8, &idb, hit, x0 + g, fy, setups, view);
-        left |= ev.left << g;
-        let at = v8::locate(x8, &ev.r, cf);
-        let tint = F32x8::interleave4([ev.tint[0], ev.tint[1], ev.tint[2], x8.splat(1.0)]);
-        let stride = cf.n as usize * cf.c;
-        // Mirror lanes whose four texels lie inside one face and within reach of four-lane
-        // reads: straight to the blend, no further test.
-        let direct = ev.mirror & at.ok & at.inside & at.reach & ((1u32 << cnt) - 1);
-        let mut m = direct;
-        while m != 0 {
-            let lane = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let data = cf.faces[at.layer[lane] as usize];
-            // `reach` says `index + stride + c + 4 ≤ data.len()`; lane < cnt, so the
-            // pixel's four floats are in `orow`.
-            crate::fast::bilinear_tinted(
-                &data[at.index[lane] as usize..],
-                stride,
-                cf.c,
-                at.fx[lane],
-                at.fy[lane],
-                &tint[lane],
-                &mut orow[4 * lane..],
-            );
-        }
-        let mut rest = ((1u32 << cnt) - 1) & !direct;
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            let bit = 1 << lane;
-            let o = &mut orow[4 * lane..4 * lane + 4];
-            if ev.mirror & bit == 0 {
-                if none & bit != 0 {
-                    o.fill(0.0);
-                }
-                continue; // not a mirror: the caller's
+mirrorball_core::simd::x8_kernel! {
+    fn mirror_row_x8(
+        x8: X8,
+        ids: &[u32],
+        x0: usize,
+        fy: f32,
+        setups: &[MirrorSetup],
+        view: &MirrorView,
+        cf: &crate::fast::CubeFaces,
+        out: &mut [f32],
+    ) -> u32 {
+        use crate::fast::{CubeLoc, SEAM};
+        use crate::raster::NO_HIT;
+        let n = ids.len().min(SPAN);
+        let mut left = 0u32;
+        let mut g = 0;
+        while g < n {
+            let cnt = (n - g).min(8);
+            let mut idb = [NO_HIT; 8];
+            idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
+            let orow = &mut out[g * 4..(g + cnt) * 4];
+            let none = x8.u32s(&idb).eq(x8.splat_i32(NO_HIT as i32)).bitmask();
+            let hit = !none & ((1u32 << cnt) - 1);
+            if hit == 0 {
+                orow.fill(0.0);
+                g += 8;
+                continue;
             }
-            // A mirror lane not blended above: no face, across a seam, or too near a face's
-            // end for four-lane reads; `fetch_tinted` sorts out which.
-            let t = tint[lane];
-            let loc = if at.ok & bit == 0 {
-                CubeLoc::NONE
-            } else if at.inside & bit == 0 {
-                CubeLoc {
-                    layer: at.layer[lane] as u32,
-                    i: SEAM,
-                    a: at.u[lane],
-                    b: at.v[lane],
+            let ev = v8::reflect(x8, &idb, hit, x0 + g, fy, setups, view);
+            left |= ev.left << g;
+            let at = v8::locate(x8, &ev.r, cf);
+            let tint = F32x8::interleave4([ev.tint[0], ev.tint[1], ev.tint[2], x8.splat(1.0)]);
+            let stride = cf.n as usize * cf.c;
+            // Mirror lanes whose four texels lie inside one face and within reach of four-lane
+            // reads: straight to the blend, no further test.
+            let direct = ev.mirror & at.ok & at.inside & at.reach & ((1u32 << cnt) - 1);
+            let mut m = direct;
+            while m != 0 {
+                let lane = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let data = cf.faces[at.layer[lane] as usize];
+                // `reach` says `index + stride + c + 4 ≤ data.len()`; lane < cnt, so the
+                // pixel's four floats are in `orow`.
+                crate::fast::bilinear_tinted(
+                    &data[at.index[lane] as usize..],
+                    stride,
+                    cf.c,
+                    at.fx[lane],
+                    at.fy[lane],
+                    &tint[lane],
+                    &mut orow[4 * lane..],
+                );
+            }
+            let mut rest = ((1u32 << cnt) - 1) & !direct;
+            while rest != 0 {
+                let lane = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                let bit = 1 << lane;
+                let o = &mut orow[4 * lane..4 * lane + 4];
+                if ev.mirror & bit == 0 {
+                    if none & bit != 0 {
+                        o.fill(0.0);
+                    }
+                    continue; // not a mirror: the caller's
                 }
-            } else {
-                CubeLoc {
-                    layer: at.layer[lane] as u32,
-                    i: at.index[lane] as u32,
-                    a: at.fx[lane],
-                    b: at.fy[lane],
-                }
-            };
-            o.copy_from_slice(&cf.fetch_tinted(&loc, t));
+                // A mirror lane not blended above: no face, across a seam, or too near a face's
+                // end for four-lane reads; `fetch_tinted` sorts out which.
+                let t = tint[lane];
+                let loc = if at.ok & bit == 0 {
+                    CubeLoc::NONE
+                } else if at.inside & bit == 0 {
+                    CubeLoc {
+                        layer: at.layer[lane] as u32,
+                        i: SEAM,
+                        a: at.u[lane],
+                        b: at.v[lane],
+                    }
+                } else {
+                    CubeLoc {
+                        layer: at.layer[lane] as u32,
+                        i: at.index[lane] as u32,
+                        a: at.fx[lane],
+                        b: at.fy[lane],
+                    }
+                };
+                o.copy_from_slice(&cf.fetch_tinted(&loc, t));
+            }
+            g += 8;
         }
-        g += 8;
+        left
     }
-    left
 }
 
 /// Eight-lane building blocks, each lane doing the scalar code's operations in its order
@@ -379,22 +379,38 @@ mod v8 {
             // then eight columns.
             let dy = fy - m.origin[1];
             let dx = fx - x8.splat(m.origin[0]);
-            let plane = |a: &[Vec3A; 3]| {
-                let row = a[0] + a[2] * dy;
-                [0, 1, 2].map(|c| x8.splat(row[c]) + x8.splat(a[1][c]) * dx)
-            };
+            // A macro, not a closure: a closure would be compiled without the kernel's AVX2.
+            macro_rules! plane {
+                ($a:expr) => {{
+                    let a: &[Vec3A; 3] = $a;
+                    let row = a[0] + a[2] * dy;
+                    [
+                        x8.splat(row[0]) + x8.splat(a[1][0]) * dx,
+                        x8.splat(row[1]) + x8.splat(a[1][1]) * dx,
+                        x8.splat(row[2]) + x8.splat(a[1][2]) * dx,
+                    ]
+                }};
+            }
             let v = if view.persp || view.per_vertex {
-                plane(&m.v)
+                plane!(&m.v)
             } else {
-                view.forward.to_array().map(|c| x8.splat(c))
+                [
+                    x8.splat(view.forward.x),
+                    x8.splat(view.forward.y),
+                    x8.splat(view.forward.z),
+                ]
             };
             let r = if view.per_vertex {
                 v // mode 2: the interpolated reflected vector itself
             } else {
-                let n = plane(&m.n);
+                let n = plane!(&m.n);
                 let nn = dot(&n, &n);
                 let t = dot(&n, &v) * x8.splat(2.0);
-                [0, 1, 2].map(|c| v[c] * nn - n[c] * t)
+                [
+                    v[0] * nn - n[0] * t,
+                    v[1] * nn - n[1] * t,
+                    v[2] * nn - n[2] * t,
+                ]
             };
             for (c, rc) in r.into_iter().enumerate() {
                 out.r[c] = same.select(rc, out.r[c]);

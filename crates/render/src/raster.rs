@@ -232,12 +232,15 @@ impl Binned {
         buf.dirty = cols.clone();
         let (depth, ids) = (&mut buf.depth[..], &mut buf.ids[..]);
         if let Some(x8) = crate::cpu::x8() {
-            x8.run(|| {
-                for &si in &self.bins[b] {
-                    let s = &self.setups[si as usize];
-                    scan_x8(x8, s, si, depth, ids, y_start, self.width);
-                }
-            });
+            scan_bin_x8(
+                x8,
+                &self.bins[b],
+                &self.setups,
+                depth,
+                ids,
+                y_start,
+                self.width,
+            );
             return cols;
         }
         for &si in &self.bins[b] {
@@ -604,6 +607,23 @@ fn row_start(s: &Setup, edges: &[([f32; 2], [f32; 2]); 3], qy: f32) -> u32 {
     xs
 }
 
+mirrorball_core::simd::x8_kernel! {
+    /// [`scan_x8`] of every setup in a band's bin.
+    fn scan_bin_x8(
+        x8: X8,
+        bin: &[u32],
+        setups: &[Setup],
+        depth: &mut [f32],
+        ids: &mut [u32],
+        y_start: u32,
+        width: u32,
+    ) {
+        for &si in bin {
+            scan_x8(x8, &setups[si as usize], si, depth, ids, y_start, width);
+        }
+    }
+}
+
 /// [`scan`] eight samples a step (AVX2 where the processor has it): each lane does the same
 /// operations in the same order, so depths, ids and the fill rule come out the same to the
 /// bit.
@@ -625,9 +645,15 @@ fn scan_x8(
     }
     let [p0, p1, p2] = s.p;
     let edges = [(p1, p2), (p2, p0), (p0, p1)];
-    let tl = edges.map(|(a, c)| x8.mask(if top_left(a, c) { 0xFF } else { 0 }));
+    // Written out rather than mapped: a closure would be compiled without the kernel's AVX2.
+    let tl_bits = |(a, c)| if top_left(a, c) { 0xFF } else { 0 };
+    let tl = [
+        x8.mask(tl_bits(edges[0])),
+        x8.mask(tl_bits(edges[1])),
+        x8.mask(tl_bits(edges[2])),
+    ];
     let inv_area = x8.splat(1.0 / s.area);
-    let z4 = s.z.map(|z| x8.splat(z));
+    let z4 = [x8.splat(s.z[0]), x8.splat(s.z[1]), x8.splat(s.z[2])];
     let x_end = x8.splat(s.x1 as f32 + 1.0);
     let lanes = x8.f32s([0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5]);
     let zero = x8.splat(0.0);

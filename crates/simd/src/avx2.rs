@@ -4,8 +4,9 @@
 //! A value of [`F32x8`], [`I32x8`] or [`M32x8`] is made only through an [`X8`] token, and
 //! [`X8::get`] hands one out only where the processor has AVX2: so every operation on a
 //! value that exists is safe to run. The operations are `#[inline(always)]` and meant to be
-//! used inside [`X8::run`], whose body is compiled with AVX2 enabled, so that they become
-//! single instructions; elsewhere they still give the same results, a call each.
+//! used inside a kernel defined with [`crate::x8_kernel!`], whose body is compiled with AVX2
+//! enabled, so that they become single instructions; elsewhere (in a closure, even one
+//! written inside a kernel) they still give the same results, a call each.
 
 use std::arch::x86_64::*;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
@@ -26,8 +27,9 @@ impl X8 {
     pub fn get() -> Option<X8> {
         std::is_x86_feature_detected!("avx2").then_some(X8(()))
     }
-    /// `f()`, compiled with AVX2 enabled (it is inlined into a function that has the
-    /// feature), so that the eight-lane operations in it are single instructions.
+    /// `f()`, called from a function compiled with AVX2. The closure itself is compiled
+    /// without it unless LLVM inlines it, so this is for tests and cold code; hot code is a
+    /// kernel ([`crate::x8_kernel!`]).
     #[inline(always)]
     pub fn run<R>(self, f: impl FnOnce() -> R) -> R {
         #[target_feature(enable = "avx2")]

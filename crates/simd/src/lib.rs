@@ -5,8 +5,9 @@
 //!   x86-64 (part of its baseline, so always there), plain arrays elsewhere.
 //! - [`F32x8`], [`I32x8`], [`M32x8`]: AVX2 on x86-64, chosen at run time: a value of these
 //!   types can only be made through an [`X8`] token, which [`X8::get`] hands out only
-//!   where the processor has AVX2, and code that uses them runs inside [`X8::run`], which
-//!   compiles it with AVX2 enabled. Elsewhere plain arrays, and the token is always there.
+//!   where the processor has AVX2, and code that uses them is a kernel defined with
+//!   [`x8_kernel!`], whose body is compiled with AVX2 enabled (so that every operation is
+//!   one instruction). Elsewhere plain arrays, and the token is always there.
 //! - Byte kernels for file codecs ([`prefix_sum_biased`]) and a cache [`prefetch`] hint.
 //!
 //! Every operation is the IEEE operation lane by lane (no fused multiply-add, no
@@ -70,6 +71,68 @@ pub fn prefetch<T>(p: *const T) {
     sse2::prefetch(p);
     #[cfg(not(all(target_arch = "x86_64", not(feature = "portable"))))]
     let _ = p;
+}
+
+/// Defines an eight-lane kernel: a safe function whose first argument is the [`X8`] token
+/// and whose body is compiled with AVX2 enabled on x86-64 (with the portable lanes, an
+/// ordinary function).
+///
+/// The lane operations are `#[inline(always)]` wrappers of AVX2 intrinsics; they become
+/// single instructions only inside a function compiled with AVX2. A closure does not
+/// inherit its caller's target features, so hot eight-lane code must be such a kernel,
+/// not a closure passed to [`X8::run`]. Everything the body calls that is
+/// `#[inline(always)]` is compiled into it with AVX2 too. Generic parameters are not
+/// supported; the signature's lifetimes may be elided.
+///
+/// ```
+/// use mirrorball_simd::{x8_kernel, X8};
+/// x8_kernel! {
+///     /// Adds `b` to `a`, eight at a time (the rest one at a time).
+///     fn add_into(x8: X8, a: &mut [f32], b: &[f32]) {
+///         let n = a.len().min(b.len()) / 8 * 8;
+///         for i in (0..n).step_by(8) {
+///             let s = x8.load(&a[i..]) + x8.load(&b[i..]);
+///             a[i..i + 8].copy_from_slice(&s.to_array());
+///         }
+///         for i in n..a.len().min(b.len()) {
+///             a[i] += b[i];
+///         }
+///     }
+/// }
+/// if let Some(x8) = X8::get() {
+///     let mut a = [1.0f32; 11];
+///     add_into(x8, &mut a, &[2.0; 11]);
+///     assert_eq!(a, [3.0; 11]);
+/// }
+/// ```
+#[cfg(all(target_arch = "x86_64", not(feature = "portable")))]
+#[macro_export]
+macro_rules! x8_kernel {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident($x8:ident: X8 $(, $arg:ident: $ty:ty)* $(,)?) $(-> $ret:ty)? $body:block) => {
+        $(#[$meta])*
+        #[inline]
+        #[allow(clippy::too_many_arguments)]
+        $vis fn $name($x8: $crate::X8 $(, $arg: $ty)*) $(-> $ret)? {
+            #[target_feature(enable = "avx2")]
+            #[allow(clippy::too_many_arguments)]
+            fn kernel($x8: $crate::X8 $(, $arg: $ty)*) $(-> $ret)? $body
+            // SAFETY: an `X8` exists only where the processor has AVX2 (`X8::get`).
+            unsafe { kernel($x8 $(, $arg)*) }
+        }
+    };
+}
+
+/// Defines an eight-lane kernel (see the x86-64 form): with the portable lanes, an
+/// ordinary function.
+#[cfg(not(all(target_arch = "x86_64", not(feature = "portable"))))]
+#[macro_export]
+macro_rules! x8_kernel {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident($x8:ident: X8 $(, $arg:ident: $ty:ty)* $(,)?) $(-> $ret:ty)? $body:block) => {
+        $(#[$meta])*
+        #[inline]
+        #[allow(clippy::too_many_arguments)]
+        $vis fn $name($x8: $crate::X8 $(, $arg: $ty)*) $(-> $ret)? $body
+    };
 }
 
 #[cfg(test)]

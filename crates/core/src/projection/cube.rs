@@ -6,21 +6,25 @@ use mirrorball_simd::{F32x4, F32x8, I32x4, I32x8, M32x4, M32x8, X8};
 
 /// [`face_coords`] with the face chosen as [`CubeFace::select_f32`] chooses it, by masks:
 /// `x` major (ties to x), else `y` major (ties to y), else `z`; its positive side where the
-/// component is `≥ 0`. Written once for [`F32x4`] and [`F32x8`] (`$splat`: a lane
-/// constant; `$m`: the mask type).
+/// component is `≥ 0`. Written once for [`F32x4`] and [`F32x8`] (`[$splat]`: what makes a
+/// lane constant; `$m`: the mask type), without closures: a closure is compiled as a
+/// function of its own, without an eight-lane kernel's AVX2.
 macro_rules! select_lanes {
-    ($x:expr, $y:expr, $z:expr, $splat:expr, $splat_i:expr, $m:ty) => {{
+    ($x:expr, $y:expr, $z:expr, [$($splat:tt)+], [$($splat_i:tt)+], $m:ty) => {{
         let (x, y, z) = ($x, $y, $z);
         let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
         let is_x: $m = ax.ge(ay) & ax.ge(az);
         let is_y: $m = ay.ge(az).and_not(is_x);
         let is_z: $m = !(is_x | is_y);
-        let zero = $splat(0.0);
+        let zero = $($splat)+(0.0);
         let (px, py, pz) = (x.ge(zero), y.ge(zero), z.ge(zero));
         let pos = (is_x & px) | (is_y & py) | (is_z & pz);
         FaceLanes {
             // 0, 2 or 4 by the major axis, plus 1 on its negative side (a set mask is −1).
-            layer: is_x.select_i32($splat_i(0), is_y.select_i32($splat_i(2), $splat_i(4)))
+            layer: is_x.select_i32(
+                $($splat_i)+(0),
+                is_y.select_i32($($splat_i)+(2), $($splat_i)+(4)),
+            )
                 - (!pos).to_i32(),
             sc: is_x.select(px.select(-z, z), is_y.select(x, pz.select(x, -x))),
             tc: is_x.select(-y, is_y.select(py.select(z, -z), -y)),
@@ -96,13 +100,13 @@ impl CubeFace {
     /// direction `k` (the same ties, the same sign flips; tested).
     #[inline(always)]
     pub fn select4(x: F32x4, y: F32x4, z: F32x4) -> FaceLanes<F32x4, I32x4> {
-        select_lanes!(x, y, z, F32x4::splat, I32x4::splat, M32x4)
+        select_lanes!(x, y, z, [F32x4::splat], [I32x4::splat], M32x4)
     }
 
     /// [`CubeFace::select4`] of eight directions (AVX2 where the processor has it: `x8`).
     #[inline(always)]
     pub fn select8(x8: X8, x: F32x8, y: F32x8, z: F32x8) -> FaceLanes<F32x8, I32x8> {
-        select_lanes!(x, y, z, |v| x8.splat(v), |v| x8.splat_i32(v), M32x8)
+        select_lanes!(x, y, z, [x8.splat], [x8.splat_i32], M32x8)
     }
 
     /// The point on the unit cube for face coordinates `sc`, `tc` ∈ `[-1, 1]` (the inverse
