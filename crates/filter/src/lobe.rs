@@ -28,6 +28,7 @@
 //!   Burley 2012, Karis 2013 and Filament).
 
 use glam::DVec3;
+use mirrorball_core::quadrature::gauss_legendre;
 use std::f64::consts::PI;
 
 /// A reflection lobe.
@@ -116,7 +117,7 @@ impl Lobe {
                 let mut s = 0.0;
                 for win in edges.windows(2) {
                     let (hi, lo) = (win[0], win[1]);
-                    s += gauss_legendre_16(lo, hi, |c| self.kernel(c));
+                    s += gauss_legendre(lo, hi, |c| self.kernel(c));
                 }
                 2.0 * PI * s
             }
@@ -160,36 +161,6 @@ pub fn roughness_from_phong_exponent(exponent: f64) -> f64 {
         return 0.0;
     }
     (2.0 / (exponent.max(0.0) + 2.0)).powf(0.25)
-}
-
-/// 16-point Gauss–Legendre on `[a, b]`.
-pub(crate) fn gauss_legendre_16(a: f64, b: f64, f: impl Fn(f64) -> f64) -> f64 {
-    const X: [f64; 8] = [
-        0.095_012_509_837_637_44,
-        0.281_603_550_779_258_9,
-        0.458_016_777_657_227_4,
-        0.617_876_244_402_643_7,
-        0.755_404_408_355_003,
-        0.865_631_202_387_831_7,
-        0.944_575_023_073_232_6,
-        0.989_400_934_991_649_9,
-    ];
-    const W: [f64; 8] = [
-        0.189_450_610_455_068_5,
-        0.182_603_415_044_923_6,
-        0.169_156_519_395_002_5,
-        0.149_595_988_816_576_7,
-        0.124_628_971_255_533_9,
-        0.095_158_511_682_492_78,
-        0.062_253_523_938_647_89,
-        0.027_152_459_411_754_1,
-    ];
-    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
-    let mut s = 0.0;
-    for i in 0..8 {
-        s += W[i] * (f(m - h * X[i]) + f(m + h * X[i]));
-    }
-    s * h
 }
 
 #[cfg(test)]
