@@ -36,4 +36,4 @@ pub use remap::{Remap, RemapError};
 pub use resample::{resample, resample_to_extent, ResampleOptions, Resampler, Rotation};
 
 pub use glam;
-pub use projection::quadrature;
+pub use projection::{derivative, quadrature};
