@@ -713,7 +713,7 @@ fn material_of(e: &MaterialEntry) -> Result<Material, String> {
                         );
                     }
                     SpecularLobe::Phong {
-                        exponent: e.exponent.unwrap_or(32.0),
+                        exponent: e.exponent.unwrap_or(32.0) as f64,
                     }
                 }
                 "ggx" => {
@@ -723,19 +723,24 @@ fn material_of(e: &MaterialEntry) -> Result<Material, String> {
                         );
                     }
                     SpecularLobe::Ggx {
-                        roughness: e.roughness.unwrap_or(0.3),
+                        roughness: e.roughness.unwrap_or(0.3) as f64,
                     }
                 }
                 other => return Err(format!("lobe '{other}' is not phong or ggx")),
             };
-            if !lobe.is_valid() {
+            // An infinite exponent (a mirror, to the filter crate) is refused here.
+            if !lobe.is_valid()
+                || matches!(lobe, SpecularLobe::Phong { exponent } if exponent.is_infinite())
+            {
+                // The parameters were read as `f32`: print them so.
                 return Err(match lobe {
-                    SpecularLobe::Phong { exponent } => {
-                        format!("phong exponent {exponent} must be a number ≥ 0")
-                    }
                     SpecularLobe::Ggx { roughness } => {
-                        format!("ggx roughness {roughness} is outside [0, 1]")
+                        format!("ggx roughness {} is outside [0, 1]", roughness as f32)
                     }
+                    _ => format!(
+                        "phong exponent {} must be a number ≥ 0",
+                        e.exponent.unwrap_or(32.0)
+                    ),
                 });
             }
             Material::Greene {
