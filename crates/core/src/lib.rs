@@ -16,6 +16,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod color;
 mod envmap;
 mod image;
 pub mod layout;
