@@ -123,7 +123,7 @@ mod tests {
 
     #[test]
     fn octahedral_folds_are_creases_and_the_rim_is_one_sided() {
-        let o = Octahedral::default();
+        let o = Octahedral;
         let uv = DVec2::new(0.5, 0.3); // on the fold a = 0
         let f0 = o.uv_to_dir(0, uv).unwrap();
         assert!(uv_derivative(&o, 0, uv, f0, DVec2::X).unwrap().crease);
