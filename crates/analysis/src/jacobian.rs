@@ -15,26 +15,17 @@
 //! equator, and there its anisotropy is 1.
 //!
 //! `J` is computed from the projection's own `uv_to_dir` (the code the converter uses) by
-//! central differences in `f64` with a step of `10⁻⁶` in `uv` (truncation error ~`δ²`,
-//! rounding ~`ε/δ`: about 10⁻¹⁰ relative). Two complications are handled:
-//!
-//! * **Domain edges** (the rim of a disk map): where a central stencil leaves the covered
-//!   domain, a second-order one-sided difference is used instead.
-//! * **Kinks** (the fold lines of the octahedral maps pass through texel centres): where the
-//!   forward and backward differences disagree by more than 10⁻³ relative *and* the
-//!   disagreement does not shrink when the step is halved (as it would on a smooth but
-//!   strongly curved map, near a singular rim), the point lies on a crease and `J` is
-//!   two-valued; the anisotropy reported is the larger of the values just either side of it
-//!   (a conservative choice).
+//! [`mirrorball_core::derivative`]'s finite differences (step `10⁻⁶` in `uv`, one-sided at
+//! the rim of a disk map). Where the point lies on a crease (the fold lines of the
+//! octahedral maps pass through texel centres), `J` is two-valued; the anisotropy reported
+//! is the larger of the values just either side of it (a conservative choice).
 //!
 //! The singular values come from the 2×2 Gram matrix `G = JᵀJ`:
 //! `σ²₁,₂ = (tr G ± √(tr² G − 4 det G))/2`.
 
 use glam::{DVec2, DVec3};
+use mirrorball_core::derivative::{uv_derivative, UV_STEP as DELTA};
 use mirrorball_core::WorldProjection;
-
-/// Step in `uv` for the finite differences.
-const DELTA: f64 = 1e-6;
 
 /// The Jacobian of a projection's inverse in pixel coordinates at one point: `[∂d/∂X, ∂d/∂Y]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,7 +71,7 @@ impl Jacobian {
     }
 }
 
-/// One partial derivative `∂d/∂s` along `e` (a unit step in `uv`), or `Err(())` at a kink.
+/// One partial derivative `∂d/∂s` along `e` (a unit step in `uv`), or `Err(())` on a crease.
 fn derivative<P: WorldProjection + ?Sized>(
     p: &P,
     layer: usize,
@@ -88,42 +79,8 @@ fn derivative<P: WorldProjection + ?Sized>(
     f0: DVec3,
     e: DVec2,
 ) -> Option<Result<DVec3, ()>> {
-    let fp = p.uv_to_dir(layer, uv + e * DELTA);
-    let fm = p.uv_to_dir(layer, uv - e * DELTA);
-    match (fp, fm) {
-        (Some(fp), Some(fm)) => {
-            let fwd = (fp - f0) / DELTA;
-            let bwd = (f0 - fm) / DELTA;
-            let scale = fwd.length().max(bwd.length());
-            let gap = (fwd - bwd).length();
-            if scale > 0.0 && gap > 1e-3 * scale {
-                // Smooth but strongly curved (near a singular rim), or a kink? On a smooth
-                // curve the gap shrinks with the step; across a kink it does not.
-                let h = 0.5 * DELTA;
-                if let (Some(fp2), Some(fm2)) = (
-                    p.uv_to_dir(layer, uv + e * h),
-                    p.uv_to_dir(layer, uv - e * h),
-                ) {
-                    let gap2 = ((fp2 - f0) / h - (f0 - fm2) / h).length();
-                    if gap2 > 0.75 * gap {
-                        return Some(Err(()));
-                    }
-                } else {
-                    return Some(Err(()));
-                }
-            }
-            Some(Ok((fp - fm) / (2.0 * DELTA)))
-        }
-        (Some(fp), None) => {
-            let f2 = p.uv_to_dir(layer, uv + e * (2.0 * DELTA))?;
-            Some(Ok((-3.0 * f0 + 4.0 * fp - f2) / (2.0 * DELTA)))
-        }
-        (None, Some(fm)) => {
-            let f2 = p.uv_to_dir(layer, uv - e * (2.0 * DELTA))?;
-            Some(Ok((3.0 * f0 - 4.0 * fm + f2) / (2.0 * DELTA)))
-        }
-        (None, None) => None,
-    }
+    let d = uv_derivative(p, layer, uv, f0, e)?;
+    Some(if d.crease { Err(()) } else { Ok(d.value) })
 }
 
 /// The pixel-coordinate Jacobian of `p` at `uv` of `layer` for a `w×h` layer, or `None`

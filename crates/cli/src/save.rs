@@ -3,7 +3,8 @@
 
 use crate::error::CliError;
 use crate::load::{layer_names, FACE};
-use mirrorball_core::{resample, EnvMap, Layout, ProjectionKind, ResampleOptions, WorldProjection};
+use mirrorball_core::{EnvMap, Image, Layout, ProjectionKind, WorldProjection};
+use mirrorball_filter::MipChain;
 use mirrorball_io::{Format, MapInfo, WriteOptions};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -133,18 +134,15 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
     let path = Path::new(out);
     let format = check(out, env.projection().kind(), opts.layout)?;
     if format.is_cube_container() {
-        let mut levels = vec![env.layers().to_vec()];
-        if opts.mips {
-            let mut size = env.width() / 2;
-            while size >= 1 {
-                let lv = resample(env, *env.projection(), size, &ResampleOptions::default());
-                levels.push(lv.into_layers());
-                if size == 1 {
-                    break;
-                }
-                size /= 2;
-            }
-        }
+        let levels: Vec<Vec<Image>> = if opts.mips {
+            MipChain::resampled(env)
+                .into_levels()
+                .into_iter()
+                .map(EnvMap::into_layers)
+                .collect()
+        } else {
+            vec![env.layers().to_vec()]
+        };
         let mut write = opts.write;
         write.declared = Some(MapInfo {
             projection: *env.projection(),

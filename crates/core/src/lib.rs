@@ -17,6 +17,7 @@
 #![warn(missing_docs)]
 
 pub mod choice;
+pub mod color;
 mod envmap;
 mod fault;
 mod image;
@@ -45,4 +46,4 @@ pub use resample::{resample, resample_to_extent, ResampleOptions, Resampler, Rot
 pub use glam;
 /// The SIMD lanes the fast variants are written on.
 pub use mirrorball_simd as simd;
-pub use projection::quadrature;
+pub use projection::{derivative, quadrature};

@@ -130,7 +130,10 @@ impl Default for ResampleOptions {
 /// Below this footprint ratio (2× linear minification) one bilinear lookup is used.
 const BILINEAR_MAX_RATIO: f64 = 4.0;
 
-/// A source map with its solid-angle-weighted mip pyramid (only as deep as needed).
+/// A source map with its solid-angle-weighted mip pyramid (only as deep as needed), for the
+/// resampler's lookups alone: each 2×2 block weighted by the density at the texel centres
+/// (cheap, and exact enough for a bilinear read). `mirrorball-filter`'s `MipChain` is the
+/// public, energy-exact pyramid (exact texel solid angles, odd sizes split fractionally).
 pub(crate) struct Pyramid<'a> {
     base: &'a [Image],
     levels: Vec<Vec<Image>>,

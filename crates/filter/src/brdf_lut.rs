@@ -54,7 +54,7 @@ pub fn integrate(n_dot_v: f64, roughness: f64, samples: u32, vis: Visibility) ->
     for i in 0..n {
         let (u1, u2) = lattice(i, n);
         let phi = 2.0 * std::f64::consts::PI * u2;
-        let ch = ((1.0 - u1) / (1.0 + (a2 - 1.0) * u1)).max(0.0).sqrt();
+        let ch = crate::lobe::ggx::cos_h(u1, a2);
         let sh = (1.0 - ch * ch).max(0.0).sqrt();
         let h = [sh * phi.cos(), sh * phi.sin(), ch];
         let vh = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];

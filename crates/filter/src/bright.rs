@@ -196,7 +196,7 @@ pub(crate) fn split(cube: &mut EnvMap, k: f32, max_texels: usize) -> Option<Brig
 /// A zonal kernel `K(c)` evaluated in `f32` for the bright sum.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum BrightKernel {
-    /// GGX with `α²`: `K(c) = α²/(π q²)·c`, `q = ½(1 + c)(α² − 1) + 1`.
+    /// GGX with `α²` ([`crate::lobe::ggx::kernel_f32`]).
     Ggx(f32),
     /// Phong with exponent `s`: `K(c) = c^s`.
     Phong(f32),
@@ -206,10 +206,7 @@ impl BrightKernel {
     #[inline(always)]
     fn eval(self, c: f32) -> f32 {
         match self {
-            BrightKernel::Ggx(a2) => {
-                let q = 0.5 * (1.0 + c) * (a2 - 1.0) + 1.0;
-                a2 * std::f32::consts::FRAC_1_PI * c / (q * q)
-            }
+            BrightKernel::Ggx(a2) => crate::lobe::ggx::kernel_f32(c, a2),
             BrightKernel::Phong(s) => c.powf(s),
         }
     }

@@ -450,7 +450,8 @@ mod tests {
 
     #[test]
     fn working_cube_follows_the_outputs() {
-        use crate::prefilter::{chain_lobes, LobeKind};
+        use crate::lobe::LobeKind;
+        use crate::prefilter::chain_lobes;
         use crate::specular::RoughnessMapping;
         let cube = Projection::Cube(CubeMap);
         let ll = mirrorball_core::ProjectionKind::LatLong.default_projection();

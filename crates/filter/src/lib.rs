@@ -82,9 +82,9 @@ pub mod sh;
 pub mod specular;
 
 pub use brdf_lut::{BrdfLut, Visibility};
-pub use lobe::Lobe;
+pub use lobe::{Lobe, LobeKind};
 pub use mip::{MipChain, MipFilter};
-pub use prefilter::{chain_lobes, chain_rows, LobeKind, PrefilterOptions, Prefilterer};
+pub use prefilter::{chain_lobes, chain_rows, PrefilterOptions, Prefilterer};
 pub use reference::BruteForce;
 pub use robust::{compress, Compression, EnergyReport};
 pub use sampler::{Filter, Footprint, Sampler};

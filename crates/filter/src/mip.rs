@@ -20,6 +20,11 @@
 //!   filters across edges (at a corner the three texels meeting there are each weighted).
 //!
 //! Sizes halve, rounding down, to 1×1 (a `w×h` layer has `1 + ⌊log₂ max(w, h)⌋` levels).
+//!
+//! [`MipChain::resampled`] is the third way, each level converted from level 0 by the
+//! resampler: what `convert --mips` writes into KTX2 and DDS files. (The resampler's own
+//! lookup pyramid, inside `mirrorball-core`, weights each 2×2 block by the density at the
+//! texel centres: cheaper, and only ever read through its bilinear lookups.)
 
 use glam::DVec2;
 use mirrorball_core::{EnvMap, Image, Projection, WorldProjection};
@@ -57,6 +62,31 @@ impl MipChain {
             }
             let next = downsample(last, filter);
             levels.push(next);
+        }
+        MipChain { levels }
+    }
+
+    /// The pyramid `convert --mips` writes: level `k` is level 0 converted to half, quarter…
+    /// the edge by [`mirrorball_core::resample`] (each output texel integrated over its
+    /// footprint on level 0, not a mean of the level before), down to 1 texel along the
+    /// edge. Unlike [`MipChain::build`], the weights are the resampler's (density at the
+    /// integration points), so energy is conserved to the resampler's accuracy rather than
+    /// exactly; it is kept for the files `convert` has always written.
+    pub fn resampled(env: &EnvMap) -> MipChain {
+        let mut levels = vec![env.clone()];
+        let proj = *env.projection();
+        let mut size = env.width() / 2;
+        while size >= 1 {
+            levels.push(mirrorball_core::resample(
+                env,
+                proj,
+                size,
+                &mirrorball_core::ResampleOptions::default(),
+            ));
+            if size == 1 {
+                break;
+            }
+            size /= 2;
         }
         MipChain { levels }
     }

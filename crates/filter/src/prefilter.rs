@@ -17,7 +17,7 @@
 use crate::bright::{split, BrightKernel, BrightSet, BrightWalk};
 use crate::cube::{needed_face, seamless_pyramid, working_cube, working_face, SeamlessCube};
 use crate::irradiance::MomentPyramid;
-use crate::lobe::Lobe;
+use crate::lobe::{Lobe, LobeKind};
 use crate::specular::{fis, sample_count, RoughnessMapping, SampleSet};
 use glam::{DVec3, Vec3, Vec4};
 use mirrorball_core::{EnvMap, Image, Projection, WorldProjection};
@@ -374,17 +374,6 @@ pub fn chain_rows(out: &Projection, size: u32, levels: usize) -> u64 {
     (0..levels)
         .map(|i| (h0 >> i).max(1) as u64 * out.layer_count() as u64)
         .sum()
-}
-
-/// The kind of lobe of a prefiltered chain.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LobeKind {
-    /// Lambert (every level the same lobe).
-    Lambert,
-    /// Phong, exponent `2/α² − 2` from each level's roughness unless given.
-    Phong,
-    /// GGX, one roughness per level.
-    Ggx,
 }
 
 /// The lobes of an `levels`-level chain: GGX with `mapping`'s roughness per level; Phong

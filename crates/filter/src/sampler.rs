@@ -12,7 +12,7 @@
 //!   components along `d` are dropped).
 //!
 //! The ellipse is carried to texture space through the projection's Jacobian at `d`:
-//! with `∂d/∂u`, `∂d/∂v` from central differences of [`WorldProjection::uv_to_dir`] and an
+//! with `∂d/∂u`, `∂d/∂v` from [`mirrorball_core::derivative`] (differences of [`WorldProjection::uv_to_dir`]) and an
 //! orthonormal tangent frame `(t₁, t₂)`, `M = [tᵢ·∂d/∂u, tᵢ·∂d/∂v]` maps `uv` steps to
 //! tangent steps, and `J = M⁻¹` maps the footprint's semi-diameters to `uv` (then to texels
 //! of the level used). `|det M|` is the projection's area element, which the tests check.
@@ -127,21 +127,7 @@ fn tangent_frame(d: DVec3) -> (DVec3, DVec3) {
     (t, d.cross(t))
 }
 
-/// `∂d/∂u` and `∂d/∂v` at `(layer, uv)`, by central differences (one-sided where the
-/// projection stops covering).
-pub fn uv_derivatives(proj: &Projection, layer: usize, uv: DVec2) -> Option<(DVec3, DVec3)> {
-    let h = 1e-5;
-    let diff = |e: DVec2| -> Option<DVec3> {
-        let c = proj.uv_to_dir(layer, uv)?;
-        match (proj.uv_to_dir(layer, uv + e), proj.uv_to_dir(layer, uv - e)) {
-            (Some(p), Some(m)) => Some((p - m) / (2.0 * h)),
-            (Some(p), None) => Some((p - c) / h),
-            (None, Some(m)) => Some((c - m) / h),
-            (None, None) => None,
-        }
-    };
-    Some((diff(DVec2::new(h, 0.0))?, diff(DVec2::new(0.0, h))?))
-}
+pub use mirrorball_core::derivative::uv_derivatives;
 
 /// The footprint of `dir` carried into texture coordinates through the projection's
 /// Jacobian (`None` where the projection does not cover `dir` or is singular there).

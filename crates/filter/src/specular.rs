@@ -43,7 +43,7 @@
 
 use crate::cube::SeamlessCube;
 use crate::lobe::Lobe;
-use glam::{DVec3, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 use mirrorball_core::simd::F32x4;
 use mirrorball_core::CubeMap;
 use std::f64::consts::PI;
@@ -164,33 +164,7 @@ impl SampleSet {
         for i in 0..n {
             let (u1, u2) = lattice(i, n);
             let phi = 2.0 * PI * u2;
-            let (l, w, pdf) = match *lobe {
-                Lobe::Lambert => {
-                    // Cosine-weighted: cos θ = √u, p = cos θ/π.
-                    let c = u1.sqrt();
-                    (polar(c, phi), 1.0, c / PI)
-                }
-                Lobe::Phong { exponent } => {
-                    // p = (s + 1)/(2π) cos^s θ ⇒ cos θ = u^{1/(s+1)}.
-                    let c = u1.powf(1.0 / (exponent + 1.0));
-                    (
-                        polar(c, phi),
-                        1.0,
-                        (exponent + 1.0) / (2.0 * PI) * c.powf(exponent),
-                    )
-                }
-                Lobe::Ggx { .. } => {
-                    // Half vector from D(h)(n·h): cos²θ_h = (1 − u)/(1 + (α² − 1)u).
-                    let a = lobe.alpha().expect("ggx");
-                    let a2 = a * a;
-                    let ch = ((1.0 - u1) / (1.0 + (a2 - 1.0) * u1)).max(0.0).sqrt();
-                    let h = polar(ch, phi);
-                    let l = DVec3::new(2.0 * ch * h.x, 2.0 * ch * h.y, 2.0 * ch * ch - 1.0);
-                    let q = ch * ch * (a2 - 1.0) + 1.0;
-                    let d = a2 / (PI * q * q);
-                    (l, l.z.max(0.0), d / 4.0)
-                }
-            };
+            let (l, w, pdf) = lobe.sample(u1, phi);
             if w <= 0.0 {
                 // A GGX reflection below the horizon: weight 0, costs without counting.
                 continue;
@@ -222,12 +196,6 @@ impl SampleSet {
             .collect();
         SampleSet { groups, weight_sum }
     }
-}
-
-#[inline]
-fn polar(c: f64, phi: f64) -> DVec3 {
-    let s = (1.0 - c * c).max(0.0).sqrt();
-    DVec3::new(s * phi.cos(), s * phi.sin(), c)
 }
 
 /// A continuous tangent frame about `n`: `t = normalize(ŷ × n)`, `b = n × t` (the poles

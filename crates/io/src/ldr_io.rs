@@ -9,6 +9,7 @@ use crate::{atomic::stage, Error, Format, Limits, Loaded, Precision, Staged, Wri
 use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::{DynamicImage, ExtendedColorType, ImageDecoder, ImageEncoder, ImageError, ImageFormat};
+use mirrorball_core::color::{linear_to_srgb, srgb_to_linear};
 use mirrorball_core::Image;
 use rayon::prelude::*;
 use std::fs::File;
@@ -286,27 +287,7 @@ pub fn write(
 }
 
 // ---------------------------------------------------------------------------------------
-// sRGB transfer functions.
-
-/// The sRGB EOTF: encoded value in [0, 1] to linear light, computed in `f64`.
-fn srgb_to_linear(s: f64) -> f64 {
-    if s <= 0.04045 {
-        s / 12.92
-    } else {
-        ((s + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// The inverse sRGB EOTF: linear light in [0, 1] to an encoded value, in `f64` so that
-/// 16-bit codes round to nearest exactly.
-#[inline]
-fn linear_to_srgb(l: f64) -> f64 {
-    if l <= 0.003_130_8 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    }
-}
+// sRGB tables, from `mirrorball_core::color`'s transfer functions.
 
 /// Linear light of each 8-bit sRGB code.
 fn lut8() -> &'static [f32; 256] {

@@ -17,6 +17,7 @@
 //! reported as [`Loaded::declared`]; its pictures follow OpenEXR's conventions, which
 //! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
 
+mod apng;
 mod atomic;
 mod bounds;
 mod dds_io;
@@ -29,6 +30,7 @@ mod ldr_io;
 mod meta_text;
 pub mod openexr;
 
+pub use apng::write_apng;
 pub use atomic::{atomic_write, commit_all, interrupted, Staged};
 pub use error::{Error, Fault};
 

@@ -26,42 +26,9 @@ use mirrorball_core::EnvMap;
 use mirrorball_filter::{Footprint, Lobe, PrefilterOptions, Prefilterer, Sampler};
 use std::sync::{Arc, Mutex, Weak};
 
-/// The specular lobe of Greene's material.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum SpecularLobe {
-    /// Phong, `max(r·l, 0)^exponent` (Greene §7, Miller & Hoffman).
-    Phong {
-        /// The exponent (≥ 0).
-        exponent: f32,
-    },
-    /// GGX in the split-sum form (`n = v = r`), perceptual roughness in `[0, 1]`.
-    Ggx {
-        /// Perceptual roughness; `α = roughness²`.
-        roughness: f32,
-    },
-}
-
-impl SpecularLobe {
-    /// The filter crate's lobe.
-    pub fn lobe(self) -> Lobe {
-        match self {
-            SpecularLobe::Phong { exponent } => Lobe::Phong {
-                exponent: exponent as f64,
-            },
-            SpecularLobe::Ggx { roughness } => Lobe::Ggx {
-                roughness: roughness as f64,
-            },
-        }
-    }
-
-    /// Whether the parameter is in range (exponent ≥ 0, roughness in `[0, 1]`, finite).
-    pub fn is_valid(self) -> bool {
-        match self {
-            SpecularLobe::Phong { exponent } => exponent.is_finite() && exponent >= 0.0,
-            SpecularLobe::Ggx { roughness } => (0.0..=1.0).contains(&roughness),
-        }
-    }
-}
+/// The specular lobe of Greene's material: the filter crate's [`Lobe`] (Phong, GGX, or
+/// Lambert), under the name the scene has always used.
+pub type SpecularLobe = Lobe;
 
 /// Greene's two prefiltered maps for one lobe, in the environment's projection.
 #[derive(Debug)]
@@ -166,7 +133,7 @@ impl EnvCache {
         let specular = match g.specular.iter().find(|(l, _)| *l == lobe) {
             Some((_, s)) => s.clone(),
             None => {
-                let l = lobe.lobe();
+                let l = lobe;
                 let (w, h) = extent_for(map, l.angular_scale() / 4.0);
                 let s = Arc::new(pf.render_extent(&l, *map.projection(), w, h));
                 g.specular.push((lobe, s.clone()));

@@ -2,17 +2,16 @@
 //! light in `[0, 1]`; `mirrorball-io` applies the sRGB encoding when it writes 8- or 16-bit
 //! files. EXR output skips this and keeps the linear radiance.
 
-use mirrorball_core::{Choice, Image};
+use mirrorball_core::{color, Choice, Image};
 
 /// How linear radiance is squeezed into `[0, 1]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Tone {
     /// Clip at 1.
     Clamp,
-    /// Reinhard's `x / (1 + x)` on each channel.
+    /// Reinhard's `x / (1 + x)` on each channel ([`color::reinhard`]).
     Reinhard,
-    /// Narkowicz's fit of the ACES filmic curve,
-    /// `x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14)`, clipped to `[0, 1]`.
+    /// Narkowicz's fit of the ACES filmic curve ([`color::aces_narkowicz`]).
     #[default]
     Aces,
 }
@@ -33,8 +32,8 @@ impl Tone {
         let x = if x.is_finite() { x.max(0.0) } else { 0.0 };
         match self {
             Tone::Clamp => x.min(1.0),
-            Tone::Reinhard => x / (1.0 + x),
-            Tone::Aces => (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0),
+            Tone::Reinhard => color::reinhard(x),
+            Tone::Aces => color::aces_narkowicz(x),
         }
     }
 }

@@ -707,7 +707,7 @@ fn material_of(e: &MaterialEntry) -> Result<Material, String> {
                         );
                     }
                     SpecularLobe::Phong {
-                        exponent: e.exponent.unwrap_or(32.0),
+                        exponent: e.exponent.unwrap_or(32.0) as f64,
                     }
                 }
                 "ggx" => {
@@ -717,19 +717,24 @@ fn material_of(e: &MaterialEntry) -> Result<Material, String> {
                         );
                     }
                     SpecularLobe::Ggx {
-                        roughness: e.roughness.unwrap_or(0.3),
+                        roughness: e.roughness.unwrap_or(0.3) as f64,
                     }
                 }
                 other => return Err(format!("lobe '{other}' is not phong or ggx")),
             };
-            if !lobe.is_valid() {
+            // An infinite exponent (a mirror, to the filter crate) is refused here.
+            if !lobe.is_valid()
+                || matches!(lobe, SpecularLobe::Phong { exponent } if exponent.is_infinite())
+            {
+                // The parameters were read as `f32`: print them so.
                 return Err(match lobe {
-                    SpecularLobe::Phong { exponent } => {
-                        format!("phong exponent {exponent} must be a number ≥ 0")
-                    }
                     SpecularLobe::Ggx { roughness } => {
-                        format!("ggx roughness {roughness} is outside [0, 1]")
+                        format!("ggx roughness {} is outside [0, 1]", roughness as f32)
                     }
+                    _ => format!(
+                        "phong exponent {} must be a number ≥ 0",
+                        e.exponent.unwrap_or(32.0)
+                    ),
                 });
             }
             Material::Greene {
@@ -1144,7 +1149,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     }
     if !anim.is_empty() {
         let p = sibling(&plan.output, "turntable", "png");
-        write_apng(&p, &anim, 24)?;
+        mirrorball_io::write_apng(&p, &anim, 24)?;
         if !plan.quiet {
             eprintln!(
                 "wrote {} (animated PNG, {} frames)",
@@ -1174,55 +1179,6 @@ fn ext_of(f: Format) -> &'static str {
         Format::Jpeg => "jpg",
         _ => "png",
     }
-}
-
-/// The sRGB encoding of linear `x ∈ [0, 1]`, as 8 bits.
-fn srgb8(x: f32) -> u8 {
-    let x = x.clamp(0.0, 1.0);
-    let s = if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5) as u8
-}
-
-/// Writes display-ready frames (linear, in `[0, 1]`) as an animated PNG that loops, at
-/// `fps` frames per second, atomically.
-fn write_apng(path: &Path, frames: &[Image], fps: u16) -> Result<(), CliError> {
-    let (w, h) = (frames[0].width(), frames[0].height());
-    let fail = |e: String| mirrorball_io::Error::input(path, e);
-    mirrorball_io::atomic_write(path, |out| {
-        let mut enc = png::Encoder::new(out, w, h);
-        enc.set_color(png::ColorType::Rgba);
-        enc.set_depth(png::BitDepth::Eight);
-        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        enc.set_animated(frames.len() as u32, 0)
-            .map_err(|e| fail(e.to_string()))?;
-        enc.set_frame_delay(1, fps)
-            .map_err(|e| fail(e.to_string()))?;
-        let mut wr = enc.write_header().map_err(|e| fail(e.to_string()))?;
-        for f in frames {
-            let c = f.channels();
-            let bytes: Vec<u8> = f
-                .data()
-                .chunks_exact(c)
-                .flat_map(|p| {
-                    let a = if c == 4 { p[3] } else { 1.0 };
-                    [
-                        srgb8(p[0]),
-                        srgb8(p[1]),
-                        srgb8(p[2]),
-                        (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8,
-                    ]
-                })
-                .collect();
-            wr.write_image_data(&bytes)
-                .map_err(|e| fail(e.to_string()))?;
-        }
-        wr.finish().map_err(|e| fail(e.to_string()))
-    })?;
-    Ok(())
 }
 
 /// An RGB picture as RGBA with alpha 1.

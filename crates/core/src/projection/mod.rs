@@ -14,6 +14,7 @@
 mod azimuthal;
 mod continuous_cube;
 mod cube;
+pub mod derivative;
 pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
