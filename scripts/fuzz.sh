@@ -2,7 +2,7 @@
 # A coverage-guided (libFuzzer) campaign of one of the hostile::fuzz_* bolero targets, on the
 # stable toolchain: builds the target's test binary with sanitizer coverage (in
 # target/fuzz) and runs libFuzzer on it. See docs/fuzzing.md.
-#   scripts/fuzz.sh TARGET [SECONDS]     TARGET: exr hdr png jpeg webp ktx2 dds obj gltf scene spec
+#   scripts/fuzz.sh TARGET [SECONDS]     TARGET: exr hdr png jpeg webp ktx2 dds obj gltf spec
 # The corpus grows in target/fuzz/corpus/TARGET; crashes are written to
 # target/fuzz/crashes/TARGET/ (save them under the seeds' crashes/ folder with the fix).
 # FUZZ_TARGET_DIR moves target/fuzz elsewhere.
@@ -14,7 +14,13 @@ seconds="${2:-1800}"
 case "$target" in
     exr|hdr|png|jpeg|webp|ktx2|dds) pkg=mirrorball-io; bin=io ;;
     obj|gltf) pkg=mirrorball-render; bin=render ;;
-    scene|spec) pkg=mirrorball-cli; bin=cli ;;
+    spec) pkg=mirrorball-core; bin=core ;;
+    scene)
+        # A process per input (the `mirrorball` binary reads the scene): libFuzzer would see
+        # no coverage, and the instrumented binary does not link without libFuzzer.
+        echo "fuzz.sh: the scene target runs the binary per input; use the random engine:" >&2
+        echo "  BOLERO_RANDOM_ITERATIONS=100000000 BOLERO_RANDOM_TEST_TIME_MS=1800000 cargo test -p mirrorball-cli --test cli -- hostile::fuzz_scene --exact" >&2
+        exit 2 ;;
     *) echo "fuzz.sh: unknown target '$target'" >&2; exit 2 ;;
 esac
 flags="--cfg fuzzing -Cpasses=sancov-module --cfg fuzzing_libfuzzer \
