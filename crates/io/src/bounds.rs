@@ -8,7 +8,7 @@
 //! rare but valid coding can pack more (Radiance's old-style chained runs), the bound is
 //! set well above the common coding's (64 texels a byte where new-style runs reach 16), and
 //! every file may declare [`FLOOR_TEXELS`]. WebP's coding has no such bound, so it is held
-//! to a plausible density instead ([`check_texels_plausible`]); DWA's DCT with deflated DC
+//! to a plausible density instead ([`Density::Plausible`]); DWA's DCT with deflated DC
 //! values is bounded by checking each block's counters (`exr_io`).
 
 use crate::Error;
@@ -25,57 +25,47 @@ fn file_len(path: &Path) -> Result<u64, Error> {
         .map_err(|e| Error::io(path, e))
 }
 
-/// Refuses a `width × height` image declared by a `format` file when the file is too short
-/// to hold it: more than `per_byte` texels for each of its bytes (and more than
-/// [`FLOOR_TEXELS`]).
+/// How a format's texels-a-byte bound is known.
+#[derive(Clone, Copy)]
+pub(crate) enum Density {
+    /// The coding cannot pack more: a file declaring more is corrupt or truncated.
+    Most(u64),
+    /// The coding has no hard bound, but no real picture comes near this: a file declaring
+    /// more is corrupt or hostile (a few bytes would allocate gigabytes).
+    Plausible(u64),
+}
+
+/// Refuses a `width × height` image declared by a `format` file of more texels than its
+/// length allows at `density` texels a byte (and more than [`FLOOR_TEXELS`]).
 pub(crate) fn check_texels_fit(
     path: &Path,
     width: u64,
     height: u64,
-    per_byte: u64,
+    density: Density,
     format: &str,
 ) -> Result<(), Error> {
     let len = file_len(path)?;
+    let per_byte = match density {
+        Density::Most(n) | Density::Plausible(n) => n,
+    };
     let most = len.saturating_mul(per_byte).max(FLOOR_TEXELS);
     let texels = width.saturating_mul(height);
-    if texels > most {
-        return Err(Error::input(
-            path,
-            format!(
-                "declares a {width}×{height} image ({texels} texels), but a {format} file of \
-                 {len} bytes holds at most {most}: the file is corrupt or truncated"
-            ),
-        ));
+    if texels <= most {
+        return Ok(());
     }
-    Ok(())
-}
-
-/// Refuses a `width × height` image declared by a `format` file whose coding has no hard
-/// bound on texels a byte, when it declares more than `per_byte` texels for each byte (and
-/// more than [`FLOOR_TEXELS`]): a far denser picture than any real file, which would make a
-/// few bytes allocate gigabytes.
-pub(crate) fn check_texels_plausible(
-    path: &Path,
-    width: u64,
-    height: u64,
-    per_byte: u64,
-    format: &str,
-) -> Result<(), Error> {
-    let len = file_len(path)?;
-    let most = len.saturating_mul(per_byte).max(FLOOR_TEXELS);
-    let texels = width.saturating_mul(height);
-    if texels > most {
-        return Err(Error::input(
-            path,
-            format!(
-                "declares a {width}×{height} image ({texels} texels) in {len} bytes: more \
-                 than {per_byte} texels a byte, which no real {format} picture reaches \
-                 (mirrorball reads {format} files up to {most} texels at this length); the \
-                 file is corrupt or hostile"
-            ),
-        ));
-    }
-    Ok(())
+    let problem = match density {
+        Density::Most(_) => format!(
+            "declares a {width}×{height} image ({texels} texels), but a {format} file of \
+             {len} bytes holds at most {most}: the file is corrupt or truncated"
+        ),
+        Density::Plausible(_) => format!(
+            "declares a {width}×{height} image ({texels} texels) in {len} bytes: more than \
+             {per_byte} texels a byte, which no real {format} picture reaches (mirrorball \
+             reads {format} files up to {most} texels at this length); the file is corrupt \
+             or hostile"
+        ),
+    };
+    Err(Error::input(path, problem))
 }
 
 /// Refuses an image whose raw samples (`raw_bytes`, as the file's header declares them)

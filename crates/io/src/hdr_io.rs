@@ -55,7 +55,13 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         // A new-style run-length line costs at least 2 bytes a channel per 127 texels (16
         // texels a byte); old-style runs can chain repeat counts further, and files that
         // use them are rare: 64 texels a byte (and any file up to the floor) covers them.
-        crate::bounds::check_texels_fit(path, width as u64, height as u64, 64, "Radiance HDR")?;
+        crate::bounds::check_texels_fit(
+            path,
+            width as u64,
+            height as u64,
+            crate::bounds::Density::Most(64),
+            "Radiance HDR",
+        )?;
         let lines = decoder.metadata().custom_attributes;
         let get = |key: &str| lines.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
         let recorded = crate::recorded(get, width, height);

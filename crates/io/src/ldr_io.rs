@@ -151,11 +151,12 @@ fn check_fits_file(
     width: u32,
     height: u32,
 ) -> Result<(), Error> {
+    use crate::bounds::{check_texels_fit, Density};
     let (w, h) = (width as u64, height as u64);
     match format {
-        Format::Png => crate::bounds::check_texels_fit(path, w, h, 8 * 1040, name),
-        Format::Jpeg => crate::bounds::check_texels_fit(path, w, h, 1024, name),
-        Format::Webp => crate::bounds::check_texels_plausible(path, w, h, 4096, name),
+        Format::Png => check_texels_fit(path, w, h, Density::Most(8 * 1040), name),
+        Format::Jpeg => check_texels_fit(path, w, h, Density::Most(1024), name),
+        Format::Webp => check_texels_fit(path, w, h, Density::Plausible(4096), name),
         _ => Ok(()),
     }
 }
