@@ -16,6 +16,7 @@
 //! Reading gives them back as [`Loaded::recorded`]. OpenEXR's own `envmap` attribute is
 //! reported as [`Loaded::declared`]; its pictures follow OpenEXR's conventions, which
 //! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
+#![warn(missing_docs)]
 
 mod apng;
 mod atomic;
