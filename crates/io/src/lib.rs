@@ -245,6 +245,22 @@ pub struct Loaded {
 }
 
 /// Reads an image or cube map, checking declared sizes against `limits` before allocating.
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_io::{read, write_image, Fault, Limits, WriteOptions};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("map.exr");
+/// let mut img = Image::new(8, 4, 3);
+/// img.set(1, 2, &[0.25, 0.5, 4.0]);
+/// write_image(&path, &img, &WriteOptions::default()).unwrap();
+/// let loaded = read(&path, &Limits::default()).unwrap();
+/// assert_eq!(loaded.layers[0].get(1, 2), &[0.25, 0.5, 4.0]);
+/// // A missing file is an error that names it and says whose fault it is.
+/// let e = read(&dir.path().join("none.exr"), &Limits::default()).unwrap_err();
+/// assert!(e.to_string().starts_with(&dir.path().join("none.exr").display().to_string()));
+/// assert_ne!(e.fault(), Fault::Request);
+/// ```
 pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
@@ -301,6 +317,19 @@ pub fn write_image_staged(
 /// Writes a cube map with its mip chain to KTX2 or DDS, atomically. `levels[0]` holds the
 /// six level-0 faces in OpenGL order (+X −X +Y −Y +Z −Z), `levels[i]` the faces of level i,
 /// each half the size of the one before (rounded down, at least 1).
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_io::{read, write_cube, Limits, WriteOptions};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("sky.ktx2");
+/// let levels: Vec<Vec<Image>> = [4u32, 2, 1]
+///     .iter()
+///     .map(|&n| (0..6).map(|_| Image::new(n, n, 3)).collect())
+///     .collect();
+/// write_cube(&path, &levels, &WriteOptions::default()).unwrap();
+/// assert_eq!(read(&path, &Limits::default()).unwrap().layers.len(), 6);
+/// ```
 pub fn write_cube(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<(), Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
