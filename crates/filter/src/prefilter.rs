@@ -76,6 +76,18 @@ impl Default for PrefilterOptions {
 }
 
 /// A source prepared for prefiltering.
+///
+/// ```
+/// use mirrorball_core::{EnvMap, ProjectionKind};
+/// use mirrorball_filter::{Lobe, PrefilterOptions, Prefilterer};
+/// // A constant environment prefilters to the same constant, whatever the lobe.
+/// let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 32, 3, |_| [0.5, 0.5, 0.5, 1.0]);
+/// let p = Prefilterer::new(&src, PrefilterOptions::default());
+/// let cube = ProjectionKind::Cube.default_projection();
+/// let glossy = p.render(&Lobe::Ggx { roughness: 0.5 }, cube, 8);
+/// assert_eq!(glossy.layers().len(), 6);
+/// assert!(glossy.layers()[0].data().iter().all(|&v| (v - 0.5).abs() < 1e-4));
+/// ```
 pub struct Prefilterer {
     /// The working cube, whole.
     cube: EnvMap,
