@@ -27,18 +27,6 @@ impl X8 {
     pub fn get() -> Option<X8> {
         std::is_x86_feature_detected!("avx2").then_some(X8(()))
     }
-    /// `f()`, called from a function compiled with AVX2. The closure itself is compiled
-    /// without it unless LLVM inlines it, so this is for tests and cold code; hot code is a
-    /// kernel ([`crate::x8_kernel!`]).
-    #[inline(always)]
-    pub fn run<R>(self, f: impl FnOnce() -> R) -> R {
-        #[target_feature(enable = "avx2")]
-        #[inline]
-        fn with_avx2<R>(f: impl FnOnce() -> R) -> R {
-            f()
-        }
-        unsafe { with_avx2(f) }
-    }
     /// Every lane `x`.
     #[inline(always)]
     pub fn splat(self, x: f32) -> F32x8 {

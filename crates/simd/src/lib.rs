@@ -80,7 +80,7 @@ pub fn prefetch<T>(p: *const T) {
 /// The lane operations are `#[inline(always)]` wrappers of AVX2 intrinsics; they become
 /// single instructions only inside a function compiled with AVX2. A closure does not
 /// inherit its caller's target features, so hot eight-lane code must be such a kernel,
-/// not a closure passed to [`X8::run`]. Everything the body calls that is
+/// not a closure. Everything the body calls that is
 /// `#[inline(always)]` is compiled into it with AVX2 too. Generic parameters are not
 /// supported; the signature's lifetimes may be elided.
 ///

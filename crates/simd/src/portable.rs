@@ -361,11 +361,6 @@ impl X8 {
     pub fn get() -> Option<X8> {
         Some(X8(()))
     }
-    /// `f()`, with the eight-lane types' instructions available to it.
-    #[inline(always)]
-    pub fn run<R>(self, f: impl FnOnce() -> R) -> R {
-        f()
-    }
     /// [`F32x8::splat`].
     #[inline(always)]
     pub fn splat(self, x: f32) -> F32x8 {

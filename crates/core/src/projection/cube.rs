@@ -463,7 +463,7 @@ mod tests {
                 }
             }
             if let Some(x8) = x8 {
-                x8.run(|| {
+                {
                     let eight = |a: usize| x8.f32s(std::array::from_fn(|i| lane(0, i)[a]));
                     let s = CubeMap::uv8(x8, eight(0), eight(1), eight(2));
                     let (l, u, v, m) = (
@@ -477,7 +477,7 @@ mod tests {
                         assert_eq!(l[i] as usize, h, "{d}");
                         assert_eq!([u[i], v[i], m[i]].map(bits), [hu, hv, hm].map(bits), "{d}");
                     }
-                });
+                }
             }
         }
     }
