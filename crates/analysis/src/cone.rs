@@ -21,6 +21,7 @@
 
 use crate::geom::{basis, spherical_polygon_area};
 use glam::{DVec2, DVec3};
+use mirrorball_core::par::fold_in_order;
 use mirrorball_core::{Projection, WorldProjection};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -214,28 +215,25 @@ pub fn cone_region(p: &Projection, size: u32, cone: &Cone) -> ConeRegion {
     let mut texels = 0;
     let mut solid_angle = 0.0;
     for (l, m) in mask.iter_mut().enumerate() {
-        let (t, s) = m
-            .par_chunks_mut(w as usize)
-            .enumerate()
-            .map(|(y, row)| {
-                let y = y as u32;
-                let (mut t, mut s) = (0u64, 0.0);
-                for (x, c) in row.iter_mut().enumerate() {
-                    let x = x as u32;
-                    let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-                    if let Some(d) = p.uv_to_dir(l, uv) {
-                        if cone.contains(d) {
-                            *c = class::INSIDE;
-                            t += 1;
-                            s += p.texel_solid_angle(l, x, y, w, h);
-                        } else {
-                            *c = class::OUTSIDE;
-                        }
+        let rows = m.par_chunks_mut(w as usize).enumerate().map(|(y, row)| {
+            let y = y as u32;
+            let (mut t, mut s) = (0u64, 0.0);
+            for (x, c) in row.iter_mut().enumerate() {
+                let x = x as u32;
+                let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                if let Some(d) = p.uv_to_dir(l, uv) {
+                    if cone.contains(d) {
+                        *c = class::INSIDE;
+                        t += 1;
+                        s += p.texel_solid_angle(l, x, y, w, h);
+                    } else {
+                        *c = class::OUTSIDE;
                     }
                 }
-                (t, s)
-            })
-            .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+            }
+            (t, s)
+        });
+        let (t, s) = fold_in_order(rows, (0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
         texels += t;
         solid_angle += s;
     }

@@ -99,21 +99,20 @@ where
     let rows: Vec<(usize, u32)> = (0..p.layer_count())
         .flat_map(|l| (0..h).map(move |y| (l, y)))
         .collect();
-    rows.par_iter()
-        .map(|&(l, y)| {
-            let v = (y as f64 + 0.5) / h as f64;
-            let mut n = 0;
-            let mut s = 0.0;
-            for x in 0..w {
-                let uv = DVec2::new((x as f64 + 0.5) / w as f64, v);
-                if p.uv_to_dir(l, uv).is_some_and(&inside) {
-                    n += 1;
-                    s += p.texel_solid_angle(l, x, y, w, h);
-                }
+    let per_row = rows.par_iter().map(|&(l, y)| {
+        let v = (y as f64 + 0.5) / h as f64;
+        let mut n = 0;
+        let mut s = 0.0;
+        for x in 0..w {
+            let uv = DVec2::new((x as f64 + 0.5) / w as f64, v);
+            if p.uv_to_dir(l, uv).is_some_and(&inside) {
+                n += 1;
+                s += p.texel_solid_angle(l, x, y, w, h);
             }
-            (n, s)
-        })
-        .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
+        }
+        (n, s)
+    });
+    mirrorball_core::par::fold_in_order(per_row, (0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
 
 /// Measures `frustum` in closed form, as a polygon, and on each of `on` (projection, size).

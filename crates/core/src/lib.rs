@@ -23,6 +23,7 @@ mod fault;
 mod image;
 pub mod layout;
 pub mod metrics;
+pub mod par;
 pub mod projection;
 mod remap;
 mod resample;

@@ -36,39 +36,36 @@ where
     let (mut se, mut wsum, mut peak) = (0.0f64, 0.0f64, 0.0f64);
     for layer in 0..reference.layers().len() {
         let (a, b) = (&reference.layers()[layer], &test.layers()[layer]);
-        let (s, ws, pk) = (0..h)
-            .into_par_iter()
-            .map(|y| {
-                let (mut s, mut ws, mut pk) = (0.0f64, 0.0f64, 0.0f64);
-                for x in 0..w {
-                    let wt = p.texel_solid_angle(layer, x, y, w, h);
-                    if wt <= 0.0 {
-                        continue;
-                    }
-                    let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-                    if !p
-                        .uv_to_dir(layer, p.nearest_covered(layer, uv))
-                        .is_some_and(&keep)
-                    {
-                        continue;
-                    }
-                    let (pa, pb) = (a.get(x, y), b.get(x, y));
-                    for c in 0..3 {
-                        let (la, lb) = (lg(pa[c]), lg(pb[c]));
-                        if !la.is_finite() || !lb.is_finite() {
-                            continue;
-                        }
-                        s += wt * (la - lb) * (la - lb);
-                        pk = pk.max(la);
-                    }
-                    ws += 3.0 * wt;
+        let rows = (0..h).into_par_iter().map(|y| {
+            let (mut s, mut ws, mut pk) = (0.0f64, 0.0f64, 0.0f64);
+            for x in 0..w {
+                let wt = p.texel_solid_angle(layer, x, y, w, h);
+                if wt <= 0.0 {
+                    continue;
                 }
-                (s, ws, pk)
-            })
-            .reduce(
-                || (0.0, 0.0, 0.0),
-                |a, b| (a.0 + b.0, a.1 + b.1, a.2.max(b.2)),
-            );
+                let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                if !p
+                    .uv_to_dir(layer, p.nearest_covered(layer, uv))
+                    .is_some_and(&keep)
+                {
+                    continue;
+                }
+                let (pa, pb) = (a.get(x, y), b.get(x, y));
+                for c in 0..3 {
+                    let (la, lb) = (lg(pa[c]), lg(pb[c]));
+                    if !la.is_finite() || !lb.is_finite() {
+                        continue;
+                    }
+                    s += wt * (la - lb) * (la - lb);
+                    pk = pk.max(la);
+                }
+                ws += 3.0 * wt;
+            }
+            (s, ws, pk)
+        });
+        let (s, ws, pk) = crate::par::fold_in_order(rows, (0.0, 0.0, 0.0), |a, b| {
+            (a.0 + b.0, a.1 + b.1, a.2.max(b.2))
+        });
         se += s;
         wsum += ws;
         peak = peak.max(pk);

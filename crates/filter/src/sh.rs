@@ -44,6 +44,7 @@
 
 use crate::cube::FaceGeometry;
 use glam::{DVec2, DVec3, Vec3};
+use mirrorball_core::par::fold_in_order;
 use mirrorball_core::CubeFace;
 use mirrorball_core::{EnvMap, ProjectionKind, WorldProjection};
 use rayon::prelude::*;
@@ -258,61 +259,57 @@ pub fn project(env: &EnvMap) -> Sh9 {
     let c = env.channels();
     let (w, h) = (env.width() as usize, env.height() as usize);
     let p = *env.projection();
-    let acc: [[f64; 3]; 9] = if p.kind() == ProjectionKind::Cube && w == h {
+    let acc = if p.kind() == ProjectionKind::Cube && w == h {
         let geom = FaceGeometry::new(w);
-        (0..6 * h)
-            .into_par_iter()
-            .map(|row| {
-                let (f, y) = (row / h, row % h);
-                let data = env.layers()[f].row(y as u32);
-                let g = &geom.texels[y * w..(y + 1) * w];
-                let mut acc = [[0.0f32; 3]; 9];
-                for (px, g) in data.chunks_exact(c).zip(g) {
-                    let d = CubeFace::from_face(f, Vec3::new(g[0], g[1], g[2]));
-                    let b = basis_f32(d);
-                    let l = [px[0] * g[3], px[1] * g[3], px[2] * g[3]];
-                    for (a, bi) in acc.iter_mut().zip(b) {
-                        a[0] += bi * l[0];
-                        a[1] += bi * l[1];
-                        a[2] += bi * l[2];
-                    }
+        let rows = (0..6 * h).into_par_iter().map(|row| {
+            let (f, y) = (row / h, row % h);
+            let data = env.layers()[f].row(y as u32);
+            let g = &geom.texels[y * w..(y + 1) * w];
+            let mut acc = [[0.0f32; 3]; 9];
+            for (px, g) in data.chunks_exact(c).zip(g) {
+                let d = CubeFace::from_face(f, Vec3::new(g[0], g[1], g[2]));
+                let b = basis_f32(d);
+                let l = [px[0] * g[3], px[1] * g[3], px[2] * g[3]];
+                for (a, bi) in acc.iter_mut().zip(b) {
+                    a[0] += bi * l[0];
+                    a[1] += bi * l[1];
+                    a[2] += bi * l[2];
                 }
-                acc.map(|a| a.map(|v| v as f64))
-            })
-            .reduce(|| [[0.0; 3]; 9], add9)
+            }
+            acc.map(|a| a.map(|v| v as f64))
+        });
+        fold_in_order(rows, [[0.0; 3]; 9], add9)
     } else {
         let layers = p.layer_count();
-        (0..layers * h)
-            .into_par_iter()
-            .map_init(
-                || vec![None; w],
-                |dirs, row| {
-                    let (layer, y) = (row / h, row % h);
-                    p.row_dirs(layer, y as u32, w as u32, h as u32, dirs);
-                    let data = env.layers()[layer].row(y as u32);
-                    let mut acc = [[0.0f64; 3]; 9];
-                    // A lat-long row's texels all cover the same solid angle.
-                    let row_omega = (p.kind() == ProjectionKind::LatLong)
-                        .then(|| p.texel_solid_angle(layer, 0, y as u32, w as u32, h as u32));
-                    for (x, (px, d)) in data.chunks_exact(c).zip(dirs.iter()).enumerate() {
-                        let Some((d, dens)) = *d else { continue };
-                        if dens <= 0.0 {
-                            continue;
-                        }
-                        let om = row_omega.unwrap_or_else(|| {
-                            p.texel_solid_angle(layer, x as u32, y as u32, w as u32, h as u32)
-                        });
-                        let b = basis(d);
-                        for (a, bi) in acc.iter_mut().zip(b) {
-                            for k in 0..3 {
-                                a[k] += bi * om * px[k] as f64;
-                            }
+        let rows = (0..layers * h).into_par_iter().map_init(
+            || vec![None; w],
+            |dirs, row| {
+                let (layer, y) = (row / h, row % h);
+                p.row_dirs(layer, y as u32, w as u32, h as u32, dirs);
+                let data = env.layers()[layer].row(y as u32);
+                let mut acc = [[0.0f64; 3]; 9];
+                // A lat-long row's texels all cover the same solid angle.
+                let row_omega = (p.kind() == ProjectionKind::LatLong)
+                    .then(|| p.texel_solid_angle(layer, 0, y as u32, w as u32, h as u32));
+                for (x, (px, d)) in data.chunks_exact(c).zip(dirs.iter()).enumerate() {
+                    let Some((d, dens)) = *d else { continue };
+                    if dens <= 0.0 {
+                        continue;
+                    }
+                    let om = row_omega.unwrap_or_else(|| {
+                        p.texel_solid_angle(layer, x as u32, y as u32, w as u32, h as u32)
+                    });
+                    let b = basis(d);
+                    for (a, bi) in acc.iter_mut().zip(b) {
+                        for k in 0..3 {
+                            a[k] += bi * om * px[k] as f64;
                         }
                     }
-                    acc
-                },
-            )
-            .reduce(|| [[0.0; 3]; 9], add9)
+                }
+                acc
+            },
+        );
+        fold_in_order(rows, [[0.0; 3]; 9], add9)
     };
     Sh9 { coeffs: acc }
 }
@@ -361,6 +358,32 @@ pub fn project_reference(env: &EnvMap) -> Sh9 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The coefficients do not depend on how many threads made them (nor on how rayon
+    /// split the rows): a prefilter run writes the same `.sh.json` every time.
+    #[test]
+    fn projection_gives_the_same_bits_on_any_thread_count() {
+        use mirrorball_core::Projection;
+        let latlong = ProjectionKind::LatLong.default_projection();
+        let cube = ProjectionKind::Cube.default_projection();
+        let f = |d: DVec3| [(d.x * 3.1).sin() as f32 + 1.0, d.y as f32 + 1.5, 0.7, 1.0];
+        let maps: [(Projection, u32); 2] = [(latlong, 96), (cube, 40)];
+        for (p, size) in maps {
+            let env = EnvMap::from_fn(p, size, 3, f);
+            let on = |threads: usize| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| project(&env))
+            };
+            let one = on(1);
+            for threads in [2, 3, 7] {
+                let bits = |s: &Sh9| s.coeffs.map(|c| c.map(f64::to_bits));
+                assert_eq!(bits(&on(threads)), bits(&one), "{:?}, {threads} threads", p.kind());
+            }
+        }
+    }
 
     #[test]
     #[allow(clippy::needless_range_loop)]
