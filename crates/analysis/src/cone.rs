@@ -208,6 +208,18 @@ fn bend(pts: &[DVec2]) -> f64 {
 }
 
 /// Classifies the texels of `p` (edge `size`) against `cone` and measures the pieces.
+///
+/// ```
+/// use mirrorball_analysis::cone::{cone_region, Cone};
+/// use mirrorball_core::ProjectionKind;
+/// use glam::DVec3;
+/// // A cone straight ahead covering a sixth of the sphere lands in one piece on a
+/// // lat-long map, and its texels add up to its solid angle.
+/// let cone = Cone::square(DVec3::NEG_Z, 1.0 / 6.0, 0.0);
+/// let r = cone_region(&ProjectionKind::LatLong.default_projection(), 256, &cone);
+/// assert_eq!((r.pieces, r.layers_touched), (1, 1));
+/// assert!((r.solid_angle / cone.solid_angle() - 1.0).abs() < 1e-3);
+/// ```
 pub fn cone_region(p: &Projection, size: u32, cone: &Cone) -> ConeRegion {
     let (w, h) = p.layer_extent(size);
     let n = p.layer_count();

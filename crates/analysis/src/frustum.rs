@@ -116,6 +116,18 @@ where
 }
 
 /// Measures `frustum` in closed form, as a polygon, and on each of `on` (projection, size).
+///
+/// ```
+/// use mirrorball_analysis::frustum::{frustum_share, Frustum};
+/// use mirrorball_core::ProjectionKind;
+/// // A square 90° frustum is one cube face: a sixth of the sphere, and on a cube map
+/// // exactly the texels of the −Z face.
+/// let face = Frustum { aspect: 1.0, vertical_fov_deg: 90.0 };
+/// let m = frustum_share(face, &[(ProjectionKind::Cube.default_projection(), 64)]);
+/// assert!((m.share - 1.0 / 6.0).abs() < 1e-12);
+/// assert_eq!(m.brute_force[0].texels, 64 * 64);
+/// assert!(m.brute_force[0].relative_error < 1e-12);
+/// ```
 pub fn frustum_share(frustum: Frustum, on: &[(Projection, u32)]) -> FrustumShare {
     let (a, b) = frustum.half_angles();
     let closed_form = frustum_solid_angle(a, b);

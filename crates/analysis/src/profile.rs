@@ -125,6 +125,17 @@ pub fn walk<P: WorldProjection + ?Sized>(p: &P, layer: usize, step: DVec2, name:
 }
 
 /// Zimmons' measure on `p` at edge `size`: horizontal, vertical and diagonal walks.
+///
+/// ```
+/// use mirrorball_analysis::profile::profile;
+/// use mirrorball_core::ProjectionKind;
+/// // On a cube face a texel at the centre subtends twice the angle of one at the edge
+/// // (d atan x / dx = 1/(1 + x²)), three times along the diagonal (1/(1 + 2)).
+/// let p = profile(&ProjectionKind::Cube.default_projection(), 256);
+/// let ratio = |name: &str| p.walks.iter().find(|w| w.name == name).unwrap().ratio;
+/// assert!((ratio("horizontal") - 2.0).abs() < 0.02);
+/// assert!((ratio("diagonal") - 3.0).abs() < 0.03);
+/// ```
 pub fn profile(p: &Projection, size: u32) -> Profile {
     let (w, h) = p.layer_extent(size);
     let layer = view_layer(p);

@@ -380,7 +380,12 @@ mod tests {
             let one = on(1);
             for threads in [2, 3, 7] {
                 let bits = |s: &Sh9| s.coeffs.map(|c| c.map(f64::to_bits));
-                assert_eq!(bits(&on(threads)), bits(&one), "{:?}, {threads} threads", p.kind());
+                assert_eq!(
+                    bits(&on(threads)),
+                    bits(&one),
+                    "{:?}, {threads} threads",
+                    p.kind()
+                );
             }
         }
     }
