@@ -7,10 +7,10 @@ use crate::error::CliError;
 use crate::load;
 use crate::save;
 use mirrorball_core::glam::DVec2;
-use mirrorball_core::{EnvMap, Image, Projection, ProjectionKind, WorldProjection};
+use mirrorball_core::{Choice, EnvMap, Image, Projection, ProjectionKind, WorldProjection};
 use mirrorball_filter::mip::texel_solid_angles;
 use mirrorball_filter::sh::{self, Window};
-use mirrorball_filter::{BrdfLut, EnergyReport, Lobe, LobeKind, RoughnessMapping, Visibility};
+use mirrorball_filter::{BrdfLut, EnergyReport, Lobe, LobeKind, Visibility};
 use mirrorball_io::{Format, Precision, WriteOptions};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -69,14 +69,19 @@ pub(super) fn write_chain(plan: &Plan, chain: &[EnvMap]) -> Result<Vec<String>, 
 
 /// A level's lobe as the JSON names it.
 fn describe(lobe: &Lobe) -> serde_json::Value {
+    let mut v = json!({ "lobe": lobe.kind().name() });
     match *lobe {
-        Lobe::Lambert => json!({ "lobe": "lambert" }),
-        Lobe::Phong { exponent } => json!({
-            "lobe": "phong",
-            "exponent": if exponent.is_finite() { json!(exponent) } else { json!("inf") },
-        }),
-        Lobe::Ggx { roughness } => json!({ "lobe": "ggx", "roughness": roughness }),
+        Lobe::Lambert => {}
+        Lobe::Phong { exponent } => {
+            v["exponent"] = if exponent.is_finite() {
+                json!(exponent)
+            } else {
+                json!("inf")
+            }
+        }
+        Lobe::Ggx { roughness } => v["roughness"] = json!(roughness),
     }
+    v
 }
 
 /// What the chain's JSON says besides the coefficients.
@@ -120,14 +125,9 @@ fn sh_document(plan: &Plan, sh9: &sh::Sh9, d: &Described) -> serde_json::Value {
         "irradiance_over_pi": coeffs(&windowed.lambert()),
         "irradiance_note": "evaluate sum_i c_i Y_i(n) with irradiance_over_pi to get E(n)/pi, the radiance a white Lambertian surface with normal n reflects (Ramamoorthi & Hanrahan 2001: A0 = pi, A1 = 2pi/3, A2 = pi/4, divided by pi); the window is applied",
         "window": window,
-        "lobe": match plan.kind { LobeKind::Lambert => "lambert", LobeKind::Phong => "phong", LobeKind::Ggx => "ggx" },
+        "lobe": plan.kind.name(),
         "roughness_mapping": plan.mapping.name(),
-        "roughness_to_level": match plan.mapping {
-            RoughnessMapping::Linear => "level = roughness * (levels - 1)",
-            RoughnessMapping::Ue4 => "level = levels - 2 + 1.2 * log2(roughness)",
-            RoughnessMapping::Filament => "level = (levels - 1) * roughness * (2 - roughness)",
-            RoughnessMapping::Custom(_) => "piecewise-linear inverse of the listed roughness values",
-        },
+        "roughness_to_level": plan.mapping.level_formula(),
         "projection": d.projection.name(),
         "levels": level_info,
         "energy_removed": d.energy.map(|r| json!({
@@ -199,7 +199,7 @@ pub(super) fn levels_detail(chain: &[EnvMap], lobes: &[Lobe]) -> String {
         .zip(lobes)
         .map(|(l, lobe)| {
             let what = match *lobe {
-                Lobe::Lambert => "lambert".to_string(),
+                Lobe::Lambert => LobeKind::Lambert.name().to_string(),
                 Lobe::Phong { exponent } if exponent.is_finite() => format!("s={exponent:.0}"),
                 Lobe::Phong { .. } => "mirror".to_string(),
                 Lobe::Ggx { roughness } => format!("r={roughness:.3}"),

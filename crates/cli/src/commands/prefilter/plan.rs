@@ -5,14 +5,15 @@
 
 use super::outputs::{beside, check_parent, level_path};
 use super::IrradianceMethod;
+use crate::choice::parse_flag;
 use crate::commands::convert::parse_precision;
-use crate::commands::InputPlan;
+use crate::commands::{parse_layout, InputPlan};
 use crate::error::CliError;
 use crate::guard::Files;
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::PrefilterArgs;
-use mirrorball_core::{Choice, Layout, WorldProjection};
+use mirrorball_core::{Layout, WorldProjection};
 use mirrorball_filter::sh::Window;
 use mirrorball_filter::{Compression, LobeKind, PrefilterOptions, RoughnessMapping};
 use mirrorball_io::{Format, Precision, WriteOptions};
@@ -50,23 +51,9 @@ pub(super) struct Plan {
 impl Plan {
     pub fn new(a: &PrefilterArgs) -> Result<Plan, CliError> {
         let input = InputPlan::new(&a.input_args)?;
-        let kind = match a.lobe.to_ascii_lowercase().as_str() {
-            "lambert" | "diffuse" | "irradiance" => LobeKind::Lambert,
-            "phong" => LobeKind::Phong,
-            "ggx" | "specular" | "trowbridge-reitz" => LobeKind::Ggx,
-            other => {
-                return Err(CliError::request(format!(
-                    "--lobe: unknown '{other}' (lambert, phong, ggx)"
-                )))
-            }
-        };
+        let kind = parse_flag::<LobeKind>("--lobe", &a.lobe)?;
         let to = ProjSpec::parse(&a.to).map_err(|e| bad("--to", e))?;
-        let layout = a
-            .layout
-            .as_deref()
-            .map(str::parse::<Layout>)
-            .transpose()
-            .map_err(|e| bad("--layout", e))?;
+        let layout = parse_layout("--layout", a.layout.as_deref())?;
         let format = output_format(a, &to, layout)?;
         let precision = output_precision(a, format)?;
         check_sizes(a, format)?;
@@ -74,13 +61,7 @@ impl Plan {
         let exponents = parse_exponents(a, kind)?;
         let compression = parse_compression(a)?;
         let window = parse_window(a)?;
-        let irradiance = IrradianceMethod::parse_name(&a.irradiance).map_err(|e| {
-            CliError::request(format!(
-                "--irradiance: unknown '{}' ({})",
-                e.given.to_ascii_lowercase(),
-                e.list()
-            ))
-        })?;
+        let irradiance = parse_flag::<IrradianceMethod>("--irradiance", &a.irradiance)?;
         let opts = prefilter_options(a)?;
         let plan = Plan {
             input,

@@ -4,6 +4,7 @@
 
 use crate::spec::parse_dir;
 use mirrorball_core::{Choice, UnknownName};
+use mirrorball_filter::LobeKind;
 use mirrorball_render::{Material, Ramp, SpecularLobe};
 use serde::Deserialize;
 
@@ -52,7 +53,7 @@ pub(super) struct MaterialEntry {
     /// Greene: diffuse and specular reflectance.
     dc: Option<[f32; 3]>,
     sc: Option<[f32; 3]>,
-    /// Greene: `phong` or `ggx`.
+    /// Greene: `phong` or `ggx` (as [`LobeKind`] names them).
     lobe: Option<String>,
     /// Phong exponent (Greene's phong lobe, phong-map).
     exponent: Option<f32>,
@@ -109,13 +110,13 @@ pub(super) fn parse_material(spec: &str, tint: [f32; 3], f0: f32) -> Result<Mate
             "exponent" | "phong" => {
                 e.exponent = Some(spec_number(k, v)?);
                 if k.trim() == "phong" {
-                    e.lobe = Some("phong".into());
+                    e.lobe = Some(LobeKind::Phong.name().into());
                 }
             }
             "roughness" | "ggx" => {
                 e.roughness = Some(spec_number(k, v)?);
                 if k.trim() == "ggx" {
-                    e.lobe = Some("ggx".into());
+                    e.lobe = Some(LobeKind::Ggx.name().into());
                 }
             }
             "ambient" => e.ambient = Some(spec_number(k, v)?),
@@ -186,23 +187,21 @@ pub(super) fn material_of(e: &MaterialEntry) -> Result<Material, String> {
 /// Greene's `dc·D + sc·S`: a Phong lobe (by default, exponent 32) or, given a roughness, a
 /// GGX one (by default, roughness 0.3).
 fn greene(e: &MaterialEntry) -> Result<Material, String> {
-    let lobe_name = e.lobe.clone().unwrap_or_else(|| {
-        if e.roughness.is_some() {
-            "ggx".into()
-        } else {
-            "phong".into()
-        }
-    });
-    let lobe = match lobe_name.to_ascii_lowercase().as_str() {
-        "phong" => {
-            if e.roughness.is_some() {
-                return Err("'roughness' is for the ggx lobe; phong takes 'exponent'".into());
-            }
-            SpecularLobe::Phong {
-                exponent: e.exponent.unwrap_or(32.0) as f64,
-            }
-        }
-        "ggx" => {
+    let kind = match e.lobe.as_deref() {
+        Some(name) => LobeKind::from_name(name)
+            .filter(|k| *k != LobeKind::Lambert)
+            .ok_or_else(|| {
+                let offered = [LobeKind::Phong.name(), LobeKind::Ggx.name()];
+                format!(
+                    "lobe {}",
+                    UnknownName::among(&name.to_ascii_lowercase(), offered)
+                )
+            })?,
+        None if e.roughness.is_some() => LobeKind::Ggx,
+        None => LobeKind::Phong,
+    };
+    let lobe = match kind {
+        LobeKind::Ggx => {
             if e.exponent.is_some() {
                 return Err("'exponent' is for the phong lobe; ggx takes 'roughness'".into());
             }
@@ -210,7 +209,14 @@ fn greene(e: &MaterialEntry) -> Result<Material, String> {
                 roughness: e.roughness.unwrap_or(0.3) as f64,
             }
         }
-        other => return Err(format!("lobe '{other}' is not phong or ggx")),
+        _ => {
+            if e.roughness.is_some() {
+                return Err("'roughness' is for the ggx lobe; phong takes 'exponent'".into());
+            }
+            SpecularLobe::Phong {
+                exponent: e.exponent.unwrap_or(32.0) as f64,
+            }
+        }
     };
     // An infinite exponent (a mirror, to the filter crate) is refused here.
     if !lobe.is_valid()
