@@ -188,20 +188,20 @@ pub(super) fn material_of(e: &MaterialEntry) -> Result<Material, String> {
 /// GGX one (by default, roughness 0.3).
 fn greene(e: &MaterialEntry) -> Result<Material, String> {
     let kind = match e.lobe.as_deref() {
-        Some(name) => LobeKind::from_name(name)
-            .filter(|k| *k != LobeKind::Lambert)
-            .ok_or_else(|| {
-                let offered = [LobeKind::Phong.name(), LobeKind::Ggx.name()];
-                format!(
-                    "lobe {}",
-                    UnknownName::among(&name.to_ascii_lowercase(), offered)
-                )
-            })?,
-        None if e.roughness.is_some() => LobeKind::Ggx,
-        None => LobeKind::Phong,
+        Some(name) => LobeKind::from_name(name),
+        None if e.roughness.is_some() => Some(LobeKind::Ggx),
+        None => Some(LobeKind::Phong),
     };
     let lobe = match kind {
-        LobeKind::Ggx => {
+        Some(LobeKind::Phong) => {
+            if e.roughness.is_some() {
+                return Err("'roughness' is for the ggx lobe; phong takes 'exponent'".into());
+            }
+            SpecularLobe::Phong {
+                exponent: e.exponent.unwrap_or(32.0) as f64,
+            }
+        }
+        Some(LobeKind::Ggx) => {
             if e.exponent.is_some() {
                 return Err("'exponent' is for the phong lobe; ggx takes 'roughness'".into());
             }
@@ -209,13 +209,10 @@ fn greene(e: &MaterialEntry) -> Result<Material, String> {
                 roughness: e.roughness.unwrap_or(0.3) as f64,
             }
         }
-        _ => {
-            if e.roughness.is_some() {
-                return Err("'roughness' is for the ggx lobe; phong takes 'exponent'".into());
-            }
-            SpecularLobe::Phong {
-                exponent: e.exponent.unwrap_or(32.0) as f64,
-            }
+        Some(LobeKind::Lambert) | None => {
+            let given = e.lobe.as_deref().unwrap_or_default().to_ascii_lowercase();
+            let offered = [LobeKind::Phong.name(), LobeKind::Ggx.name()];
+            return Err(format!("lobe {}", UnknownName::among(&given, offered)));
         }
     };
     // An infinite exponent (a mirror, to the filter crate) is refused here.
