@@ -18,6 +18,7 @@ use clap::parser::ValueSource;
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use error::CliError;
 use mirrorball_core::{Layout, Lens};
+use mirrorball_filter::LobeKind;
 use mirrorball_io::{ExrCompression, Precision};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{Attach, Indexing, ENVIRONMENT_FILTERS};
@@ -325,7 +326,7 @@ pub struct PrefilterArgs {
     /// per level: `{level}` in the name, or `_mip0`, `_mip1`, … added).
     output: String,
     /// The lobe: lambert (irradiance E/π), phong, or ggx (split-sum prefiltered radiance).
-    #[arg(long)]
+    #[arg(long, value_parser = names::<LobeKind>())]
     lobe: String,
     /// Face edge of level 0 (cubes; width or diameter for other projections). Default: 32
     /// for lambert; the source's resolution (a power of two, at most 512) otherwise.

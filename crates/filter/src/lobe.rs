@@ -29,6 +29,7 @@
 
 use glam::DVec3;
 use mirrorball_core::quadrature::gauss_legendre;
+use mirrorball_core::Choice;
 use std::f64::consts::PI;
 
 /// A reflection lobe.
@@ -49,7 +50,9 @@ pub enum Lobe {
 }
 
 /// The kind of a [`Lobe`], without its parameter (what a prefiltered chain's levels share:
-/// [`crate::chain_lobes`] gives each level its parameter).
+/// [`crate::chain_lobes`] gives each level its parameter). Named by its [`Choice`] table
+/// (`lambert`, `phong`, `ggx` and their aliases), as the CLI's `--lobe` and a material's
+/// `lobe` spell it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LobeKind {
     /// Lambert (every level the same lobe).
@@ -59,6 +62,15 @@ pub enum LobeKind {
     /// GGX, one roughness per level.
     Ggx,
 }
+
+impl Choice for LobeKind {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (LobeKind::Lambert, &["lambert", "diffuse", "irradiance"]),
+        (LobeKind::Phong, &["phong"]),
+        (LobeKind::Ggx, &["ggx", "specular", "trowbridge-reitz"]),
+    ];
+}
+mirrorball_core::choice_traits!(LobeKind);
 
 /// The smallest GGX `α` treated as a lobe; below it the lobe is a mirror.
 pub(crate) const MIN_ALPHA: f64 = 1e-5;
@@ -268,6 +280,28 @@ pub fn roughness_from_phong_exponent(exponent: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lobe_kinds_are_named_by_one_table() {
+        let names: Vec<&str> = LobeKind::all().map(LobeKind::name).collect();
+        assert_eq!(names, ["lambert", "phong", "ggx"]);
+        for (kind, aliases) in LobeKind::NAMES {
+            for name in *aliases {
+                assert_eq!(name.parse::<LobeKind>(), Ok(*kind));
+            }
+        }
+        assert_eq!("Trowbridge_Reitz".parse::<LobeKind>(), Ok(LobeKind::Ggx));
+        let lobes = [
+            Lobe::Lambert,
+            Lobe::Phong { exponent: 8.0 },
+            Lobe::Ggx { roughness: 0.5 },
+        ];
+        for (lobe, name) in lobes.iter().zip(names) {
+            assert_eq!(lobe.kind().to_string(), name);
+        }
+        let e = "beckmann".parse::<LobeKind>().unwrap_err();
+        assert_eq!(e.list(), "lambert, phong, ggx");
+    }
 
     #[test]
     fn integrals() {

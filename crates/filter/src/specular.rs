@@ -136,6 +136,18 @@ impl RoughnessMapping {
             RoughnessMapping::Custom(_) => "custom".into(),
         }
     }
+
+    /// [`RoughnessMapping::level`] as a formula for people (before clamping to the chain).
+    pub fn level_formula(&self) -> &'static str {
+        match self {
+            RoughnessMapping::Linear => "level = roughness * (levels - 1)",
+            RoughnessMapping::Ue4 => "level = levels - 2 + 1.2 * log2(roughness)",
+            RoughnessMapping::Filament => "level = (levels - 1) * roughness * (2 - roughness)",
+            RoughnessMapping::Custom(_) => {
+                "piecewise-linear inverse of the listed roughness values"
+            }
+        }
+    }
 }
 
 /// Point `i` of the `n`-point Fibonacci lattice on the unit square,

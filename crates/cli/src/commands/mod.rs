@@ -27,16 +27,19 @@ impl InputPlan {
             .map(ProjSpec::parse)
             .transpose()
             .map_err(|e| bad("--from", e))?;
-        let layout = a
-            .in_layout
-            .as_deref()
-            .map(str::parse::<Layout>)
-            .transpose()
-            .map_err(|e| bad("--in-layout", e))?;
+        let layout = parse_layout("--in-layout", a.in_layout.as_deref())?;
         Ok(InputPlan {
             from,
             layout,
             keep_invalid: a.keep_invalid,
         })
     }
+}
+
+/// A layout flag's value, if given.
+pub fn parse_layout(flag: &str, given: Option<&str>) -> Result<Option<Layout>, CliError> {
+    given
+        .map(str::parse::<Layout>)
+        .transpose()
+        .map_err(|e| bad(flag, e))
 }

@@ -57,6 +57,8 @@ fn every_value_the_help_lists_is_accepted() {
                 let mut args: Vec<&str> = match command {
                     "convert" => vec!["convert", missing, o, "--to", "cube"],
                     "render" => vec!["render", "--env", missing, "-o", o],
+                    // --lobe is required, and given once.
+                    _ if flag == "--lobe" => vec!["prefilter", missing, o],
                     _ => vec!["prefilter", missing, o, "--lobe", "ggx"],
                 };
                 if flag == "--fisheye-lens" {
@@ -73,15 +75,134 @@ fn every_value_the_help_lists_is_accepted() {
     assert!(seen >= 5 * 3 + 4 * 2 + 6 + 4 + 2 + 4 + 4 + 3 + 2, "{seen}");
 }
 
+/// A folder with the paths the tests name: an input that is missing (so that a run that
+/// gets past its plan fails reading it), an output and a scene file.
+struct Paths {
+    _dir: tempfile::TempDir,
+    missing: String,
+    out: String,
+    scene: String,
+}
+
+impl Paths {
+    fn new(out_ext: &str) -> Paths {
+        let dir = tempfile::tempdir().unwrap();
+        let path = |name: &str| dir.path().join(name).to_str().unwrap().replace('\\', "/");
+        Paths {
+            missing: path("missing.exr"),
+            out: path(&format!("out.{out_ext}")),
+            scene: path("scene.json"),
+            _dir: dir,
+        }
+    }
+}
+
+/// A run refused as the request's fault, saying `text`.
+fn refused(args: &[&str], text: &str) {
+    let o = run(args);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains(text), "{}", stderr(&o));
+}
+
+/// The help of `command`'s `flag`, from its line to the next flag's.
+fn help_of(command: &str, flag: &str) -> String {
+    let o = run(&[command, "--help"]);
+    let help = String::from_utf8_lossy(&o.stdout).into_owned();
+    let start = help
+        .find(&format!("      {flag} "))
+        .expect("the flag's help");
+    let rest = &help[start + flag.len() + 6..];
+    let end = rest.find("\n      -").unwrap_or(rest.len());
+    rest[..end].split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[test]
+fn every_lobe_name_is_accepted_and_the_help_lists_the_canonical_ones() {
+    let p = Paths::new("ktx2");
+    let (missing, out) = (p.missing.as_str(), p.out.as_str());
+    let help: std::collections::HashMap<String, Vec<String>> =
+        listed("prefilter").into_iter().collect();
+    assert_eq!(help["--lobe"], ["lambert", "phong", "ggx"]);
+    for name in [
+        "lambert",
+        "diffuse",
+        "irradiance",
+        "phong",
+        "ggx",
+        "specular",
+        "trowbridge-reitz",
+        "GGX",
+        "Lambert",
+    ] {
+        let o = run(&["prefilter", missing, out, "--lobe", name]);
+        let e = stderr(&o);
+        assert!(
+            e.contains("missing.exr") && !e.contains("--lobe"),
+            "{name}: {e}"
+        );
+    }
+    refused(
+        &["prefilter", missing, out, "--lobe", "Beckmann"],
+        "--lobe: unknown 'beckmann' (lambert, phong, ggx)",
+    );
+}
+
+#[test]
+fn every_material_name_is_accepted_by_the_flag_and_the_scene() {
+    let p = Paths::new("png");
+    let (missing, out, scene) = (p.missing.as_str(), p.out.as_str(), p.scene.as_str());
+    let with_material =
+        |m: &str| ["render", "--env", missing, "--material", m, "-o", out].map(String::from);
+    let canonical = [
+        "mirror",
+        "fresnel",
+        "cheap-chrome",
+        "diffuse",
+        "greene",
+        "phong-map",
+    ];
+    let help = help_of("render", "--material");
+    for name in canonical {
+        assert!(
+            help.contains(name),
+            "--material's help lacks {name}: {help}"
+        );
+    }
+    let aliases = ["chrome", "varnish", "plastic", "ramp", "matte", "phongmap"];
+    for name in canonical.into_iter().chain(aliases) {
+        let args = with_material(name);
+        let e = stderr(&run(&args.each_ref().map(String::as_str)));
+        assert!(e.contains("missing.exr"), "--material {name}: {e}");
+        let body = format!(
+            r#"{{"environment": {{"file": "{missing}"}}, "material": {{"kind": "{name}"}}}}"#
+        );
+        std::fs::write(scene, body).unwrap();
+        let e = stderr(&run(&["render", scene, "-o", out]));
+        assert!(e.contains("missing.exr"), "scene kind {name}: {e}");
+    }
+    let known = format!("(known: {})", canonical.join(", "));
+    refused(
+        &with_material("plastc").each_ref().map(String::as_str),
+        &known,
+    );
+    // Greene's lobe is a lobe name, phong or ggx.
+    for lobe in ["phong", "ggx", "GGX", "specular"] {
+        let args = with_material(&format!("greene:lobe={lobe}"));
+        let e = stderr(&run(&args.each_ref().map(String::as_str)));
+        assert!(e.contains("missing.exr"), "greene:lobe={lobe}: {e}");
+    }
+    refused(
+        &with_material("greene:lobe=lambert")
+            .each_ref()
+            .map(String::as_str),
+        "lobe 'lambert' is not phong or ggx",
+    );
+}
+
 #[test]
 fn scene_files_accept_the_names_the_flags_accept() {
-    let dir = tempfile::tempdir().unwrap();
-    let missing = dir.path().join("missing.exr");
-    let missing = missing.to_str().unwrap().replace('\\', "/");
-    let out = dir.path().join("out.png");
-    let out = out.to_str().unwrap();
-    let scene = dir.path().join("scene.json");
-    let scene_str = scene.to_str().unwrap();
+    let p = Paths::new("png");
+    let (missing, out, scene) = (p.missing.as_str(), p.out.as_str(), p.scene.as_str());
     let help: std::collections::HashMap<String, Vec<String>> =
         listed("render").into_iter().collect();
     // Every name, canonical or alias, of the flags that scene keys mirror.
@@ -104,12 +225,12 @@ fn scene_files_accept_the_names_the_flags_accept() {
             } else {
                 format!(r#"{{"environment": {{"file": "{missing}", "{key}": "{name}"}}}}"#)
             };
-            std::fs::write(&scene, body).unwrap();
-            let o = run(&["render", scene_str, "-o", out]);
+            std::fs::write(scene, body).unwrap();
+            let o = run(&["render", scene, "-o", out]);
             let e = stderr(&o);
             assert!(e.contains("missing.exr"), "scene {key} = {name}: {e}");
             accepted(
-                &["render", "--env", &missing, "-o", out, flag, name],
+                &["render", "--env", missing, "-o", out, flag, name],
                 flag,
                 name,
             );
@@ -120,10 +241,10 @@ fn scene_files_accept_the_names_the_flags_accept() {
         } else {
             format!(r#"{{"environment": {{"file": "{missing}", "{key}": "sat"}}}}"#)
         };
-        std::fs::write(&scene, body).unwrap();
-        let o = run(&["render", scene_str, "-o", out]);
+        std::fs::write(scene, body).unwrap();
+        let o = run(&["render", scene, "-o", out]);
         assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
-        let o = run(&["render", "--env", &missing, "-o", out, flag, "sat"]);
+        let o = run(&["render", "--env", missing, "-o", out, flag, "sat"]);
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     }
 }

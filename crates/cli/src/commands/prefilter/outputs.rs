@@ -1,0 +1,267 @@
+//! What `prefilter` writes: the chain (a KTX2/DDS cube, or a file per level), the
+//! spherical-harmonic JSON that describes it, the preview sheet and the split-sum table,
+//! and the line that reports them.
+
+use super::plan::Plan;
+use crate::error::CliError;
+use crate::load;
+use crate::save;
+use mirrorball_core::glam::DVec2;
+use mirrorball_core::{Choice, EnvMap, Image, Projection, ProjectionKind, WorldProjection};
+use mirrorball_filter::mip::texel_solid_angles;
+use mirrorball_filter::sh::{self, Window};
+use mirrorball_filter::{BrdfLut, EnergyReport, Lobe, LobeKind, Visibility};
+use mirrorball_io::{Format, Precision, WriteOptions};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// `dir/stem{suffix}` beside `out`.
+pub(super) fn beside(out: &str, suffix: &str) -> PathBuf {
+    let p = Path::new(out);
+    let stem = p
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "prefiltered".into());
+    let stem = stem.replace("{level}", "").replace(load::FACE, "");
+    let stem = stem.trim_end_matches(['_', '-', '.']).to_string();
+    p.with_file_name(format!("{stem}{suffix}"))
+}
+
+/// The file for level `i` of a flat (one file per level) output.
+pub(super) fn level_path(out: &str, i: usize) -> String {
+    if out.contains("{level}") {
+        return out.replace("{level}", &i.to_string());
+    }
+    crate::save::per_part_path(out, "{level}", &format!("mip{i}"))
+        .display()
+        .to_string()
+}
+
+/// `p`'s folder exists (`what` names the flag in the message).
+pub(super) fn check_parent(p: &Path, what: &str) -> Result<(), CliError> {
+    if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(CliError::request(format!(
+                "{what} {}: the folder {} does not exist",
+                p.display(),
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The chain: one cube container, or each level's file(s). Returns the files written.
+pub(super) fn write_chain(plan: &Plan, chain: &[EnvMap]) -> Result<Vec<String>, CliError> {
+    let mut written = Vec::new();
+    if plan.format.is_cube_container() {
+        let faces: Vec<Vec<Image>> = chain.iter().map(|l| l.layers().to_vec()).collect();
+        mirrorball_io::write_cube(Path::new(&plan.output), &faces, &plan.save.write)?;
+        written.push(plan.output.clone());
+    } else {
+        for (i, level) in chain.iter().enumerate() {
+            let files = save::save(level, &level_path(&plan.output, i), &plan.save)?;
+            written.extend(files.iter().map(|p| p.display().to_string()));
+        }
+    }
+    Ok(written)
+}
+
+/// A level's lobe as the JSON names it.
+fn describe(lobe: &Lobe) -> serde_json::Value {
+    let mut v = json!({ "lobe": lobe.kind().name() });
+    match *lobe {
+        Lobe::Lambert => {}
+        Lobe::Phong { exponent } => {
+            v["exponent"] = if exponent.is_finite() {
+                json!(exponent)
+            } else {
+                json!("inf")
+            }
+        }
+        Lobe::Ggx { roughness } => v["roughness"] = json!(roughness),
+    }
+    v
+}
+
+/// What the chain's JSON says besides the coefficients.
+pub(super) struct Described<'a> {
+    pub chain: &'a [EnvMap],
+    pub lobes: &'a [Lobe],
+    pub projection: &'a Projection,
+    pub energy: Option<EnergyReport>,
+    /// The files written so far.
+    pub written: &'a [String],
+}
+
+/// The SH JSON: the radiance's and the windowed irradiance's coefficients, with the
+/// chain's levels and what was compressed.
+fn sh_document(plan: &Plan, sh9: &sh::Sh9, d: &Described) -> serde_json::Value {
+    let windowed = sh9.windowed(plan.window);
+    let window = match plan.window {
+        Window::None => json!("none"),
+        Window::Hann { width } => json!({ "hann": width }),
+        Window::Lanczos { width } => json!({ "lanczos": width }),
+        Window::NonNegative => {
+            json!({ "hann": sh9.nonnegative_hann_width(), "chosen": "non-negative" })
+        }
+    };
+    let coeffs = |s: &sh::Sh9| -> Vec<[f64; 3]> { s.coeffs.to_vec() };
+    let level_info: Vec<serde_json::Value> = (d.chain.iter().zip(d.lobes).enumerate())
+        .map(|(i, (l, lobe))| {
+            let mut v = describe(lobe);
+            v["level"] = json!(i);
+            v["width"] = json!(l.width());
+            v["height"] = json!(l.height());
+            v
+        })
+        .collect();
+    json!({
+        "generator": format!("mirrorball {}", env!("CARGO_PKG_VERSION")),
+        "source": plan.source,
+        "output": d.written,
+        "basis": "real spherical harmonics, bands 0-2, index l(l+1)+m, orthonormal over the sphere, in world axes (+Y up, -Z ahead): Y0=0.282095, Y1=0.488603 y, Y2=0.488603 z, Y3=0.488603 x, Y4=1.092548 xy, Y5=1.092548 yz, Y6=0.315392 (3z^2-1), Y7=1.092548 xz, Y8=0.546274 (x^2-y^2)",
+        "radiance": coeffs(sh9),
+        "irradiance_over_pi": coeffs(&windowed.lambert()),
+        "irradiance_note": "evaluate sum_i c_i Y_i(n) with irradiance_over_pi to get E(n)/pi, the radiance a white Lambertian surface with normal n reflects (Ramamoorthi & Hanrahan 2001: A0 = pi, A1 = 2pi/3, A2 = pi/4, divided by pi); the window is applied",
+        "window": window,
+        "lobe": plan.kind.name(),
+        "roughness_mapping": plan.mapping.name(),
+        "roughness_to_level": plan.mapping.level_formula(),
+        "projection": d.projection.name(),
+        "levels": level_info,
+        "energy_removed": d.energy.map(|r| json!({
+            "operator": plan.compress_text,
+            "texels": r.texels,
+            "fraction": r.fraction_removed,
+            "energy_before_rgb": r.before,
+            "energy_after_rgb": r.after,
+            "luminance_max_before": r.max_before,
+            "luminance_max_after": r.max_after,
+        })),
+    })
+}
+
+/// The SH JSON at `p`.
+pub(super) fn write_sh(
+    plan: &Plan,
+    p: &Path,
+    sh9: &sh::Sh9,
+    d: &Described,
+) -> Result<(), CliError> {
+    let text =
+        serde_json::to_string_pretty(&sh_document(plan, sh9, d)).expect("JSON values serialise");
+    mirrorball_io::atomic_write(p, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes())
+            .map_err(|e| mirrorball_io::Error::io(p, e))
+    })?;
+    Ok(())
+}
+
+/// The preview sheet at `p`, 8-bit.
+pub(super) fn write_preview(plan: &Plan, p: &Path, chain: &[EnvMap]) -> Result<(), CliError> {
+    let sheet = preview_sheet(chain, plan.preview_exposure);
+    mirrorball_io::write_image(
+        p,
+        &sheet,
+        &WriteOptions {
+            precision: Some(Precision::U8),
+            ..Default::default()
+        },
+    )?;
+    Ok(())
+}
+
+/// The split-sum BRDF table at `p`: 16-bit in a PNG, float in an EXR.
+pub(super) fn write_lut(plan: &Plan, p: &Path) -> Result<(), CliError> {
+    let lut = BrdfLut::new(plan.lut_size, 1024, Visibility::SchlickUe4);
+    let precision = if Format::from_path(p) == Some(Format::Png) {
+        Precision::U16
+    } else {
+        Precision::Float
+    };
+    mirrorball_io::write_image(
+        p,
+        &lut.to_image(),
+        &WriteOptions {
+            precision: Some(precision),
+            ..Default::default()
+        },
+    )?;
+    Ok(())
+}
+
+/// Each level as `WIDTH:LOBE` for the report: `512:r=0.000 256:r=0.125 …`.
+pub(super) fn levels_detail(chain: &[EnvMap], lobes: &[Lobe]) -> String {
+    let detail: Vec<String> = chain
+        .iter()
+        .zip(lobes)
+        .map(|(l, lobe)| {
+            let what = match *lobe {
+                Lobe::Lambert => LobeKind::Lambert.name().to_string(),
+                Lobe::Phong { exponent } if exponent.is_finite() => format!("s={exponent:.0}"),
+                Lobe::Phong { .. } => "mirror".to_string(),
+                Lobe::Ggx { roughness } => format!("r={roughness:.3}"),
+            };
+            format!("{}:{what}", l.width())
+        })
+        .collect();
+    detail.join(" ")
+}
+
+/// Every level as a 256×128 lat-long thumbnail (bilinear, seamless), four to a row, on
+/// black, exposed so that level 0's mean luminance lands at 0.18·2^EV.
+fn preview_sheet(chain: &[EnvMap], exposure: f32) -> Image {
+    let (tw, th, gap) = (256u32, 128u32, 4u32);
+    let cols = chain.len().clamp(1, 4) as u32;
+    let rows = (chain.len() as u32).div_ceil(cols).max(1);
+    let mut sheet = Image::new(cols * (tw + gap) - gap, rows * (th + gap) - gap, 3);
+    let mean = chain.first().map_or(1.0, mean_rgb);
+    let scale = if mean > 0.0 && mean.is_finite() {
+        (0.18 / mean) as f32 * 2f32.powf(exposure)
+    } else {
+        2f32.powf(exposure)
+    };
+    let ll = ProjectionKind::LatLong.default_projection();
+    for (i, level) in chain.iter().enumerate() {
+        let (cx, cy) = (
+            (i as u32 % cols) * (tw + gap),
+            (i as u32 / cols) * (th + gap),
+        );
+        for y in 0..th {
+            for x in 0..tw {
+                let uv = DVec2::new((x as f64 + 0.5) / tw as f64, (y as f64 + 0.5) / th as f64);
+                let Some(d) = ll.uv_to_dir(0, uv) else {
+                    continue;
+                };
+                let v = level.sample(d);
+                sheet.set(cx + x, cy + y, &[v[0] * scale, v[1] * scale, v[2] * scale]);
+            }
+        }
+    }
+    sheet
+}
+
+/// The mean of R, G and B over the sphere, weighted by exact texel solid angle (one table
+/// for all six faces of a cube).
+fn mean_rgb(env: &EnvMap) -> f64 {
+    let omega = texel_solid_angles(env.projection(), env.width(), env.height());
+    let c = env.channels();
+    let (mut sum, mut total) = (0.0f64, 0.0f64);
+    for (layer, img) in env.layers().iter().enumerate() {
+        let om = &omega[layer.min(omega.len() - 1)];
+        for (px, &w) in img.data().chunks_exact(c).zip(om) {
+            let v = (px[0] + px[1] + px[2]) as f64 / 3.0;
+            if v.is_finite() && w > 0.0 {
+                sum += v * w;
+                total += w;
+            }
+        }
+    }
+    if total > 0.0 {
+        sum / total
+    } else {
+        0.0
+    }
+}
