@@ -369,7 +369,7 @@ pub struct PrefilterArgs {
     #[arg(
         long,
         default_value = "exact",
-        value_parser = names::<commands::prefilter::IrradianceMethod>()
+        value_parser = names::<mirrorball_filter::IrradianceMethod>()
     )]
     irradiance: String,
     /// Where to write the spherical-harmonic JSON (default: beside OUTPUT, .sh.json).

@@ -25,9 +25,27 @@
 use crate::cube::FaceGeometry;
 use crate::sh::{Sh9, Window};
 use glam::{Vec3, Vec4};
-use mirrorball_core::CubeFace;
+use mirrorball_core::{Choice, CubeFace};
 use mirrorball_core::{EnvMap, Image, Projection};
 use rayon::prelude::*;
+
+/// How a Lambert (irradiance) map is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IrradianceMethod {
+    /// The moment hierarchy ([`Prefilterer`](crate::Prefilterer) with
+    /// [`Lobe::Lambert`](crate::Lobe)): the brute-force sum to a tolerance.
+    Exact,
+    /// Nine spherical-harmonic coefficients ([`irradiance_map_sh`]).
+    Sh,
+}
+
+impl Choice for IrradianceMethod {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (IrradianceMethod::Exact, &["exact", "convolve", "brute"]),
+        (IrradianceMethod::Sh, &["sh", "sh9"]),
+    ];
+}
+mirrorball_core::choice_traits!(IrradianceMethod);
 
 /// The quadtree of a power-of-two cube with energy and first-moment sums per node.
 pub(crate) struct MomentPyramid {

@@ -82,6 +82,7 @@ pub mod sh;
 pub mod specular;
 
 pub use brdf_lut::{BrdfLut, Visibility};
+pub use irradiance::IrradianceMethod;
 pub use lobe::{Lobe, LobeKind};
 pub use mip::{MipChain, MipFilter};
 pub use prefilter::{chain_lobes, chain_rows, PrefilterOptions, Prefilterer};

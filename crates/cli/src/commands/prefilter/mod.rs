@@ -16,32 +16,16 @@ use crate::progress::with_progress;
 use crate::save;
 use crate::spec::bad;
 use crate::PrefilterArgs;
-use mirrorball_core::{Choice, EnvMap, Projection, ProjectionKind, WorldProjection};
+use mirrorball_core::{EnvMap, Projection, ProjectionKind, WorldProjection};
 use mirrorball_filter::mip::level_count;
 use mirrorball_filter::sh;
 use mirrorball_filter::{
-    chain_lobes, compress, irradiance, Compression, EnergyReport, Lobe, LobeKind, MipChain,
-    MipFilter, Prefilterer, RoughnessMapping,
+    chain_lobes, compress, irradiance, Compression, EnergyReport, IrradianceMethod, Lobe, LobeKind,
+    MipChain, MipFilter, Prefilterer, RoughnessMapping,
 };
 use outputs::Described;
 use plan::Plan;
 use std::time::Instant;
-
-/// How Lambert maps are computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum IrradianceMethod {
-    /// The moment hierarchy: the brute-force sum to a tolerance.
-    Exact,
-    /// Nine spherical-harmonic coefficients.
-    Sh,
-}
-
-impl Choice for IrradianceMethod {
-    const NAMES: &'static [(Self, &'static [&'static str])] = &[
-        (IrradianceMethod::Exact, &["exact", "convolve", "brute"]),
-        (IrradianceMethod::Sh, &["sh", "sh9"]),
-    ];
-}
 
 /// The chain's shape, known once the source is read.
 struct Chain {

@@ -4,7 +4,6 @@
 //! is read.
 
 use super::outputs::{beside, check_parent, level_path};
-use super::IrradianceMethod;
 use crate::choice::parse_flag;
 use crate::commands::convert::parse_precision;
 use crate::commands::{parse_layout, InputPlan};
@@ -15,6 +14,7 @@ use crate::spec::{bad, ProjSpec};
 use crate::PrefilterArgs;
 use mirrorball_core::{Layout, WorldProjection};
 use mirrorball_filter::sh::Window;
+use mirrorball_filter::IrradianceMethod;
 use mirrorball_filter::{Compression, LobeKind, PrefilterOptions, RoughnessMapping};
 use mirrorball_io::{Format, Precision, WriteOptions};
 use std::path::{Path, PathBuf};
