@@ -3,7 +3,7 @@
 use crate::projection::{Projection, WorldProjection};
 use crate::Image;
 use glam::{DVec2, DVec3};
-use mirrorball_simd::{trunc_i32, F32x4, F32x8, I32x4, I32x8, M32x4, M32x8, X8};
+use mirrorball_simd::{trunc_i32, F32x4, F32x8, I32x4, I32x8, M32x4, M32x8, Taps, X8};
 use rayon::prelude::*;
 use std::fmt;
 
@@ -397,10 +397,30 @@ pub fn bilinear_blend(p: &[f32], stride: usize, c: usize, fx: f32, fy: f32) -> F
     let p = &p[..stride + c + 4];
     let (a, b) = (F32x4::load(p), F32x4::load(&p[c..]));
     let (e, f) = (F32x4::load(&p[stride..]), F32x4::load(&p[stride + c..]));
+    bilinear_mix([a, b, e, f], fx, fy)
+}
+
+/// [`bilinear_blend`]'s arithmetic on its four reads `[a, b, c, d]` (top row, then bottom).
+#[inline(always)]
+pub fn bilinear_mix(t: [F32x4; 4], fx: f32, fy: f32) -> F32x4 {
+    let [a, b, e, f] = t;
     let (vx, vy) = (F32x4::splat(fx), F32x4::splat(fy));
     let top = a + vx * (b - a);
     let bot = e + vx * (f - e);
     top + vy * (bot - top)
+}
+
+/// [`bilinear_blend`]'s four reads in any of `N` equal layers of `c`-channel texels,
+/// `stride` floats a row, as [`Taps`] (the texels of a row `c` floats apart, the rows
+/// `stride`): index `i` of a layer is a footprint's first float, and its reads stay inside
+/// for every `i ≤ last()` (`None` where the layers cannot hold one footprint). Blend them
+/// with [`bilinear_mix`]: the same bits as [`bilinear_blend`] at `&layer[i..]` (tested).
+pub fn bilinear_taps<const N: usize>(
+    layers: [&[f32]; N],
+    stride: usize,
+    c: usize,
+) -> Option<Taps<'_, N>> {
+    Taps::new(layers, c, stride)
 }
 
 /// `floor` as an integer without a libm call.

@@ -30,8 +30,8 @@ mod resample;
 
 pub use choice::{Choice, UnknownName};
 pub use envmap::{
-    bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, count_invalid,
-    CornerLanes, EnvMap, EnvMapError, Stats,
+    bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, bilinear_mix,
+    bilinear_taps, count_invalid, CornerLanes, EnvMap, EnvMapError, Stats,
 };
 pub use fault::Fault;
 pub use image::Image;

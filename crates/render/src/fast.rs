@@ -4,9 +4,9 @@
 //! [`EnvMap::bilinear_at`], which joins faces and wraps longitude.
 
 use glam::{DVec2, DVec3, Vec3};
-use mirrorball_core::simd::{prefetch, F32x4};
+use mirrorball_core::simd::{prefetch, F32x4, Taps};
 use mirrorball_core::{
-    bilinear_blend, bilinear_corner4, CubeMap, EnvMap, Projection, WorldProjection,
+    bilinear_corner4, bilinear_mix, bilinear_taps, CubeMap, EnvMap, Projection, WorldProjection,
 };
 
 /// `(layer, u, v)` of direction `d` (not necessarily unit length for the cube).
@@ -67,6 +67,9 @@ pub fn bilinear(map: &EnvMap, layer: usize, u: f32, v: f32) -> [f32; 3] {
 pub struct CubeFaces<'a> {
     map: &'a EnvMap,
     pub(crate) faces: [&'a [f32]; 6],
+    /// The faces' bilinear footprints, read without a bounds check a read (`None` where a
+    /// face is too small to hold one).
+    pub(crate) taps: Option<Taps<'a, 6>>,
     /// Face edge in texels.
     pub(crate) n: i32,
     /// Channels a texel.
@@ -92,9 +95,11 @@ impl<'a> CubeFaces<'a> {
         {
             return None;
         }
+        let faces = std::array::from_fn(|k| l[k].data());
         Some(CubeFaces {
             map,
-            faces: std::array::from_fn(|k| l[k].data()),
+            faces,
+            taps: bilinear_taps(faces, w as usize * c, c),
             n: w as i32,
             c,
         })
@@ -190,15 +195,19 @@ impl<'a> CubeFaces<'a> {
     /// read's operations lane by lane, so the colour is the same to the bit.
     #[inline(always)]
     pub fn fetch_tinted(&self, l: &CubeLoc, t: [f32; 4]) -> [f32; 4] {
-        if (l.layer as usize) < 6 && l.i != SEAM {
-            let data = self.faces[l.layer as usize];
-            let stride = self.n as usize * self.c;
-            let i = l.i as usize;
+        if let (true, Some(taps)) = ((l.layer as usize) < 6 && l.i != SEAM, &self.taps) {
             // The second texel of each row is read as four lanes from its first channel,
-            // which for three channels reaches one float past it: not past the face.
-            if i + stride + self.c + 4 <= data.len() {
-                let mut out = [0.0f32; 4];
-                bilinear_tinted(&data[i..], stride, self.c, l.a, l.b, &t, &mut out);
+            // which for three channels reaches one float past it: within `last`, not past
+            // the face.
+            if l.i as usize <= taps.last() {
+                let mut out = [0.0; 4];
+                tinted(
+                    taps.get(l.layer as usize, l.i as usize),
+                    l.a,
+                    l.b,
+                    &t,
+                    &mut out,
+                );
                 return out;
             }
         }
@@ -249,24 +258,13 @@ impl<'a> CubeFaces<'a> {
     }
 }
 
-/// The bilinear blend inside a face, four lanes ([`bilinear_blend`]): the texels at `p[0]`,
-/// `p[c]` and a row below (`stride` floats), weights `fx`, `fy` (`CubeFaces::footprint`'s
-/// arithmetic, lane by lane, so the same bits), times the tint `t`, alpha 1, into `o[..4]`.
-/// For three channels the second texel is read as four lanes, one float past it, so `p`
-/// must hold `stride + c + 4` floats (panics otherwise). [`CubeFaces::fetch_tinted`] and
-/// the renderer's eight-lane mirror rows call it.
+/// The bilinear blend inside a face of the four reads `q` of a footprint (from
+/// [`bilinear_taps`], blended by [`bilinear_mix`]: `CubeFaces::footprint`'s arithmetic,
+/// lane by lane, so the same bits), weights `fx`, `fy`, times the tint `t`, alpha 1, into
+/// `o`. [`CubeFaces::fetch_tinted`] and the renderer's eight-lane mirror rows call it.
 #[inline(always)]
-pub(crate) fn bilinear_tinted(
-    p: &[f32],
-    stride: usize,
-    c: usize,
-    fx: f32,
-    fy: f32,
-    t: &[f32; 4],
-    o: &mut [f32],
-) {
-    let o = &mut o[..4];
-    (bilinear_blend(p, stride, c, fx, fy) * F32x4::from_array(*t)).store(o);
+pub(crate) fn tinted(q: [F32x4; 4], fx: f32, fy: f32, t: &[f32; 4], o: &mut [f32; 4]) {
+    (bilinear_mix(q, fx, fy) * F32x4::from_array(*t)).store(o);
     o[3] = 1.0;
 }
 

@@ -15,7 +15,7 @@
 //! all drop out.
 
 use glam::{Mat3, Vec3, Vec3A};
-use mirrorball_core::simd::F32x8;
+use mirrorball_core::simd::{F32x8, Taps, X8};
 
 /// What the per-pixel mirror needs of one setup, prepared once a frame: `n = Σ fₖ·nₖ` and
 /// `v = Σ fₖ·vₖ` (see the module documentation) as planes over the sample grid. The edge
@@ -193,8 +193,8 @@ mirrorball_core::simd::x8_kernel! {
 /// ([`CubeFaces::fetch_tinted`](crate::fast::CubeFaces::fetch_tinted)) written to `out`
 /// (four floats a pixel). Pixels that see nothing are written transparent black. Returns
 /// the lanes whose setup is not a mirror, left for the caller to shade; `None` where the
-/// eight-lane paths are off (no AVX2, or [`set_portable`](crate::set_portable) said so),
-/// having done nothing.
+/// eight-lane paths are off (no AVX2, or [`set_portable`](crate::set_portable) said so) or
+/// the faces are too small for footprint reads, having done nothing.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mirror_row(
     ids: &[u32],
@@ -206,7 +206,8 @@ pub(crate) fn mirror_row(
     out: &mut [f32],
 ) -> Option<u32> {
     let x8 = crate::cpu::x8()?;
-    Some(mirror_row_x8(x8, ids, x0, fy, setups, view, cf, out))
+    let taps = cf.taps.as_ref()?;
+    Some(mirror_row_x8(x8, ids, x0, fy, setups, view, cf, taps, out))
 }
 
 mirrorball_core::simd::x8_kernel! {
@@ -218,88 +219,115 @@ mirrorball_core::simd::x8_kernel! {
         setups: &[MirrorSetup],
         view: &MirrorView,
         cf: &crate::fast::CubeFaces,
+        taps: &Taps<6>,
         out: &mut [f32],
     ) -> u32 {
-        use crate::fast::{CubeLoc, SEAM};
-        use crate::raster::NO_HIT;
         let n = ids.len().min(SPAN);
+        let (px, _) = out.as_chunks_mut::<4>();
         let mut left = 0u32;
         let mut g = 0;
         while g < n {
             let cnt = (n - g).min(8);
-            let mut idb = [NO_HIT; 8];
+            let mut idb = [crate::raster::NO_HIT; 8];
             idb[..cnt].copy_from_slice(&ids[g..g + cnt]);
-            let orow = &mut out[g * 4..(g + cnt) * 4];
-            let none = x8.u32s(&idb).eq(x8.splat_i32(NO_HIT as i32)).bitmask();
-            let hit = !none & ((1u32 << cnt) - 1);
-            if hit == 0 {
-                orow.fill(0.0);
-                g += 8;
-                continue;
-            }
-            let ev = v8::reflect(x8, &idb, hit, x0 + g, fy, setups, view);
-            left |= ev.left << g;
-            let at = v8::locate(x8, &ev.r, cf);
-            let tint = F32x8::interleave4([ev.tint[0], ev.tint[1], ev.tint[2], x8.splat(1.0)]);
-            let stride = cf.n as usize * cf.c;
-            // Mirror lanes whose four texels lie inside one face and within reach of four-lane
-            // reads: straight to the blend, no further test.
-            let direct = ev.mirror & at.ok & at.inside & at.reach & ((1u32 << cnt) - 1);
-            let mut m = direct;
-            while m != 0 {
-                let lane = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let data = cf.faces[at.layer[lane] as usize];
-                // `reach` says `index + stride + c + 4 ≤ data.len()`; lane < cnt, so the
-                // pixel's four floats are in `orow`.
-                crate::fast::bilinear_tinted(
-                    &data[at.index[lane] as usize..],
-                    stride,
-                    cf.c,
-                    at.fx[lane],
-                    at.fy[lane],
-                    &tint[lane],
-                    &mut orow[4 * lane..],
-                );
-            }
-            let mut rest = ((1u32 << cnt) - 1) & !direct;
-            while rest != 0 {
-                let lane = rest.trailing_zeros() as usize;
-                rest &= rest - 1;
-                let bit = 1 << lane;
-                let o = &mut orow[4 * lane..4 * lane + 4];
-                if ev.mirror & bit == 0 {
-                    if none & bit != 0 {
-                        o.fill(0.0);
-                    }
-                    continue; // not a mirror: the caller's
+            let px = &mut px[g..g + cnt];
+            let row = Group { idb: &idb, cnt, x0: x0 + g, fy };
+            left |= match <&mut [[f32; 4]; 8]>::try_from(&mut *px) {
+                Ok(px8) => mirror_group(x8, &row, setups, view, cf, taps, px8),
+                Err(_) => {
+                    // The row's last, partial group: through eight pixels of scratch.
+                    let mut px8 = [[0.0f32; 4]; 8];
+                    px8[..cnt].copy_from_slice(px);
+                    let left = mirror_group(x8, &row, setups, view, cf, taps, &mut px8);
+                    px.copy_from_slice(&px8[..cnt]);
+                    left
                 }
-                // A mirror lane not blended above: no face, across a seam, or too near a face's
-                // end for four-lane reads; `fetch_tinted` sorts out which.
-                let t = tint[lane];
-                let loc = if at.ok & bit == 0 {
-                    CubeLoc::NONE
-                } else if at.inside & bit == 0 {
-                    CubeLoc {
-                        layer: at.layer[lane] as u32,
-                        i: SEAM,
-                        a: at.u[lane],
-                        b: at.v[lane],
-                    }
-                } else {
-                    CubeLoc {
-                        layer: at.layer[lane] as u32,
-                        i: at.index[lane] as u32,
-                        a: at.fx[lane],
-                        b: at.fy[lane],
-                    }
-                };
-                o.copy_from_slice(&cf.fetch_tinted(&loc, t));
-            }
+            } << g;
             g += 8;
         }
         left
     }
+}
+
+/// Eight pixels of a row for [`mirror_group`]: setup ids (the first `cnt` real, the rest
+/// `NO_HIT`), the first one's column, the row's centre.
+struct Group<'a> {
+    idb: &'a [u32; 8],
+    cnt: usize,
+    x0: usize,
+    fy: f32,
+}
+
+/// [`mirror_row`] of one group of eight pixels into `px`: pixels that see nothing are made
+/// transparent black, mirror pixels are blended (straight from [`Taps`] where the four
+/// texels lie in one face, else through `fetch_tinted`); returns the lanes left to shade.
+#[inline(always)]
+fn mirror_group(
+    x8: X8,
+    row: &Group,
+    setups: &[MirrorSetup],
+    view: &MirrorView,
+    cf: &crate::fast::CubeFaces,
+    taps: &Taps<6>,
+    px: &mut [[f32; 4]; 8],
+) -> u32 {
+    use crate::fast::{tinted, CubeLoc, SEAM};
+    let lanes = (1u32 << row.cnt) - 1;
+    let none = x8
+        .u32s(row.idb)
+        .eq(x8.splat_i32(crate::raster::NO_HIT as i32))
+        .bitmask();
+    let hit = !none & lanes;
+    if hit == 0 {
+        *px = [[0.0; 4]; 8];
+        return 0;
+    }
+    let ev = v8::reflect(x8, row.idb, hit, row.x0, row.fy, setups, view);
+    let at = v8::locate(x8, &ev.r, cf, taps);
+    let tint = F32x8::interleave4([ev.tint[0], ev.tint[1], ev.tint[2], x8.splat(1.0)]);
+    // Mirror lanes whose four texels lie inside one face and within the taps' reach:
+    // straight to the blend, no further test.
+    let direct = ev.mirror & at.ok & at.inside & at.reach & lanes;
+    let mut m = direct;
+    while m != 0 {
+        let lane = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let q = taps.get(at.layer[lane] as usize, at.index[lane] as usize);
+        tinted(q, at.fx[lane], at.fy[lane], &tint[lane], &mut px[lane]);
+    }
+    let mut rest = lanes & !direct;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        let bit = 1 << lane;
+        if ev.mirror & bit == 0 {
+            if none & bit != 0 {
+                px[lane] = [0.0; 4];
+            }
+            continue; // not a mirror: the caller's
+        }
+        // A mirror lane not blended above: no face, across a seam, or too near a face's
+        // end for four-lane reads; `fetch_tinted` sorts out which.
+        let loc = if at.ok & bit == 0 {
+            CubeLoc::NONE
+        } else if at.inside & bit == 0 {
+            CubeLoc {
+                layer: at.layer[lane] as u32,
+                i: SEAM,
+                a: at.u[lane],
+                b: at.v[lane],
+            }
+        } else {
+            CubeLoc {
+                layer: at.layer[lane] as u32,
+                i: at.index[lane] as u32,
+                a: at.fx[lane],
+                b: at.fy[lane],
+            }
+        };
+        px[lane] = cf.fetch_tinted(&loc, tint[lane]);
+    }
+    ev.left
 }
 
 /// Eight-lane building blocks, each lane doing the scalar code's operations in its order
@@ -308,7 +336,7 @@ mod v8 {
     use super::{MirrorSetup, MirrorView};
     use crate::fast::CubeFaces;
     use glam::Vec3A;
-    use mirrorball_core::simd::{F32x8, X8};
+    use mirrorball_core::simd::{F32x8, Taps, X8};
     use mirrorball_core::{bilinear_corner8, CubeMap};
 
     /// Reflected directions and tints of eight pixels.
@@ -325,8 +353,8 @@ mod v8 {
     pub struct Located {
         pub ok: u32,
         pub inside: u32,
-        /// Lanes whose `index + stride + c + 4` is within a face (four-lane reads of the
-        /// second texel of the lower row stay inside).
+        /// Lanes whose index is at most `Taps::last` (four-lane reads of the second texel
+        /// of the lower row stay inside the face).
         pub reach: u32,
         pub layer: [i32; 8],
         pub index: [i32; 8],
@@ -429,9 +457,10 @@ mod v8 {
     }
 
     /// `CubeFaces::locate` of eight directions: [`CubeMap::uv8`] and
-    /// [`bilinear_corner8`] (as `CubeFaces::locate4` with four).
+    /// [`bilinear_corner8`] (as `CubeFaces::locate4` with four); `reach`: the index is
+    /// within `taps.last()`.
     #[inline(always)]
-    pub fn locate(x8: X8, r: &[F32x8; 3], cf: &CubeFaces) -> Located {
+    pub fn locate(x8: X8, r: &[F32x8; 3], cf: &CubeFaces, taps: &Taps<6>) -> Located {
         let f = CubeMap::uv8(x8, r[0], r[1], r[2]);
         let (u, v) = (f.sc, f.tc);
         let inf = x8.splat(f32::INFINITY);
@@ -439,13 +468,12 @@ mod v8 {
         let c = bilinear_corner8(x8, u, v, cf.n as u32, cf.n as u32);
         let stride = cf.n * cf.c as i32;
         let index = c.y0 * x8.splat_i32(stride) + c.x0 * x8.splat_i32(cf.c as i32);
-        let reach = x8
-            .splat_i32(cf.n * stride - stride - cf.c as i32 - 3)
-            .gt(index);
+        let last = i32::try_from(taps.last()).unwrap_or(i32::MAX);
+        let beyond = index.gt(x8.splat_i32(last));
         Located {
             ok: ok.bitmask(),
             inside: c.inside.bitmask(),
-            reach: reach.bitmask(),
+            reach: !beyond.bitmask() & 0xff,
             layer: f.layer.to_array(),
             index: index.to_array(),
             fx: c.fx.to_array(),

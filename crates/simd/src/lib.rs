@@ -73,6 +73,76 @@ pub fn prefetch<T>(p: *const T) {
     let _ = p;
 }
 
+/// Four-lane reads at the corners of a 2×2 grid, `i`, `i + dx`, `i + dy` and `i + dy + dx`,
+/// from one base index `i` in any of `N` slices of one length, made safe by construction
+/// rather than by a bounds check a read: [`Taps::new`] checks once that the reads from base
+/// [`Taps::last`] stay inside, and [`Taps::get`] clamps its base to `last` (one
+/// comparison), so every read it makes is in bounds. A bilinear footprint's two rows of two
+/// texels are `dx = c` (channels), `dy = stride` (`mirrorball_core::bilinear_taps`).
+///
+/// ```
+/// use mirrorball_simd::Taps;
+/// let a: Vec<f32> = (0..16).map(|i| i as f32).collect();
+/// let t = Taps::new([&a[..], &a[..]], 2, 8).unwrap();
+/// assert_eq!(t.last(), 2); // 2 + 8 + 2 + 4 = 16
+/// let [p, q, _, s] = t.get(1, 1);
+/// assert_eq!((p.to_array(), q.to_array()), ([1.0, 2.0, 3.0, 4.0], [3.0, 4.0, 5.0, 6.0]));
+/// assert_eq!(s.to_array(), [11.0, 12.0, 13.0, 14.0]);
+/// assert_eq!(t.get(0, 99)[3].to_array(), t.get(0, 2)[3].to_array()); // clamped
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct Taps<'a, const N: usize> {
+    slices: [&'a [f32]; N],
+    dx: usize,
+    dy: usize,
+    last: usize,
+}
+
+impl<'a, const N: usize> Taps<'a, N> {
+    /// `None` unless there is a slice, every slice has the first one's length, and that
+    /// length holds four floats from `dx + dy`.
+    pub fn new(slices: [&'a [f32]; N], dx: usize, dy: usize) -> Option<Taps<'a, N>> {
+        let len = slices.first()?.len();
+        let reach = dx.checked_add(dy)?.checked_add(4)?;
+        if len < reach || slices.iter().any(|s| s.len() != len) {
+            return None;
+        }
+        Some(Taps {
+            slices,
+            dx,
+            dy,
+            last: len - reach,
+        })
+    }
+
+    /// The largest base index whose reads all lie inside: `i + dx + dy + 4 ≤ len` exactly
+    /// when `i ≤ last`.
+    #[inline(always)]
+    pub fn last(&self) -> usize {
+        self.last
+    }
+
+    /// The four floats at `i`, `i + dx`, `i + dy` and `i + dy + dx` of slice `k`, with `i`
+    /// clamped to [`last`](Self::last) (panics when `k ≥ N`).
+    #[inline(always)]
+    pub fn get(&self, k: usize, i: usize) -> [F32x4; 4] {
+        let s = self.slices[k];
+        let i = i.min(self.last);
+        let (j, dx) = (i + self.dy, self.dx);
+        // SAFETY: `i ≤ last = len − (dx + dy + 4)`, so each read's four floats end at most
+        // at `i + dy + dx + 4 ≤ len`, and every slice has length `len` (`new`); the fields
+        // are never changed.
+        unsafe {
+            [
+                F32x4::load_at(s, i),
+                F32x4::load_at(s, i + dx),
+                F32x4::load_at(s, j),
+                F32x4::load_at(s, j + dx),
+            ]
+        }
+    }
+}
+
 /// Defines an eight-lane kernel: a safe function whose first argument is the [`X8`] token
 /// and whose body is compiled with AVX2 enabled on x86-64 (with the portable lanes, an
 /// ordinary function).

@@ -285,6 +285,21 @@ lanes!(F32x4, I32x4, M32x4, 4, 16);
 lanes!(F32x8, I32x8, M32x8, 8, 32);
 
 impl F32x4 {
+    /// The four floats from `s[i]` (checked here: the portable lanes keep every bounds
+    /// check), for [`crate::Taps`].
+    ///
+    /// # Safety
+    /// None needed; `unsafe` to match the SSE2 form, which needs `i + 4 ≤ s.len()`.
+    // Called only where these are the lanes in use.
+    #[cfg_attr(
+        all(target_arch = "x86_64", not(feature = "portable")),
+        allow(dead_code)
+    )]
+    #[inline(always)]
+    pub(crate) unsafe fn load_at(s: &[f32], i: usize) -> F32x4 {
+        F32x4::load(&s[i..])
+    }
+
     /// Writes the lanes as sixteen little-endian bytes to the start of `s` (panics when `s`
     /// is shorter).
     #[inline(always)]

@@ -54,6 +54,18 @@ impl F32x4 {
         let s = &s[..4];
         F32x4(unsafe { _mm_loadu_ps(s.as_ptr()) })
     }
+    /// The four floats from `s[i]` without a bounds check, for [`crate::Taps`].
+    ///
+    /// # Safety
+    /// `i + 4 ≤ s.len()`.
+    // Called only where these are the lanes in use.
+    #[cfg_attr(feature = "portable", allow(dead_code))]
+    #[inline(always)]
+    pub(crate) unsafe fn load_at(s: &[f32], i: usize) -> F32x4 {
+        debug_assert!(i + 4 <= s.len());
+        // SAFETY: the caller's promise: the four floats are inside `s`.
+        F32x4(unsafe { _mm_loadu_ps(s.as_ptr().add(i)) })
+    }
     /// The lanes as an array.
     #[inline(always)]
     pub fn to_array(self) -> [f32; 4] {

@@ -296,3 +296,26 @@ fn prefix_sums_match() {
         }
     }
 }
+
+#[test]
+fn taps_read_what_checked_loads_read_and_clamp_to_last() {
+    let a: Vec<f32> = (0..40).map(|i| i as f32 * 0.5 - 3.0).collect();
+    let b: Vec<f32> = a.iter().map(|x| -x).collect();
+    let off = [0, 3, 18, 21];
+    let t = crate::Taps::new([&a[..], &b[..]], 3, 18).unwrap();
+    assert_eq!(t.last(), 40 - 25);
+    for (k, s) in [&a, &b].into_iter().enumerate() {
+        for i in 0..60 {
+            let at = i.min(t.last());
+            let got = t.get(k, i).map(|v| v.to_array());
+            let want = off.map(|o| crate::F32x4::load(&s[at + o..]).to_array());
+            assert_eq!(got, want, "{k} {i}");
+        }
+    }
+    // Too short, lengths differ, no slice.
+    assert!(crate::Taps::new([&a[..24]], 3, 18).is_none());
+    assert!(crate::Taps::new([&a[..25]], 3, 18).is_some());
+    assert!(crate::Taps::new([&a[..], &b[..39]], 3, 18).is_none());
+    assert!(crate::Taps::<0>::new([], 3, 18).is_none());
+    assert!(crate::Taps::new([&a[..]], usize::MAX, 0).is_none());
+}

@@ -181,3 +181,32 @@ fn bilinear_corner_is_floor_of_the_texel_centre_coordinate() {
         assert!((0.0..1.0).contains(&fx) && (0.0..1.0).contains(&fy));
     }
 }
+
+/// `bilinear_taps` read with `bilinear_mix` is `bilinear_blend` at the same index, to the
+/// bit, for three and four channels, at every index a footprint fits.
+#[test]
+fn bilinear_taps_blend_as_bilinear_blend_does() {
+    for c in [3usize, 4] {
+        let (w, h) = (5usize, 4usize);
+        let stride = w * c;
+        let a: Vec<f32> = (0..stride * h)
+            .map(|i| ((i * 37) % 101) as f32 / 7.0)
+            .collect();
+        let b: Vec<f32> = a.iter().map(|x| 3.0 - x * x).collect();
+        let taps = mirrorball_core::bilinear_taps([&a[..], &b[..]], stride, c).unwrap();
+        assert_eq!(taps.last(), a.len() - (stride + c + 4));
+        for (k, layer) in [&a, &b].into_iter().enumerate() {
+            for i in 0..=taps.last() {
+                for (fx, fy) in [(0.0, 0.0), (0.25, 0.75), (0.999, 0.5)] {
+                    let want = mirrorball_core::bilinear_blend(&layer[i..], stride, c, fx, fy);
+                    let got = mirrorball_core::bilinear_mix(taps.get(k, i), fx, fy);
+                    assert_eq!(
+                        got.to_array().map(f32::to_bits),
+                        want.to_array().map(f32::to_bits)
+                    );
+                }
+            }
+        }
+    }
+    assert!(mirrorball_core::bilinear_taps([&[0.0f32; 12][..]], 6, 3).is_none());
+}
