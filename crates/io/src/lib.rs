@@ -30,10 +30,15 @@ mod ktx2_io;
 mod ldr_io;
 mod meta_text;
 pub mod openexr;
+mod output;
 
 pub use apng::write_apng;
-pub use atomic::{atomic_write, commit_all, interrupted, Staged};
+pub use atomic::{atomic_write, interrupted};
 pub use error::{Error, Fault};
+pub use output::OutputSet;
+
+use atomic::Staged;
+use exr_io::WriteBuffers;
 
 use mirrorball_core::projection::ProjectionSpec;
 use mirrorball_core::{Image, Layout, Projection, ProjectionKind, WorldProjection};
@@ -274,33 +279,24 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     }
 }
 
-/// Writes one flat image (EXR, HDR, PNG or JPEG), atomically.
+/// Writes one flat image (EXR, HDR, PNG or JPEG), atomically. (Several files that belong
+/// together: [`OutputSet`].)
 pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
-    write_image_staged(path, image, opts)?.commit()
+    stage_image(path, image, opts, &mut WriteBuffers::default())?.commit()
 }
 
 /// Writes one flat image as [`write_image`] does, to a temporary file beside `path` that
-/// [`Staged::commit`] renames into place (dropped uncommitted, it is removed): a caller
-/// writing many files can rename each on another thread (see [`Staged`] for why).
-///
-/// ```
-/// use mirrorball_core::Image;
-/// use mirrorball_io::{write_image_staged, WriteOptions};
-/// let dir = tempfile::tempdir().unwrap();
-/// let path = dir.path().join("face.exr");
-/// let staged = write_image_staged(&path, &Image::new(4, 4, 3), &WriteOptions::default()).unwrap();
-/// assert!(!path.exists()); // written beside it, not yet in place
-/// staged.commit().unwrap();
-/// assert!(path.exists());
-/// ```
-pub fn write_image_staged(
+/// [`Staged::commit`] renames into place (dropped uncommitted, it is removed). `buffers`
+/// are the encoders' buffers, kept from one file to the next.
+pub(crate) fn stage_image(
     path: &Path,
     image: &Image,
     opts: &WriteOptions,
+    buffers: &mut WriteBuffers,
 ) -> Result<Staged, Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
-        Format::Exr => exr_io::write(path, image, opts),
+        Format::Exr => exr_io::write(path, image, opts, buffers),
         Format::Hdr => hdr_io::write(path, image, opts),
         Format::Png | Format::Jpeg => ldr_io::write(path, format, image, opts),
         Format::Webp => Err(Error::request(
