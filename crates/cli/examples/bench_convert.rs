@@ -20,6 +20,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+// The allocator the `mirrorball` binary runs with, so that the figures are the binary's.
+#[path = "../src/alloc.rs"]
+mod alloc;
+#[global_allocator]
+static ALLOC: alloc::HugePages = alloc::HugePages;
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.is_empty() || args.iter().any(|a| a == "-h" || a == "--help") {

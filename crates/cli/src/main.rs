@@ -3,6 +3,7 @@
 //! Raw arguments become a validated plan (projection specs parsed, output container and
 //! layout checked, folders checked) before any file is read or any work starts.
 
+mod alloc;
 mod budget;
 mod choice;
 mod commands;
@@ -22,6 +23,9 @@ use mirrorball_io::{ExrCompression, Precision};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{Attach, Indexing, ENVIRONMENT_FILTERS};
 use std::process::ExitCode;
+
+#[global_allocator]
+static ALLOC: alloc::HugePages = alloc::HugePages;
 
 /// Environment (reflection) maps: convert between world projections, inspect them.
 #[derive(Parser, Debug)]

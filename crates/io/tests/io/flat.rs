@@ -1160,9 +1160,9 @@ fn a_staged_write_lands_only_when_committed() {
             assert_eq!(std::fs::read(&path).unwrap(), before);
             let mut set = OutputSet::new(&WriteOptions::default());
             set.push(&target, other.clone()).unwrap();
-            assert_eq!(set.finish().unwrap(), [target.clone()]);
+            assert_eq!(set.finish().unwrap(), std::slice::from_ref(&target));
         } else {
-            assert_eq!(set.finish().unwrap(), [target.clone()]);
+            assert_eq!(set.finish().unwrap(), std::slice::from_ref(&target));
         }
         assert_eq!(
             read_one(&target).0.width(),
