@@ -242,11 +242,21 @@ pub struct Loaded {
     pub format: Format,
     /// A one-line description for people: "OpenEXR, half, ZIP compression, RGB".
     pub description: String,
-    /// How many NaN, infinite or negative colour values the texels hold (see
-    /// [`mirrorball_core::count_invalid`]), where the reader counted them as it decoded
-    /// (ZIP-compressed scan-line OpenEXR files, the common download): a caller that would
-    /// scan the map for them need not when this is `Some(0)`. `None`: not counted.
-    pub invalid: Option<u64>,
+    /// [`Loaded::invalid`], once counted: readers that decode block by block count as they
+    /// go, while the block is in cache (ZIP-compressed scan-line OpenEXR files, the common
+    /// download), or know there are none (RGBE, 8- and 16-bit files); [`read`] counts the
+    /// others' texels.
+    invalid: Option<u64>,
+}
+
+impl Loaded {
+    /// How many colour values of the layers are NaN, infinite or negative: those
+    /// [`mirrorball_core::EnvMap::sanitize`] would set to 0 (see
+    /// [`mirrorball_core::count_invalid`]). A caller need not scan a map read with none.
+    pub fn invalid(&self) -> u64 {
+        self.invalid
+            .expect("read counts the invalid values of every file")
+    }
 }
 
 /// Reads an image or cube map, checking declared sizes against `limits` before allocating.
@@ -267,6 +277,27 @@ pub struct Loaded {
 /// assert_ne!(e.fault(), Fault::Request);
 /// ```
 pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+    let mut loaded = read_format(path, limits)?;
+    if loaded.invalid.is_none() {
+        use rayon::prelude::*;
+        let count = loaded
+            .layers
+            .iter()
+            .map(|img| {
+                let rgba = img.channels() == 4;
+                img.data()
+                    .par_chunks(img.channels() * 16384)
+                    .map(|block| mirrorball_core::count_invalid(block, rgba))
+                    .sum::<u64>()
+            })
+            .sum();
+        loaded.invalid = Some(count);
+    }
+    Ok(loaded)
+}
+
+/// [`read`]'s reader for `path`'s format.
+fn read_format(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
         Format::Exr => exr_io::read(path, limits),
