@@ -21,10 +21,8 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 // The allocator the `mirrorball` binary runs with, so that the figures are the binary's.
-#[path = "../src/alloc.rs"]
-mod alloc;
 #[global_allocator]
-static ALLOC: alloc::HugePages = alloc::HugePages;
+static ALLOC: mirrorball_io::HugePages = mirrorball_io::HugePages;
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -3,7 +3,6 @@
 //! Raw arguments become a validated plan (projection specs parsed, output container and
 //! layout checked, folders checked) before any file is read or any work starts.
 
-mod alloc;
 mod budget;
 mod choice;
 mod commands;
@@ -25,7 +24,7 @@ use mirrorball_render::{Attach, Indexing, ENVIRONMENT_FILTERS};
 use std::process::ExitCode;
 
 #[global_allocator]
-static ALLOC: alloc::HugePages = alloc::HugePages;
+static ALLOC: mirrorball_io::HugePages = mirrorball_io::HugePages;
 
 /// Environment (reflection) maps: convert between world projections, inspect them.
 #[derive(Parser, Debug)]

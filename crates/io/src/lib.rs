@@ -4,7 +4,8 @@
 //!
 //! Reading gives linear `f32` [`Image`]s (sRGB-encoded 8/16-bit files are decoded to linear
 //! light); writing goes to a temporary file beside the target that is renamed into place, so
-//! a failed write never leaves a half-written output. Every error names the file and says
+//! a failed write never leaves a half-written output, and files that belong together (an
+//! [`OutputSet`]) are renamed into place together. Every error names the file and says
 //! whose fault it is ([`Fault`]).
 //!
 //! **What a file says about its map.** Written maps record their projection with every
@@ -18,6 +19,7 @@
 //! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
 #![warn(missing_docs)]
 
+mod alloc;
 mod apng;
 mod atomic;
 mod bounds;
@@ -32,6 +34,7 @@ mod meta_text;
 pub mod openexr;
 mod output;
 
+pub use alloc::HugePages;
 pub use apng::write_apng;
 pub use atomic::{atomic_write, interrupted};
 pub use error::{Error, Fault};
