@@ -20,6 +20,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+// The allocator the `mirrorball` binary runs with, so that the figures are the binary's.
+#[global_allocator]
+static ALLOC: mirrorball_io::HugePages = mirrorball_io::HugePages;
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.is_empty() || args.iter().any(|a| a == "-h" || a == "--help") {

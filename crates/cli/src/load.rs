@@ -32,10 +32,10 @@ pub struct Source {
     pub description: String,
     /// How projection and layout were decided (said to the user).
     pub decided: String,
-    /// NaN, infinite and negative values the reader counted in what it decoded, if it
-    /// counted (see `mirrorball_io::Loaded::invalid`): `Some(0)` spares [`Source::prepare`]
-    /// its scan of the whole map.
-    pub invalid: Option<u64>,
+    /// NaN, infinite and negative values in the file(s) as read
+    /// (`mirrorball_io::Loaded::invalid`): none spares [`Source::prepare`] its pass over the
+    /// whole map.
+    pub invalid: u64,
 }
 
 impl Source {
@@ -56,7 +56,7 @@ impl Source {
             env.height(),
             self.decided
         )];
-        if !keep_invalid && self.invalid != Some(0) {
+        if !keep_invalid && self.invalid != 0 {
             let fixed = self.env.sanitize();
             if fixed > 0 {
                 lines.push(format!(
@@ -80,13 +80,14 @@ pub fn load(
     }
     let path = Path::new(input);
     let loaded = mirrorball_io::read(path, limits)?;
+    let invalid = loaded.invalid();
     let Loaded {
         layers,
         declared,
         recorded,
         format,
         description,
-        invalid,
+        ..
     } = loaded;
     // What the file records (see `mirrorball_io::MapInfo`): unreadable, it matters only
     // when nothing else says the projection.
@@ -330,7 +331,7 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
         .map(|p| mirrorball_io::read(p, limits))
         .collect::<Result<_, _>>()?;
     // Counted in every file, or not known.
-    let invalid = loaded.iter().map(|l| l.invalid).sum::<Option<u64>>();
+    let invalid = loaded.iter().map(Loaded::invalid).sum();
     // The projection every file records, when they agree and it has this many layers.
     let recorded = match (from, &loaded[0].recorded) {
         (None, Some(Ok(info)))

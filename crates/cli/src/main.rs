@@ -24,6 +24,9 @@ use mirrorball_render::tone::Tone;
 use mirrorball_render::{Attach, Indexing, ENVIRONMENT_FILTERS};
 use std::process::ExitCode;
 
+#[global_allocator]
+static ALLOC: mirrorball_io::HugePages = mirrorball_io::HugePages;
+
 /// Environment (reflection) maps: convert between world projections, inspect them.
 #[derive(Parser, Debug)]
 #[command(name = "mirrorball", version, about, long_about = None)]

@@ -5,8 +5,7 @@ use crate::error::CliError;
 use crate::load::{layer_names, FACE};
 use mirrorball_core::{EnvMap, Image, Layout, ProjectionKind, WorldProjection};
 use mirrorball_filter::MipChain;
-use mirrorball_io::{Format, MapInfo, WriteOptions};
-use rayon::prelude::*;
+use mirrorball_io::{Format, MapInfo, OutputSet, WriteOptions};
 use std::path::{Path, PathBuf};
 
 /// What to write.
@@ -154,15 +153,10 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
     let n = env.layers().len();
     let layout = output_layout(out, n, opts);
     if let Some(paths) = layer_files(out, n, opts) {
-        let write = per_layer_write(&opts.write, *env.projection());
         // Renamed into place together: a failed or interrupted run leaves the set as it was.
-        let staged = paths
-            .par_iter()
-            .zip(env.layers().par_iter())
-            .map(|(p, img)| mirrorball_io::write_image_staged(p, img, &write))
-            .collect::<Result<Vec<_>, _>>()?;
-        mirrorball_io::commit_all(staged)?;
-        return Ok(paths);
+        let mut set = OutputSet::new(&per_layer_write(&opts.write, *env.projection()));
+        set.push_all(&paths, env.layers())?;
+        return Ok(set.finish()?);
     }
     let mut write = opts.write;
     // Recorded in the file, so that reading it back needs no --from.

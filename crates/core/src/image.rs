@@ -30,7 +30,7 @@ impl Image {
             width,
             height,
             channels,
-            data: zeroed(len),
+            data: vec![0.0; len],
         }
     }
 
@@ -205,7 +205,6 @@ impl Image {
         let row_len = width as usize * channels;
         let len = row_len * height as usize;
         let mut data: Vec<f32> = Vec::with_capacity(len);
-        advise_huge_pages(data.spare_capacity_mut());
         if row_len > 0 {
             data.spare_capacity_mut()[..len]
                 .par_chunks_mut(row_len)
@@ -230,46 +229,3 @@ impl Image {
         }
     }
 }
-
-/// `len` zeros, in memory the operating system backs with huge pages where it can.
-///
-/// A large zeroed vector comes straight from the kernel (`calloc` of fresh pages), and every
-/// 4 KiB page of it faults once when first written: writing a 6×1024² float cube so costs
-/// ~18,000 faults, about as long as the conversion itself. On Linux with transparent huge
-/// pages in `madvise` mode (the default), asking for huge pages before the first write makes
-/// that 36 faults of 2 MiB (numpy does the same for its arrays of 4 MiB and more). Elsewhere,
-/// or for small images, a plain zeroed vector.
-pub(crate) fn zeroed(len: usize) -> Vec<f32> {
-    let mut v = vec![0.0f32; len];
-    advise_huge_pages(&mut v);
-    v
-}
-
-#[cfg(target_os = "linux")]
-fn advise_huge_pages<T>(v: &mut [T]) {
-    const HUGE: usize = 2 << 20;
-    let bytes = std::mem::size_of_val(v);
-    if bytes < 2 * HUGE {
-        return;
-    }
-    // madvise wants a page-aligned start; the advice covers whole pages inside the buffer.
-    const PAGE: usize = 4096;
-    let start = v.as_mut_ptr() as usize;
-    let aligned = start.next_multiple_of(PAGE);
-    let end = (start + bytes) & !(PAGE - 1);
-    if end > aligned {
-        // SAFETY: the range lies inside `v`'s allocation, which we borrow mutably; the advice
-        // only changes how the kernel backs those pages (their contents stay zero), and a
-        // failure (no THP support) leaves them as they were.
-        unsafe {
-            libc::madvise(
-                aligned as *mut libc::c_void,
-                end - aligned,
-                libc::MADV_HUGEPAGE,
-            );
-        }
-    }
-}
-
-#[cfg(not(target_os = "linux"))]
-fn advise_huge_pages<T>(_: &mut [T]) {}

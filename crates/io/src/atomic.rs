@@ -3,8 +3,8 @@
 //!
 //! - Every temporary file is registered while it exists, so that [`interrupted`] (called
 //!   on SIGINT/SIGTERM) can remove them all before the process exits.
-//! - A set of files that belong together (six cube faces, a mip chain) is renamed into
-//!   place by [`commit_all`] under one guard: an interrupt waits for the set to land, and no
+//! - A set of files that belong together (six cube faces, a mip chain: an
+//!   [`crate::OutputSet`]) is renamed into place by [`commit_all`] under one guard: an interrupt waits for the set to land, and no
 //!   set starts landing after an interrupt, so a set is either all new or all old.
 //! - An output that is a symbolic link is written through (the file it points to is
 //!   replaced, the link kept), as `cp` does.
@@ -63,7 +63,7 @@ where
 /// uncommitted, the temporary file is removed and the destination is left as it was.
 #[must_use = "a staged file is removed unless committed"]
 #[derive(Debug)]
-pub struct Staged {
+pub(crate) struct Staged {
     /// The temporary file, until committed.
     tmp: Option<PathBuf>,
     /// Where it goes (through symbolic links).
@@ -74,13 +74,13 @@ pub struct Staged {
 
 impl Staged {
     /// The destination.
-    pub fn path(&self) -> &Path {
+    pub(crate) fn path(&self) -> &Path {
         &self.path
     }
 
     /// Renames the temporary file over the destination. On failure the temporary file is
     /// removed and the destination is left as it was.
-    pub fn commit(self) -> Result<(), Error> {
+    pub(crate) fn commit(self) -> Result<(), Error> {
         let _guard = COMMITS.read().unwrap_or_else(|e| e.into_inner());
         self.rename()
     }
@@ -105,22 +105,12 @@ impl Drop for Staged {
     }
 }
 
-/// Renames a set of staged files into place together (on a thread each: a rename over an
-/// existing file can wait on the file system for milliseconds). An interrupt that comes
-/// meanwhile waits for the whole set; one that came before keeps the set from landing.
-/// Every file is tried; the first error is returned, and the files that failed are removed.
-pub fn commit_all(staged: Vec<Staged>) -> Result<(), Error> {
+/// Renames a set of staged files into place together: an interrupt that comes meanwhile
+/// waits for the whole set; one that came before keeps the set from landing. Every file is
+/// tried; the first error is returned, and the files that failed are removed.
+pub(crate) fn commit_all(staged: Vec<Staged>) -> Result<(), Error> {
     let _guard = COMMITS.read().unwrap_or_else(|e| e.into_inner());
-    let results: Vec<Result<(), Error>> = std::thread::scope(|scope| {
-        let renames: Vec<_> = staged
-            .into_iter()
-            .map(|s| scope.spawn(move || s.rename()))
-            .collect();
-        renames
-            .into_iter()
-            .map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    });
+    let results: Vec<Result<(), Error>> = staged.into_iter().map(Staged::rename).collect();
     results.into_iter().collect()
 }
 

@@ -240,11 +240,17 @@ fn image_other(opts: &WriteOptions) -> std::collections::HashMap<Text, Attribute
 /// Writes `image` as a single-part scan-line OpenEXR file: half texels unless
 /// `opts.precision` asks for float, compressed with `opts.exr_compression`, RGB or RGBA by
 /// the image's channel count. Blocks are compressed on all cores, into a temporary file
-/// that the returned [`Staged`] renames into place.
+/// that the returned [`Staged`] renames into place. `buffers` are kept between
+/// files.
 ///
 /// Half output clamps finite values to ±65504 (the largest half) instead of overflowing to
 /// infinity.
-pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, Error> {
+pub fn write(
+    path: &Path,
+    image: &Image,
+    opts: &WriteOptions,
+    buffers: &mut WriteBuffers,
+) -> Result<Staged, Error> {
     let sample_type = match opts.precision {
         None | Some(Precision::Half) => SampleType::F16,
         Some(Precision::Float) => SampleType::F32,
@@ -303,7 +309,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
         let mut exr_image = exr::image::Image::from_layer(layer);
         exr_image.attributes.other = image_other(opts);
         stage(path, |out| {
-            write_layer(out, exr_image.write(), image).map_err(|e| write_error(path, e))
+            write_layer(out, exr_image.write(), image, buffers).map_err(|e| write_error(path, e))
         })
     } else {
         let texels = SpecificChannels {
@@ -317,7 +323,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
         let mut exr_image = exr::image::Image::from_layer(layer);
         exr_image.attributes.other = image_other(opts);
         stage(path, |out| {
-            write_layer(out, exr_image.write(), image).map_err(|e| write_error(path, e))
+            write_layer(out, exr_image.write(), image, buffers).map_err(|e| write_error(path, e))
         })
     }
 }
@@ -330,6 +336,7 @@ fn write_layer<'i, L, F>(
     out: &mut std::io::BufWriter<File>,
     writer: exr::image::write::WriteImageWithOptions<'i, L, F>,
     image: &Image,
+    buffers: &mut WriteBuffers,
 ) -> exr::error::UnitResult
 where
     L: exr::image::write::layers::WritableLayers<'i>,
@@ -351,7 +358,7 @@ where
         _ => return writer.to_buffered(out),
     };
     if !zip {
-        return write_uncompressed(out, &headers, image, &layout);
+        return write_uncompressed(out, &headers, image, &layout, buffers);
     }
     let (w, c) = (image.width() as usize, image.channels());
     let data = image.data();
@@ -408,6 +415,7 @@ fn write_uncompressed(
     headers: &[Header],
     image: &Image,
     layout: &[(usize, SampleType)],
+    buffers: &mut WriteBuffers,
 ) -> exr::error::UnitResult {
     use exr::meta::{magic_number, MetaData};
     use rayon::prelude::*;
@@ -460,51 +468,24 @@ fn write_uncompressed(
         );
     };
     // Two buffers: each batch is handed to the kernel while the next is packed.
-    let [mut ready, mut next] = LineBuffers::take();
-    pack(0, &mut ready);
+    let [ready, next] = &mut buffers.lines;
+    pack(0, ready);
     for start in (batch..h).step_by(batch) {
-        let (written, ()) = rayon::join(|| out.write_all(&ready), || pack(start, &mut next));
+        let (written, ()) = rayon::join(|| out.write_all(ready), || pack(start, next));
         written?;
-        std::mem::swap(&mut ready, &mut next);
+        std::mem::swap(ready, next);
     }
-    out.write_all(&ready)?;
-    LineBuffers::give_back([ready, next]);
+    out.write_all(ready)?;
     Ok(())
 }
 
-/// The uncompressed writer's two batch buffers (~2 MiB each), kept between files.
-///
-/// Freed, they would go back to the kernel (the allocator maps and unmaps blocks this
-/// large), and the next file's would be fresh memory again, zeroed and mapped a page at a
-/// time on first touch: in a `mirrorball convert` to six float faces these buffers took
-/// half the process's page faults. `convert` writes one file a cube face, so the six faces
-/// share one pair.
-struct LineBuffers;
-
-impl LineBuffers {
-    fn slot() -> &'static std::sync::Mutex<Vec<Vec<u8>>> {
-        static SLOT: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
-        &SLOT
-    }
-
-    /// Two buffers: kept ones where there are, else empty ones.
-    fn take() -> [Vec<u8>; 2] {
-        let mut kept = Self::slot().lock().unwrap_or_else(|p| p.into_inner());
-        [
-            kept.pop().unwrap_or_default(),
-            kept.pop().unwrap_or_default(),
-        ]
-    }
-
-    /// Keeps `bufs` for the next file (at most two pairs, for writers on two threads).
-    fn give_back(bufs: [Vec<u8>; 2]) {
-        let mut kept = Self::slot().lock().unwrap_or_else(|p| p.into_inner());
-        for b in bufs {
-            if kept.len() < 4 {
-                kept.push(b);
-            }
-        }
-    }
+/// What the writer keeps from one file to the next: the uncompressed writer's two batch
+/// buffers (~2 MiB each). Freed, they would go back to the kernel (the allocator maps and
+/// unmaps blocks this large), and the next file's would be fresh memory, zeroed and mapped
+/// a page at a time on first touch. An [`crate::OutputSet`] keeps one for its files.
+#[derive(Debug, Default)]
+pub(crate) struct WriteBuffers {
+    lines: [Vec<u8>; 2],
 }
 
 /// Lays out `rows` (interleaved texels, `w` a row, `c` channels) as a scan-line block's raw

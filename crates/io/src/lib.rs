@@ -4,7 +4,8 @@
 //!
 //! Reading gives linear `f32` [`Image`]s (sRGB-encoded 8/16-bit files are decoded to linear
 //! light); writing goes to a temporary file beside the target that is renamed into place, so
-//! a failed write never leaves a half-written output. Every error names the file and says
+//! a failed write never leaves a half-written output, and files that belong together (an
+//! [`OutputSet`]) are renamed into place together. Every error names the file and says
 //! whose fault it is ([`Fault`]).
 //!
 //! **What a file says about its map.** Written maps record their projection with every
@@ -18,6 +19,7 @@
 //! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
 #![warn(missing_docs)]
 
+mod alloc;
 mod apng;
 mod atomic;
 mod bounds;
@@ -30,10 +32,16 @@ mod ktx2_io;
 mod ldr_io;
 mod meta_text;
 pub mod openexr;
+mod output;
 
+pub use alloc::HugePages;
 pub use apng::write_apng;
-pub use atomic::{atomic_write, commit_all, interrupted, Staged};
+pub use atomic::{atomic_write, interrupted};
 pub use error::{Error, Fault};
+pub use output::OutputSet;
+
+use atomic::Staged;
+use exr_io::WriteBuffers;
 
 use mirrorball_core::projection::ProjectionSpec;
 use mirrorball_core::{Image, Layout, Projection, ProjectionKind, WorldProjection};
@@ -237,11 +245,21 @@ pub struct Loaded {
     pub format: Format,
     /// A one-line description for people: "OpenEXR, half, ZIP compression, RGB".
     pub description: String,
-    /// How many NaN, infinite or negative colour values the texels hold (see
-    /// [`mirrorball_core::count_invalid`]), where the reader counted them as it decoded
-    /// (ZIP-compressed scan-line OpenEXR files, the common download): a caller that would
-    /// scan the map for them need not when this is `Some(0)`. `None`: not counted.
-    pub invalid: Option<u64>,
+    /// [`Loaded::invalid`], once counted: readers that decode block by block count as they
+    /// go, while the block is in cache (ZIP-compressed scan-line OpenEXR files, the common
+    /// download), or know there are none (RGBE, 8- and 16-bit files); [`read`] counts the
+    /// others' texels.
+    invalid: Option<u64>,
+}
+
+impl Loaded {
+    /// How many colour values of the layers are NaN, infinite or negative: those
+    /// [`mirrorball_core::EnvMap::sanitize`] would set to 0 (see
+    /// [`mirrorball_core::count_invalid`]). A caller need not scan a map read with none.
+    pub fn invalid(&self) -> u64 {
+        self.invalid
+            .expect("read counts the invalid values of every file")
+    }
 }
 
 /// Reads an image or cube map, checking declared sizes against `limits` before allocating.
@@ -262,6 +280,27 @@ pub struct Loaded {
 /// assert_ne!(e.fault(), Fault::Request);
 /// ```
 pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+    let mut loaded = read_format(path, limits)?;
+    if loaded.invalid.is_none() {
+        use rayon::prelude::*;
+        let count = loaded
+            .layers
+            .iter()
+            .map(|img| {
+                let rgba = img.channels() == 4;
+                img.data()
+                    .par_chunks(img.channels() * 16384)
+                    .map(|block| mirrorball_core::count_invalid(block, rgba))
+                    .sum::<u64>()
+            })
+            .sum();
+        loaded.invalid = Some(count);
+    }
+    Ok(loaded)
+}
+
+/// [`read`]'s reader for `path`'s format.
+fn read_format(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
         Format::Exr => exr_io::read(path, limits),
@@ -274,33 +313,24 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     }
 }
 
-/// Writes one flat image (EXR, HDR, PNG or JPEG), atomically.
+/// Writes one flat image (EXR, HDR, PNG or JPEG), atomically. (Several files that belong
+/// together: [`OutputSet`].)
 pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
-    write_image_staged(path, image, opts)?.commit()
+    stage_image(path, image, opts, &mut WriteBuffers::default())?.commit()
 }
 
 /// Writes one flat image as [`write_image`] does, to a temporary file beside `path` that
-/// [`Staged::commit`] renames into place (dropped uncommitted, it is removed): a caller
-/// writing many files can rename each on another thread (see [`Staged`] for why).
-///
-/// ```
-/// use mirrorball_core::Image;
-/// use mirrorball_io::{write_image_staged, WriteOptions};
-/// let dir = tempfile::tempdir().unwrap();
-/// let path = dir.path().join("face.exr");
-/// let staged = write_image_staged(&path, &Image::new(4, 4, 3), &WriteOptions::default()).unwrap();
-/// assert!(!path.exists()); // written beside it, not yet in place
-/// staged.commit().unwrap();
-/// assert!(path.exists());
-/// ```
-pub fn write_image_staged(
+/// [`Staged::commit`] renames into place (dropped uncommitted, it is removed). `buffers`
+/// are the encoders' buffers, kept from one file to the next.
+pub(crate) fn stage_image(
     path: &Path,
     image: &Image,
     opts: &WriteOptions,
+    buffers: &mut WriteBuffers,
 ) -> Result<Staged, Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
-        Format::Exr => exr_io::write(path, image, opts),
+        Format::Exr => exr_io::write(path, image, opts, buffers),
         Format::Hdr => hdr_io::write(path, image, opts),
         Format::Png | Format::Jpeg => ldr_io::write(path, format, image, opts),
         Format::Webp => Err(Error::request(

@@ -14,6 +14,10 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
+// The allocator the `mirrorball` binary runs with, so that the figures are the binary's.
+#[global_allocator]
+static ALLOC: mirrorball_io::HugePages = mirrorball_io::HugePages;
+
 fn arg(name: &str, default: u32) -> u32 {
     let a: Vec<String> = std::env::args().collect();
     a.iter()

@@ -9,12 +9,10 @@ use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
 use mirrorball_core::{
-    resample, Choice, Image, Layout, Projection, ResampleOptions, Resampler, Rotation,
-    WorldProjection,
+    resample, Choice, Layout, Projection, ResampleOptions, Resampler, Rotation, WorldProjection,
 };
-use mirrorball_io::{ExrCompression, Format, Precision, WriteOptions};
+use mirrorball_io::{ExrCompression, Format, OutputSet, Precision, WriteOptions};
 use std::path::PathBuf;
-use std::sync::mpsc;
 use std::time::Instant;
 
 /// Everything `convert` will do, checked before any work starts.
@@ -179,8 +177,9 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
             c,
         );
         let layer = budget::f32_texels(w as u64 * h as u64, c);
-        // One file a layer: two layers in memory. One file: the map, and a packed copy for
-        // flat layouts (a third more for a mip chain).
+        // One file a layer: one layer in memory, two counted (a margin for the encoders'
+        // buffers). One file: the map, and a packed copy for flat layouts (a third more for
+        // a mip chain).
         let more = match &layer_files {
             Some(_) => 2 * layer,
             None => layer.saturating_mul(dst.layer_count() as u64 * 2),
@@ -194,19 +193,12 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     }
     let t1 = Instant::now();
     let (files, t_conv, t_write) = match layer_files {
-        // One file a layer: each is written while the next is converted.
+        // One file a layer: each is written as soon as it is made.
         Some(paths) => {
             with_progress("converting", rows, a.quiet, |counter| {
                 plan.resample.progress = Some(counter);
-                let job = Job {
-                    src,
-                    dst,
-                    w,
-                    h,
-                    opts: &plan.resample,
-                };
                 let write = save::per_layer_write(&plan.save.write, dst);
-                write_while_converting(job, &paths, &write)
+                convert_layers(src, (dst, w, h), &plan.resample, &paths, &write)
             })?;
             (paths, t1.elapsed(), None)
         }
@@ -253,76 +245,31 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// What `write_while_converting` makes: `src` in `dst`'s projection, layers `w`×`h`.
-struct Job<'a> {
+/// Converts `src` into `dst`'s projection, layers `w`×`h`, one layer after another, and
+/// writes layer `i` to `paths[i]`, the set landing together (`mirrorball_io::OutputSet`): an
+/// interrupted or failed run leaves the old files as they were. One layer is in memory at a
+/// time, its buffer filled again for the next.
+fn convert_layers(
     src: load::Source,
-    dst: Projection,
-    w: u32,
-    h: u32,
-    opts: &'a ResampleOptions,
-}
-
-/// Converts the job's layers one after another and writes layer `i` to `paths[i]` on
-/// another thread meanwhile, so that the file's encoding and the kernel's share of writing
-/// it overlap the next layer's conversion. The files are renamed into place together once
-/// all are written (`mirrorball_io::commit_all`): an interrupted or failed run leaves the
-/// set as it was. Stops at the first failed write.
-///
-/// The source is freed as soon as the last layer is made, while that layer is still being
-/// written.
-fn write_while_converting(
-    job: Job,
+    (dst, w, h): (Projection, u32, u32),
+    opts: &ResampleOptions,
     paths: &[PathBuf],
-    opts: &WriteOptions,
+    write: &WriteOptions,
 ) -> Result<(), CliError> {
-    let Job {
-        src,
-        dst,
-        w,
-        h,
-        opts: resample,
-    } = job;
-    std::thread::scope(|scope| {
-        let r = Resampler::new(&src.env, dst, w, h, resample);
-        // At most two layers in memory: one is made while the other is written. Written
-        // layers' buffers come back to be filled again, so that only the first two pay for
-        // fresh memory (the kernel zeroes and maps it a page at a time on first touch).
-        const IN_MEMORY: usize = 2;
-        let (tx, rx) = mpsc::sync_channel::<(&PathBuf, Image)>(IN_MEMORY - 1);
-        let (give_back, take_back) = mpsc::channel::<Image>();
-        let writer = scope.spawn(move || -> Result<(), CliError> {
-            // Its own threads: on the global pool, the file's blocks would queue behind
-            // the conversion's rows, and writing would wait for conversion to finish.
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(rayon::current_num_threads())
-                .build()
-                .map_err(|e| CliError::system(format!("cannot start writer threads: {e}")))?;
-            let mut staged = Vec::with_capacity(paths.len());
-            for (path, img) in rx {
-                staged.push(pool.install(|| mirrorball_io::write_image_staged(path, &img, opts))?);
-                // The converter may have finished and gone: then the buffer is dropped.
-                let _ = give_back.send(img);
-            }
-            mirrorball_io::commit_all(staged).map_err(CliError::from)
-        });
-        for (layer, path) in paths.iter().enumerate() {
-            let img = if layer < IN_MEMORY {
-                r.layer(layer)
-            } else {
-                // Err: the writer stopped on an error, which its join reports.
-                let Ok(mut img) = take_back.recv() else { break };
+    let r = Resampler::new(&src.env, dst, w, h, opts);
+    let mut set = OutputSet::new(write);
+    for (layer, path) in paths.iter().enumerate() {
+        let img = match set.spare() {
+            Some(mut img) => {
                 r.layer_into(layer, &mut img);
                 img
-            };
-            if tx.send((path, img)).is_err() {
-                break; // the writer stopped on an error, which join reports
             }
-        }
-        drop(tx);
-        drop(r);
-        drop(src);
-        writer
-            .join()
-            .unwrap_or_else(|e| std::panic::resume_unwind(e))
-    })
+            None => r.layer(layer),
+        };
+        set.push(path, img)?;
+    }
+    drop(r);
+    drop(src);
+    set.finish()?;
+    Ok(())
 }
