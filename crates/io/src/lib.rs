@@ -26,6 +26,7 @@ mod error;
 mod exr_io;
 mod exr_zip;
 mod hdr_io;
+mod ktx1_io;
 mod ktx2_io;
 mod ldr_io;
 mod meta_text;
@@ -33,7 +34,11 @@ pub mod openexr;
 
 pub use apng::write_apng;
 pub use atomic::{atomic_write, commit_all, interrupted, Staged};
+pub use dds_io::write_dds;
 pub use error::{Error, Fault};
+pub use ktx1_io::{filament_sh_text, write_ktx1};
+pub use ktx2_io::{write_ktx2, CubeWrite};
+pub use mirrorball_encode::{Effort, Encoding};
 
 use mirrorball_core::projection::ProjectionSpec;
 use mirrorball_core::{Image, Layout, Projection, ProjectionKind, WorldProjection};
