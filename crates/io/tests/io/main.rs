@@ -1,5 +1,6 @@
 //! The mirrorball-io integration tests: one binary, one module per concern.
 mod cube;
+mod encoded;
 mod flat;
 mod hostile;
 mod imf_envmap;
