@@ -176,6 +176,22 @@ fn quantize10(t: f32) -> i32 {
     }
 }
 
+/// The nearest endpoint at or below `t` (`up` false) or at or above it (`up` true), so
+/// that two endpoints bracket the values between them and the 4-bit weights reach them
+/// more finely than the endpoints' own 64-unit steps.
+fn quantize10_toward(t: f32, up: bool) -> i32 {
+    let q = quantize10(t);
+    let u = unquantize10(q) as f32;
+    let step = if up && u < t {
+        1
+    } else if !up && u > t {
+        -1
+    } else {
+        0
+    };
+    (q + step).clamp(-511, 511)
+}
+
 /// The specification's interpolation of two unquantized endpoints.
 fn interpolate(a: i32, b: i32, w: i32) -> i32 {
     (a * (64 - w) + b * w + 32) >> 6
@@ -233,9 +249,20 @@ pub fn encode_signed_block(texels: &[[f32; 3]; 16]) -> [u8; 16] {
         .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| {
             (lo.min(p), hi.max(p))
         });
-    let ends = [lo, hi].map(|s| [0, 1, 2].map(|c| quantize10(mean[c] + s * axis[c])));
-    let (mut idx, mut err) = assign(&ends, &targets);
-    let mut q = ends;
+    let lo_end = [0, 1, 2].map(|c| mean[c] + lo * axis[c]);
+    let hi_end = [0, 1, 2].map(|c| mean[c] + hi * axis[c]);
+    // Two candidates: each endpoint rounded to the nearest, or rounded outwards so the pair
+    // brackets the block's colours in every channel.
+    let nearest = [lo_end.map(quantize10), hi_end.map(quantize10)];
+    let outward = [
+        [0, 1, 2].map(|c| quantize10_toward(lo_end[c], lo_end[c] > hi_end[c])),
+        [0, 1, 2].map(|c| quantize10_toward(hi_end[c], hi_end[c] >= lo_end[c])),
+    ];
+    let (mut q, (mut idx, mut err)) = [nearest, outward]
+        .into_iter()
+        .map(|q| (q, assign(&q, &targets)))
+        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+        .expect("two candidates");
 
     // Least-squares endpoints for the chosen weights, requantized, kept while better.
     for _ in 0..3 {

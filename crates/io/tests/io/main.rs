@@ -6,4 +6,5 @@ mod hostile;
 mod imf_envmap;
 mod mutate;
 mod openexr;
+mod quality;
 mod records;
