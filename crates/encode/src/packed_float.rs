@@ -27,10 +27,10 @@ pub fn to_small_ufloat(v: f32, mantissa_bits: u32) -> u32 {
     let v = f64::from(v);
     // The exponent e of v's leading bit, at least the subnormal one (−14).
     let e = ((v.to_bits() >> 52) as i32 - 1023).max(-14);
-    // v / 2^(e − m) is exact in f64; rounding it gives the mantissa with its leading bit
+    // v / 2^(e − m) = v · 2^(m − e) is exact in f64; rounding it gives the mantissa with its leading bit
     // (or a subnormal one below 2^m). A carry out of the mantissa lands in the exponent
     // field, which is the next binade's correct encoding.
-    let q = (v / 2f64.powi(e - m)).round_ties_even() as u32;
+    let q = (v * crate::shared_exp::pow2(m - e)).round_ties_even() as u32;
     if e == -14 && q < 1 << m {
         return q; // subnormal: exponent field 0
     }

@@ -30,6 +30,11 @@ fn floor_log2(v: f32) -> i32 {
     ((v.to_bits() >> 23) & 0xff) as i32 - 127
 }
 
+/// `2^e` for a normal `f64` exponent, from its bits.
+pub(crate) fn pow2(e: i32) -> f64 {
+    f64::from_bits(((e + 1023) as u64) << 52)
+}
+
 /// Packs one linear RGB texel.
 pub fn encode(rgb: [f32; 3]) -> u32 {
     // `max(0, min(MAX, c))` with NaN going to 0: `c > 0` is false for NaN.
@@ -42,14 +47,15 @@ pub fn encode(rgb: [f32; 3]) -> u32 {
         floor_log2(max_c)
     };
     let mut exp = log + 1 + B;
-    // Exact in f64: c is an f32 and the divisor a power of two, and c/2^k < 2^10.
-    let step = |e: i32| 2f64.powi(e - B - N);
-    let max_s = (f64::from(max_c) / step(exp) + 0.5).floor();
+    // c / 2^(e − B − N) as c · 2^(B + N − e): exact in f64 (c is an f32, the factor a power
+    // of two, the product below 2^10), and so is the + ½.
+    let inv_step = |e: i32| pow2(B + N - e);
+    let max_s = (f64::from(max_c) * inv_step(exp) + 0.5).floor();
     if max_s >= f64::from(1 << N) {
         exp += 1;
     }
-    let s = step(exp);
-    let m = c.map(|c| (f64::from(c) / s + 0.5).floor() as u32);
+    let s = inv_step(exp);
+    let m = c.map(|c| (f64::from(c) * s + 0.5).floor() as u32);
     m[0] | m[1] << 9 | m[2] << 18 | (exp as u32) << 27
 }
 

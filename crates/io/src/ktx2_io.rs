@@ -282,8 +282,11 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
 }
 
 /// Writes a cube map with its mip chain as KTX 2.0 in `how.encoding`, Zstandard-compressed
-/// when `how.zstd` is given. `levels` is as [`crate::write_cube`] takes it. Every file passes
-/// the checks of KTX-Software's `ktx validate` (the tests implement them).
+/// when `how.zstd` is given. `levels` is as [`crate::write_cube`] takes it. The files are
+/// made to pass the checks KTX-Software's `ktx validate` makes of such a file (header,
+/// index, DFD against the vkFormat, key/value data, level order, alignment and lengths);
+/// `tests/io/encoded.rs` implements them from the specification and runs them on every
+/// encoding, with and without Zstandard.
 pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result<(), Error> {
     let encoding = how.encoding;
     let size = validate_cube(path, levels)?;

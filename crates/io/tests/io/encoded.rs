@@ -509,6 +509,13 @@ fn dds_every_dxgi_encoding_round_trips() {
             .caps2
             .contains(Caps2::CUBEMAP | Caps2::CUBEMAP_ALLFACES));
         assert_eq!(dds.header.mip_map_count, Some(levels.len() as u32));
+        if e.is_block_compressed() {
+            // DDSD_LINEARSIZE: level 0's bytes, whole blocks.
+            assert_eq!(
+                dds.header.linear_size,
+                Some(e.image_bytes(size, size) as u32)
+            );
+        }
         // Face-major data: each face with its whole chain.
         let chain: usize = (0..levels.len())
             .map(|p| e.image_bytes((size >> p).max(1), (size >> p).max(1)))
