@@ -287,6 +287,26 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
 /// index, DFD against the vkFormat, key/value data, level order, alignment and lengths);
 /// `tests/io/encoded.rs` implements them from the specification and runs them on every
 /// encoding, with and without Zstandard.
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_io::{read, write_ktx2, CubeWrite, Encoding, Limits};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("sky.ktx2");
+/// let levels: Vec<Vec<Image>> = [8u32, 4, 2, 1]
+///     .iter()
+///     .map(|&n| (0..6).map(|_| Image::new(n, n, 3)).collect())
+///     .collect();
+/// let how = CubeWrite {
+///     encoding: Encoding::Bc6hUnsigned,
+///     zstd: Some(3),
+///     ..CubeWrite::default()
+/// };
+/// write_ktx2(&path, &levels, &how).unwrap();
+/// let loaded = read(&path, &Limits::default()).unwrap();
+/// assert_eq!(loaded.layers.len(), 6);
+/// assert!(loaded.description.contains("BC6H"));
+/// ```
 pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result<(), Error> {
     let encoding = how.encoding;
     let size = validate_cube(path, levels)?;
