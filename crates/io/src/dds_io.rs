@@ -1,7 +1,10 @@
 //! DirectDraw Surface cube maps, with the headers of the `ddsfile` crate.
 //!
-//! Written files have the DX10 extension header: `DXGI_FORMAT_R16G16B16A16_FLOAT` or
-//! `DXGI_FORMAT_R32G32B32A32_FLOAT`, `D3D10_RESOURCE_MISC_TEXTURECUBE` with an array size of
+//! Written files have the DX10 extension header: `DXGI_FORMAT_R16G16B16A16_FLOAT`,
+//! `DXGI_FORMAT_R32G32B32A32_FLOAT`, `DXGI_FORMAT_R9G9B9E5_SHAREDEXP`,
+//! `DXGI_FORMAT_R11G11B10_FLOAT` (the same bits as Vulkan's B10G11R11: R lowest),
+//! `DXGI_FORMAT_BC6H_UF16` or `DXGI_FORMAT_BC6H_SF16` (4×4 blocks, small mips padded to one
+//! block), `D3D10_RESOURCE_MISC_TEXTURECUBE` with an array size of
 //! 1 (one cube; Direct3D counts cubes, not faces, there), `DDSCAPS2_CUBEMAP` with all six face
 //! bits, and the mip count. The data is face-major: face 0 (+X) with its whole mip chain,
 //! then face 1 (−X) and so on, in Direct3D's face order +X −X +Y −Y +Z −Z, which is
@@ -14,20 +17,22 @@
 //! DDS has no place for text, so the projection is not recorded (a DDS cube is a cube by its
 //! header's cube-map flags).
 //!
-//! The reader takes level 0 of DX10 RGBA16F, RGBA32F, RGB32F, R11G11B10F and RGB9E5 files and
+//! The reader takes level 0 of DX10 RGBA16F, RGBA32F, RGB32F, R11G11B10F, RGB9E5 and BC6H files and
 //! of legacy `D3DFMT_A16B16G16R16F` (113) and `D3DFMT_A32B32G32R32F` (116) files, cube maps or
 //! 2D textures. It parses the headers with `ddsfile`, checks the declared size against the
 //! [`Limits`] and the file length, and only then reads the texels it needs.
 
 use crate::ktx2_io::{
-    check_limits, max_levels, mip_phrase, validate_cube, written_format, TexelFormat,
+    check_encodable, check_limits, max_levels, mip_phrase, validate_cube, written_format,
+    TexelFormat,
 };
-use crate::{atomic_write, Error, Format, Limits, Loaded, WriteOptions};
+use crate::{atomic_write, CubeWrite, Error, Format, Limits, Loaded, WriteOptions};
 use ddsfile::{
     AlphaMode, Caps2, D3D10ResourceDimension, DxgiFormat, FourCC, Header, Header10, MiscFlag,
     PixelFormat, PixelFormatFlags,
 };
 use mirrorball_core::{Image, ProjectionKind};
+use mirrorball_encode::Encoding;
 use std::fs::File;
 use std::io::{BufReader, Read, Write};
 use std::path::Path;
@@ -46,16 +51,52 @@ fn dds_error(path: &Path, e: ddsfile::Error) -> Error {
     }
 }
 
-/// Writes a cube map with its mip chain as DDS with a DX10 header, face-major (each face with
-/// its whole mip chain). Face images are stored unchanged: Direct3D uses OpenGL's face order
-/// and major-axis table and puts row 0 at the top, mirrorball's `t = 0` row.
+/// Writes a cube map with its mip chain as DDS with a DX10 header, RGBA16F or RGBA32F as
+/// `opts` asks; see [`write_dds`].
 pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<(), Error> {
-    let format = written_format(path, opts, "DDS")?;
-    let size = validate_cube(path, levels)?;
-    let dxgi = match format {
-        TexelFormat::Rgba16F => DxgiFormat::R16G16B16A16_Float,
-        _ => DxgiFormat::R32G32B32A32_Float,
+    let encoding = written_format(path, opts, "DDS")?;
+    write_dds(
+        path,
+        levels,
+        &CubeWrite {
+            encoding,
+            ..CubeWrite::default()
+        },
+    )
+}
+
+/// Writes a cube map with its mip chain as DDS with a DX10 header in `how.encoding`,
+/// face-major (each face with its whole mip chain). Face images are stored unchanged:
+/// Direct3D uses OpenGL's face order and major-axis table and puts row 0 at the top,
+/// mirrorball's `t = 0` row. DDS has no supercompression and no place for RGBD's or RGBM's
+/// record, so those are refused.
+pub fn write_dds(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result<(), Error> {
+    let encoding = how.encoding;
+    let dxgi = match encoding {
+        Encoding::Rgba16F => DxgiFormat::R16G16B16A16_Float,
+        Encoding::Rgba32F => DxgiFormat::R32G32B32A32_Float,
+        Encoding::Rgb9E5 => DxgiFormat::R9G9B9E5_SharedExp,
+        Encoding::B10G11R11 => DxgiFormat::R11G11B10_Float,
+        Encoding::Bc6hUnsigned => DxgiFormat::BC6H_UF16,
+        Encoding::Bc6hSigned => DxgiFormat::BC6H_SF16,
+        Encoding::Rgbd | Encoding::Rgbm => {
+            return Err(Error::request(
+                path,
+                format!(
+                    "DDS has no place to record that its 8-bit texels are {}; write KTX2",
+                    encoding.label()
+                ),
+            ))
+        }
     };
+    if how.zstd.is_some() {
+        return Err(Error::request(
+            path,
+            "DDS has no supercompression; Zstandard is for KTX2".into(),
+        ));
+    }
+    let size = validate_cube(path, levels)?;
+    check_encodable(path, levels, encoding)?;
     let mut header = Header::new_dxgi(
         size,
         size,
@@ -88,7 +129,7 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
         let mut buf = Vec::new();
         for face in 0..6 {
             for level in levels {
-                format.encode_rgba(&level[face], &mut buf);
+                encoding.encode_with(&level[face], how.effort, &mut buf);
                 w.write_all(&buf).map_err(|e| Error::io(path, e))?;
             }
         }
@@ -119,11 +160,13 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let (format, cube, kind) = match &header10 {
         Some(h10) => {
             let format = match h10.dxgi_format {
-                DxgiFormat::R16G16B16A16_Float => TexelFormat::Rgba16F,
-                DxgiFormat::R32G32B32A32_Float => TexelFormat::Rgba32F,
+                DxgiFormat::R16G16B16A16_Float => TexelFormat::Encoded(Encoding::Rgba16F),
+                DxgiFormat::R32G32B32A32_Float => TexelFormat::Encoded(Encoding::Rgba32F),
                 DxgiFormat::R32G32B32_Float => TexelFormat::Rgb32F,
-                DxgiFormat::R11G11B10_Float => TexelFormat::Rg11B10F,
-                DxgiFormat::R9G9B9E5_SharedExp => TexelFormat::Rgb9E5,
+                DxgiFormat::R11G11B10_Float => TexelFormat::Encoded(Encoding::B10G11R11),
+                DxgiFormat::R9G9B9E5_SharedExp => TexelFormat::Encoded(Encoding::Rgb9E5),
+                DxgiFormat::BC6H_UF16 => TexelFormat::Encoded(Encoding::Bc6hUnsigned),
+                DxgiFormat::BC6H_SF16 => TexelFormat::Encoded(Encoding::Bc6hSigned),
                 other => return Err(unsupported_format(path, &format!("{other:?}"))),
             };
             if h10.resource_dimension != D3D10ResourceDimension::Texture2D {
@@ -144,8 +187,8 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         }
         None => {
             let format = match header.spf.fourcc {
-                Some(FourCC(FourCC::A16B16G16R16F)) => TexelFormat::Rgba16F,
-                Some(FourCC(FourCC::A32B32G32R32F)) => TexelFormat::Rgba32F,
+                Some(FourCC(FourCC::A16B16G16R16F)) => TexelFormat::Encoded(Encoding::Rgba16F),
+                Some(FourCC(FourCC::A32B32G32R32F)) => TexelFormat::Encoded(Encoding::Rgba32F),
                 Some(FourCC(code)) => {
                     return Err(unsupported_format(path, &format!("FourCC {code:#010x}")))
                 }
@@ -184,10 +227,9 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     }
 
     // Each face (array layer) holds its whole mip chain; check the file holds them all.
-    let texel = format.bytes() as u64;
-    let level0 = u64::from(width) * u64::from(height) * texel;
+    let level0 = format.image_bytes(width, height);
     let chain: u64 = (0..mips)
-        .map(|p| u64::from((width >> p).max(1)) * u64::from((height >> p).max(1)) * texel)
+        .map(|p| format.image_bytes((width >> p).max(1), (height >> p).max(1)))
         .sum();
     let faces: u64 = if cube { 6 } else { 1 };
     let data_start = HEADER_LEN + if header10.is_some() { HEADER10_LEN } else { 0 };
@@ -202,9 +244,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let mut bytes = vec![0u8; level0 as usize];
     for face in 0..faces {
         r.read_exact(&mut bytes).map_err(io)?;
-        let image = Image::from_vec(width, height, format.channels(), format.decode(&bytes))
-            .expect("decoded length matches the face size");
-        layers.push(image);
+        layers.push(format.decode(&bytes, width, height));
         if face + 1 < faces {
             // Skip this face's smaller mips (bounded by the file length checked above).
             r.seek_relative((chain - level0) as i64).map_err(io)?;
@@ -238,7 +278,7 @@ fn unsupported_format(path: &Path, what: &str) -> Error {
         path,
         format!(
             "unsupported DDS pixel format {what}; mirrorball reads float formats: RGBA16F, \
-             RGBA32F, RGB32F, R11G11B10F and RGB9E5"
+             RGBA32F, RGB32F, R11G11B10F, RGB9E5 and BC6H"
         ),
     )
 }

@@ -1,23 +1,28 @@
 //! KTX 2.0 cube maps (Khronos KTX File Format Specification, version 2.0).
 //!
-//! The writer is written by hand from the specification: RGBA16F
-//! (`VK_FORMAT_R16G16B16A16_SFLOAT`) or RGBA32F (`VK_FORMAT_R32G32B32A32_SFLOAT`), faceCount 6,
-//! every mip level given, no supercompression, a basic Data Format Descriptor and the
-//! `KTXorientation` = `rd` and `KTXwriter` metadata (and `mirrorball:projection` when the
-//! projection is given, read back as [`Loaded::recorded`]). Faces go in the order +X −X +Y −Y +Z −Z
+//! The writer is written by hand from the specification: faceCount 6, every mip level given,
+//! texels in any [`Encoding`] (vkFormats in [`vk_format`]), no supercompression or Zstandard
+//! (supercompressionScheme 2, each level compressed on its own), a basic Data Format
+//! Descriptor as KTX-Software's `vk2dfd` makes it for the vkFormat ([`data_format_descriptor`])
+//! and the `KTXorientation` = `rd` and `KTXwriter` metadata (and `mirrorball:projection` when
+//! the projection is given, read back as [`Loaded::recorded`]; `mirrorball:encoding` for
+//! RGBD and RGBM, which share `R8G8B8A8_UNORM`). Faces go in the order +X −X +Y −Y +Z −Z
 //! with row 0 (`t = 0`) first, which is how KTX2 and Vulkan define cube faces (orientation
 //! `rd`: s increases to the right, t downwards), so mirrorball's face images are stored
 //! unchanged.
 //!
 //! The reader uses the `ktx2` crate after checking the header against the [`Limits`] and the
-//! file length, and takes level 0 of uncompressed float cube maps or 2D textures.
+//! file length, and takes level 0 of float cube maps or 2D textures (Zstandard-compressed
+//! too), BC6H, and RGBD/RGBM recorded as such.
 //!
 //! This module also holds what the KTX2 and DDS code share: cube validation, texel formats
 //! and size checks.
 
-use crate::{atomic_write, Error, Format, Limits, Loaded, Precision, WriteOptions};
+use crate::{atomic_write, Error, Format, Limits, Loaded, MapInfo, Precision, WriteOptions};
 use half::f16;
-use mirrorball_core::{Image, ProjectionKind};
+use mirrorball_core::{Choice, Image, ProjectionKind};
+use mirrorball_encode::{Effort, Encoding};
+use rayon::prelude::*;
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::Path;
@@ -33,130 +38,82 @@ const LEVEL_INDEX_LEN: usize = 24;
 /// Largest DFD plus key/value data we are willing to read (they are tiny in practice).
 const MAX_METADATA: u64 = 16 << 20;
 
+const VK_FORMAT_R8G8B8A8_UNORM: u32 = 37;
 const VK_FORMAT_R16G16B16_SFLOAT: u32 = 90;
 const VK_FORMAT_R16G16B16A16_SFLOAT: u32 = 97;
 const VK_FORMAT_R32G32B32_SFLOAT: u32 = 106;
 const VK_FORMAT_R32G32B32A32_SFLOAT: u32 = 109;
 const VK_FORMAT_B10G11R11_UFLOAT_PACK32: u32 = 122;
 const VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: u32 = 123;
+const VK_FORMAT_BC6H_UFLOAT_BLOCK: u32 = 143;
+const VK_FORMAT_BC6H_SFLOAT_BLOCK: u32 = 144;
+/// supercompressionScheme 2.
+const SUPERCOMPRESSION_ZSTD: u32 = 2;
+/// The key/value key that tells RGBD from RGBM (both `R8G8B8A8_UNORM`).
+pub(crate) const ENCODING_KEY: &str = "mirrorball:encoding";
 
-/// How the texels of a KTX2 or DDS file are encoded.
+/// The vkFormat of each encoding and its typeSize (KTX 2.0 §3.2, §3.3: the size of the
+/// component, or of the packed word, that endianness conversion swaps; 1 for block formats
+/// and bytes).
+pub(crate) fn vk_format(encoding: Encoding) -> (u32, u32) {
+    match encoding {
+        Encoding::Rgba16F => (VK_FORMAT_R16G16B16A16_SFLOAT, 2),
+        Encoding::Rgba32F => (VK_FORMAT_R32G32B32A32_SFLOAT, 4),
+        Encoding::Rgb9E5 => (VK_FORMAT_E5B9G9R9_UFLOAT_PACK32, 4),
+        Encoding::B10G11R11 => (VK_FORMAT_B10G11R11_UFLOAT_PACK32, 4),
+        Encoding::Rgbd | Encoding::Rgbm => (VK_FORMAT_R8G8B8A8_UNORM, 1),
+        Encoding::Bc6hUnsigned => (VK_FORMAT_BC6H_UFLOAT_BLOCK, 1),
+        Encoding::Bc6hSigned => (VK_FORMAT_BC6H_SFLOAT_BLOCK, 1),
+    }
+}
+
+/// How the texels of a KTX2 or DDS file are stored: an [`Encoding`] mirrorball writes, or
+/// one of the RGB float layouts it only reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum TexelFormat {
-    /// Four little-endian binary16 floats, R G B A.
-    Rgba16F,
-    /// Four little-endian binary32 floats, R G B A.
-    Rgba32F,
+    /// One of the encodings mirrorball writes.
+    Encoded(Encoding),
     /// Three binary16 floats, R G B.
     Rgb16F,
     /// Three binary32 floats, R G B.
     Rgb32F,
-    /// One 32-bit word: unsigned 11-bit R (bits 0–10), 11-bit G, 10-bit B floats.
-    Rg11B10F,
-    /// One 32-bit word: 9-bit R, G, B mantissas and a shared 5-bit exponent (bits 27–31).
-    Rgb9E5,
 }
 
 impl TexelFormat {
-    /// Bytes per texel.
-    pub(crate) fn bytes(self) -> usize {
+    /// Bytes of one `width`×`height` image (whole blocks for BC6H).
+    pub(crate) fn image_bytes(self, width: u32, height: u32) -> u64 {
+        let texels = u64::from(width) * u64::from(height);
         match self {
-            TexelFormat::Rgba16F => 8,
-            TexelFormat::Rgba32F => 16,
-            TexelFormat::Rgb16F => 6,
-            TexelFormat::Rgb32F => 12,
-            TexelFormat::Rg11B10F | TexelFormat::Rgb9E5 => 4,
-        }
-    }
-
-    /// Channels of the decoded image: 4 for the RGBA formats, 3 otherwise.
-    pub(crate) fn channels(self) -> usize {
-        match self {
-            TexelFormat::Rgba16F | TexelFormat::Rgba32F => 4,
-            _ => 3,
+            TexelFormat::Encoded(e) => e.image_bytes(width, height) as u64,
+            TexelFormat::Rgb16F => texels * 6,
+            TexelFormat::Rgb32F => texels * 12,
         }
     }
 
     /// Short name for descriptions.
     pub(crate) fn name(self) -> &'static str {
         match self {
-            TexelFormat::Rgba16F => "RGBA16F",
-            TexelFormat::Rgba32F => "RGBA32F",
+            TexelFormat::Encoded(Encoding::B10G11R11) => "R11G11B10F",
+            TexelFormat::Encoded(e) => e.label(),
             TexelFormat::Rgb16F => "RGB16F",
             TexelFormat::Rgb32F => "RGB32F",
-            TexelFormat::Rg11B10F => "R11G11B10F",
-            TexelFormat::Rgb9E5 => "RGB9E5",
         }
     }
 
-    /// Decodes tightly packed texels into interleaved `f32`s (`channels()` per texel).
-    pub(crate) fn decode(self, bytes: &[u8]) -> Vec<f32> {
-        let word = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-        match self {
-            TexelFormat::Rgba16F | TexelFormat::Rgb16F => bytes
+    /// Decodes one `width`×`height` image of [`TexelFormat::image_bytes`] bytes.
+    pub(crate) fn decode(self, bytes: &[u8], width: u32, height: u32) -> Image {
+        let data = match self {
+            TexelFormat::Encoded(e) => return e.decode(bytes, width, height),
+            TexelFormat::Rgb16F => bytes
                 .chunks_exact(2)
                 .map(|b| f16::from_le_bytes([b[0], b[1]]).to_f32())
                 .collect(),
-            TexelFormat::Rgba32F | TexelFormat::Rgb32F => bytes
+            TexelFormat::Rgb32F => bytes
                 .chunks_exact(4)
-                .map(|b| f32::from_bits(word(b)))
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
                 .collect(),
-            TexelFormat::Rg11B10F => bytes
-                .chunks_exact(4)
-                .flat_map(|b| {
-                    let v = word(b);
-                    [
-                        small_ufloat(v & 0x7ff, 6),
-                        small_ufloat((v >> 11) & 0x7ff, 6),
-                        small_ufloat(v >> 22, 5),
-                    ]
-                })
-                .collect(),
-            TexelFormat::Rgb9E5 => bytes
-                .chunks_exact(4)
-                .flat_map(|b| {
-                    let v = word(b);
-                    // value = mantissa × 2^(exponent − bias − mantissa bits), bias 15.
-                    let scale = 2f32.powi((v >> 27) as i32 - 15 - 9);
-                    [
-                        (v & 0x1ff) as f32 * scale,
-                        ((v >> 9) & 0x1ff) as f32 * scale,
-                        ((v >> 18) & 0x1ff) as f32 * scale,
-                    ]
-                })
-                .collect(),
-        }
-    }
-
-    /// Encodes `image` as tightly packed RGBA texels (alpha = 1 for RGB images) into `out`,
-    /// replacing its contents. Only the formats mirrorball writes: RGBA16F and RGBA32F.
-    pub(crate) fn encode_rgba(self, image: &Image, out: &mut Vec<u8>) {
-        out.clear();
-        out.reserve(image.width() as usize * image.height() as usize * self.bytes());
-        let c = image.channels();
-        for px in image.data().chunks_exact(c) {
-            let rgba = [px[0], px[1], px[2], if c == 4 { px[3] } else { 1.0 }];
-            for v in rgba {
-                match self {
-                    TexelFormat::Rgba16F => out.extend_from_slice(&f16::from_f32(v).to_le_bytes()),
-                    TexelFormat::Rgba32F => out.extend_from_slice(&v.to_le_bytes()),
-                    _ => unreachable!("mirrorball writes only RGBA16F and RGBA32F"),
-                }
-            }
-        }
-    }
-}
-
-/// An unsigned float with a 5-bit exponent (bias 15) above `mantissa_bits` of mantissa and no
-/// sign, as in the 11- and 10-bit channels of `B10G11R11_UFLOAT_PACK32`.
-fn small_ufloat(bits: u32, mantissa_bits: u32) -> f32 {
-    let one = (1u32 << mantissa_bits) as f32;
-    let m = bits & ((1 << mantissa_bits) - 1);
-    match bits >> mantissa_bits {
-        0 => m as f32 / one * 2f32.powi(-14),
-        31 if m == 0 => f32::INFINITY,
-        31 => f32::NAN,
-        e => (1.0 + m as f32 / one) * 2f32.powi(e as i32 - 15),
+        };
+        Image::from_vec(width, height, 3, data).expect("decoded length matches the image size")
     }
 }
 
@@ -165,15 +122,50 @@ pub(crate) fn written_format(
     path: &Path,
     opts: &WriteOptions,
     container: &str,
-) -> Result<TexelFormat, Error> {
+) -> Result<Encoding, Error> {
     match opts.precision {
-        None | Some(Precision::Half) => Ok(TexelFormat::Rgba16F),
-        Some(Precision::Float) => Ok(TexelFormat::Rgba32F),
+        None | Some(Precision::Half) => Ok(Encoding::Rgba16F),
+        Some(Precision::Float) => Ok(Encoding::Rgba32F),
         Some(p) => Err(Error::request(
             path,
             format!("{container} cube maps are written as half or float, not {p:?}"),
         )),
     }
+}
+
+/// How [`write_ktx2`], [`crate::write_dds`] and [`crate::write_ktx1`] write a cube: its
+/// texel encoding, the unsigned BC6H encoder's effort, Zstandard supercompression (KTX2
+/// only) and what the file records.
+#[derive(Clone, Debug, Default)]
+pub struct CubeWrite {
+    /// The texel encoding of every face and level.
+    pub encoding: Encoding,
+    /// How hard the unsigned BC6H encoder searches.
+    pub effort: Effort,
+    /// Zstandard level (1–22; 3 is Zstandard's and KTX-Software's default) to
+    /// supercompress each KTX2 level with, or `None` for none.
+    pub zstd: Option<i32>,
+    /// The projection (and packing) to record under [`crate::PROJECTION_KEY`] (KTX2).
+    pub declared: Option<MapInfo>,
+    /// More key/value pairs (KTX2, KTX1): UTF-8 text, written NUL-terminated.
+    pub metadata: Vec<(String, String)>,
+}
+
+/// Refuses what `write` cannot encode, before any work: everything [`Encoding::check`]
+/// refuses (negative values as unsigned BC6H), in any face of any level.
+pub(crate) fn check_encodable(
+    path: &Path,
+    levels: &[Vec<Image>],
+    encoding: Encoding,
+) -> Result<(), Error> {
+    for (i, level) in levels.iter().enumerate() {
+        for (f, face) in level.iter().enumerate() {
+            encoding
+                .check(face)
+                .map_err(|e| Error::request(path, format!("face {f} of mip level {i}: {e}")))?;
+        }
+    }
+    Ok(())
 }
 
 /// Checks that `levels` is a cube map with a mip chain: six square faces per level, all the
@@ -277,40 +269,121 @@ fn gcd(a: usize, b: usize) -> usize {
     }
 }
 
-/// Writes a cube map with its mip chain as KTX 2.0. See the module documentation.
+/// Writes a cube map with its mip chain as KTX 2.0, RGBA16F or RGBA32F as `opts` asks.
+/// See the module documentation.
 pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<(), Error> {
-    let format = written_format(path, opts, "KTX2")?;
-    let size = validate_cube(path, levels)?;
-    let level_count = levels.len();
-    let texel = format.bytes();
-    let (vk_format, type_size) = match format {
-        TexelFormat::Rgba16F => (VK_FORMAT_R16G16B16A16_SFLOAT, 2u32),
-        _ => (VK_FORMAT_R32G32B32A32_SFLOAT, 4u32),
+    let encoding = written_format(path, opts, "KTX2")?;
+    let how = CubeWrite {
+        encoding,
+        declared: opts.declared,
+        ..CubeWrite::default()
     };
+    write_ktx2(path, levels, &how)
+}
 
-    let dfd = data_format_descriptor(format);
-    let writer = format!("mirrorball {}", env!("CARGO_PKG_VERSION"));
-    let mut pairs = vec![("KTXorientation", "rd".to_string()), ("KTXwriter", writer)];
-    if let Some(info) = &opts.declared {
-        // Sorted by key, as the specification requires: "KTX…" < "mirrorball:…".
-        pairs.push((crate::PROJECTION_KEY, info.texts().0));
+/// Writes a cube map with its mip chain as KTX 2.0 in `how.encoding`, Zstandard-compressed
+/// when `how.zstd` is given. `levels` is as [`crate::write_cube`] takes it. The files are
+/// made to pass the checks KTX-Software's `ktx validate` makes of such a file (header,
+/// index, DFD against the vkFormat, key/value data, level order, alignment and lengths);
+/// `tests/io/encoded.rs` implements them from the specification and runs them on every
+/// encoding, with and without Zstandard.
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_io::{read, write_ktx2, CubeWrite, Encoding, Limits};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("sky.ktx2");
+/// let levels: Vec<Vec<Image>> = [8u32, 4, 2, 1]
+///     .iter()
+///     .map(|&n| (0..6).map(|_| Image::new(n, n, 3)).collect())
+///     .collect();
+/// let how = CubeWrite {
+///     encoding: Encoding::Bc6hUnsigned,
+///     zstd: Some(3),
+///     ..CubeWrite::default()
+/// };
+/// write_ktx2(&path, &levels, &how).unwrap();
+/// let loaded = read(&path, &Limits::default()).unwrap();
+/// assert_eq!(loaded.layers.len(), 6);
+/// assert!(loaded.description.contains("BC6H"));
+/// ```
+pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result<(), Error> {
+    let encoding = how.encoding;
+    let size = validate_cube(path, levels)?;
+    if let Some(level) = how.zstd {
+        if !(1..=22).contains(&level) {
+            return Err(Error::request(
+                path,
+                format!("Zstandard level {level} is outside 1–22"),
+            ));
+        }
     }
-    let pairs: Vec<(&str, &str)> = pairs.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    check_encodable(path, levels, encoding)?;
+    let level_count = levels.len();
+    let (vk_format, type_size) = vk_format(encoding);
+    let supercompressed = how.zstd.is_some();
+
+    let dfd = data_format_descriptor(encoding, supercompressed);
+    let writer = format!("mirrorball {}", env!("CARGO_PKG_VERSION"));
+    // Sorted by key, as the specification requires (code-point order: "KTX…" before
+    // "mirrorball:…").
+    let mut pairs = std::collections::BTreeMap::new();
+    pairs.insert("KTXorientation".to_string(), "rd".to_string());
+    pairs.insert("KTXwriter".to_string(), writer);
+    if let Some(info) = &how.declared {
+        pairs.insert(crate::PROJECTION_KEY.to_string(), info.texts().0);
+    }
+    if matches!(encoding, Encoding::Rgbd | Encoding::Rgbm) {
+        pairs.insert(ENCODING_KEY.to_string(), encoding.name().to_string());
+    }
+    for (k, v) in &how.metadata {
+        pairs.insert(k.clone(), v.clone());
+    }
+    let pairs: Vec<(&str, &str)> = pairs
+        .iter()
+        .map(|(k, v)| (k.as_str(), v.as_str()))
+        .collect();
     let kvd = key_value_data(&pairs);
     let dfd_offset = HEADER_LEN + LEVEL_INDEX_LEN * level_count;
     let kvd_offset = dfd_offset + dfd.len();
     let data_start = (kvd_offset + kvd.len()) as u64;
 
+    // Supercompressed levels are made before the index, which holds their lengths.
+    let encode_level = |p: usize| -> Vec<u8> {
+        let mut level = Vec::new();
+        let mut buf = Vec::new();
+        for face in &levels[p] {
+            encoding.encode_with(face, how.effort, &mut buf);
+            level.extend_from_slice(&buf);
+        }
+        level
+    };
+    let compressed: Vec<Vec<u8>> = match how.zstd {
+        None => Vec::new(),
+        Some(z) => (0..level_count)
+            .into_par_iter()
+            .map(|p| zstd::bulk::compress(&encode_level(p), z))
+            .collect::<Result<_, _>>()
+            .map_err(|e| Error::io(path, e))?,
+    };
+
     // The Mip Level Array holds the smallest level first; each level starts on a multiple of
-    // lcm(texel block size, 4) (mipPadding). The Level Index lists level 0 first.
-    let align = (texel * 4 / gcd(texel, 4)) as u64;
-    let mut index = vec![(0u64, 0u64); level_count];
+    // lcm(texel block size, 4) (mipPadding), or of 1 when supercompressed. The Level Index
+    // lists level 0 first.
+    let block = encoding.block_bytes();
+    let align = if supercompressed {
+        1
+    } else {
+        (block * 4 / gcd(block, 4)) as u64
+    };
+    let mut index = vec![(0u64, 0u64, 0u64); level_count];
     let mut cursor = data_start;
     for p in (0..level_count).rev() {
-        let s = u64::from((size >> p).max(1));
-        let len = 6 * s * s * texel as u64;
+        let s = (size >> p).max(1);
+        let raw = 6 * encoding.image_bytes(s, s) as u64;
+        let len = compressed.get(p).map_or(raw, |c| c.len() as u64);
         let offset = cursor.div_ceil(align) * align;
-        index[p] = (offset, len);
+        index[p] = (offset, len, raw);
         cursor = offset + len;
     }
 
@@ -325,20 +398,24 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
         0,                  // layerCount: not an array
         6,                  // faceCount: cube map
         level_count as u32, // levelCount
-        0,                  // supercompressionScheme: none
-        dfd_offset as u32,  // dfdByteOffset
-        dfd.len() as u32,   // dfdByteLength
-        kvd_offset as u32,  // kvdByteOffset
-        kvd.len() as u32,   // kvdByteLength
+        if supercompressed {
+            SUPERCOMPRESSION_ZSTD
+        } else {
+            0
+        },
+        dfd_offset as u32, // dfdByteOffset
+        dfd.len() as u32,  // dfdByteLength
+        kvd_offset as u32, // kvdByteOffset
+        kvd.len() as u32,  // kvdByteLength
     ] {
         head.extend_from_slice(&v.to_le_bytes());
     }
-    head.extend_from_slice(&0u64.to_le_bytes()); // sgdByteOffset
+    head.extend_from_slice(&0u64.to_le_bytes()); // sgdByteOffset: Zstandard has none
     head.extend_from_slice(&0u64.to_le_bytes()); // sgdByteLength
-    for &(offset, len) in &index {
+    for &(offset, len, raw) in &index {
         head.extend_from_slice(&offset.to_le_bytes());
         head.extend_from_slice(&len.to_le_bytes()); // byteLength
-        head.extend_from_slice(&len.to_le_bytes()); // uncompressedByteLength
+        head.extend_from_slice(&raw.to_le_bytes()); // uncompressedByteLength
     }
     debug_assert_eq!(head.len(), dfd_offset);
     head.extend_from_slice(&dfd);
@@ -351,12 +428,17 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
         let mut written = data_start;
         let mut buf = Vec::new();
         for p in (0..level_count).rev() {
-            let (offset, _) = index[p];
+            let (offset, len, _) = index[p];
             let padding = (offset - written) as usize;
             w.write_all(&[0u8; 16][..padding]).map_err(io)?;
             written = offset;
+            if let Some(level) = compressed.get(p) {
+                w.write_all(level).map_err(io)?;
+                written += len;
+                continue;
+            }
             for face in &levels[p] {
-                format.encode_rgba(face, &mut buf);
+                encoding.encode_with(face, how.effort, &mut buf);
                 w.write_all(&buf).map_err(io)?;
                 written += buf.len() as u64;
             }
@@ -365,46 +447,101 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
     })
 }
 
-/// The Data Format Descriptor for the RGBA float formats mirrorball writes (Khronos Data
-/// Format Specification 1.3/1.4, basic descriptor block): `dfdTotalSize`, then one block
-/// with vendor 0 (Khronos), type 0 (basic), version 2 (1.3), colour model RGBSDA, BT.709
-/// primaries, linear transfer, straight alpha, a 1×1×1×1 texel block of `bytes()` bytes in
-/// plane 0, and one sample per channel (R=0, G=1, B=2, A=15) with the signed and float
-/// qualifiers, its bit offset and length, and sampleLower/Upper = −1.0/1.0 as `f32` bits,
-/// as the specification's examples do for float formats.
-fn data_format_descriptor(format: TexelFormat) -> Vec<u8> {
-    const SAMPLE_SIGNED: u32 = 0x40;
-    const SAMPLE_FLOAT: u32 = 0x80;
-    let bits: u32 = match format {
-        TexelFormat::Rgba16F => 16,
-        _ => 32,
+/// One sample of a Data Format Descriptor: bit offset, bit length, channel type with its
+/// qualifiers, sampleLower, sampleUpper.
+type Sample = (u32, u32, u32, u32, u32);
+
+/// The Data Format Descriptor of `encoding`'s vkFormat as KTX-Software's `vk2dfd` makes it
+/// (`createDFDUnpacked`, `createDFDPacked` and its E5B9G9R9 case, `createDFDCompressed` in
+/// dfdutils' `createdfd.c`), which `ktx validate` compares a file's with: `dfdTotalSize`,
+/// then one basic block (Khronos Data Format Specification 1.3 §5): vendor 0, type 0,
+/// version 2, the colour model (RGBSDA, or BC6H = 133), BT.709 primaries, linear transfer
+/// (every encoding here is linear or decoded by the shader), straight alpha, the texel block
+/// dimensions minus one (3, 3, 0, 0 for BC6H's 4×4 blocks), bytesPlane0 = the block's bytes
+/// (0 when supercompressed: the validator requires "unsized" planes then), and the samples:
+///
+/// - float channels: the FLOAT qualifier (and SIGNED when signed), sampleLower/Upper the
+///   bits of −1.0 (or 0.0 when unsigned) and 1.0;
+/// - E5B9G9R9: per channel a 9-bit mantissa (lower 0, upper 8448) and the shared 5-bit
+///   exponent at bit 27 with the EXPONENT qualifier (lower 15, upper 31);
+/// - R8G8B8A8_UNORM: 8 bits a channel, lower 0, upper 255;
+/// - BC6H: one 128-bit sample of channel 0 (BC6H colour).
+pub(crate) fn data_format_descriptor(encoding: Encoding, supercompressed: bool) -> Vec<u8> {
+    const MODEL_RGBSDA: u8 = 1;
+    const MODEL_BC6H: u8 = 133;
+    const EXPONENT: u32 = 0x20;
+    const SIGNED: u32 = 0x40;
+    const FLOAT: u32 = 0x80;
+    const ALPHA: u32 = 15;
+    let one = 1.0f32.to_bits();
+    let minus_one = (-1.0f32).to_bits();
+    let float4 = |bits: u32| -> Vec<Sample> {
+        [0, 1, 2, ALPHA]
+            .iter()
+            .enumerate()
+            .map(|(i, &c)| (i as u32 * bits, bits, c | SIGNED | FLOAT, minus_one, one))
+            .collect()
     };
-    let channels = [0u32, 1, 2, 15];
-    let block_size = 24 + 16 * channels.len() as u32;
+    let (model, dims, samples): (u8, [u8; 4], Vec<Sample>) = match encoding {
+        Encoding::Rgba16F => (MODEL_RGBSDA, [0; 4], float4(16)),
+        Encoding::Rgba32F => (MODEL_RGBSDA, [0; 4], float4(32)),
+        Encoding::Rgb9E5 => (
+            MODEL_RGBSDA,
+            [0; 4],
+            (0..3)
+                .flat_map(|c| [(9 * c, 9, c, 0, 8448), (27, 5, c | EXPONENT, 15, 31)])
+                .collect(),
+        ),
+        Encoding::B10G11R11 => (
+            MODEL_RGBSDA,
+            [0; 4],
+            vec![
+                (0, 11, FLOAT, 0, one),
+                (11, 11, 1 | FLOAT, 0, one),
+                (22, 10, 2 | FLOAT, 0, one),
+            ],
+        ),
+        Encoding::Rgbd | Encoding::Rgbm => (
+            MODEL_RGBSDA,
+            [0; 4],
+            [0, 1, 2, ALPHA]
+                .iter()
+                .enumerate()
+                .map(|(i, &c)| (8 * i as u32, 8, c, 0, 255))
+                .collect(),
+        ),
+        Encoding::Bc6hUnsigned => (MODEL_BC6H, [3, 3, 0, 0], vec![(0, 128, FLOAT, 0, one)]),
+        Encoding::Bc6hSigned => (
+            MODEL_BC6H,
+            [3, 3, 0, 0],
+            vec![(0, 128, SIGNED | FLOAT, minus_one, one)],
+        ),
+    };
+    let block_size = 24 + 16 * samples.len() as u32;
     let mut out = Vec::with_capacity(4 + block_size as usize);
     out.extend_from_slice(&(4 + block_size).to_le_bytes()); // dfdTotalSize
     out.extend_from_slice(&0u32.to_le_bytes()); // vendorId 0 | descriptorType 0 << 17
     out.extend_from_slice(&(2 | block_size << 16).to_le_bytes()); // version | block size
-    out.extend_from_slice(&[1, 1, 1, 0]); // RGBSDA, BT709, LINEAR, straight alpha
-    out.extend_from_slice(&[0, 0, 0, 0]); // texelBlockDimension0..3 (stored minus 1)
+    out.extend_from_slice(&[model, 1, 1, 0]); // model, BT709, LINEAR, straight alpha
+    out.extend_from_slice(&dims); // texelBlockDimension0..3 (stored minus 1)
     let mut planes = [0u8; 8];
-    planes[0] = format.bytes() as u8;
+    if !supercompressed {
+        planes[0] = encoding.block_bytes() as u8;
+    }
     out.extend_from_slice(&planes); // bytesPlane0..7
-    for (i, &channel) in channels.iter().enumerate() {
-        let word = (i as u32 * bits) // bitOffset
-            | (bits - 1) << 16 // bitLength − 1
-            | (channel | SAMPLE_SIGNED | SAMPLE_FLOAT) << 24; // channelType | qualifiers
+    for (offset, bits, channel, lower, upper) in samples {
+        let word = offset | (bits - 1) << 16 | channel << 24;
         out.extend_from_slice(&word.to_le_bytes());
         out.extend_from_slice(&[0, 0, 0, 0]); // samplePosition0..3
-        out.extend_from_slice(&(-1.0f32).to_bits().to_le_bytes()); // sampleLower
-        out.extend_from_slice(&1.0f32.to_bits().to_le_bytes()); // sampleUpper
+        out.extend_from_slice(&lower.to_le_bytes());
+        out.extend_from_slice(&upper.to_le_bytes());
     }
     out
 }
 
 /// Key/value data: each pair as keyAndValueByteLength, key, NUL, value, NUL, padded to 4
 /// bytes. `pairs` must be sorted by key (the specification requires code-point order).
-fn key_value_data(pairs: &[(&str, &str)]) -> Vec<u8> {
+pub(crate) fn key_value_data(pairs: &[(&str, &str)]) -> Vec<u8> {
     debug_assert!(pairs.windows(2).all(|w| w[0].0 < w[1].0));
     let mut out = Vec::new();
     for (key, value) in pairs {
@@ -473,41 +610,40 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let scheme = read_u32(&head, 44);
 
     let format = match vk_format {
-        VK_FORMAT_R16G16B16A16_SFLOAT => TexelFormat::Rgba16F,
-        VK_FORMAT_R32G32B32A32_SFLOAT => TexelFormat::Rgba32F,
+        VK_FORMAT_R16G16B16A16_SFLOAT => TexelFormat::Encoded(Encoding::Rgba16F),
+        VK_FORMAT_R32G32B32A32_SFLOAT => TexelFormat::Encoded(Encoding::Rgba32F),
         VK_FORMAT_R16G16B16_SFLOAT => TexelFormat::Rgb16F,
         VK_FORMAT_R32G32B32_SFLOAT => TexelFormat::Rgb32F,
-        VK_FORMAT_B10G11R11_UFLOAT_PACK32 => TexelFormat::Rg11B10F,
-        VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 => TexelFormat::Rgb9E5,
+        VK_FORMAT_B10G11R11_UFLOAT_PACK32 => TexelFormat::Encoded(Encoding::B10G11R11),
+        VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 => TexelFormat::Encoded(Encoding::Rgb9E5),
+        VK_FORMAT_BC6H_UFLOAT_BLOCK => TexelFormat::Encoded(Encoding::Bc6hUnsigned),
+        VK_FORMAT_BC6H_SFLOAT_BLOCK => TexelFormat::Encoded(Encoding::Bc6hSigned),
+        // RGBD or RGBM, told apart by the key/value data once it is read.
+        VK_FORMAT_R8G8B8A8_UNORM => TexelFormat::Encoded(Encoding::Rgbd),
         _ => {
             let name = header
                 .format
                 .map_or("VK_FORMAT_UNDEFINED".to_string(), |f| format!("{f:?}"));
             return Err(invalid(format!(
-                "unsupported KTX2 format {name} ({vk_format}); mirrorball reads uncompressed \
-                 float formats: RGBA16F, RGBA32F, RGB16F, RGB32F, B10G11R11 and E5B9G9R9"
+                "unsupported KTX2 format {name} ({vk_format}); mirrorball reads float formats: \
+                 RGBA16F, RGBA32F, RGB16F, RGB32F, B10G11R11, E5B9G9R9 and BC6H (and RGBD or \
+                 RGBM 8-bit when the file records which)"
             )));
         }
     };
-    match scheme {
-        0 => {}
-        2 => {
-            return Err(invalid(
-                "Zstandard-supercompressed KTX2 is not supported; save the file without \
-                 supercompression"
-                    .into(),
-            ))
-        }
+    let zstd = match scheme {
+        0 => false,
+        SUPERCOMPRESSION_ZSTD => true,
         s => {
             let name = header
                 .supercompression_scheme
                 .map_or(String::new(), |s| format!("{s:?} "));
             return Err(invalid(format!(
                 "KTX2 supercompression scheme {name}({s}) is not supported; save the file \
-                 without supercompression"
+                 without supercompression or with Zstandard"
             )));
         }
-    }
+    };
     let (width, height) = (header.pixel_width, header.pixel_height);
     if height == 0 {
         return Err(invalid("1D KTX2 textures are not supported".into()));
@@ -549,21 +685,26 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     // must hold exactly the texels its size calls for, before anything big is read.
     let mut index = vec![0u8; LEVEL_INDEX_LEN * level_count as usize];
     file.read_exact(&mut index).map_err(io)?;
-    let texel = format.bytes() as u64;
     let mut end = (HEADER_LEN + index.len()) as u64;
+    let mut level0_raw = 0u64;
     for p in 0..level_count as usize {
         let offset = read_u64(&index, p * LEVEL_INDEX_LEN);
         let len = read_u64(&index, p * LEVEL_INDEX_LEN + 8);
-        let (w, h) = (
-            u64::from((width >> p).max(1)),
-            u64::from((height >> p).max(1)),
-        );
-        let want = u64::from(faces) * w * h * texel;
-        if len != want {
+        let raw = read_u64(&index, p * LEVEL_INDEX_LEN + 16);
+        let (w, h) = ((width >> p).max(1), (height >> p).max(1));
+        let want = u64::from(faces) * format.image_bytes(w, h);
+        // Supercompressed levels hold any number of bytes that inflate to exactly the
+        // texels; plain ones hold the texels.
+        let held = if zstd { raw } else { len };
+        if held != want {
             return Err(invalid(format!(
-                "mip level {p} holds {len} bytes; {faces} face(s) of {w}×{h} {} need {want}",
+                "mip level {p} holds {held} bytes{}; {faces} face(s) of {w}×{h} {} need {want}",
+                if zstd { " uncompressed" } else { "" },
                 format.name()
             )));
+        }
+        if p == 0 {
+            level0_raw = want;
         }
         let level_end = offset
             .checked_add(len)
@@ -612,19 +753,6 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         .next()
         .ok_or_else(|| invalid("KTX2 file has no mip levels".into()))?;
 
-    let face_len = width as usize * height as usize * format.bytes();
-    let mut layers = Vec::with_capacity(faces as usize);
-    for face in level0.data.chunks_exact(face_len).take(faces as usize) {
-        let texels = format.decode(face);
-        let image = Image::from_vec(width, height, format.channels(), texels)
-            .expect("decoded length matches the face size");
-        layers.push(image);
-    }
-    if layers.len() != faces as usize {
-        return Err(invalid("mip level 0 is shorter than its faces".into()));
-    }
-
-    let levels = mip_phrase(level_count);
     let get = |key: &str| {
         reader
             .key_value_data()
@@ -635,6 +763,45 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
                     .to_string()
             })
     };
+    let format = match format {
+        TexelFormat::Encoded(Encoding::Rgbd) => match get(ENCODING_KEY).as_deref() {
+            Some("rgbd") => TexelFormat::Encoded(Encoding::Rgbd),
+            Some("rgbm") => TexelFormat::Encoded(Encoding::Rgbm),
+            other => {
+                return Err(invalid(format!(
+                    "8-bit KTX2 (R8G8B8A8_UNORM) is read only as RGBD or RGBM, recorded under \
+                     {ENCODING_KEY}; this file records {}",
+                    other.map_or("nothing".to_string(), |o| format!("'{o}'"))
+                )))
+            }
+        },
+        f => f,
+    };
+    let inflated;
+    let level0 = if zstd {
+        inflated = zstd::bulk::decompress(level0.data, level0_raw as usize)
+            .map_err(|e| invalid(format!("mip level 0 is not valid Zstandard data: {e}")))?;
+        if inflated.len() as u64 != level0_raw {
+            return Err(invalid(format!(
+                "mip level 0 inflates to {} bytes, not the {level0_raw} its index gives",
+                inflated.len()
+            )));
+        }
+        &inflated[..]
+    } else {
+        level0.data
+    };
+
+    let face_len = format.image_bytes(width, height) as usize;
+    let mut layers = Vec::with_capacity(faces as usize);
+    for face in level0.chunks_exact(face_len).take(faces as usize) {
+        layers.push(format.decode(face, width, height));
+    }
+    if layers.len() != faces as usize {
+        return Err(invalid("mip level 0 is shorter than its faces".into()));
+    }
+
+    let levels = mip_phrase(level_count);
     let recorded = crate::recorded(get, width, height);
     let (declared, description) = if faces == 6 {
         // Cube faces are always `rd` (the specification requires it), so they are kept as is.

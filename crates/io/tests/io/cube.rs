@@ -25,6 +25,17 @@ fn texel(face: usize, level: usize, x: u32, y: u32) -> [f32; 4] {
 
 /// A cube of `size`×`size` faces with the full mip chain down to 1×1.
 fn make_cube(size: u32, channels: usize) -> Vec<Vec<Image>> {
+    chain(size, channels, |face, level, x, y, _| {
+        texel(face, level, x, y)
+    })
+}
+
+/// A cube of `size`×`size` faces with the full mip chain down to 1×1, texel
+/// `(x, y)` of `face` at `level` (of edge `s`) being `f(face, level, x, y, s)`.
+pub(crate) fn chain<F, const N: usize>(size: u32, channels: usize, f: F) -> Vec<Vec<Image>>
+where
+    F: Fn(usize, usize, u32, u32, u32) -> [f32; N],
+{
     let count = 32 - size.leading_zeros() as usize;
     (0..count)
         .map(|level| {
@@ -34,7 +45,7 @@ fn make_cube(size: u32, channels: usize) -> Vec<Vec<Image>> {
                     let mut img = Image::new(s, s, channels);
                     for y in 0..s {
                         for x in 0..s {
-                            img.set(x, y, &texel(face, level, x, y));
+                            img.set(x, y, &f(face, level, x, y, s));
                         }
                     }
                     img

@@ -1,8 +1,10 @@
 //! The mirrorball-io integration tests: one binary, one module per concern.
 mod cube;
+mod encoded;
 mod flat;
 mod hostile;
 mod imf_envmap;
 mod mutate;
 mod openexr;
+mod quality;
 mod records;

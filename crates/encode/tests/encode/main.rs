@@ -1,0 +1,3 @@
+//! The mirrorball-encode integration tests: one binary, one module per concern.
+mod bc6h;
+mod formats;
