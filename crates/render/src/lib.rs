@@ -30,26 +30,30 @@
 //! ```
 #![warn(missing_docs)]
 
-pub mod camera;
-pub mod capture;
-pub mod cone;
+mod camera;
+mod capture;
 mod cpu;
-pub mod fast;
-pub mod load;
-pub mod lookup;
-pub mod maps;
+mod fast;
+mod load;
+mod lookup;
+mod maps;
 pub mod mesh;
 mod mirror;
-pub mod raster;
+mod raster;
 mod render;
-pub mod scene;
+mod scene;
 mod shading;
-pub mod teapot;
+mod teapot;
+#[cfg(test)]
+mod test_envs;
 pub mod tone;
 
 pub use camera::{Camera, Lens, Rays};
+pub use capture::{capture_cube, render_fisheye};
 pub use cpu::set_portable;
+pub use load::{load_mesh, MeshError, MAX_EXTENT};
 pub use lookup::{EnvCache, SpecularLobe};
+pub use maps::phong_sphere_map;
 pub use mesh::{Builtin, Mesh};
 pub use render::{
     render, render_into, render_with_progress, sphere_map_texcoords, texture_space_diagram, Aovs,

@@ -32,11 +32,11 @@ pub type SpecularLobe = Lobe;
 
 /// Greene's two prefiltered maps for one lobe, in the environment's projection.
 #[derive(Debug)]
-pub struct GreeneMaps {
+pub(crate) struct GreeneMaps {
     /// `E/π` (Lambert), read at the normal.
-    pub diffuse: Arc<EnvMap>,
+    pub(crate) diffuse: Arc<EnvMap>,
     /// The lobe's prefiltered radiance, read at the reflected vector.
-    pub specular: Arc<EnvMap>,
+    pub(crate) specular: Arc<EnvMap>,
 }
 
 #[derive(Default)]
@@ -88,7 +88,7 @@ impl EnvCache {
     }
 
     /// The footprint sampler of `map` for `filter` (trilinear or EWA).
-    pub fn sampler(&self, map: &Arc<EnvMap>, filter: Filter) -> Arc<Sampler> {
+    pub(crate) fn sampler(&self, map: &Arc<EnvMap>, filter: Filter) -> Arc<Sampler> {
         let mut g = self.for_map(map);
         if let Some((_, s)) = g.samplers.iter().find(|(f, _)| *f == filter) {
             return s.clone();
@@ -100,7 +100,7 @@ impl EnvCache {
     }
 
     /// Greene's diffuse and specular maps of `map` for `lobe`.
-    pub fn greene(&self, map: &Arc<EnvMap>, lobe: SpecularLobe) -> GreeneMaps {
+    pub(crate) fn greene(&self, map: &Arc<EnvMap>, lobe: SpecularLobe) -> GreeneMaps {
         let mut g = self.for_map(map);
         let pf = match &g.prefilterer {
             Some(p) => p.clone(),
@@ -173,7 +173,7 @@ pub(crate) fn effective(filter: Filter, mode: Indexing) -> Filter {
 /// A pixel's footprint from the unit directions through its four corners (pixel order
 /// `(−,−) (+,−) (+,+) (−,+)`): the ray differentials `∂d/∂x`, `∂d/∂y` as the mean of the
 /// two opposite edges (a point where a corner is degenerate).
-pub fn footprint(c: &[DVec3; 4]) -> Footprint {
+pub(crate) fn footprint(c: &[DVec3; 4]) -> Footprint {
     if c.iter().any(|x| !x.is_finite() || x.length_squared() < 0.5) {
         return Footprint::Point;
     }

@@ -11,6 +11,8 @@
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use mirrorball_core::Choice;
 
+pub use crate::teapot::teapot;
+
 /// An indexed triangle mesh with per-vertex unit normals (and optional texture coordinates).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
@@ -459,7 +461,7 @@ pub enum Builtin {
     Cube,
     /// [`quad`].
     Quad,
-    /// [`crate::teapot::teapot`].
+    /// [`teapot`].
     Teapot,
 }
 
@@ -549,7 +551,7 @@ impl Builtin {
             Builtin::Torus => torus(0.7, 0.3, level),
             Builtin::Cube => cube(level),
             Builtin::Quad => quad(level),
-            Builtin::Teapot => crate::teapot::teapot(level),
+            Builtin::Teapot => teapot(level),
         }
     }
 }

@@ -34,8 +34,9 @@ pub enum Indexing {
     /// at that pixel give the reflected direction, looked up per pixel.
     PerPixel,
     /// **Mode 4**, Greene (1986, §5–6): the reflected rays through a pixel's four corners
-    /// bound a region of the world projection, and the region is filtered (see
-    /// [`crate::cone`]), so highly curved surfaces do not alias.
+    /// bound a region of the world projection, and the region is filtered over the filter
+    /// crate's solid-angle-weighted mip pyramid (EWA, or trilinear when the environment's
+    /// filter is [`Filter::Trilinear`]), so highly curved surfaces do not alias.
     Cone,
 }
 

@@ -125,7 +125,7 @@ fn load_object(o: &ObjectPlan) -> Result<Object, CliError> {
     let (mesh, fit) = match &o.source {
         MeshSource::Builtin(b, l) => (b.mesh(*l), Mat4::IDENTITY),
         MeshSource::File(p) => {
-            let m: Mesh = mirrorball_render::load::load_mesh(p)?;
+            let m: Mesh = mirrorball_render::load_mesh(p)?;
             let fit = if o.normalize {
                 m.normalizing_transform()
             } else {
@@ -174,7 +174,7 @@ fn render_frame(
         ..plan.settings
     };
     let frame = match plan.fisheye {
-        Some((lens, fov)) => mirrorball_render::capture::render_fisheye(
+        Some((lens, fov)) => mirrorball_render::render_fisheye(
             scene,
             cam.eye,
             cam.target,
