@@ -29,6 +29,20 @@ pub enum Lens {
 }
 
 /// A camera: placement, lens, clipping planes and image size.
+///
+/// ```
+/// use glam::Vec3;
+/// use mirrorball_render::Camera;
+/// let cam = Camera::perspective(Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, 60.0, 320, 240);
+/// assert_eq!(cam.aspect(), 320.0 / 240.0);
+/// // The ray through the picture's centre leaves the eye towards the target…
+/// let (origin, centre) = cam.ray_ndc(0.0, 0.0);
+/// assert_eq!(origin, cam.eye);
+/// assert!((centre - (cam.target - cam.eye).normalize()).length() < 1e-6);
+/// // …and the one through the middle of its top edge, half the vertical field of view above.
+/// let (_, top) = cam.ray_ndc(0.0, 1.0);
+/// assert!((top.angle_between(centre).to_degrees() - 30.0).abs() < 1e-3);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Where the camera is.

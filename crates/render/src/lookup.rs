@@ -50,8 +50,32 @@ struct Inner {
     builds: usize,
 }
 
-/// Derived data of an environment map, built on first use and shared by every render of
-/// the environment (see the module docs).
+/// Derived data of an environment map (the filter crate's mip pyramid and samplers,
+/// Greene's prefiltered maps), built on first use and shared by every render of the
+/// environment and by its clones: an animation builds them once.
+///
+/// ```
+/// use glam::{Mat4, Vec3};
+/// use mirrorball_core::{EnvMap, ProjectionKind};
+/// use mirrorball_render::{mesh, render, Camera, Environment, Indexing, Material, Object, Scene, Settings};
+/// use std::sync::Arc;
+/// let cube = ProjectionKind::Cube.default_projection();
+/// let env = Environment::new(EnvMap::from_fn(cube, 16, 3, |d| [d.x as f32, 0.5, 0.5, 1.0]));
+/// let cache = env.cache.clone();
+/// let scene = Scene {
+///     objects: vec![Object { mesh: Arc::new(mesh::sphere(16)), model: Mat4::IDENTITY, material: Material::mirror() }],
+///     environment: Some(env),
+///     background: false,
+/// };
+/// let settings = Settings { indexing: Indexing::Cone, ..Settings::default() };
+/// assert_eq!(cache.builds(), 0);
+/// for turn in 0..3 {
+///     let cam = Camera::perspective(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 40.0, 16, 16)
+///         .orbited(turn as f32 * 0.3);
+///     render(&scene, &cam, &settings).unwrap();
+///     assert_eq!(cache.builds(), 1, "mode 4's pyramid is built by the first frame only");
+/// }
+/// ```
 #[derive(Clone, Default)]
 pub struct EnvCache(Arc<Mutex<Inner>>);
 

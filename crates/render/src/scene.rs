@@ -280,6 +280,21 @@ pub struct Object {
 }
 
 /// Everything rendered.
+///
+/// ```
+/// use glam::Vec3;
+/// use mirrorball_core::{EnvMap, ProjectionKind};
+/// use mirrorball_render::{render, Camera, Environment, Scene, Settings};
+/// // No objects, the environment as background: every pixel shows the environment along
+/// // its primary ray (here +Y is bright, −Y dark, and the camera looks up).
+/// let latlong = ProjectionKind::LatLong.default_projection();
+/// let env = EnvMap::from_fn(latlong, 64, 3, |d| [0.5 + 0.5 * d.y as f32, 0.0, 0.0, 1.0]);
+/// let scene = Scene { objects: vec![], environment: Some(Environment::new(env)), background: true };
+/// let mut cam = Camera::perspective(Vec3::ZERO, Vec3::Y, 30.0, 8, 8);
+/// cam.up = Vec3::Z;
+/// let frame = render(&scene, &cam, &Settings::default()).unwrap();
+/// assert!(frame.color.get(4, 4)[0] > 0.98 && frame.color.get(4, 4)[3] == 1.0);
+/// ```
 #[derive(Clone, Debug)]
 pub struct Scene {
     /// The objects.

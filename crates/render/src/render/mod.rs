@@ -82,6 +82,32 @@ impl RenderError {
 }
 
 /// Renders `scene` through `cam`.
+///
+/// ```
+/// use glam::{Mat4, Vec3};
+/// use mirrorball_core::{EnvMap, ProjectionKind};
+/// use mirrorball_render::{mesh, render, Camera, Environment, Material, Object, Scene, Settings};
+/// use std::sync::Arc;
+/// // A mirror in a uniform environment shows that colour wherever it covers the picture.
+/// let cube = ProjectionKind::Cube.default_projection();
+/// let env = EnvMap::from_fn(cube, 8, 3, |_| [0.25, 0.5, 0.75, 1.0]);
+/// let scene = Scene {
+///     objects: vec![Object {
+///         mesh: Arc::new(mesh::sphere(24)),
+///         model: Mat4::IDENTITY,
+///         material: Material::mirror(),
+///     }],
+///     environment: Some(Environment::new(env)),
+///     background: false,
+/// };
+/// let cam = Camera::perspective(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 40.0, 24, 24);
+/// let frame = render(&scene, &cam, &Settings::default()).unwrap();
+/// let centre = frame.color.get(12, 12);
+/// assert!((centre[0] - 0.25).abs() < 1e-5 && (centre[2] - 0.75).abs() < 1e-5);
+/// assert_eq!(centre[3], 1.0);
+/// // Without a background, where nothing is drawn stays transparent.
+/// assert_eq!(frame.color.get(0, 0)[3], 0.0);
+/// ```
 pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame, RenderError> {
     let mut frame = Frame {
         color: Image::new(0, 0, 4),
