@@ -13,7 +13,7 @@
 //! `CubeMap::uv_to_dir` and is projected into the 90° view that was rendered, so the result
 //! follows the core's conventions by construction.
 
-use crate::camera::{Camera, Lens};
+use crate::camera::{Camera, CameraLens};
 use crate::render::{render, RenderError};
 use crate::scene::{Scene, Settings};
 use glam::{DVec2, Vec3, Vec4};
@@ -74,7 +74,7 @@ pub fn capture_cube(
             eye: centre,
             target: centre + fwd,
             up,
-            lens: Lens::Perspective { fov_y_deg: fov },
+            lens: CameraLens::Perspective { fov_y_deg: fov },
             near: 1e-3,
             far: 1e4,
             width: n,

@@ -30,9 +30,10 @@ use prepare::{prepare, Prepared};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// A rendered picture and, when asked, its diagnostic channels.
+/// What [`render`] returns: the picture and, when asked, its diagnostic channels (one
+/// frame of an animation; not the core's `Frame`, a projection's orientation).
 #[derive(Clone, Debug)]
-pub struct Frame {
+pub struct Rendered {
     /// Linear RGBA; alpha is the fraction of the pixel covered by objects, or 1 where the
     /// background was drawn.
     pub color: Image,
@@ -108,8 +109,8 @@ impl RenderError {
 /// // Without a background, where nothing is drawn stays transparent.
 /// assert_eq!(frame.color.get(0, 0)[3], 0.0);
 /// ```
-pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame, RenderError> {
-    let mut frame = Frame {
+pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Rendered, RenderError> {
+    let mut frame = Rendered {
         color: Image::new(0, 0, 4),
         aovs: None,
     };
@@ -125,7 +126,7 @@ pub fn render_into(
     scene: &Scene,
     cam: &Camera,
     settings: &Settings,
-    frame: &mut Frame,
+    frame: &mut Rendered,
 ) -> Result<(), RenderError> {
     render_counting(scene, cam, settings, frame, None)
 }
@@ -137,8 +138,8 @@ pub fn render_with_progress(
     cam: &Camera,
     settings: &Settings,
     rows_done: &AtomicU64,
-) -> Result<Frame, RenderError> {
-    let mut frame = Frame {
+) -> Result<Rendered, RenderError> {
+    let mut frame = Rendered {
         color: Image::new(0, 0, 4),
         aovs: None,
     };
@@ -150,7 +151,7 @@ fn render_counting(
     scene: &Scene,
     cam: &Camera,
     settings: &Settings,
-    frame: &mut Frame,
+    frame: &mut Rendered,
     rows_done: Option<&AtomicU64>,
 ) -> Result<(), RenderError> {
     validate(scene, cam, settings)?;

@@ -1,7 +1,8 @@
 use glam::{Mat4, Vec3};
 use mirrorball_core::{EnvMap, Image};
 use mirrorball_render::{
-    render, Attach, Camera, Environment, Frame, Indexing, Material, Mesh, Object, Scene, Settings,
+    render, Attach, Camera, Environment, Indexing, Material, Mesh, Object, Rendered, Scene,
+    Settings,
 };
 use std::sync::Arc;
 
@@ -24,7 +25,7 @@ pub fn scene_with(mesh: Mesh, model: Mat4, env: EnvMap, attach: Attach, backgrou
     }
 }
 
-pub fn draw(scene: &Scene, cam: &Camera, mode: Indexing, ss: u32, aovs: bool) -> Frame {
+pub fn draw(scene: &Scene, cam: &Camera, mode: Indexing, ss: u32, aovs: bool) -> Rendered {
     render(
         scene,
         cam,
