@@ -60,6 +60,6 @@ pub use render::{
     RenderError, Rendered,
 };
 pub use scene::{
-    environment_filter, Attach, Environment, Filter, Indexing, Material, Object, Ramp, Scene,
-    Settings, ENVIRONMENT_FILTERS,
+    environment_filter, Attach, Environment, Filter, Indexing, Material, MaterialKind, Object,
+    Ramp, Scene, Settings, ENVIRONMENT_FILTERS,
 };

@@ -259,6 +259,25 @@ impl Material {
         }
     }
 
+    /// Which of the materials this is.
+    ///
+    /// ```
+    /// use mirrorball_render::{Material, MaterialKind};
+    /// assert_eq!(Material::mirror().kind(), MaterialKind::Mirror);
+    /// assert_eq!("chrome".parse::<MaterialKind>().unwrap(), MaterialKind::Mirror);
+    /// assert_eq!(MaterialKind::PhongMap.to_string(), "phong-map");
+    /// ```
+    pub fn kind(&self) -> MaterialKind {
+        match self {
+            Material::Mirror { .. } => MaterialKind::Mirror,
+            Material::Fresnel { .. } => MaterialKind::Fresnel,
+            Material::CheapChrome { .. } => MaterialKind::CheapChrome,
+            Material::Diffuse { .. } => MaterialKind::Diffuse,
+            Material::Greene { .. } => MaterialKind::Greene,
+            Material::PhongMap { .. } => MaterialKind::PhongMap,
+        }
+    }
+
     /// Whether the material reads the environment.
     pub fn uses_environment(&self) -> bool {
         matches!(
@@ -267,6 +286,37 @@ impl Material {
         )
     }
 }
+
+/// The materials by name, without their parameters: the one table of material names (a
+/// [`Choice`], canonical name first), read by the CLI's `--material`, its help and the
+/// scene file's `kind`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MaterialKind {
+    /// [`Material::Mirror`].
+    Mirror,
+    /// [`Material::Fresnel`].
+    Fresnel,
+    /// [`Material::CheapChrome`].
+    CheapChrome,
+    /// [`Material::Diffuse`].
+    Diffuse,
+    /// [`Material::Greene`].
+    Greene,
+    /// [`Material::PhongMap`].
+    PhongMap,
+}
+
+impl Choice for MaterialKind {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (MaterialKind::Mirror, &["mirror", "chrome"]),
+        (MaterialKind::Fresnel, &["fresnel", "varnish", "plastic"]),
+        (MaterialKind::CheapChrome, &["cheap-chrome", "ramp"]),
+        (MaterialKind::Diffuse, &["diffuse", "matte"]),
+        (MaterialKind::Greene, &["greene"]),
+        (MaterialKind::PhongMap, &["phong-map", "phongmap"]),
+    ];
+}
+mirrorball_core::choice_traits!(MaterialKind);
 
 /// One object: a mesh, where it is, what it is made of.
 #[derive(Clone, Debug)]
