@@ -156,9 +156,12 @@ pub struct Triangle {
     pub n: [DVec3; 3],
 }
 
-/// How a map is indexed in a study.
+/// Which per-vertex quantity a study interpolates across a triangle: the renderer's
+/// modes 2 (`PerVertexReflection`) and 1 (`PerVertexTexgen`) of its `Indexing`, measured
+/// exactly and without rendering. Its other two modes (per pixel, Greene's cones)
+/// interpolate nothing a study could measure, so this is its own type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum Indexing {
+pub enum VertexIndexing {
     /// Interpolate the reflected vector, look it up per pixel.
     Vector,
     /// Interpolate per-vertex texture coordinates (`GL_SPHERE_MAP`-style texgen).
@@ -168,13 +171,13 @@ pub enum Indexing {
 /// A map to measure texture-coordinate error on, and how it is indexed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MapSpec {
-    /// The projection (for [`Indexing::Texgen`] on a sphere map, its frame is replaced by the
+    /// The projection (for [`VertexIndexing::Texgen`] on a sphere map, its frame is replaced by the
     /// camera's for every viewer: `GL_SPHERE_MAP` works in eye space).
     pub projection: Projection,
     /// Layer edge size, texels.
     pub size: u32,
     /// How it is indexed.
-    pub indexing: Indexing,
+    pub indexing: VertexIndexing,
 }
 
 /// Texture-coordinate error on one map.
@@ -235,7 +238,7 @@ fn measure(
         return;
     };
     match spec.indexing {
-        Indexing::Vector => {
+        VertexIndexing::Vector => {
             let Some((li, uvi)) = proj.dir_to_uv(interp) else {
                 return;
             };
@@ -249,7 +252,7 @@ fn measure(
             acc.sum_texels += t;
             acc.n += 1;
         }
-        Indexing::Texgen => {
+        VertexIndexing::Texgen => {
             let mut uv = DVec2::ZERO;
             let mut layer = None;
             let mut first = DVec2::ZERO;
@@ -323,7 +326,9 @@ where
     let projs: Vec<Projection> = maps
         .iter()
         .map(|s| match (s.projection, s.indexing) {
-            (Projection::Sphere(_), Indexing::Texgen) => Projection::Sphere(SphereMap::new(cam)),
+            (Projection::Sphere(_), VertexIndexing::Texgen) => {
+                Projection::Sphere(SphereMap::new(cam))
+            }
             (p, _) => p,
         })
         .collect();

@@ -12,7 +12,9 @@
 use crate::claims::{claims, Claim};
 use crate::cone::{class, cone_region, greene_cone, Cone, ConeRegion};
 use crate::frustum::{frustum_share, Frustum, FrustumShare};
-use crate::indexing::{Indexing, LineStudy, MapSpec, QuadStudy, SphereStudy, ViewResult, Worst};
+use crate::indexing::{
+    LineStudy, MapSpec, QuadStudy, SphereStudy, VertexIndexing, ViewResult, Worst,
+};
 use crate::jacobian;
 use crate::plot::{self, esc, heat_panel, ColorScale, Legend, LineChart, Marker, Series};
 use crate::profile::{profile, Profile};
@@ -305,10 +307,10 @@ fn indexing_studies(cfg: &Config) -> IndexingReport {
     };
     let mut maps = Vec::new();
     for (k, ix) in [
-        (ProjectionKind::Sphere, Indexing::Texgen),
-        (ProjectionKind::Cube, Indexing::Vector),
-        (ProjectionKind::Paraboloid, Indexing::Vector),
-        (ProjectionKind::LatLong, Indexing::Texgen),
+        (ProjectionKind::Sphere, VertexIndexing::Texgen),
+        (ProjectionKind::Cube, VertexIndexing::Vector),
+        (ProjectionKind::Paraboloid, VertexIndexing::Vector),
+        (ProjectionKind::LatLong, VertexIndexing::Texgen),
     ] {
         let (projection, size) = size_of(k);
         maps.push(MapSpec {

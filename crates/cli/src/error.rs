@@ -62,8 +62,8 @@ impl From<mirrorball_render::RenderError> for CliError {
     }
 }
 
-impl From<mirrorball_render::load::MeshError> for CliError {
-    fn from(e: mirrorball_render::load::MeshError) -> CliError {
+impl From<mirrorball_render::MeshError> for CliError {
+    fn from(e: mirrorball_render::MeshError) -> CliError {
         CliError::new(e.fault(), e.to_string())
     }
 }

@@ -7,8 +7,8 @@
 use glam::{Mat4, Vec3};
 use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions};
 use mirrorball_render::{
-    load::load_mesh, render, render_into, Builtin, Camera, Environment, Indexing, Material, Mesh,
-    Object, Scene, Settings,
+    load_mesh, render, render_into, Builtin, Camera, Environment, Indexing, Material, Mesh, Object,
+    Scene, Settings,
 };
 use std::path::Path;
 use std::sync::Arc;

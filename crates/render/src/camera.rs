@@ -12,9 +12,12 @@
 
 use glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
 
-/// How the camera projects.
+/// How the camera projects: the two projections of OpenGL's fixed-function pipeline. (A
+/// fisheye picture is not a camera lens here but a captured cube resampled into the core's
+/// fisheye projection, whose radial mapping is `mirrorball_core::Lens`: see
+/// [`crate::render_fisheye`].)
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Lens {
+pub enum CameraLens {
     /// `gluPerspective` with this vertical field of view, in degrees.
     Perspective {
         /// Vertical field of view in degrees (0 < fov < 180).
@@ -29,6 +32,20 @@ pub enum Lens {
 }
 
 /// A camera: placement, lens, clipping planes and image size.
+///
+/// ```
+/// use glam::Vec3;
+/// use mirrorball_render::Camera;
+/// let cam = Camera::perspective(Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, 60.0, 320, 240);
+/// assert_eq!(cam.aspect(), 320.0 / 240.0);
+/// // The ray through the picture's centre leaves the eye towards the target…
+/// let (origin, centre) = cam.ray_ndc(0.0, 0.0);
+/// assert_eq!(origin, cam.eye);
+/// assert!((centre - (cam.target - cam.eye).normalize()).length() < 1e-6);
+/// // …and the one through the middle of its top edge, half the vertical field of view above.
+/// let (_, top) = cam.ray_ndc(0.0, 1.0);
+/// assert!((top.angle_between(centre).to_degrees() - 30.0).abs() < 1e-3);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Where the camera is.
@@ -38,7 +55,7 @@ pub struct Camera {
     /// Which way is up (need not be orthogonal to the view direction).
     pub up: Vec3,
     /// Perspective or orthographic.
-    pub lens: Lens,
+    pub lens: CameraLens,
     /// Near clipping distance (> 0 for perspective).
     pub near: f32,
     /// Far clipping distance.
@@ -56,7 +73,7 @@ impl Camera {
             eye,
             target,
             up: Vec3::Y,
-            lens: Lens::Perspective { fov_y_deg },
+            lens: CameraLens::Perspective { fov_y_deg },
             near: 0.05,
             far: 1000.0,
             width,
@@ -77,7 +94,7 @@ impl Camera {
             eye,
             target,
             up: Vec3::Y,
-            lens: Lens::Orthographic { half_height },
+            lens: CameraLens::Orthographic { half_height },
             near: 0.05,
             far: 1000.0,
             width,
@@ -98,7 +115,7 @@ impl Camera {
             return Err("up must not be parallel to the view direction".into());
         }
         match self.lens {
-            Lens::Perspective { fov_y_deg } => {
+            CameraLens::Perspective { fov_y_deg } => {
                 if !(fov_y_deg.is_finite() && 0.0 < fov_y_deg && fov_y_deg < 180.0) {
                     return Err(format!("field of view {fov_y_deg}° is outside (0°, 180°)"));
                 }
@@ -106,7 +123,7 @@ impl Camera {
                     return Err("a perspective camera needs near > 0".into());
                 }
             }
-            Lens::Orthographic { half_height } => {
+            CameraLens::Orthographic { half_height } => {
                 if half_height.is_nan() || half_height <= 0.0 {
                     return Err("an orthographic camera needs a positive height".into());
                 }
@@ -139,7 +156,7 @@ impl Camera {
     /// Eye to clip space (`gluPerspective` / `glOrtho`).
     pub fn projection(&self) -> Mat4 {
         match self.lens {
-            Lens::Perspective { fov_y_deg } => {
+            CameraLens::Perspective { fov_y_deg } => {
                 let f = 1.0 / (fov_y_deg.to_radians() * 0.5).tan();
                 let (n, fa) = (self.near, self.far);
                 Mat4::from_cols(
@@ -149,7 +166,7 @@ impl Camera {
                     Vec4::new(0.0, 0.0, 2.0 * fa * n / (n - fa), 0.0),
                 )
             }
-            Lens::Orthographic { half_height } => {
+            CameraLens::Orthographic { half_height } => {
                 let (t, r) = (half_height, half_height * self.aspect());
                 let (n, fa) = (self.near, self.far);
                 Mat4::from_cols(
@@ -164,7 +181,7 @@ impl Camera {
 
     /// `true` for a perspective camera.
     pub fn is_perspective(&self) -> bool {
-        matches!(self.lens, Lens::Perspective { .. })
+        matches!(self.lens, CameraLens::Perspective { .. })
     }
 
     /// The primary ray through normalised device coordinates `(x, y)`: origin and unit
@@ -177,11 +194,11 @@ impl Camera {
     pub fn rays(&self) -> Rays {
         let (right, up, forward) = self.basis();
         let (sx, sy) = match self.lens {
-            Lens::Perspective { fov_y_deg } => {
+            CameraLens::Perspective { fov_y_deg } => {
                 let t = (fov_y_deg.to_radians() * 0.5).tan();
                 (t * self.aspect(), t)
             }
-            Lens::Orthographic { half_height } => (half_height * self.aspect(), half_height),
+            CameraLens::Orthographic { half_height } => (half_height * self.aspect(), half_height),
         };
         Rays {
             eye: self.eye,

@@ -13,7 +13,7 @@
 //! `CubeMap::uv_to_dir` and is projected into the 90° view that was rendered, so the result
 //! follows the core's conventions by construction.
 
-use crate::camera::{Camera, Lens};
+use crate::camera::{Camera, CameraLens};
 use crate::render::{render, RenderError};
 use crate::scene::{Scene, Settings};
 use glam::{DVec2, Vec3, Vec4};
@@ -22,6 +22,24 @@ use mirrorball_core::{CubeFace, CubeMap, EnvMap, Image, Projection, WorldProject
 /// Renders `scene` from `centre` into a cube map with `face`-texel faces, leaving out the
 /// object with index `exclude`. `settings` gives the indexing mode and supersampling used for
 /// the views (diagnostic channels are not made).
+///
+/// ```
+/// use glam::{DVec3, Vec3};
+/// use mirrorball_core::{EnvMap, ProjectionKind};
+/// use mirrorball_render::{capture_cube, Environment, Scene, Settings};
+/// // With no objects, the captured cube is the environment resampled into a cube.
+/// let latlong = ProjectionKind::LatLong.default_projection();
+/// let env = EnvMap::from_fn(latlong, 64, 3, |d| {
+///     [0.5 + 0.5 * d.x as f32, 0.5 + 0.5 * d.y as f32, 0.5 + 0.5 * d.z as f32, 1.0]
+/// });
+/// let scene = Scene { objects: vec![], environment: Some(Environment::new(env.clone())), background: true };
+/// let cube = capture_cube(&scene, Vec3::ZERO, 16, None, &Settings::default()).unwrap();
+/// assert_eq!(cube.layers().len(), 6);
+/// for d in [DVec3::X, DVec3::NEG_Y, DVec3::new(1.0, 1.0, -1.0).normalize()] {
+///     let (a, b) = (cube.sample(d), env.sample(d));
+///     assert!((0..3).all(|i| (a[i] - b[i]).abs() < 0.02), "{d}: {a:?} {b:?}");
+/// }
+/// ```
 pub fn capture_cube(
     scene: &Scene,
     centre: Vec3,
@@ -56,7 +74,7 @@ pub fn capture_cube(
             eye: centre,
             target: centre + fwd,
             up,
-            lens: Lens::Perspective { fov_y_deg: fov },
+            lens: CameraLens::Perspective { fov_y_deg: fov },
             near: 1e-3,
             far: 1e4,
             width: n,

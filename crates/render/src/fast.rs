@@ -3,7 +3,7 @@
 //! against it). Texels whose bilinear footprint crosses a seam are handed to
 //! [`EnvMap::bilinear_at`], which joins faces and wraps longitude.
 
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DVec2, Vec3};
 use mirrorball_core::simd::{prefetch, F32x4, Taps};
 use mirrorball_core::{
     bilinear_corner4, bilinear_mix, bilinear_taps, CubeMap, EnvMap, Projection, WorldProjection,
@@ -105,13 +105,7 @@ impl<'a> CubeFaces<'a> {
         })
     }
 
-    /// Bilinear lookup in direction `d` (any length); zero where `d` has no face.
-    #[inline(always)]
-    pub fn sample(&self, d: Vec3) -> [f32; 3] {
-        self.fetch(&self.locate(d))
-    }
-
-    /// First half of [`CubeFaces::sample`]: where the lookup in direction `d` reads. The
+    /// First half of a lookup (`fetch(&locate(d))`): where the lookup in direction `d` reads. The
     /// texels are prefetched, so that a batch of locations has its cache misses in flight
     /// together before [`CubeFaces::fetch`] reads them.
     #[inline(always)]
@@ -215,7 +209,7 @@ impl<'a> CubeFaces<'a> {
         [c[0] * t[0], c[1] * t[1], c[2] * t[2], 1.0]
     }
 
-    /// Second half of [`CubeFaces::sample`]: the bilinear read at `l`.
+    /// Second half of a lookup: the bilinear read at `l`.
     #[inline(always)]
     pub fn fetch(&self, l: &CubeLoc) -> [f32; 3] {
         let mut out = [0.0f32; 3];
@@ -292,8 +286,8 @@ impl CubeLoc {
 }
 
 /// Bilinear lookup in direction `d`; zero where the projection does not cover `d`.
-#[inline]
-pub fn sample(map: &EnvMap, d: Vec3) -> [f32; 3] {
+#[cfg(test)]
+fn sample(map: &EnvMap, d: Vec3) -> [f32; 3] {
     match dir_to_uv(map, d) {
         Some((l, u, v)) => bilinear(map, l, u, v),
         None => [0.0; 3],
@@ -301,7 +295,11 @@ pub fn sample(map: &EnvMap, d: Vec3) -> [f32; 3] {
 }
 
 /// The `f64` reference, for tests: `EnvMap::sample`.
-pub fn sample_reference(map: &EnvMap, d: Vec3) -> [f32; 3] {
-    let s = map.sample(DVec3::new(d.x as f64, d.y as f64, d.z as f64).normalize());
+#[cfg(test)]
+fn sample_reference(map: &EnvMap, d: Vec3) -> [f32; 3] {
+    let s = map.sample(glam::DVec3::new(d.x as f64, d.y as f64, d.z as f64).normalize());
     [s[0], s[1], s[2]]
 }
+
+#[cfg(test)]
+mod tests;

@@ -8,7 +8,7 @@
 //! The pipeline: [`Scene`] (meshes with model matrices and [`Material`]s, an
 //! [`Environment`] in any world projection of `mirrorball-core`, attached to the world or
 //! the eye) → [`render()`] with a [`Camera`] and [`Settings`] (indexing mode, `n×n`
-//! supersampling, diagnostic channels) → [`Frame`] of linear RGBA plus [`Aovs`] →
+//! supersampling, diagnostic channels) → [`Rendered`] of linear RGBA plus [`Aovs`] →
 //! [`tone::to_display`] for PNGs.
 //!
 //! ```
@@ -30,32 +30,36 @@
 //! ```
 #![warn(missing_docs)]
 
-pub mod camera;
-pub mod capture;
-pub mod cone;
+mod camera;
+mod capture;
 mod cpu;
-pub mod fast;
-pub mod load;
-pub mod lookup;
-pub mod maps;
+mod fast;
+mod load;
+mod lookup;
+mod maps;
 pub mod mesh;
 mod mirror;
-pub mod raster;
+mod raster;
 mod render;
-pub mod scene;
+mod scene;
 mod shading;
-pub mod teapot;
+mod teapot;
+#[cfg(test)]
+mod test_envs;
 pub mod tone;
 
-pub use camera::{Camera, Lens, Rays};
+pub use camera::{Camera, CameraLens, Rays};
+pub use capture::{capture_cube, render_fisheye};
 pub use cpu::set_portable;
+pub use load::{load_mesh, MeshError, MAX_EXTENT};
 pub use lookup::{EnvCache, SpecularLobe};
+pub use maps::phong_sphere_map;
 pub use mesh::{Builtin, Mesh};
 pub use render::{
     render, render_into, render_with_progress, sphere_map_texcoords, texture_space_diagram, Aovs,
-    Frame, RenderError,
+    RenderError, Rendered,
 };
 pub use scene::{
-    environment_filter, Attach, Environment, Filter, Indexing, Material, Object, Ramp, Scene,
-    Settings, ENVIRONMENT_FILTERS,
+    environment_filter, Attach, Environment, Filter, Indexing, Material, MaterialKind, Object,
+    Ramp, Scene, Settings, ENVIRONMENT_FILTERS,
 };

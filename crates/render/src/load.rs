@@ -60,6 +60,23 @@ fn open_fault(path: &Path) -> Fault {
 }
 
 /// Reads a mesh from a `.glb`, `.gltf` or `.obj` file.
+///
+/// ```
+/// use mirrorball_core::Fault;
+/// use mirrorball_render::load_mesh;
+/// let path = std::env::temp_dir().join(format!("mirrorball-doc-{}.obj", std::process::id()));
+/// std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+/// let mesh = load_mesh(&path);
+/// std::fs::remove_file(&path).unwrap();
+/// let mesh = mesh.unwrap();
+/// assert_eq!(mesh.triangles.len(), 1);
+/// // The file has no normals: they are made, facing the side the triangle winds
+/// // counter-clockwise around (+Z).
+/// assert!((mesh.normals[0] - glam::Vec3::Z).length() < 1e-6);
+/// // A file that is not there is the input's fault.
+/// let err = load_mesh(std::path::Path::new("no/such/mesh.obj")).unwrap_err();
+/// assert_eq!(err.fault(), Fault::Input);
+/// ```
 pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
     let ext = path
         .extension()

@@ -32,11 +32,11 @@ pub type SpecularLobe = Lobe;
 
 /// Greene's two prefiltered maps for one lobe, in the environment's projection.
 #[derive(Debug)]
-pub struct GreeneMaps {
+pub(crate) struct GreeneMaps {
     /// `E/π` (Lambert), read at the normal.
-    pub diffuse: Arc<EnvMap>,
+    pub(crate) diffuse: Arc<EnvMap>,
     /// The lobe's prefiltered radiance, read at the reflected vector.
-    pub specular: Arc<EnvMap>,
+    pub(crate) specular: Arc<EnvMap>,
 }
 
 #[derive(Default)]
@@ -50,8 +50,32 @@ struct Inner {
     builds: usize,
 }
 
-/// Derived data of an environment map, built on first use and shared by every render of
-/// the environment (see the module docs).
+/// Derived data of an environment map (the filter crate's mip pyramid and samplers,
+/// Greene's prefiltered maps), built on first use and shared by every render of the
+/// environment and by its clones: an animation builds them once.
+///
+/// ```
+/// use glam::{Mat4, Vec3};
+/// use mirrorball_core::{EnvMap, ProjectionKind};
+/// use mirrorball_render::{mesh, render, Camera, Environment, Indexing, Material, Object, Scene, Settings};
+/// use std::sync::Arc;
+/// let cube = ProjectionKind::Cube.default_projection();
+/// let env = Environment::new(EnvMap::from_fn(cube, 16, 3, |d| [d.x as f32, 0.5, 0.5, 1.0]));
+/// let cache = env.cache.clone();
+/// let scene = Scene {
+///     objects: vec![Object { mesh: Arc::new(mesh::sphere(16)), model: Mat4::IDENTITY, material: Material::mirror() }],
+///     environment: Some(env),
+///     background: false,
+/// };
+/// let settings = Settings { indexing: Indexing::Cone, ..Settings::default() };
+/// assert_eq!(cache.builds(), 0);
+/// for turn in 0..3 {
+///     let cam = Camera::perspective(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 40.0, 16, 16)
+///         .orbited(turn as f32 * 0.3);
+///     render(&scene, &cam, &settings).unwrap();
+///     assert_eq!(cache.builds(), 1, "mode 4's pyramid is built by the first frame only");
+/// }
+/// ```
 #[derive(Clone, Default)]
 pub struct EnvCache(Arc<Mutex<Inner>>);
 
@@ -88,7 +112,7 @@ impl EnvCache {
     }
 
     /// The footprint sampler of `map` for `filter` (trilinear or EWA).
-    pub fn sampler(&self, map: &Arc<EnvMap>, filter: Filter) -> Arc<Sampler> {
+    pub(crate) fn sampler(&self, map: &Arc<EnvMap>, filter: Filter) -> Arc<Sampler> {
         let mut g = self.for_map(map);
         if let Some((_, s)) = g.samplers.iter().find(|(f, _)| *f == filter) {
             return s.clone();
@@ -100,7 +124,7 @@ impl EnvCache {
     }
 
     /// Greene's diffuse and specular maps of `map` for `lobe`.
-    pub fn greene(&self, map: &Arc<EnvMap>, lobe: SpecularLobe) -> GreeneMaps {
+    pub(crate) fn greene(&self, map: &Arc<EnvMap>, lobe: SpecularLobe) -> GreeneMaps {
         let mut g = self.for_map(map);
         let pf = match &g.prefilterer {
             Some(p) => p.clone(),
@@ -173,7 +197,7 @@ pub(crate) fn effective(filter: Filter, mode: Indexing) -> Filter {
 /// A pixel's footprint from the unit directions through its four corners (pixel order
 /// `(−,−) (+,−) (+,+) (−,+)`): the ray differentials `∂d/∂x`, `∂d/∂y` as the mean of the
 /// two opposite edges (a point where a corner is degenerate).
-pub fn footprint(c: &[DVec3; 4]) -> Footprint {
+pub(crate) fn footprint(c: &[DVec3; 4]) -> Footprint {
     if c.iter().any(|x| !x.is_finite() || x.length_squared() < 0.5) {
         return Footprint::Point;
     }

@@ -7,9 +7,23 @@
 //!
 //! Built-ins are centred on the origin, about unit size (radius 1 for the sphere, a 2×2 quad
 //! in the `z = 0` plane facing +Z, a cube of edge 2), with outward unit normals.
+//!
+//! ```
+//! use mirrorball_render::{mesh, Builtin};
+//! let sphere = mesh::sphere(32);
+//! assert!(sphere.positions.iter().all(|p| (p.length() - 1.0).abs() < 1e-5));
+//! assert!(sphere.is_closed_outward());
+//! // Each built-in by name, at a tessellation: what the CLI's `--object sphere` makes.
+//! let named: Builtin = "sphere".parse().unwrap();
+//! assert_eq!(named.mesh(32).triangles, sphere.triangles);
+//! // The teapot's 32 patches, each (level + 1)² vertices.
+//! assert_eq!(mesh::teapot(4).positions.len(), 32 * 25);
+//! ```
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use mirrorball_core::Choice;
+
+pub use crate::teapot::teapot;
 
 /// An indexed triangle mesh with per-vertex unit normals (and optional texture coordinates).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -459,7 +473,7 @@ pub enum Builtin {
     Cube,
     /// [`quad`].
     Quad,
-    /// [`crate::teapot::teapot`].
+    /// [`teapot`].
     Teapot,
 }
 
@@ -549,7 +563,7 @@ impl Builtin {
             Builtin::Torus => torus(0.7, 0.3, level),
             Builtin::Cube => cube(level),
             Builtin::Quad => quad(level),
-            Builtin::Teapot => crate::teapot::teapot(level),
+            Builtin::Teapot => teapot(level),
         }
     }
 }

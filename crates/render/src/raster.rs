@@ -60,12 +60,9 @@ impl Sample {
 }
 
 /// A grid of samples, row 0 at the top.
+#[cfg(test)]
 #[derive(Clone, Debug)]
 pub struct VisBuffer {
-    /// Samples per row.
-    pub width: u32,
-    /// Rows.
-    pub height: u32,
     /// `width × height` samples, row by row.
     pub samples: Vec<Sample>,
 }
@@ -178,16 +175,6 @@ impl Binned {
             height,
             band,
         }
-    }
-
-    /// Number of bands.
-    pub fn bands(&self) -> usize {
-        self.bins.len()
-    }
-
-    /// Rows in each band (the last may have fewer).
-    pub fn band_rows(&self) -> u32 {
-        self.band
     }
 
     /// Scans band `b` into `buf` (its samples row by row, `width ×` the band's rows): each
@@ -316,19 +303,16 @@ impl Binned {
     pub fn band_is_empty(&self, b: usize) -> bool {
         self.bins[b].is_empty()
     }
-
-    /// Sample rows of the grid.
-    pub fn height(&self) -> u32 {
-        self.height
-    }
 }
 
 /// Sample rows per band of [`rasterize`].
+#[cfg(test)]
 const BAND: u32 = 8;
 
 /// Rasterises triangles `tris` over clip-space vertices `clip` into a `width × height`
-/// sample grid.
-pub fn rasterize(clip: &[Vec4], tris: &[[u32; 3]], width: u32, height: u32) -> VisBuffer {
+/// sample grid: the whole scan, for tests.
+#[cfg(test)]
+fn rasterize(clip: &[Vec4], tris: &[[u32; 3]], width: u32, height: u32) -> VisBuffer {
     let binned = Binned::new(clip, tris, width, height, BAND, |_| Cull::None);
     let mut samples = vec![Sample::EMPTY; width as usize * height as usize];
     samples
@@ -343,11 +327,7 @@ pub fn rasterize(clip: &[Vec4], tris: &[[u32; 3]], width: u32, height: u32) -> V
                 *cell = binned.sample(buf.ids[i], buf.depth[i], x, y);
             }
         });
-    VisBuffer {
-        width,
-        height,
-        samples,
-    }
+    VisBuffer { samples }
 }
 
 /// Clips triangle `t` against the near plane and pushes what is left (a fan of up to two
@@ -732,3 +712,6 @@ fn blend_ids(ids: &mut [u32], keep: u32, id: u32) {
 
 /// Offsets of the four samples a SIMD step of [`scan`] tests (sample centres).
 const LANES: Vec4 = Vec4::new(0.5, 1.5, 2.5, 3.5);
+
+#[cfg(test)]
+mod tests;

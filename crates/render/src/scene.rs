@@ -34,8 +34,9 @@ pub enum Indexing {
     /// at that pixel give the reflected direction, looked up per pixel.
     PerPixel,
     /// **Mode 4**, Greene (1986, §5–6): the reflected rays through a pixel's four corners
-    /// bound a region of the world projection, and the region is filtered (see
-    /// [`crate::cone`]), so highly curved surfaces do not alias.
+    /// bound a region of the world projection, and the region is filtered over the filter
+    /// crate's solid-angle-weighted mip pyramid (EWA, or trilinear when the environment's
+    /// filter is [`Filter::Trilinear`]), so highly curved surfaces do not alias.
     Cone,
 }
 
@@ -258,6 +259,25 @@ impl Material {
         }
     }
 
+    /// Which of the materials this is.
+    ///
+    /// ```
+    /// use mirrorball_render::{Material, MaterialKind};
+    /// assert_eq!(Material::mirror().kind(), MaterialKind::Mirror);
+    /// assert_eq!("chrome".parse::<MaterialKind>().unwrap(), MaterialKind::Mirror);
+    /// assert_eq!(MaterialKind::PhongMap.to_string(), "phong-map");
+    /// ```
+    pub fn kind(&self) -> MaterialKind {
+        match self {
+            Material::Mirror { .. } => MaterialKind::Mirror,
+            Material::Fresnel { .. } => MaterialKind::Fresnel,
+            Material::CheapChrome { .. } => MaterialKind::CheapChrome,
+            Material::Diffuse { .. } => MaterialKind::Diffuse,
+            Material::Greene { .. } => MaterialKind::Greene,
+            Material::PhongMap { .. } => MaterialKind::PhongMap,
+        }
+    }
+
     /// Whether the material reads the environment.
     pub fn uses_environment(&self) -> bool {
         matches!(
@@ -266,6 +286,37 @@ impl Material {
         )
     }
 }
+
+/// The materials by name, without their parameters: the one table of material names (a
+/// [`Choice`], canonical name first), read by the CLI's `--material`, its help and the
+/// scene file's `kind`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MaterialKind {
+    /// [`Material::Mirror`].
+    Mirror,
+    /// [`Material::Fresnel`].
+    Fresnel,
+    /// [`Material::CheapChrome`].
+    CheapChrome,
+    /// [`Material::Diffuse`].
+    Diffuse,
+    /// [`Material::Greene`].
+    Greene,
+    /// [`Material::PhongMap`].
+    PhongMap,
+}
+
+impl Choice for MaterialKind {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (MaterialKind::Mirror, &["mirror", "chrome"]),
+        (MaterialKind::Fresnel, &["fresnel", "varnish", "plastic"]),
+        (MaterialKind::CheapChrome, &["cheap-chrome", "ramp"]),
+        (MaterialKind::Diffuse, &["diffuse", "matte"]),
+        (MaterialKind::Greene, &["greene"]),
+        (MaterialKind::PhongMap, &["phong-map", "phongmap"]),
+    ];
+}
+mirrorball_core::choice_traits!(MaterialKind);
 
 /// One object: a mesh, where it is, what it is made of.
 #[derive(Clone, Debug)]
@@ -279,6 +330,21 @@ pub struct Object {
 }
 
 /// Everything rendered.
+///
+/// ```
+/// use glam::Vec3;
+/// use mirrorball_core::{EnvMap, ProjectionKind};
+/// use mirrorball_render::{render, Camera, Environment, Scene, Settings};
+/// // No objects, the environment as background: every pixel shows the environment along
+/// // its primary ray (here +Y is bright, −Y dark, and the camera looks up).
+/// let latlong = ProjectionKind::LatLong.default_projection();
+/// let env = EnvMap::from_fn(latlong, 64, 3, |d| [0.5 + 0.5 * d.y as f32, 0.0, 0.0, 1.0]);
+/// let scene = Scene { objects: vec![], environment: Some(Environment::new(env)), background: true };
+/// let mut cam = Camera::perspective(Vec3::ZERO, Vec3::Y, 30.0, 8, 8);
+/// cam.up = Vec3::Z;
+/// let frame = render(&scene, &cam, &Settings::default()).unwrap();
+/// assert!(frame.color.get(4, 4)[0] > 0.98 && frame.color.get(4, 4)[3] == 1.0);
+/// ```
 #[derive(Clone, Debug)]
 pub struct Scene {
     /// The objects.

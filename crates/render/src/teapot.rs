@@ -15,7 +15,7 @@ use glam::{Vec2, Vec3};
 /// Control-point indices of the 32 patches, 16 each (row-major 4×4): rim 0–3, body 4–11,
 /// handle 12–15, spout 16–19, lid 20–27, bottom 28–31.
 #[rustfmt::skip]
-pub const PATCHES: [[u16; 16]; 32] = [
+pub(crate) const PATCHES: [[u16; 16]; 32] = [
     [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15],
     [3, 16, 17, 18, 7, 19, 20, 21, 11, 22, 23, 24, 15, 25, 26, 27],
     [18, 28, 29, 30, 21, 31, 32, 33, 24, 34, 35, 36, 27, 37, 38, 39],
@@ -52,7 +52,7 @@ pub const PATCHES: [[u16; 16]; 32] = [
 
 /// Newell's 290 control points, `(x, y, z)` with +Z up.
 #[rustfmt::skip]
-pub const VERTICES: [[f32; 3]; 290] = [
+pub(crate) const VERTICES: [[f32; 3]; 290] = [
     [1.4, 0.0, 2.4],
     [1.4, -0.784, 2.4],
     [0.784, -1.4, 2.4],
@@ -427,4 +427,14 @@ pub fn teapot(level: u32) -> Mesh {
     }
     let fit = m.normalizing_transform();
     m.transformed(fit)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn teapot_has_32_patches_over_its_vertex_table() {
+        assert_eq!(super::PATCHES.len(), 32);
+        let max = super::PATCHES.iter().flatten().copied().max().unwrap() as usize;
+        assert_eq!(max + 1, super::VERTICES.len());
+    }
 }

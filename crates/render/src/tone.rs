@@ -39,6 +39,17 @@ impl Tone {
 }
 
 /// `image × 2^exposure` through `tone`, colour channels only (alpha is kept).
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_render::tone::{to_display, Tone};
+/// let mut img = Image::new(1, 1, 4);
+/// img.data_mut().copy_from_slice(&[0.25, 2.0, 0.5, 0.5]);
+/// // One stop up doubles the light; clamping clips at 1; alpha is kept.
+/// assert_eq!(to_display(&img, 1.0, Tone::Clamp).get(0, 0), &[0.5, 1.0, 1.0, 0.5]);
+/// // Reinhard's x/(1 + x) takes 1 to ½.
+/// assert_eq!(to_display(&img, 2.0, Tone::Reinhard).get(0, 0)[0], 0.5);
+/// ```
 pub fn to_display(image: &Image, exposure: f32, tone: Tone) -> Image {
     let k = exposure.exp2();
     let mut out = image.clone();

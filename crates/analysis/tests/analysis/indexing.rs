@@ -3,7 +3,7 @@ use crate::util::close;
 use glam::DVec3;
 use mirrorball_analysis::cone::{cone_region, greene_cone};
 use mirrorball_analysis::geom::reflect;
-use mirrorball_analysis::indexing::{Indexing, LineStudy, MapSpec, QuadStudy, SphereStudy};
+use mirrorball_analysis::indexing::{LineStudy, MapSpec, QuadStudy, SphereStudy, VertexIndexing};
 use mirrorball_core::ProjectionKind as K;
 use std::f64::consts::PI;
 
@@ -50,7 +50,7 @@ fn a_flat_quad_seen_from_above_its_centre_is_exact_under_vector_indexing() {
     let maps = [MapSpec {
         projection: K::Cube.default_projection(),
         size: 64,
-        indexing: Indexing::Vector,
+        indexing: VertexIndexing::Vector,
     }];
     let (res, _) = q.run(&[0.0, -5.0], &maps);
     assert!(res[0].worst.degrees < 1e-9, "{:?}", res[0].worst);
@@ -67,12 +67,12 @@ fn a_finer_sphere_has_smaller_errors() {
         MapSpec {
             projection: K::Sphere.default_projection(),
             size: 256,
-            indexing: Indexing::Texgen,
+            indexing: VertexIndexing::Texgen,
         },
         MapSpec {
             projection: K::Paraboloid.default_projection(),
             size: 256,
-            indexing: Indexing::Vector,
+            indexing: VertexIndexing::Vector,
         },
     ];
     let coarse = SphereStudy {

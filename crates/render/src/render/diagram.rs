@@ -2,7 +2,7 @@
 //! and Zimmons' texture-space diagram of what a frame read.
 
 use super::texgen::Texgen;
-use super::{Frame, RenderError};
+use super::{RenderError, Rendered};
 use crate::camera::Camera;
 use crate::scene::{Indexing, Scene, Settings};
 use glam::{Mat3, Mat4, Vec2};
@@ -43,7 +43,7 @@ pub fn texture_space_diagram(
     scene: &Scene,
     cam: &Camera,
     settings: &Settings,
-    frame: &Frame,
+    frame: &Rendered,
     cell: u32,
 ) -> Result<Image, RenderError> {
     let env = scene

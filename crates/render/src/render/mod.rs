@@ -30,9 +30,10 @@ use prepare::{prepare, Prepared};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// A rendered picture and, when asked, its diagnostic channels.
+/// What [`render`] returns: the picture and, when asked, its diagnostic channels (one
+/// frame of an animation; not the core's `Frame`, a projection's orientation).
 #[derive(Clone, Debug)]
-pub struct Frame {
+pub struct Rendered {
     /// Linear RGBA; alpha is the fraction of the pixel covered by objects, or 1 where the
     /// background was drawn.
     pub color: Image,
@@ -82,8 +83,34 @@ impl RenderError {
 }
 
 /// Renders `scene` through `cam`.
-pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Frame, RenderError> {
-    let mut frame = Frame {
+///
+/// ```
+/// use glam::{Mat4, Vec3};
+/// use mirrorball_core::{EnvMap, ProjectionKind};
+/// use mirrorball_render::{mesh, render, Camera, Environment, Material, Object, Scene, Settings};
+/// use std::sync::Arc;
+/// // A mirror in a uniform environment shows that colour wherever it covers the picture.
+/// let cube = ProjectionKind::Cube.default_projection();
+/// let env = EnvMap::from_fn(cube, 8, 3, |_| [0.25, 0.5, 0.75, 1.0]);
+/// let scene = Scene {
+///     objects: vec![Object {
+///         mesh: Arc::new(mesh::sphere(24)),
+///         model: Mat4::IDENTITY,
+///         material: Material::mirror(),
+///     }],
+///     environment: Some(Environment::new(env)),
+///     background: false,
+/// };
+/// let cam = Camera::perspective(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 40.0, 24, 24);
+/// let frame = render(&scene, &cam, &Settings::default()).unwrap();
+/// let centre = frame.color.get(12, 12);
+/// assert!((centre[0] - 0.25).abs() < 1e-5 && (centre[2] - 0.75).abs() < 1e-5);
+/// assert_eq!(centre[3], 1.0);
+/// // Without a background, where nothing is drawn stays transparent.
+/// assert_eq!(frame.color.get(0, 0)[3], 0.0);
+/// ```
+pub fn render(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<Rendered, RenderError> {
+    let mut frame = Rendered {
         color: Image::new(0, 0, 4),
         aovs: None,
     };
@@ -99,7 +126,7 @@ pub fn render_into(
     scene: &Scene,
     cam: &Camera,
     settings: &Settings,
-    frame: &mut Frame,
+    frame: &mut Rendered,
 ) -> Result<(), RenderError> {
     render_counting(scene, cam, settings, frame, None)
 }
@@ -111,8 +138,8 @@ pub fn render_with_progress(
     cam: &Camera,
     settings: &Settings,
     rows_done: &AtomicU64,
-) -> Result<Frame, RenderError> {
-    let mut frame = Frame {
+) -> Result<Rendered, RenderError> {
+    let mut frame = Rendered {
         color: Image::new(0, 0, 4),
         aovs: None,
     };
@@ -124,7 +151,7 @@ fn render_counting(
     scene: &Scene,
     cam: &Camera,
     settings: &Settings,
-    frame: &mut Frame,
+    frame: &mut Rendered,
     rows_done: Option<&AtomicU64>,
 ) -> Result<(), RenderError> {
     validate(scene, cam, settings)?;

@@ -3,7 +3,7 @@
 use crate::util::*;
 use glam::{DVec2, Mat4, Vec3};
 use mirrorball_core::{resample, CubeMap, ProjectionKind, ResampleOptions, WorldProjection};
-use mirrorball_render::capture::capture_cube;
+use mirrorball_render::capture_cube;
 use mirrorball_render::{mesh, Attach, Camera, Environment, Indexing, Material, Object, Settings};
 use std::sync::Arc;
 
@@ -106,7 +106,7 @@ fn dynamic_reflection_shows_the_neighbour_but_not_itself() {
 #[test]
 fn omnimax_fisheye_looks_at_the_target_and_keeps_the_world() {
     use mirrorball_core::{Fisheye, Frame, Lens, Projection};
-    use mirrorball_render::capture::render_fisheye;
+    use mirrorball_render::render_fisheye;
     let ll = env_of(ProjectionKind::LatLong, 256, smooth);
     let red = Object {
         mesh: Arc::new(mesh::cube(1)),

@@ -500,7 +500,7 @@ fn leaving_out_hidden_back_faces_changes_no_picture() {
     // each other, in every indexing mode, through perspective and orthographic cameras,
     // and with the camera so close that the near plane cuts the sphere (no culling there,
     // and the inside shows): the same picture with and without culling, to the bit.
-    use mirrorball_render::{load::load_mesh, Object};
+    use mirrorball_render::{load_mesh, Object};
     use std::sync::Arc;
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let bunny = load_mesh(&root.join("assets/meshes/bunny.obj")).unwrap();

@@ -6,7 +6,7 @@
 #[path = "../../../io/tests/io/mutate.rs"]
 mod mutate;
 
-use mirrorball_render::load::load_mesh;
+use mirrorball_render::load_mesh;
 use mirrorball_render::mesh::MAX_TRIANGLES;
 use mirrorball_render::Builtin;
 use mutate::{apply_script, mutations};

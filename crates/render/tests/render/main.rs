@@ -1,5 +1,5 @@
 //! mirrorball-render integration tests: analytic checks of every indexing mode, the GL
-//! texgen formula, the rasteriser's rules, meshes and loading, and small golden images.
+//! texgen formula, meshes and loading, and small golden images.
 mod analytic;
 mod capture;
 mod features;
@@ -7,5 +7,4 @@ mod golden;
 mod hostile;
 mod meshes;
 mod names;
-mod rasterizer;
 mod util;

@@ -5,7 +5,7 @@ use mirrorball_core::{Choice, EnvMap, Fault, ProjectionKind};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{
     environment_filter, mesh, render, Attach, Builtin, Camera, Environment, Filter, Indexing,
-    Material, Object, Scene, Settings, ENVIRONMENT_FILTERS,
+    Material, MaterialKind, Object, Scene, Settings, ENVIRONMENT_FILTERS,
 };
 use std::sync::Arc;
 
@@ -29,6 +29,7 @@ fn every_name_and_alias_parses_back_to_its_value() {
     round_trips::<Tone>();
     round_trips::<Builtin>();
     round_trips::<Filter>();
+    round_trips::<MaterialKind>();
     assert_eq!(Indexing::all().collect::<Vec<_>>(), Indexing::ALL);
     assert_eq!(Builtin::all().collect::<Vec<_>>(), Builtin::ALL);
     for (i, m) in Indexing::ALL.iter().enumerate() {

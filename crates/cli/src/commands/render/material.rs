@@ -5,39 +5,15 @@
 use crate::spec::parse_dir;
 use mirrorball_core::{Choice, UnknownName};
 use mirrorball_filter::LobeKind;
-use mirrorball_render::{Material, Ramp, SpecularLobe};
+use mirrorball_render::{Material, MaterialKind, Ramp, SpecularLobe};
 use serde::Deserialize;
 
-/// The materials, by the names the spec and the scene's `kind` use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum MaterialKind {
-    Mirror,
-    Fresnel,
-    CheapChrome,
-    Diffuse,
-    Greene,
-    PhongMap,
-}
-
-impl Choice for MaterialKind {
-    const NAMES: &'static [(Self, &'static [&'static str])] = &[
-        (MaterialKind::Mirror, &["mirror", "chrome"]),
-        (MaterialKind::Fresnel, &["fresnel", "varnish", "plastic"]),
-        (MaterialKind::CheapChrome, &["cheap-chrome", "ramp"]),
-        (MaterialKind::Diffuse, &["diffuse", "matte"]),
-        (MaterialKind::Greene, &["greene"]),
-        (MaterialKind::PhongMap, &["phong-map", "phongmap"]),
-    ];
-}
-
-impl MaterialKind {
-    /// The keys besides `kind`, `tint` and `f0` that apply to the material.
-    fn keys(self) -> &'static [&'static str] {
-        match self {
-            MaterialKind::Greene => &["dc", "sc", "lobe", "exponent", "roughness"],
-            MaterialKind::PhongMap => &["specular", "exponent", "light", "ambient"],
-            _ => &[],
-        }
+/// The keys besides `kind`, `tint` and `f0` that apply to material `kind`.
+fn keys(kind: MaterialKind) -> &'static [&'static str] {
+    match kind {
+        MaterialKind::Greene => &["dc", "sc", "lobe", "exponent", "roughness"],
+        MaterialKind::PhongMap => &["specular", "exponent", "light", "ambient"],
+        _ => &[],
     }
 }
 
@@ -168,7 +144,7 @@ pub(super) fn material_of(e: &MaterialEntry) -> Result<Material, String> {
         ("light", e.light.is_some()),
         ("ambient", e.ambient.is_some()),
     ] {
-        if set && !kind.keys().contains(&key) {
+        if set && !keys(kind).contains(&key) {
             return Err(format!("'{key}' does not apply to material '{}'", e.kind));
         }
     }

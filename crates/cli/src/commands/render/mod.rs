@@ -18,7 +18,7 @@ use crate::{load, RenderArgs};
 use mirrorball_core::glam::Mat4;
 use mirrorball_core::{resample, ResampleOptions, WorldProjection};
 use mirrorball_render::tone;
-use mirrorball_render::{Camera, Environment, Frame, Mesh, Object, Scene, Settings};
+use mirrorball_render::{Camera, Environment, Mesh, Object, Rendered, Scene, Settings};
 use plan::{MeshSource, ObjectPlan, RenderPlan};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -125,7 +125,7 @@ fn load_object(o: &ObjectPlan) -> Result<Object, CliError> {
     let (mesh, fit) = match &o.source {
         MeshSource::Builtin(b, l) => (b.mesh(*l), Mat4::IDENTITY),
         MeshSource::File(p) => {
-            let m: Mesh = mirrorball_render::load::load_mesh(p)?;
+            let m: Mesh = mirrorball_render::load_mesh(p)?;
             let fit = if o.normalize {
                 m.normalizing_transform()
             } else {
@@ -150,7 +150,7 @@ impl RenderPlan {
 }
 
 /// Every frame, with a progress bar in pixel rows.
-fn render_frames(plan: &RenderPlan, scene: &Scene) -> Vec<Result<Frame, CliError>> {
+fn render_frames(plan: &RenderPlan, scene: &Scene) -> Vec<Result<Rendered, CliError>> {
     let frames = plan.frames as usize;
     let label = if frames > 1 { "frames" } else { "render" };
     let rows = plan.camera.height as u64;
@@ -167,14 +167,14 @@ fn render_frame(
     scene: &Scene,
     i: usize,
     counter: &AtomicU64,
-) -> Result<Frame, CliError> {
+) -> Result<Rendered, CliError> {
     let cam = plan.frame_camera(i);
     let settings = Settings {
         motion_from: plan.pan_blur.map(|p| cam.panned(p)),
         ..plan.settings
     };
     let frame = match plan.fisheye {
-        Some((lens, fov)) => mirrorball_render::capture::render_fisheye(
+        Some((lens, fov)) => mirrorball_render::render_fisheye(
             scene,
             cam.eye,
             cam.target,
@@ -187,7 +187,7 @@ fn render_frame(
         )
         .map(|img| {
             counter.fetch_add(plan.camera.height as u64, Ordering::Relaxed);
-            Frame {
+            Rendered {
                 color: img.with_channels(4),
                 aovs: None,
             }

@@ -8,7 +8,7 @@ use crate::guard::Files;
 use mirrorball_core::Image;
 use mirrorball_io::{Format, Precision, WriteOptions};
 use mirrorball_render::tone;
-use mirrorball_render::{Frame, Scene};
+use mirrorball_render::{Rendered, Scene};
 use std::path::{Path, PathBuf};
 
 /// The diagnostic channels' file tags, in the order `--aovs` documents them.
@@ -121,7 +121,7 @@ pub(super) fn write_frame(
     plan: &RenderPlan,
     scene: &Scene,
     i: usize,
-    f: &Frame,
+    f: &Rendered,
 ) -> Result<(), CliError> {
     let path = plan.frame_path(i);
     write_colour(&path, &f.color, plan)?;

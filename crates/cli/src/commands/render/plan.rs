@@ -15,7 +15,7 @@ use mirrorball_io::Format;
 use mirrorball_render::mesh::MAX_TRIANGLES;
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{
-    environment_filter, Attach, Builtin, Camera, Filter, Indexing, Lens, Material, Settings,
+    environment_filter, Attach, Builtin, Camera, CameraLens, Filter, Indexing, Material, Settings,
 };
 use std::path::{Path, PathBuf};
 
@@ -171,8 +171,8 @@ fn flag_camera(a: &RenderArgs, (width, height): (u32, u32)) -> Result<Camera, Cl
     let target = parse_point("--target", &a.target)?;
     let up = parse_vec3("--up", &a.up)?;
     let lens = match a.ortho {
-        Some(hh) => Lens::Orthographic { half_height: hh },
-        None => Lens::Perspective { fov_y_deg: a.fov },
+        Some(hh) => CameraLens::Orthographic { half_height: hh },
+        None => CameraLens::Perspective { fov_y_deg: a.fov },
     };
     let camera = Camera {
         eye,

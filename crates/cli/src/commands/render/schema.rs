@@ -8,7 +8,7 @@ use crate::spec::{bad, ProjSpec};
 use mirrorball_core::glam::{Mat4, Vec3};
 use mirrorball_core::{Choice, Fault};
 use mirrorball_render::{
-    environment_filter, Attach, Builtin, Camera, Filter, Indexing, Lens, Material, Settings,
+    environment_filter, Attach, Builtin, Camera, CameraLens, Filter, Indexing, Material, Settings,
 };
 use serde::Deserialize;
 use std::path::Path;
@@ -210,8 +210,8 @@ impl<'a> Scene<'a> {
     /// none.
     fn camera(&self, c: &CameraEntry, flags: &Camera) -> Result<Camera, CliError> {
         let lens = match (c.ortho_half_height, c.fov) {
-            (Some(h), _) => Lens::Orthographic { half_height: h },
-            (None, Some(f)) => Lens::Perspective { fov_y_deg: f },
+            (Some(h), _) => CameraLens::Orthographic { half_height: h },
+            (None, Some(f)) => CameraLens::Perspective { fov_y_deg: f },
             (None, None) => flags.lens,
         };
         let camera = Camera {

@@ -1,8 +1,7 @@
 //! The rasteriser's rules: every sample of a shared edge drawn once, depth order,
 //! near-plane clipping keeps perspective-correct weights.
 
-use glam::{Vec3, Vec4};
-use mirrorball_render::raster::{rasterize, NO_HIT};
+use super::*;
 
 #[test]
 fn two_triangles_of_a_square_cover_each_sample_once() {
@@ -19,9 +18,7 @@ fn two_triangles_of_a_square_cover_each_sample_once() {
     let both = rasterize(&clip, &[[0, 1, 2], [0, 2, 3]], w, h);
     let a = rasterize(&clip, &[[0, 1, 2]], w, h);
     let b = rasterize(&clip, &[[0, 2, 3]], w, h);
-    let count = |v: &mirrorball_render::raster::VisBuffer| {
-        v.samples.iter().filter(|s| s.tri != NO_HIT).count()
-    };
+    let count = |v: &VisBuffer| v.samples.iter().filter(|s| s.tri != NO_HIT).count();
     // Sample centres inside [4, 28) × [3, 27): x+½ in (4, 28), y+½ in (3, 27).
     let expect = (28 - 4) * (27 - 3);
     assert_eq!(count(&both), expect);
@@ -50,8 +47,7 @@ fn nearer_triangle_wins_whatever_the_order() {
 fn near_clipping_keeps_perspective_correct_weights() {
     // A triangle crossing the near plane: its visible part's weights must be those of the
     // unclipped triangle. Eye-space triangle, projected with a GL perspective matrix.
-    let cam =
-        mirrorball_render::Camera::perspective(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), 90.0, 16, 16);
+    let cam = crate::Camera::perspective(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), 90.0, 16, 16);
     let m = cam.projection();
     let eye = [
         Vec3::new(-1.0, -0.5, 1.0),
@@ -84,7 +80,6 @@ fn near_clipping_keeps_perspective_correct_weights() {
 
 #[test]
 fn culling_leaves_out_the_winding_it_names_as_gl_cull_face_does() {
-    use mirrorball_render::raster::{Binned, Cull};
     // In NDC (y up), (−½,−½) → (½,−½) → (0,½) runs counter-clockwise: OpenGL's front face.
     let clip = vec![
         Vec4::new(-0.5, -0.5, 0.0, 1.0),
@@ -108,7 +103,6 @@ fn a_band_buffer_reused_band_after_band_sees_what_a_fresh_one_sees() {
     // Triangles scattered so that neighbouring bands cover disjoint, overlapping and no
     // columns: a buffer reused in any order of bands (as a rendering thread takes them)
     // must hold exactly what a fresh buffer holds, band by band.
-    use mirrorball_render::raster::{BandBuffer, Binned, Cull};
     let (w, h, band) = (96u32, 64u32, 8u32);
     let mut clip = Vec::new();
     let mut tris = Vec::new();
