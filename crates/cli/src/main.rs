@@ -110,7 +110,7 @@ pub struct ConvertArgs {
     roll: f64,
     /// Mirror the environment across a plane: x, y or z (z switches between right- and
     /// left-handed worlds). May be repeated.
-    #[arg(long, value_name = "AXIS")]
+    #[arg(long, value_name = "AXIS", value_parser = names::<mirrorball_core::Axis>())]
     flip: Vec<String>,
     /// Exposure in stops (texels times 2^EV).
     #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]

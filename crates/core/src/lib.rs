@@ -42,7 +42,7 @@ pub use projection::{
     ProjectionKind, RadialMap, SphereMap, UnknownProjection, WorldProjection,
 };
 pub use remap::{Remap, RemapError};
-pub use resample::{resample, resample_to_extent, ResampleOptions, Resampler, Rotation};
+pub use resample::{resample, resample_to_extent, Axis, ResampleOptions, Resampler, Rotation};
 
 pub use glam;
 /// The SIMD lanes the fast variants are written on.

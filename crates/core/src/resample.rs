@@ -24,6 +24,23 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
+/// A world axis, named `x`, `y` or `z`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Axis {
+    /// +X, to the right.
+    X = 0,
+    /// +Y, up.
+    Y = 1,
+    /// +Z, towards the viewer.
+    Z = 2,
+}
+
+impl crate::Choice for Axis {
+    const NAMES: &'static [(Self, &'static [&'static str])] =
+        &[(Axis::X, &["x"]), (Axis::Y, &["y"]), (Axis::Z, &["z"])];
+}
+crate::choice_traits!(Axis);
+
 /// An orthogonal transform of the environment (a rotation, or a mirroring to switch
 /// handedness conventions): the output shows the source turned by it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,11 +90,18 @@ impl Rotation {
         })
     }
 
-    /// Mirrors the environment across the plane through the origin normal to `axis`
-    /// (0 = x, 1 = y, 2 = z): for example z, to go between right- and left-handed worlds.
-    pub fn mirror(axis: usize) -> Rotation {
+    /// Mirrors the environment across the plane through the origin normal to `axis`: for
+    /// example z, to go between right- and left-handed worlds.
+    ///
+    /// ```
+    /// use mirrorball_core::{Axis, Rotation};
+    /// use glam::DVec3;
+    /// let r = Rotation::mirror(Axis::Z);
+    /// assert_eq!(r.source_of(DVec3::new(0.6, 0.0, 0.8)), DVec3::new(0.6, 0.0, -0.8));
+    /// ```
+    pub fn mirror(axis: Axis) -> Rotation {
         let mut d = DVec3::ONE;
-        d[axis.min(2)] = -1.0;
+        d[axis as usize] = -1.0;
         Rotation {
             to_source: DMat3::from_diagonal(d),
         }

@@ -9,7 +9,7 @@ use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
 use mirrorball_core::{
-    resample, Choice, Layout, Projection, ResampleOptions, Resampler, Rotation, WorldProjection,
+    resample, Axis, Layout, Projection, ResampleOptions, Resampler, Rotation, WorldProjection,
 };
 use mirrorball_io::{ExrCompression, Format, OutputSet, Precision, WriteOptions};
 use std::path::PathBuf;
@@ -25,26 +25,12 @@ struct Plan {
 }
 
 pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
-    p.map(|p| {
-        Precision::parse_name(p).map_err(|e| {
-            CliError::request(format!(
-                "--precision: unknown '{}' ({})",
-                e.given.to_ascii_lowercase(),
-                e.list()
-            ))
-        })
-    })
-    .transpose()
+    p.map(|p| crate::choice::parse_flag("--precision", p))
+        .transpose()
 }
 
 fn parse_compression(c: &str) -> Result<ExrCompression, CliError> {
-    ExrCompression::parse_name(c).map_err(|e| {
-        CliError::request(format!(
-            "--compression: unknown '{}' ({})",
-            e.given.to_ascii_lowercase(),
-            e.list()
-        ))
-    })
+    crate::choice::parse_flag("--compression", c)
 }
 
 impl Plan {
@@ -90,16 +76,7 @@ impl Plan {
         }
         let mut rotation = Rotation::from_euler_deg(a.yaw, a.pitch, a.roll);
         for f in &a.flip {
-            let axis = match f.to_ascii_lowercase().as_str() {
-                "x" => 0,
-                "y" => 1,
-                "z" => 2,
-                other => {
-                    return Err(CliError::request(format!(
-                        "--flip: '{other}' is not x, y or z"
-                    )))
-                }
-            };
+            let axis = crate::choice::parse_flag::<Axis>("--flip", f)?;
             rotation = rotation.then(Rotation::mirror(axis));
         }
         if !a.exposure.is_finite() {

@@ -241,7 +241,7 @@ fn rotation_and_exposure() {
         Projection::from(mirrorball_core::CubeMap),
         32,
         &ResampleOptions {
-            rotation: Rotation::mirror(2),
+            rotation: Rotation::mirror(mirrorball_core::Axis::Z),
             ..Default::default()
         },
     );
