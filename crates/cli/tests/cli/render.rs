@@ -383,6 +383,40 @@ fn render_bad_toml_scene_names_the_file_and_the_place() {
     assert!(!out.exists());
 }
 
+/// The careless user's `render … out.png`: the picture's name lands where the scene file
+/// goes. The message says it was read as a scene file and where the output goes; nothing
+/// is written, and the exit status is an input's (1).
+#[test]
+fn an_output_name_given_as_the_scene_says_how_to_name_the_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mirror-ball.png");
+    let env = asset("venice.exr");
+    let r = run(&[
+        "render",
+        "--env",
+        env.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    let msg = stderr(&r);
+    assert_eq!(r.status.code(), Some(1), "{msg}");
+    assert!(
+        msg.contains("mirror-ball.png")
+            && msg.contains("scene file")
+            && msg.contains("-o/--output"),
+        "{msg}"
+    );
+    assert!(!out.exists());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    // A scene file that is missing is named as such, with no hint about pictures.
+    let missing = dir.path().join("scene.json");
+    let r = run(&["render", missing.to_str().unwrap()]);
+    let msg = stderr(&r);
+    assert!(
+        msg.contains("scene.json: cannot read the scene file") && !msg.contains("-o/"),
+        "{msg}"
+    );
+}
+
 #[test]
 fn render_greene_material_from_the_command_line_and_a_scene() {
     let dir = tempfile::tempdir().unwrap();

@@ -93,7 +93,16 @@ impl<'a> Scene<'a> {
     fn read(path: &'a Path) -> Result<Scene<'a>, CliError> {
         let name = path.display();
         let text = std::fs::read_to_string(path).map_err(|e| {
-            CliError::new(Fault::of_io(e.kind()), format!("{name}: cannot read: {e}"))
+            // A picture's name where the scene goes is the output given without -o.
+            let hint = if mirrorball_io::Format::from_path(path).is_some() {
+                " (the picture to write is given with -o/--output)"
+            } else {
+                ""
+            };
+            CliError::new(
+                Fault::of_io(e.kind()),
+                format!("{name}: cannot read the scene file: {e}{hint}"),
+            )
         })?;
         let is_toml = path
             .extension()
