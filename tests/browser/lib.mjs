@@ -78,3 +78,27 @@ export function run(args) {
     throw new Error(`mirrorball ${args.join(' ')} failed:\n${e.stderr ?? e}`);
   }
 }
+
+const EXAMPLES = path.join(ROOT, 'target', 'debug', 'examples');
+
+/// Builds the bake crate's examples once (`cargo build -p mirrorball-bake --examples`).
+let built = false;
+function buildExamples() {
+  if (built) return;
+  execFileSync('cargo', ['build', '-q', '-p', 'mirrorball-bake', '--examples'], { cwd: ROOT, stdio: 'inherit' });
+  built = true;
+}
+
+/// Writes the direction-coded lat-long EXR (colour = ½ + ½·d) to `file`.
+export function directionCoded(file, width = 1024) {
+  buildExamples();
+  execFileSync(path.join(EXAMPLES, 'direction_coded'), [file, String(width)], { stdio: 'inherit' });
+  return file;
+}
+
+/// Bakes `input` for `engine` into `dir` (level 0 `size`²); returns the files written.
+export function bake(engine, input, dir, size = 64) {
+  buildExamples();
+  const out = execFileSync(path.join(EXAMPLES, 'bake'), [engine, input, dir, String(size)], { encoding: 'utf8' });
+  return out.split('\n').filter(Boolean);
+}
