@@ -102,3 +102,11 @@ export function bake(engine, input, dir, size = 64) {
   const out = execFileSync(path.join(EXAMPLES, 'bake'), [engine, input, dir, String(size)], { encoding: 'utf8' });
   return out.split('\n').filter(Boolean);
 }
+
+/// The library's own GGX prefilter of the lat-long `input` at perceptual `roughness`, about
+/// each direction in `dirs` (the bake crate's example `prefiltered`): `[[r, g, b], …]`.
+export function prefiltered(input, roughness, dirs) {
+  buildExamples();
+  const args = [input, String(roughness), ...dirs.map((d) => d.join(','))];
+  return JSON.parse(execFileSync(path.join(EXAMPLES, 'prefiltered'), args, { encoding: 'utf8' }));
+}

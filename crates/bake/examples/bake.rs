@@ -32,6 +32,10 @@ fn main() {
         source: args[1].clone(),
         ..Default::default()
     };
+    if let Err(e) = engine.check(&opts) {
+        eprintln!("{e}");
+        std::process::exit(2);
+    }
     let spec = engine.chain_spec(&opts);
     let lighting = Lighting::from_env(&env, &spec, Default::default());
     let dir = Path::new(&args[2]);

@@ -150,6 +150,15 @@ impl Lighting {
 }
 
 impl Engine {
+    /// Refuses a bake this engine cannot take (its size, encoding or supercompression), with
+    /// the reason, before any work.
+    pub fn check(self, opts: &BakeOptions) -> Result<(), String> {
+        match self {
+            Engine::Three => three::check(opts),
+            _ => Ok(()),
+        }
+    }
+
     /// What this engine's lighting is made of, for a bake asked as `opts` says.
     pub fn chain_spec(self, opts: &BakeOptions) -> ChainSpec {
         match self {

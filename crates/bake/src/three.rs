@@ -1,18 +1,203 @@
-//! Lighting for three: the files, the convention and the roughness-to-mip rule.
+//! Lighting for three.js (r187, the npm version the browser tests pin): the files, the
+//! convention and the roughness-to-mip rule. Line numbers cite `three@0.187.0`'s sources.
+//!
+//! **What r187 takes as prefiltered.** Its PMREM is no longer a "CubeUV" atlas (there is no
+//! `CubeUVReflectionMapping` in `src/constants.js`): `PMREMGenerator` makes a cube render
+//! target whose mip `lod` of `maxLod + 1` holds GGX-filtered radiance at perceptual
+//! roughness `1 − √(1 − lod/maxLod)` (`src/extras/PMREMGenerator.js` 236–240,
+//! `lodToRoughness`), faces `size >> lod` down to `2^LOD_MIN` = 8 (lines 25 and 279–283),
+//! and marks it `isPMREMTexture`. Any texture so marked is used as it is
+//! (`src/renderers/webgl/WebGLEnvironments.js` 73); the shaders read mip
+//! `ENVMAP_MAX_LOD · r(2 − r)` for roughness `r` (`envmap_common_pars_fragment.glsl.js`
+//! 12–18, the inverse), with `ENVMAP_MAX_LOD` = the mip count − 1, counted from
+//! `image[0].mipmaps` for a `CompressedCubeTexture` (`src/renderers/webgl/WebGLPrograms.js`
+//! 191 and 225), and take the diffuse light from the last, roughness-1 level times π
+//! (`envmap_physical_pars_fragment.glsl.js` 4–19). So the prefiltered radiance is written
+//! as exactly those levels, GGX-prefiltered by mirrorball at exactly those roughnesses.
+//!
+//! **Which loader.** three's `KTX2Loader` has no BC6H in its vkFormat table and returns
+//! uncompressed cubes as flat `DataTexture`s (`examples/jsm/loaders/KTX2Loader.js` 992–1050
+//! and 1233–1238), and `HDRCubeTextureLoader` makes one level a face (an uncompressed
+//! `CubeTexture` counts its mips without the base level, `WebGLTextures.js` 1621–1625, while
+//! `WebGLPrograms.js` 191 counts them with it). `DDSLoader` reads a BC6H cube with its mips
+//! (`DDSLoader.js` 253–266 and 319–370), so the PMREM is `pmrem.dds`, BC6H, wrapped as a
+//! `CompressedCubeTexture` (what `KTX2Loader` makes of compressed cubes) by the note's three
+//! lines. The plain cube, for backgrounds and for materials three filters itself, is six
+//! Radiance RGBE faces for `HDRCubeTextureLoader`, which returns a `CubeTexture`: what a
+//! three user loads HDR cube maps with, and it needs no texture-compression extension.
+//!
+//! **Mirroring.** three looks a `CubeTexture` that is not a render target up at
+//! `(−x, y, z)`: `envMapRotation` and `backgroundRotation` are premultiplied by
+//! `diag(−1, 1, 1)` (`WebGLMaterials.js` 9 and 248–252, `WebGLBackground.js` 17 and
+//! 144–148), and a loaded `CompressedCubeTexture` is such a cube too. Both files are
+//! therefore written as the world mirrored in x ([`mirror_x`]), so that three's lookup at
+//! `(−x, y, z)` returns mirrorball's radiance in `(x, y, z)`. Faces are uploaded unchanged,
+//! row 0 to `t = 0` (`CubeTexture` and `DataTexture` have `flipY` false).
 
-use crate::{mip_levels, not_written, BakeOptions, ChainSpec, Lighting};
-use mirrorball_io::Error;
+use crate::{BakeOptions, ChainSpec, Lighting};
+use mirrorball_core::Image;
+use mirrorball_io::{CubeWrite, Encoding, Error, WriteOptions};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// The levels three takes.
-pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
-    ChainSpec {
-        levels: mip_levels(opts.size, |i, n| i as f64 / (n.max(2) - 1) as f64),
-        diffuse_face: Some(32),
+/// Log2 of the face edge of three's roughest PMREM level (`PMREMGenerator.js` 25).
+const LOD_MIN: u32 = 3;
+
+/// The PMREM file.
+pub(crate) const PMREM_FILE: &str = "pmrem.dds";
+/// The folder of the plain cube's faces.
+pub(crate) const CUBE_DIR: &str = "cube";
+/// The plain cube's face files in three's order, +X −X +Y −Y +Z −Z (OpenGL's).
+pub(crate) const CUBE_FACES: [&str; 6] =
+    ["px.hdr", "nx.hdr", "py.hdr", "ny.hdr", "pz.hdr", "nz.hdr"];
+
+/// The perceptual roughness three reads mip `lod` of a PMREM with last mip `max_lod` at:
+/// `PMREMGenerator.lodToRoughness` (`PMREMGenerator.js` 236–240), the inverse of the
+/// shaders' `roughnessToMip`, `lod = max_lod · r(2 − r)`.
+pub(crate) fn lod_to_roughness(lod: u32, max_lod: u32) -> f64 {
+    if max_lod == 0 {
+        0.0
+    } else {
+        1.0 - (1.0 - lod as f64 / max_lod as f64).sqrt()
     }
 }
 
-/// Writes three's files into `dir`.
-pub(crate) fn write(_l: &Lighting, dir: &Path, _opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    Err(not_written(dir, "three"))
+/// Refuses what three cannot load or what has no PMREM levels, before any work.
+pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
+    let size = opts.size;
+    if !size.is_power_of_two() || size < 2 << LOD_MIN {
+        return Err(format!(
+            "three.js needs a power-of-two size of at least {} (its PMREM's levels go down to \
+             {0}×{0} faces, 2^LOD_MIN with LOD_MIN = {LOD_MIN}); {size} was asked",
+            2 << LOD_MIN
+        ));
+    }
+    if let Some(e) = opts.encoding {
+        if !matches!(e, Encoding::Bc6hUnsigned | Encoding::Bc6hSigned) {
+            return Err(format!(
+                "three.js's DDSLoader reads HDR cubes only as BC6H; {} cannot be loaded \
+                 (use bc6h or bc6h-sf16)",
+                e.label()
+            ));
+        }
+    }
+    if opts.zstd.is_some() {
+        return Err(
+            "three.js's PMREM is a DDS file, which has no Zstandard supercompression".into(),
+        );
+    }
+    Ok(())
+}
+
+/// three's PMREM levels: faces `size >> lod` for `lod` in `0..=log2(size) − LOD_MIN`, each at
+/// [`lod_to_roughness`]; no diffuse cube (three takes diffuse light from the last level).
+pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
+    let max_lod = opts.size.max(1).ilog2().saturating_sub(LOD_MIN);
+    ChainSpec {
+        levels: (0..=max_lod)
+            .map(|lod| ((opts.size >> lod).max(1), lod_to_roughness(lod, max_lod)))
+            .collect(),
+        diffuse_face: None,
+    }
+}
+
+/// The cube whose lookup at `(−x, y, z)` gives `faces`' value at `(x, y, z)`, texel for
+/// texel: faces in OpenGL order and orientation (ARCHITECTURE.md). Negating x swaps the ±X
+/// faces and, on every face, negates the `s` coordinate (OpenGL 4.6 table 8.19: `sc` is
+/// `∓z` on ±X, whose images swap; `x` on ±Y and +Z, `−x` on −Z), `t` unchanged: each
+/// face is its partner mirrored left to right.
+pub(crate) fn mirror_x(faces: &[Image]) -> Vec<Image> {
+    const PARTNER: [usize; 6] = [1, 0, 2, 3, 4, 5];
+    PARTNER.iter().map(|&p| faces[p].flipped(true)).collect()
+}
+
+/// Writes three's files into `dir`: `pmrem.dds`, `cube/{px,nx,py,ny,pz,nz}.hdr` and the note.
+pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+    check(opts).map_err(|e| Error::request(dir, e))?;
+    let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
+    let levels: Vec<Vec<Image>> = l.specular.iter().map(|m| mirror_x(m.layers())).collect();
+    let pmrem = dir.join(PMREM_FILE);
+    mirrorball_io::write_dds(
+        &pmrem,
+        &levels,
+        &CubeWrite {
+            encoding,
+            effort: opts.effort,
+            ..CubeWrite::default()
+        },
+    )?;
+    let mut files = vec![pmrem];
+
+    let cube = dir.join(CUBE_DIR);
+    std::fs::create_dir_all(&cube).map_err(|e| Error::io(&cube, e))?;
+    for (face, name) in levels[0].iter().zip(CUBE_FACES) {
+        let path = cube.join(name);
+        mirrorball_io::write_image(&path, face, &WriteOptions::default())?;
+        files.push(path);
+    }
+
+    let note = dir.join("README.md");
+    let text = note_text(l, opts, encoding);
+    mirrorball_io::atomic_write(&note, |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|e| Error::io(&note, e))
+    })?;
+    files.push(note);
+    Ok(files)
+}
+
+/// The note: what each file is and the lines of three.js that load it.
+fn note_text(l: &Lighting, opts: &BakeOptions, encoding: Encoding) -> String {
+    let levels: Vec<String> = l
+        .specular
+        .iter()
+        .zip(&l.roughness)
+        .enumerate()
+        .map(|(lod, (m, r))| format!("{lod}: {0}×{0} at {r:.4}", m.width()))
+        .collect();
+    let source = if opts.source.is_empty() {
+        String::new()
+    } else {
+        format!(" from `{}`", opts.source)
+    };
+    format!(
+        r#"# Image-based lighting for three.js (r187){source}
+
+- `{PMREM_FILE}`: the prefiltered radiance as three's own PMREM, a cube with mips,
+  {label}, level `lod` GGX-prefiltered at perceptual roughness 1 − √(1 − lod/maxLod)
+  (`PMREMGenerator.lodToRoughness`), the roughness three's shaders read it at
+  (mip = maxLod · r(2 − r)); the last level is three's diffuse light.
+  Levels (lod: face, roughness): {levels}.
+- `{CUBE_DIR}/px.hdr … nz.hdr`: the plain cube (RGBE), for `scene.background` and for
+  materials three filters itself.
+
+Both are mirrored left to right for three's cube lookup at (−x, y, z), so three shows
+them the right way round: do not flip them again.
+
+```js
+import * as THREE from 'three';
+import {{ DDSLoader }} from 'three/addons/loaders/DDSLoader.js';
+import {{ HDRCubeTextureLoader }} from 'three/addons/loaders/HDRCubeTextureLoader.js';
+
+// The PMREM (needs EXT_texture_compression_bptc: renderer.extensions.has(…)).
+const dds = await new DDSLoader().loadAsync('{PMREM_FILE}');
+const pmrem = new THREE.CompressedCubeTexture(dds.image, dds.format);
+pmrem.isPMREMTexture = true; // already prefiltered: three uses it as it is
+pmrem.minFilter = THREE.LinearMipmapLinearFilter;
+pmrem.colorSpace = THREE.LinearSRGBColorSpace;
+pmrem.needsUpdate = true;
+scene.environment = pmrem; // or material.envMap = pmrem (MeshStandardMaterial)
+
+// The background (or envMap of MeshBasicMaterial/MeshPhongMaterial).
+scene.background = await new HDRCubeTextureLoader().setPath('{CUBE_DIR}/')
+  .loadAsync(['px.hdr', 'nx.hdr', 'py.hdr', 'ny.hdr', 'pz.hdr', 'nz.hdr']);
+// A blurred background reads the PMREM: scene.background = pmrem; scene.backgroundBlurriness = 0.5;
+```
+
+Without BC6H support, set `scene.environment` to the plain cube: three then makes its own
+PMREM from it (`PMREMGenerator`).
+"#,
+        label = encoding.label(),
+        levels = levels.join(", "),
+    )
 }
