@@ -150,6 +150,16 @@ impl Lighting {
 }
 
 impl Engine {
+    /// Refuses, before any work, a bake this engine cannot take (a face edge or an encoding
+    /// its loader does not read); `dir` is the output folder, for the message.
+    pub fn check(self, dir: &Path, opts: &BakeOptions) -> Result<(), Error> {
+        match self {
+            Engine::Babylon => babylon::check(dir, opts, "Babylon.js"),
+            Engine::Gltf => gltf::check(dir, opts),
+            _ => Ok(()),
+        }
+    }
+
     /// What this engine's lighting is made of, for a bake asked as `opts` says.
     pub fn chain_spec(self, opts: &BakeOptions) -> ChainSpec {
         match self {
