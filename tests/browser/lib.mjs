@@ -4,6 +4,7 @@
 import { createServer } from 'node:http';
 import { readFile, stat } from 'node:fs/promises';
 import { execFileSync } from 'node:child_process';
+import { inflateSync } from 'node:zlib';
 import { mkdtempSync, rmSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
@@ -101,4 +102,54 @@ export function bake(engine, input, dir, size = 64) {
   buildExamples();
   const out = execFileSync(path.join(EXAMPLES, 'bake'), [engine, input, dir, String(size)], { encoding: 'utf8' });
   return out.split('\n').filter(Boolean);
+}
+
+/// Decodes an 8-bit, non-interlaced PNG (greyscale, RGB or RGBA) from its bytes, exactly:
+/// no colour management or premultiplication (a 2D canvas would premultiply RGBD's alpha).
+/// Returns `{ width, height, channels, data }`, `data` the samples, top row first.
+export function readPng(bytes) {
+  const buf = Buffer.from(bytes);
+  const SIG = [0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a];
+  if (!SIG.every((b, i) => buf[i] === b)) throw new Error('not a PNG');
+  let pos = 8, width = 0, height = 0, channels = 0;
+  const idat = [];
+  while (pos < buf.length) {
+    const len = buf.readUInt32BE(pos);
+    const type = buf.toString('latin1', pos + 4, pos + 8);
+    const body = buf.subarray(pos + 8, pos + 8 + len);
+    if (type === 'IHDR') {
+      width = body.readUInt32BE(0);
+      height = body.readUInt32BE(4);
+      const [depth, colour, , , interlace] = body.subarray(8, 13);
+      channels = { 0: 1, 2: 3, 6: 4 }[colour];
+      if (depth !== 8 || !channels || interlace) throw new Error(`unsupported PNG (depth ${depth}, colour ${colour}, interlace ${interlace})`);
+    } else if (type === 'IDAT') idat.push(body);
+    else if (type === 'IEND') break;
+    pos += 12 + len;
+  }
+  const raw = inflateSync(Buffer.concat(idat));
+  const stride = width * channels;
+  const data = new Uint8Array(height * stride);
+  for (let y = 0; y < height; y++) {
+    const filter = raw[y * (stride + 1)];
+    const line = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
+    for (let x = 0; x < stride; x++) {
+      const a = x >= channels ? data[y * stride + x - channels] : 0;
+      const b = y > 0 ? data[(y - 1) * stride + x] : 0;
+      const c = x >= channels && y > 0 ? data[(y - 1) * stride + x - channels] : 0;
+      const p = a + b - c;
+      const pa = Math.abs(p - a), pb = Math.abs(p - b), pc = Math.abs(p - c);
+      const paeth = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+      const pred = [0, a, b, (a + b) >> 1, paeth][filter];
+      if (pred === undefined) throw new Error(`PNG filter ${filter}`);
+      data[y * stride + x] = (line[x] + pred) & 0xff;
+    }
+  }
+  return { width, height, channels, data };
+}
+
+/// Babylon.js's `fromRGBD` (helperFunctions.fx): `toLinearSpace(rgb) / D`, gamma 2.2.
+export function rgbdDecode(r, g, b, d) {
+  const k = d / 255;
+  return [r, g, b].map((v) => (k ? Math.pow(v / 255, 2.2) / k : 0));
 }
