@@ -136,4 +136,59 @@ mod tests {
         });
         assert_eq!(small.levels, [(16, 0.0)]);
     }
+
+    #[test]
+    fn the_gltf_reads_back_as_written_and_bad_requests_are_refused_first() {
+        use mirrorball_core::{EnvMap, ProjectionKind};
+        let env = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 128, 3, |d| {
+            [
+                (0.5 + 0.5 * d.x) as f32,
+                0.5,
+                (0.5 - 0.25 * d.z) as f32,
+                1.0,
+            ]
+        });
+        let opts = BakeOptions {
+            size: 32,
+            source: "coded.exr".into(),
+            ..Default::default()
+        };
+        let spec = chain_spec(&opts);
+        let lighting = Lighting::from_env(&env, &spec, Default::default());
+        let dir = tempfile::tempdir().unwrap();
+        let files = write(&lighting, dir.path(), &opts).unwrap();
+        assert_eq!(files.len(), 2 * 6 + 2);
+        let back = mirrorball_io::read_gltf_ibl(&dir.path().join(FILE)).unwrap();
+        assert_eq!(back.name, "coded.exr");
+        assert_eq!((back.intensity, back.rotation), (1.0, [0.0, 0.0, 0.0, 1.0]));
+        let want = babylon_harmonics(&lighting.sh9);
+        for (b, w) in back
+            .irradiance_coefficients
+            .iter()
+            .flatten()
+            .zip(want.iter().flatten())
+        {
+            assert!((b - w).abs() <= 1e-15 * w.abs().max(1.0), "{b} vs {w}");
+        }
+        let made: Vec<_> = lighting
+            .specular
+            .iter()
+            .map(|level| rgbd_faces(&babylon_cube(level)))
+            .collect();
+        assert_eq!(back.levels, made);
+
+        for (size, encoding) in [
+            (48, None),
+            (32, Some(mirrorball_io::Encoding::Bc6hUnsigned)),
+        ] {
+            let bad = BakeOptions {
+                size,
+                encoding,
+                ..Default::default()
+            };
+            let e = check(dir.path(), &bad).unwrap_err();
+            assert_eq!(e.fault(), mirrorball_io::Fault::Request);
+            assert!(e.problem().contains("EXT_lights_image_based"), "{e}");
+        }
+    }
 }

@@ -219,3 +219,64 @@ pub(crate) fn check_faces(path: &Path, levels: &[[Rgba8Face; 6]], width: u32) ->
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chain(width: u32) -> Vec<[Rgba8Face; 6]> {
+        let n = width.trailing_zeros() + 1;
+        (0..n)
+            .map(|i| {
+                let size = width >> i;
+                std::array::from_fn(|f| Rgba8Face {
+                    size,
+                    texels: (0..size * size * 4)
+                        .map(|b| (b as usize * 7 + f) as u8)
+                        .collect(),
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_written_env_reads_back_and_damaged_ones_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.env");
+        let env = BabylonEnv {
+            polynomial: std::array::from_fn(|i| [i as f64, 0.5, -0.25]),
+            lod_generation_scale: 0.8,
+            levels: chain(8),
+        };
+        write_babylon_env(&path, &env).unwrap();
+        assert_eq!(read_babylon_env(&path).unwrap(), env);
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(bytes[..8], MAGIC);
+
+        let damaged = |b: &[u8], says: &str| {
+            let p = dir.path().join("b.env");
+            std::fs::write(&p, b).unwrap();
+            let e = read_babylon_env(&p).unwrap_err();
+            assert_eq!(e.fault(), crate::Fault::Input);
+            assert!(e.problem().contains(says), "{e}");
+        };
+        let mut no_magic = bytes.clone();
+        no_magic[0] ^= 1;
+        damaged(&no_magic, "magic");
+        damaged(&bytes[..bytes.len() - 10], "outside the file");
+        let key = b"\"width\":8";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap();
+        let mut narrower = bytes.clone();
+        narrower[at + key.len() - 1] = b'4';
+        damaged(&narrower, "specular images");
+
+        // A chain that stops short is refused before anything is written.
+        let short = BabylonEnv {
+            levels: chain(8)[..2].to_vec(),
+            ..env
+        };
+        let e = write_babylon_env(&dir.path().join("c.env"), &short).unwrap_err();
+        assert_eq!(e.fault(), crate::Fault::Request);
+        assert!(!dir.path().join("c.env").exists());
+    }
+}
