@@ -13,38 +13,16 @@ import test from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { bake, browser, directionCoded, readPng, rgbdDecode, serve, tempDir } from './lib.mjs';
+import { bake, browser, directionCoded, mirrorChecks, readPng, reflect, rgbdDecode, serve, sphereHit, tempDir, viewRay } from './lib.mjs';
 
 const SIZE = 64;
 const FOV = 0.7;
 
-/// The ray through pixel (px, py) (top row 0) of a w×h canvas, camera at (0, 0, −4)
-/// looking along +Z with vertical field of view FOV, in Babylon's world.
-function ray(px, py, w, h) {
-  const t = Math.tan(FOV / 2);
-  const x = ((2 * (px + 0.5)) / w - 1) * t * (w / h);
-  const y = (1 - (2 * (py + 0.5)) / h) * t;
-  const n = Math.hypot(x, y, 1);
-  return [x / n, y / n, 1 / n];
-}
-
-/// Where the ray from (0, 0, −4) hits the unit sphere at the origin: its normal there, or null.
-function hit(d) {
-  const o = [0, 0, -4];
-  const b = o[0] * d[0] + o[1] * d[1] + o[2] * d[2];
-  const disc = b * b - (16 - 1);
-  if (disc < 0) return null;
-  const s = -b - Math.sqrt(disc);
-  return [o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]];
-}
-
-const reflect = (d, n) => {
-  const k = 2 * (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
-  return [d[0] - k * n[0], d[1] - k * n[1], d[2] - k * n[2]];
-};
 /// Babylon's world direction to mirrorball's.
 const toMirrorball = (d) => [d[0], d[1], -d[2]];
-const coded = (d) => d.map((c) => 0.5 + 0.5 * c);
+const EYE = [0, 0, -4];
+const ray = (px, py, w, h) => viewRay(px, py, w, h, FOV, 1);
+const hit = (d) => sphereHit(EYE, d);
 const pixel = (r, px, py) => [0, 1, 2].map((k) => r.pixels[(py * r.w + px) * 4 + k] / 255);
 
 /// Reads a .env as Babylon's GetEnvInfo does: the magic, the NUL-ended manifest, the images.
@@ -81,25 +59,10 @@ test('Babylon.js loads the .env and shows it the right way round', async (t) => 
     assert.ok(Math.abs(mirror.info.lodGenerationScale - 0.8) < 1e-9, JSON.stringify(mirror.info));
     assert.equal(mirror.info.lodGenerationOffset, 0);
     assert.equal(mirror.info.linearSpecularLOD, false);
+    assert.equal(mirror.info.gammaSpace, false, 'the .env loader marks its texture linear');
 
     const { w, h } = mirror;
-    const checks = [];
-    // Background: left, right, up, down of the sphere and the corners; mirror: the centre
-    // (what is behind the camera, mirrorball's +Z) and four points off it.
-    for (const [fx, fy, what] of [
-      [0.06, 0.5, 'background left'], [0.94, 0.5, 'background right'],
-      [0.5, 0.06, 'background up'], [0.5, 0.94, 'background down'],
-      [0.1, 0.1, 'background up-left'], [0.9, 0.9, 'background down-right'],
-      [0.5, 0.5, 'mirror centre'], [0.34, 0.5, 'mirror left'], [0.66, 0.5, 'mirror right'],
-      [0.5, 0.34, 'mirror up'], [0.5, 0.66, 'mirror down'], [0.4, 0.6, 'mirror down-left'],
-    ]) {
-      const [px, py] = [Math.floor(fx * w), Math.floor(fy * h)];
-      const d = ray(px, py, w, h);
-      const n = hit(d);
-      assert.equal(n !== null, what.startsWith('mirror'), `${what}: the ray ${n ? 'hits' : 'misses'} the sphere`);
-      const seen = toMirrorball(n ? reflect(d, n) : d);
-      checks.push({ what, got: pixel(mirror, px, py), want: coded(seen) });
-    }
+    const checks = mirrorChecks(mirror, { eye: EYE, forward: 1, fov: FOV, toWorld: toMirrorball });
     for (const { what, got, want } of checks) {
       const err = Math.max(...got.map((g, k) => Math.abs(g - want[k])));
       t.diagnostic(`${what}: got ${got.map((v) => v.toFixed(3))} want ${want.map((v) => v.toFixed(3))}`);

@@ -15,7 +15,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 import validator from 'gltf-validator';
-import { bake, directionCoded, readPng, tempDir } from './lib.mjs';
+import { bake, browser, directionCoded, mirrorChecks, readPng, serve, tempDir } from './lib.mjs';
 
 const EXT = 'EXT_lights_image_based';
 const SIZE = 64;
@@ -87,5 +87,59 @@ test('the EXT_lights_image_based glTF passes the Khronos validator', async (t) =
     assert.deepEqual([first.width, first.channels], [SIZE, 4]);
   } finally {
     tmp.remove();
+  }
+});
+
+// The same light in Babylon.js: its glTF loader's EXT_lights_image_based path (see
+// babylon.html's loadGltfLight: Babylon's own RawCubeTexture.updateRGBDAsync and
+// SphericalHarmonics/SphericalPolynomial, the loader's few lines of glue transcribed, as
+// @babylonjs/loaders has no release matching the pinned core), in a right-handed scene
+// where the glTF world is the scene's: a mirror sphere and the background right way round,
+// compared as babylon.test.mjs compares (linear output, traced directions), and the
+// polynomial Babylon makes from the coefficients against the one it sums from the pixels.
+//
+// Babylon's loader leaves the RawCubeTexture's gammaSpace at its default, true, so its
+// shader takes the decoded radiance for gamma-encoded and linearises it once more
+// (GAMMAREFLECTION, Materials/materialHelper.functions.js:756: toLinearSpace, x^2.2): the
+// light comes out as radiance^2.2, darker. That is Babylon's, not the file's (the extension
+// says a four-channel PNG is RGBD HDR, linear); the comparison applies the same x^2.2 and
+// asserts the flag, so a Babylon that fixes it shows here.
+test('Babylon.js shows the glTF light the right way round', async (t) => {
+  const tmp = tempDir();
+  const { server, url } = await serve(tmp.dir);
+  const b = await browser();
+  try {
+    const input = directionCoded(path.join(tmp.dir, 'coded.exr'), 512);
+    bake('gltf', input, tmp.dir, SIZE);
+    const page = await b.newPage();
+    const errors = [];
+    page.on('pageerror', (e) => errors.push(e.message));
+    await page.goto(`${url}/babylon.html`);
+    await page.waitForFunction(() => window.ready === true, null, { timeout: 20000 });
+    const fov = 0.7;
+    const r = await page.evaluate(([u, f]) => window.renderEnv(u, 0, f), ['/baked/lighting.gltf', fov]);
+    await page.screenshot({ path: path.join(tmp.dir, 'gltf-mirror.png') });
+    assert.deepEqual(errors, []);
+    assert.ok(Math.abs(r.info.lodGenerationScale - 2 / 6) < 1e-9, JSON.stringify(r.info.lodGenerationScale));
+    assert.equal(r.info.gammaSpace, true, 'Babylon now takes the light as linear: drop the x^2.2 below');
+    for (const check of mirrorChecks(r, { eye: [0, 0, 4], forward: -1, fov, toWorld: (d) => d })) {
+      const { what, got } = check;
+      const want = check.want.map((v) => Math.pow(v, 2.2));
+      const err = Math.max(...got.map((g, k) => Math.abs(g - want[k])));
+      t.diagnostic(`${what}: got ${got.map((v) => v.toFixed(3))} want ${want.map((v) => v.toFixed(3))}`);
+      assert.ok(err < 0.035, `${what}: Babylon shows ${got.map((v) => v.toFixed(3))}, the world there is ${want.map((v) => v.toFixed(3))}`);
+    }
+    for (let i = 0; i < 9; i++) {
+      for (let k = 0; k < 3; k++) {
+        const [a, s] = [r.info.declared[i][k], r.info.summed[i][k]];
+        assert.ok(Math.abs(a - s) < 0.01, `polynomial term ${i}[${k}]: from the coefficients ${a}, Babylon sums ${s}`);
+      }
+    }
+    assert.ok(r.info.declared[0][0] > 0.2 && r.info.declared[1][1] > 0.2 && r.info.declared[2][2] < -0.2, JSON.stringify(r.info.declared));
+  } finally {
+    await b.close();
+    server.close();
+    if (!process.env.KEEP) tmp.remove();
+    else console.log(`kept ${tmp.dir}`);
   }
 });

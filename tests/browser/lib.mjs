@@ -153,3 +153,55 @@ export function rgbdDecode(r, g, b, d) {
   const k = d / 255;
   return [r, g, b].map((v) => (k ? Math.pow(v / 255, 2.2) / k : 0));
 }
+
+/// The unit view ray through pixel (px, py) (row 0 at the top) of a w×h picture from a
+/// camera with vertical field of view `fov` (radians), +X right and +Y up on the screen,
+/// looking along `forward`·Z (+1: a left-handed camera as Babylon's default, −1: OpenGL's).
+export function viewRay(px, py, w, h, fov, forward) {
+  const t = Math.tan(fov / 2);
+  const x = ((2 * (px + 0.5)) / w - 1) * t * (w / h);
+  const y = (1 - (2 * (py + 0.5)) / h) * t;
+  const n = Math.hypot(x, y, 1);
+  return [x / n, y / n, forward / n];
+}
+
+/// Where the ray from `origin` along unit `d` first meets the unit sphere at the origin (its
+/// outward normal there), or null.
+export function sphereHit(origin, d) {
+  const b = origin[0] * d[0] + origin[1] * d[1] + origin[2] * d[2];
+  const disc = b * b - (origin[0] ** 2 + origin[1] ** 2 + origin[2] ** 2 - 1);
+  if (disc < 0) return null;
+  const s = -b - Math.sqrt(disc);
+  return [0, 1, 2].map((k) => origin[k] + s * d[k]);
+}
+
+/// `d` reflected about unit normal `n`.
+export function reflect(d, n) {
+  const k = 2 * (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
+  return [0, 1, 2].map((i) => d[i] - k * n[i]);
+}
+
+/// The right-way-round checks of a picture (`{ w, h, pixels }`, RGBA bytes, top row first,
+/// linear) of a unit mirror sphere at the origin in front of a direction-coded background
+/// (colour ½ + ½·d), seen from `eye` along `forward`·Z with vertical field of view `fov`:
+/// per point (background left, right, up, down and two corners; the sphere's centre and
+/// five points off it) what the picture shows and the colour of the direction seen there,
+/// `toWorld` turning the scene's direction into the environment's.
+export function mirrorChecks(r, { eye, forward, fov, toWorld }) {
+  const points = [
+    [0.06, 0.5, 'background left'], [0.94, 0.5, 'background right'],
+    [0.5, 0.06, 'background up'], [0.5, 0.94, 'background down'],
+    [0.1, 0.1, 'background up-left'], [0.9, 0.9, 'background down-right'],
+    [0.5, 0.5, 'mirror centre'], [0.34, 0.5, 'mirror left'], [0.66, 0.5, 'mirror right'],
+    [0.5, 0.34, 'mirror up'], [0.5, 0.66, 'mirror down'], [0.4, 0.6, 'mirror down-left'],
+  ];
+  return points.map(([fx, fy, what]) => {
+    const [px, py] = [Math.floor(fx * r.w), Math.floor(fy * r.h)];
+    const d = viewRay(px, py, r.w, r.h, fov, forward);
+    const n = sphereHit(eye, d);
+    if ((n !== null) !== what.startsWith('mirror')) throw new Error(`${what}: the ray ${n ? 'hits' : 'misses'} the sphere`);
+    const seen = toWorld(n ? reflect(d, n) : d);
+    const got = [0, 1, 2].map((k) => r.pixels[(py * r.w + px) * 4 + k] / 255);
+    return { what, got, want: seen.map((c) => 0.5 + 0.5 * c) };
+  });
+}
