@@ -73,11 +73,11 @@ pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
 pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
     check(dir, opts)?;
     let ibl = GltfIbl {
-        name: if opts.source.is_empty() {
-            "environment".into()
-        } else {
-            opts.source.clone()
-        },
+        name: Path::new(&opts.source)
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("environment")
+            .to_string(),
         intensity: 1.0,
         rotation: [0.0, 0.0, 0.0, 1.0],
         irradiance_coefficients: babylon_harmonics(&l.sh9),
@@ -101,7 +101,10 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
          ```js\n\
          scene.useRightHandedSystem = true;\n\
          await BABYLON.SceneLoader.AppendAsync(\"./\", \"{FILE}\", scene); // @babylonjs/loaders\n\
-         ```\n",
+         ```\n\n\
+         Babylon's loader leaves the light's texture marked gamma-encoded (`gammaSpace` \
+         true), so its shader darkens the light to radiance^2.2; the file's RGBD is linear, \
+         as the extension says.\n",
         name = ibl.name,
         size = opts.size,
         low = opts.size >> (n - 1),
@@ -150,7 +153,7 @@ mod tests {
         });
         let opts = BakeOptions {
             size: 32,
-            source: "coded.exr".into(),
+            source: "/maps/coded.exr".into(),
             ..Default::default()
         };
         let spec = chain_spec(&opts);
