@@ -11,7 +11,7 @@
 //!   (viewer along −Z) through the lookup `(x, y, −z)`: the cube Babylon gets shows, at
 //!   `d`, what mirrorball's shows at `(d.x, d.y, −d.z)` ([`babylon_cube`]).
 //! - **Rows.** Each PNG is uploaded with `invertY` (`_OnImageReadyAsync`,
-//!   `Misc/environmentTextureTools.pure.js:357`) and drawn into the face by a full-screen
+//!   `Misc/environmentTextureTools.pure.js:358`) and drawn into the face by a full-screen
 //!   pass whose `vUV = 0` is the face's row `t = 0`: the picture's bottom row is `t = 0`,
 //!   so a PNG holds OpenGL's face upside down ([`rgbd_faces`]).
 //! - **Levels.** The shader reads `lod = log2(width · α) · lodGenerationScale + offset`
@@ -19,7 +19,7 @@
 //!   pbrIBLFunctions.js:5`; `convertRoughnessToAverageSlope`, `pbrHelperFunctions.js:9`;
 //!   the scale and offset, `pbrBlockReflection.js:95`), the offset 0 for a `.env`; level
 //!   `i` is therefore GGX at `α = 2^(i/scale)/width`, as Babylon's own prefilter makes it
-//!   (`HDRFiltering`, `Materials/Textures/Filtering/hdrFiltering.pure.js:85`, level 0 a
+//!   (`HDRFiltering`, `Materials/Textures/Filtering/hdrFiltering.js:85`, level 0 a
 //!   mirror), roughness clamped to 1 ([`level_roughness`]). The scale is Babylon's 0.8.
 //! - **Diffuse.** A spherical polynomial made from SH as Babylon makes it
 //!   ([`babylon_harmonics`], [`spherical_polynomial`]); no irradiance cube.
@@ -143,7 +143,7 @@ pub(crate) fn rgbd_faces(cube: &EnvMap) -> [Rgba8Face; 6] {
 /// cosine kernel π, 2π/3, π/4, the same as [`Sh9::lambert`]'s times π): the irradiance E,
 /// `[l00, l1_1, l10, l11, l2_2, l2_1, l20, l21, l22][channel]`.
 ///
-/// Its basis (`SH3ylmBasisConstants`, `Maths/sphericalPolynomial.pure.js:41`) has the
+/// Its basis (`SH3ylmBasisConstants`, `Maths/sphericalPolynomial.pure.js:40`) has the
 /// constants of ours with a minus sign on `y`, `x`, `yz`, `xz` (Condon–Shortley), and it is
 /// evaluated at Babylon's lookup direction `(x, y, −z)` (the module documentation), which
 /// flips `z`, `yz`, `xz`: coefficient `i` is ours times `SIGN[i]`.
@@ -155,7 +155,7 @@ pub(crate) fn babylon_harmonics(sh: &Sh9) -> [[f64; 3]; 9] {
 
 /// Babylon's `SphericalPolynomial.FromHarmonics` of harmonics `h` after its
 /// `convertIrradianceToLambertianRadiance` (÷π), constants and signs as
-/// `updateFromHarmonics` has them (`Maths/sphericalPolynomial.pure.js:270`), its own final
+/// `updateFromHarmonics` has them (`Maths/sphericalPolynomial.pure.js:375`), its own final
 /// ÷π included: the `.env` manifest's `irradiance`, terms `x y z xx yy zz yz zx xy`.
 pub(crate) fn spherical_polynomial(irradiance: &[[f64; 3]; 9]) -> [[f64; 3]; 9] {
     let h = |i: usize, k: usize| irradiance[i][k] / PI;
