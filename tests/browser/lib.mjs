@@ -4,6 +4,7 @@
 import { createServer } from 'node:http';
 import { readFile, stat } from 'node:fs/promises';
 import { execFileSync } from 'node:child_process';
+import { inflateSync } from 'node:zlib';
 import { mkdtempSync, rmSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
@@ -109,4 +110,106 @@ export function prefiltered(input, roughness, dirs) {
   buildExamples();
   const args = [input, String(roughness), ...dirs.map((d) => d.join(','))];
   return JSON.parse(execFileSync(path.join(EXAMPLES, 'prefiltered'), args, { encoding: 'utf8' }));
+}
+
+/// Decodes an 8-bit, non-interlaced PNG (greyscale, RGB or RGBA) from its bytes, exactly:
+/// no colour management or premultiplication (a 2D canvas would premultiply RGBD's alpha).
+/// Returns `{ width, height, channels, data }`, `data` the samples, top row first.
+export function readPng(bytes) {
+  const buf = Buffer.from(bytes);
+  const SIG = [0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a];
+  if (!SIG.every((b, i) => buf[i] === b)) throw new Error('not a PNG');
+  let pos = 8, width = 0, height = 0, channels = 0;
+  const idat = [];
+  while (pos < buf.length) {
+    const len = buf.readUInt32BE(pos);
+    const type = buf.toString('latin1', pos + 4, pos + 8);
+    const body = buf.subarray(pos + 8, pos + 8 + len);
+    if (type === 'IHDR') {
+      width = body.readUInt32BE(0);
+      height = body.readUInt32BE(4);
+      const [depth, colour, , , interlace] = body.subarray(8, 13);
+      channels = { 0: 1, 2: 3, 6: 4 }[colour];
+      if (depth !== 8 || !channels || interlace) throw new Error(`unsupported PNG (depth ${depth}, colour ${colour}, interlace ${interlace})`);
+    } else if (type === 'IDAT') idat.push(body);
+    else if (type === 'IEND') break;
+    pos += 12 + len;
+  }
+  const raw = inflateSync(Buffer.concat(idat));
+  const stride = width * channels;
+  const data = new Uint8Array(height * stride);
+  for (let y = 0; y < height; y++) {
+    const filter = raw[y * (stride + 1)];
+    const line = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
+    for (let x = 0; x < stride; x++) {
+      const a = x >= channels ? data[y * stride + x - channels] : 0;
+      const b = y > 0 ? data[(y - 1) * stride + x] : 0;
+      const c = x >= channels && y > 0 ? data[(y - 1) * stride + x - channels] : 0;
+      const p = a + b - c;
+      const pa = Math.abs(p - a), pb = Math.abs(p - b), pc = Math.abs(p - c);
+      const paeth = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+      const pred = [0, a, b, (a + b) >> 1, paeth][filter];
+      if (pred === undefined) throw new Error(`PNG filter ${filter}`);
+      data[y * stride + x] = (line[x] + pred) & 0xff;
+    }
+  }
+  return { width, height, channels, data };
+}
+
+/// Babylon.js's `fromRGBD` (helperFunctions.fx): `toLinearSpace(rgb) / D`, gamma 2.2.
+export function rgbdDecode(r, g, b, d) {
+  const k = d / 255;
+  return [r, g, b].map((v) => (k ? Math.pow(v / 255, 2.2) / k : 0));
+}
+
+/// The unit view ray through pixel (px, py) (row 0 at the top) of a w×h picture from a
+/// camera with vertical field of view `fov` (radians), +X right and +Y up on the screen,
+/// looking along `forward`·Z (+1: a left-handed camera as Babylon's default, −1: OpenGL's).
+export function viewRay(px, py, w, h, fov, forward) {
+  const t = Math.tan(fov / 2);
+  const x = ((2 * (px + 0.5)) / w - 1) * t * (w / h);
+  const y = (1 - (2 * (py + 0.5)) / h) * t;
+  const n = Math.hypot(x, y, 1);
+  return [x / n, y / n, forward / n];
+}
+
+/// Where the ray from `origin` along unit `d` first meets the unit sphere at the origin (its
+/// outward normal there), or null.
+export function sphereHit(origin, d) {
+  const b = origin[0] * d[0] + origin[1] * d[1] + origin[2] * d[2];
+  const disc = b * b - (origin[0] ** 2 + origin[1] ** 2 + origin[2] ** 2 - 1);
+  if (disc < 0) return null;
+  const s = -b - Math.sqrt(disc);
+  return [0, 1, 2].map((k) => origin[k] + s * d[k]);
+}
+
+/// `d` reflected about unit normal `n`.
+export function reflect(d, n) {
+  const k = 2 * (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
+  return [0, 1, 2].map((i) => d[i] - k * n[i]);
+}
+
+/// The right-way-round checks of a picture (`{ w, h, pixels }`, RGBA bytes, top row first,
+/// linear) of a unit mirror sphere at the origin in front of a direction-coded background
+/// (colour ½ + ½·d), seen from `eye` along `forward`·Z with vertical field of view `fov`:
+/// per point (background left, right, up, down and two corners; the sphere's centre and
+/// five points off it) what the picture shows and the colour of the direction seen there,
+/// `toWorld` turning the scene's direction into the environment's.
+export function mirrorChecks(r, { eye, forward, fov, toWorld }) {
+  const points = [
+    [0.06, 0.5, 'background left'], [0.94, 0.5, 'background right'],
+    [0.5, 0.06, 'background up'], [0.5, 0.94, 'background down'],
+    [0.1, 0.1, 'background up-left'], [0.9, 0.9, 'background down-right'],
+    [0.5, 0.5, 'mirror centre'], [0.34, 0.5, 'mirror left'], [0.66, 0.5, 'mirror right'],
+    [0.5, 0.34, 'mirror up'], [0.5, 0.66, 'mirror down'], [0.4, 0.6, 'mirror down-left'],
+  ];
+  return points.map(([fx, fy, what]) => {
+    const [px, py] = [Math.floor(fx * r.w), Math.floor(fy * r.h)];
+    const d = viewRay(px, py, r.w, r.h, fov, forward);
+    const n = sphereHit(eye, d);
+    if ((n !== null) !== what.startsWith('mirror')) throw new Error(`${what}: the ray ${n ? 'hits' : 'misses'} the sphere`);
+    const seen = toWorld(n ? reflect(d, n) : d);
+    const got = [0, 1, 2].map((k) => r.pixels[(py * r.w + px) * 4 + k] / 255);
+    return { what, got, want: seen.map((c) => 0.5 + 0.5 * c) };
+  });
 }

@@ -32,13 +32,13 @@ fn main() {
         source: args[1].clone(),
         ..Default::default()
     };
-    if let Err(e) = engine.check(&opts) {
+    let dir = Path::new(&args[2]);
+    if let Err(e) = engine.check(dir, &opts) {
         eprintln!("{e}");
         std::process::exit(2);
     }
     let spec = engine.chain_spec(&opts);
     let lighting = Lighting::from_env(&env, &spec, Default::default());
-    let dir = Path::new(&args[2]);
     std::fs::create_dir_all(dir).expect("the output folder");
     match write(engine, &lighting, dir, &opts) {
         Ok(files) => files.iter().for_each(|f| println!("{}", f.display())),

@@ -1,18 +1,197 @@
-//! Lighting for gltf: the files, the convention and the roughness-to-mip rule.
+//! Lighting for glTF 2.0's `EXT_lights_image_based` (the file: `mirrorball_io::gltf_ibl`).
+//!
+//! The extension's README (KhronosGroup/glTF, `extensions/2.0/Vendor/EXT_lights_image_based`)
+//! fixes the containers (N×6 images, faces +X −X +Y −Y +Z −Z, a four-channel PNG is RGBD,
+//! 9×3 SH coefficients "for irradiance") but not the SH basis, the faces' exact
+//! orientation or which roughness each level holds; those are what its one loader,
+//! Babylon.js's (`packages/dev/loaders/src/glTF/2.0/Extensions/EXT_lights_image_based.ts`,
+//! `_loadLightAsync`), reads:
+//!
+//! - the images go through the same upload as a `.env`'s (`updateRGBDAsync` →
+//!   `UploadRadianceLevelsAsync`), so faces, rows and RGBD are [`crate::babylon`]'s;
+//! - `irradianceCoefficients` are `SphericalHarmonics.FromArray`, scaled by `intensity`,
+//!   then `convertIrradianceToLambertianRadiance` and `SphericalPolynomial.FromHarmonics`:
+//!   Babylon's harmonics of the irradiance, [`crate::babylon::babylon_harmonics`];
+//! - `lodGenerationScale = (N − 1)/log2(specularImageSize)` for N levels, so the shader
+//!   (`lod = log2(size·α)·scale`) reads level `i` at `α = 2^(i/scale)/size`: roughness 1
+//!   at the last level. The README's "levels evenly map to roughness values from 0 to 1"
+//!   is not what that loader does; the levels here hold what it reads.
+//!
+//! The chain stops at [`LOWEST_EDGE`] (the README: the lowest mip "say, 16x16" holds
+//! roughness 1). The glTF world is mirrorball's (right-handed, +Y up); Babylon sees the
+//! light the right way round in a right-handed scene (`useRightHandedSystem`, the usual
+//! setting for glTF). The light's `rotation` is the identity and its `intensity` 1.
 
-use crate::{mip_levels, not_written, BakeOptions, ChainSpec, Lighting};
-use mirrorball_io::Error;
+use crate::babylon::{babylon_cube, babylon_harmonics, level_roughness, rgbd_faces};
+use crate::{BakeOptions, ChainSpec, Lighting};
+use mirrorball_io::{write_gltf_ibl, Error, GltfIbl};
 use std::path::{Path, PathBuf};
 
-/// The levels gltf takes.
+/// The smallest specular level's edge (when level 0 is larger).
+pub(crate) const LOWEST_EDGE: u32 = 16;
+
+/// The glTF file's name in the output folder.
+pub(crate) const FILE: &str = "lighting.gltf";
+
+/// Refuses, before any work, what the extension cannot hold (see [`crate::babylon::check`]).
+pub(crate) fn check(dir: &Path, opts: &BakeOptions) -> Result<(), Error> {
+    crate::babylon::check(dir, opts, "glTF's EXT_lights_image_based")?;
+    if opts.size < 2 {
+        return Err(Error::request(
+            dir,
+            "EXT_lights_image_based needs level 0 at least 2×2 (its loader divides by \
+             log2 of the size)"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Babylon's loader's `lodGenerationScale` for `levels` levels of edge `size` down.
+pub(crate) fn lod_generation_scale(levels: usize, size: u32) -> f64 {
+    (levels as f64 - 1.0) / f64::from(size.max(2)).log2()
+}
+
+/// The levels: level 0's edge halved down to [`LOWEST_EDGE`], level `i` at the roughness
+/// Babylon's loader and shader read it at; no irradiance cube (SH only).
 pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
+    let size = opts.size.max(1);
+    let n = (size
+        .trailing_zeros()
+        .saturating_sub(LOWEST_EDGE.trailing_zeros())
+        + 1) as usize;
+    let scale = lod_generation_scale(n, size);
     ChainSpec {
-        levels: mip_levels(opts.size, |i, n| i as f64 / (n.max(2) - 1) as f64),
-        diffuse_face: Some(32),
+        levels: (0..n)
+            .map(|i| ((size >> i).max(1), level_roughness(i, size, scale)))
+            .collect(),
+        diffuse_face: None,
     }
 }
 
-/// Writes gltf's files into `dir`.
-pub(crate) fn write(_l: &Lighting, dir: &Path, _opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    Err(not_written(dir, "gltf"))
+/// Writes `lighting.gltf`, its images and a note into `dir`.
+pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+    check(dir, opts)?;
+    let ibl = GltfIbl {
+        name: Path::new(&opts.source)
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("environment")
+            .to_string(),
+        intensity: 1.0,
+        rotation: [0.0, 0.0, 0.0, 1.0],
+        irradiance_coefficients: babylon_harmonics(&l.sh9),
+        levels: l
+            .specular
+            .iter()
+            .map(|level| rgbd_faces(&babylon_cube(level)))
+            .collect(),
+    };
+    let mut files = write_gltf_ibl(&dir.join(FILE), &ibl)?;
+    let note = dir.join("README.md");
+    let n = l.specular.len();
+    let text = format!(
+        "# glTF image-based light from {name}\n\n\
+         `{FILE}`: glTF 2.0 with one `EXT_lights_image_based` light, referenced by the \
+         default scene: {n} specular levels of six RGBD PNG faces ({size}² down to {low}²), \
+         level i GGX at α = 2^(i·log2({size})/{last})/{size} (roughness 1 at the last level, \
+         as Babylon.js's loader reads them), irradiance as 9×3 SH coefficients in Babylon's \
+         basis. Load it into a right-handed Babylon scene, which sees the glTF world the \
+         right way round (a left-handed one turns it half a turn about +Y):\n\n\
+         ```js\n\
+         scene.useRightHandedSystem = true;\n\
+         await BABYLON.SceneLoader.AppendAsync(\"./\", \"{FILE}\", scene); // @babylonjs/loaders\n\
+         ```\n\n\
+         Babylon's loader leaves the light's texture marked gamma-encoded (`gammaSpace` \
+         true), so its shader darkens the light to radiance^2.2; the file's RGBD is linear, \
+         as the extension says.\n",
+        name = ibl.name,
+        size = opts.size,
+        low = opts.size >> (n - 1),
+        last = (n - 1).max(1),
+    );
+    mirrorball_io::atomic_write(&note, |w| {
+        std::io::Write::write_all(w, text.as_bytes()).map_err(|e| Error::io(&note, e))
+    })?;
+    files.push(note);
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_chain_runs_from_a_mirror_to_roughness_one_at_the_lowest_level() {
+        let spec = chain_spec(&BakeOptions {
+            size: 256,
+            ..Default::default()
+        });
+        let edges: Vec<u32> = spec.levels.iter().map(|l| l.0).collect();
+        assert_eq!(edges, [256, 128, 64, 32, 16]);
+        assert_eq!(spec.levels[0].1, 0.0);
+        assert!((spec.levels[4].1 - (1.0f64 - 0.0005).sqrt()).abs() < 1e-12);
+        assert!(spec.levels.windows(2).all(|w| w[0].1 < w[1].1));
+        // A 16² bake is one mirror level, as the loader reads it (scale 0).
+        let small = chain_spec(&BakeOptions {
+            size: 16,
+            ..Default::default()
+        });
+        assert_eq!(small.levels, [(16, 0.0)]);
+    }
+
+    #[test]
+    fn the_gltf_reads_back_as_written_and_bad_requests_are_refused_first() {
+        use mirrorball_core::{EnvMap, ProjectionKind};
+        let env = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 128, 3, |d| {
+            [
+                (0.5 + 0.5 * d.x) as f32,
+                0.5,
+                (0.5 - 0.25 * d.z) as f32,
+                1.0,
+            ]
+        });
+        let opts = BakeOptions {
+            size: 32,
+            source: "/maps/coded.exr".into(),
+            ..Default::default()
+        };
+        let spec = chain_spec(&opts);
+        let lighting = Lighting::from_env(&env, &spec, Default::default());
+        let dir = tempfile::tempdir().unwrap();
+        let files = write(&lighting, dir.path(), &opts).unwrap();
+        assert_eq!(files.len(), 2 * 6 + 2);
+        let back = mirrorball_io::read_gltf_ibl(&dir.path().join(FILE)).unwrap();
+        assert_eq!(back.name, "coded.exr");
+        assert_eq!((back.intensity, back.rotation), (1.0, [0.0, 0.0, 0.0, 1.0]));
+        let want = babylon_harmonics(&lighting.sh9);
+        for (b, w) in back
+            .irradiance_coefficients
+            .iter()
+            .flatten()
+            .zip(want.iter().flatten())
+        {
+            assert!((b - w).abs() <= 1e-15 * w.abs().max(1.0), "{b} vs {w}");
+        }
+        let made: Vec<_> = lighting
+            .specular
+            .iter()
+            .map(|level| rgbd_faces(&babylon_cube(level)))
+            .collect();
+        assert_eq!(back.levels, made);
+
+        for (size, encoding) in [
+            (48, None),
+            (32, Some(mirrorball_io::Encoding::Bc6hUnsigned)),
+        ] {
+            let bad = BakeOptions {
+                size,
+                encoding,
+                ..Default::default()
+            };
+            let e = check(dir.path(), &bad).unwrap_err();
+            assert_eq!(e.fault(), mirrorball_io::Fault::Request);
+            assert!(e.problem().contains("EXT_lights_image_based"), "{e}");
+        }
+    }
 }

@@ -150,11 +150,13 @@ impl Lighting {
 }
 
 impl Engine {
-    /// Refuses a bake this engine cannot take (its size, encoding or supercompression), with
-    /// the reason, before any work.
-    pub fn check(self, opts: &BakeOptions) -> Result<(), String> {
+    /// Refuses, before any work, a bake this engine cannot take (a face edge or an encoding
+    /// its loader does not read); `dir` is the output folder, for the message.
+    pub fn check(self, dir: &Path, opts: &BakeOptions) -> Result<(), Error> {
         match self {
-            Engine::Three => three::check(opts),
+            Engine::Babylon => babylon::check(dir, opts, "Babylon.js"),
+            Engine::Gltf => gltf::check(dir, opts),
+            Engine::Three => three::check(opts).map_err(|e| Error::request(dir, e)),
             _ => Ok(()),
         }
     }

@@ -22,11 +22,13 @@
 mod alloc;
 mod apng;
 mod atomic;
+mod babylon_env;
 mod bounds;
 mod dds_io;
 mod error;
 mod exr_io;
 mod exr_zip;
+mod gltf_ibl;
 mod hdr_io;
 mod ktx1_io;
 mod ktx2_io;
@@ -34,16 +36,20 @@ mod ldr_io;
 mod meta_text;
 pub mod openexr;
 mod output;
+mod rgba_png;
 
 pub use alloc::HugePages;
 pub use apng::write_apng;
 pub use atomic::{atomic_write, interrupted};
+pub use babylon_env::{read_babylon_env, write_babylon_env, BabylonEnv};
 pub use dds_io::write_dds;
 pub use error::{Error, Fault};
+pub use gltf_ibl::{read_gltf_ibl, write_gltf_ibl, GltfIbl};
 pub use ktx1_io::{filament_sh_text, write_ktx1};
 pub use ktx2_io::{write_ktx2, CubeWrite};
 pub use mirrorball_encode::{Effort, Encoding};
 pub use output::OutputSet;
+pub use rgba_png::Rgba8Face;
 
 use atomic::Staged;
 use exr_io::WriteBuffers;
