@@ -249,7 +249,7 @@ impl ProjectionSpec {
                     self.vfov.unwrap_or(90.0),
                 );
                 let [yaw, pitch, roll] = self.aim.map(|a| a.unwrap_or(0.0));
-                if !(d >= 0.0) {
+                if d.is_nan() || d < 0.0 {
                     return Err(format!("pannini: d must be 0 or more, not {d}"));
                 }
                 let view = if pannini {
