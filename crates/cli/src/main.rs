@@ -66,9 +66,12 @@ enum Command {
 pub struct InputArgs {
     /// Projection of the input, `NAME[:key=value…]` (guessed from the file when omitted).
     /// Names: latlong, cube, sphere, paraboloid, continuous-cube, mercator, angular, fisheye,
-    /// octahedral, equal-area-octahedral (aliases: equirect, cubemap, matcap, probe, …).
+    /// octahedral, equal-area-octahedral, cylindrical, cylindrical-equal-area, half-equirect,
+    /// hammer, sinusoidal, perspective, pannini (aliases: equirect, cubemap, matcap, probe,
+    /// cea, vr180, rectilinear, flat, …).
     /// Keys: look=+x|-z|x,y,z  fov=DEG  lens=equidistant|equisolid|stereographic|orthographic
-    /// max-lat=DEG.
+    /// max-lat=DEG  hfov=DEG vfov=DEG (cylinders, half-equirect, views)  d=NUM (pannini)
+    /// yaw=DEG pitch=DEG roll=DEG (views: right, up, about the view axis).
     #[arg(long, value_name = "PROJECTION")]
     from: Option<String>,
     /// Layout of the input's layers.
@@ -90,7 +93,8 @@ pub struct ConvertArgs {
     /// Output projection, `NAME[:key=value…]` (see --from).
     #[arg(long, value_name = "PROJECTION")]
     to: String,
-    /// Face edge (cubes), width (lat-long, Mercator) or diameter (disk maps), in texels.
+    /// Face edge (cubes), width (lat-long, Mercator, cylinders, Hammer, sinusoidal, views) or
+    /// diameter (disk maps), in texels.
     /// Default: about the source's resolution.
     #[arg(long)]
     size: Option<u32>,

@@ -37,9 +37,10 @@ pub use fault::Fault;
 pub use image::Image;
 pub use layout::{guess, Guess, Layout};
 pub use projection::{
-    AngularMap, ContinuousCube, CubeFace, CubeMap, DirRun, DualParaboloid, EqualAreaOctahedral,
-    FaceLanes, Fisheye, Frame, LatLong, Lens, Lookup, Mercator, Octahedral, Projection,
-    ProjectionKind, RadialMap, SphereMap, UnknownProjection, WorldProjection,
+    AngularMap, ContinuousCube, CubeFace, CubeMap, Cylinder, CylinderRule, DirRun, DualParaboloid,
+    EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,
+    Octahedral, Projection, ProjectionKind, RadialMap, Sinusoidal, SphereMap, UnknownProjection,
+    View, WorldProjection,
 };
 pub use remap::{Remap, RemapError};
 pub use resample::{resample, resample_to_extent, Axis, ResampleOptions, Resampler, Rotation};

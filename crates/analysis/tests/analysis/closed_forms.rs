@@ -48,7 +48,9 @@ fn crossovers_of_the_other_disk_maps() {
 fn used_area_fractions() {
     for k in K::ALL {
         let want = match k {
-            K::Sphere | K::Paraboloid | K::Angular | K::Fisheye => PI / 4.0,
+            K::Sphere | K::Paraboloid | K::Angular | K::Fisheye | K::Hammer => PI / 4.0,
+            // |u − ½| ≤ ½ sin πv.
+            K::Sinusoidal => 2.0 / PI,
             _ => 1.0,
         };
         // Disk maps accept points up to 10⁻¹² outside the rim (core's tolerance), so the

@@ -9,9 +9,10 @@ fn small_analysis_serialises_and_draws() {
         ..Default::default()
     };
     let a = analyze(&cfg);
-    assert_eq!(a.report.projections.len(), 10);
+    let kinds = mirrorball_core::ProjectionKind::ALL.len();
+    assert_eq!(a.report.projections.len(), kinds);
     let v: serde_json::Value = serde_json::from_str(&json(&a.report)).expect("valid JSON");
-    assert_eq!(v["projections"].as_array().unwrap().len(), 10);
+    assert_eq!(v["projections"].as_array().unwrap().len(), kinds);
     assert!(v["claims"].as_array().unwrap().len() > 20);
     let ids: Vec<&str> = a.figures.iter().map(|f| f.id.as_str()).collect();
     for id in [

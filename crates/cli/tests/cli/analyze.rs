@@ -26,7 +26,10 @@ fn analyze_writes_a_report() {
     let json = std::fs::read_to_string(out.join("report.json")).unwrap();
     let v: serde_json::Value = serde_json::from_str(&json).expect("report.json parses");
     let projections = v["projections"].as_array().unwrap();
-    assert_eq!(projections.len(), 10);
+    assert_eq!(
+        projections.len(),
+        mirrorball_core::ProjectionKind::ALL.len()
+    );
     assert_eq!(v["sizing"]["mode"], "size");
     assert_eq!(projections[1]["stats"]["width"], 64); // the cube, edge 64
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();

@@ -12,3 +12,4 @@ mod render;
 mod roundtrip;
 mod safety;
 mod util;
+mod v360;

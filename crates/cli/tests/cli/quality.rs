@@ -14,7 +14,7 @@ fn edge_for_budget(kind: ProjectionKind, budget: f64) -> u32 {
 }
 
 /// Recorded log-PSNR (dB) at 1× budget: city, venice, studio, sky.
-const RECORDED: [(ProjectionKind, [f64; 4]); 9] = [
+const RECORDED: [(ProjectionKind, [f64; 4]); 16] = [
     (ProjectionKind::Cube, [43.76, 41.30, 39.36, 43.91]),
     (ProjectionKind::Sphere, [40.88, 35.12, 38.93, 42.85]),
     (ProjectionKind::Paraboloid, [43.00, 40.31, 39.89, 43.96]),
@@ -27,6 +27,16 @@ const RECORDED: [(ProjectionKind, [f64; 4]); 9] = [
         ProjectionKind::EqualAreaOctahedral,
         [44.45, 41.34, 39.11, 43.68],
     ),
+    (ProjectionKind::Cylindrical, [45.38, 41.46, 39.36, 51.78]),
+    (
+        ProjectionKind::CylindricalEqualArea,
+        [44.64, 42.02, 39.10, 43.80],
+    ),
+    (ProjectionKind::HalfEquirect, [45.68, 42.70, 46.27, 40.97]),
+    (ProjectionKind::Hammer, [43.51, 41.95, 39.29, 44.30]),
+    (ProjectionKind::Sinusoidal, [44.88, 47.24, 41.81, 44.86]),
+    (ProjectionKind::Perspective, [40.15, 38.35, 50.74, 42.54]),
+    (ProjectionKind::Pannini, [44.27, 39.20, 47.27, 43.15]),
 ];
 
 #[test]

@@ -409,7 +409,7 @@ macro_rules! radial_impl {
 
 /// Moves `uv` radially onto the disk if it lies outside.
 #[inline]
-fn clamp_to_disk(uv: DVec2) -> DVec2 {
+pub(super) fn clamp_to_disk(uv: DVec2) -> DVec2 {
     let ab = RadialMap::uv_to_ab(uv);
     let r = ab.length();
     if r <= 1.0 {

@@ -249,7 +249,7 @@ impl CubeMap {
 
 /// `atan(ab/√(1+a²+b²))`: the solid angle of the face rectangle `[0,a]×[0,b]`.
 #[inline]
-fn cube_area(a: f64, b: f64) -> f64 {
+pub(super) fn cube_area(a: f64, b: f64) -> f64 {
     (a * b / (1.0 + a * a + b * b).sqrt()).atan()
 }
 

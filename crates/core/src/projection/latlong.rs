@@ -14,8 +14,10 @@ fn lon_of_u(u: f64) -> f64 {
     TAU * (u - 0.5)
 }
 
+/// The unit direction at longitude `lon` and latitude `lat` (radians), as [`LatLong`] reads
+/// them.
 #[inline]
-fn dir_from_lon_lat(lon: f64, lat: f64) -> DVec3 {
+pub(super) fn dir_from_lon_lat(lon: f64, lat: f64) -> DVec3 {
     let (sl, cl) = lon.sin_cos();
     let (sp, cp) = lat.sin_cos();
     DVec3::new(sl * cp, sp, -cl * cp)

@@ -14,18 +14,24 @@
 mod azimuthal;
 mod continuous_cube;
 mod cube;
+mod cylindrical;
 pub mod derivative;
 pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
+mod perspective;
+mod pseudo;
 pub mod quadrature;
 mod spec;
 
 pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap, SphereMap};
 pub use continuous_cube::ContinuousCube;
 pub use cube::{CubeFace, CubeMap, FaceLanes};
+pub use cylindrical::{Cylinder, CylinderRule};
 pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
+pub use perspective::View;
+pub use pseudo::{Hammer, Sinusoidal};
 pub use spec::{parse_dir, ProjectionSpec};
 
 use crate::{Choice, UnknownName};
@@ -177,7 +183,8 @@ pub trait WorldProjection {
         }
     }
 
-    /// The solid angle the projection covers: 4π for all but the fisheye and Mercator.
+    /// The solid angle the projection covers: 4π for all but those with a limit (fisheye,
+    /// Mercator, the views and cylinders with a field of view).
     fn covered_solid_angle(&self) -> f64 {
         4.0 * std::f64::consts::PI
     }
@@ -254,11 +261,25 @@ pub enum ProjectionKind {
     Octahedral,
     /// Equal-area octahedral.
     EqualAreaOctahedral,
+    /// Central cylindrical (`tan` latitude linear in `v`).
+    Cylindrical,
+    /// Lambert's cylindrical equal-area.
+    CylindricalEqualArea,
+    /// Half equirectangular (VR180): the front hemisphere.
+    HalfEquirect,
+    /// Hammer's equal-area ellipse (Hammer–Aitoff).
+    Hammer,
+    /// Sinusoidal (Sanson–Flamsteed).
+    Sinusoidal,
+    /// Rectilinear (perspective) view.
+    Perspective,
+    /// Pannini view.
+    Pannini,
 }
 
 impl ProjectionKind {
     /// Every kind, in the order the documentation lists them.
-    pub const ALL: [ProjectionKind; 10] = [
+    pub const ALL: [ProjectionKind; 17] = [
         ProjectionKind::LatLong,
         ProjectionKind::Cube,
         ProjectionKind::Sphere,
@@ -269,6 +290,13 @@ impl ProjectionKind {
         ProjectionKind::Fisheye,
         ProjectionKind::Octahedral,
         ProjectionKind::EqualAreaOctahedral,
+        ProjectionKind::Cylindrical,
+        ProjectionKind::CylindricalEqualArea,
+        ProjectionKind::HalfEquirect,
+        ProjectionKind::Hammer,
+        ProjectionKind::Sinusoidal,
+        ProjectionKind::Perspective,
+        ProjectionKind::Pannini,
     ];
 
     /// The canonical command-line name (the canonical name of [`Choice`]).
@@ -290,6 +318,17 @@ impl ProjectionKind {
             ProjectionKind::Octahedral => Projection::Octahedral(Octahedral),
             ProjectionKind::EqualAreaOctahedral => {
                 Projection::EqualAreaOctahedral(EqualAreaOctahedral)
+            }
+            ProjectionKind::Cylindrical => Projection::Cylinder(Cylinder::central()),
+            ProjectionKind::CylindricalEqualArea => Projection::Cylinder(Cylinder::equal_area()),
+            ProjectionKind::HalfEquirect => Projection::Cylinder(Cylinder::half_equirect()),
+            ProjectionKind::Hammer => Projection::Hammer(Hammer::default()),
+            ProjectionKind::Sinusoidal => Projection::Sinusoidal(Sinusoidal),
+            ProjectionKind::Perspective => {
+                Projection::View(View::perspective(90.0, 90.0, 0.0, 0.0, 0.0).expect("valid"))
+            }
+            ProjectionKind::Pannini => {
+                Projection::View(View::pannini(1.0, 120.0, 90.0, 0.0, 0.0, 0.0).expect("valid"))
             }
         }
     }
@@ -349,6 +388,38 @@ impl Choice for ProjectionKind {
             ProjectionKind::EqualAreaOctahedral,
             &["equal-area-octahedral", "eao", "clarberg", "equal-area-oct"],
         ),
+        (
+            ProjectionKind::Cylindrical,
+            &["cylindrical", "central-cylindrical", "cylinder"],
+        ),
+        (
+            ProjectionKind::CylindricalEqualArea,
+            &[
+                "cylindrical-equal-area",
+                "cylindricalea",
+                "cea",
+                "lambert-cylindrical",
+            ],
+        ),
+        (
+            ProjectionKind::HalfEquirect,
+            &[
+                "half-equirect",
+                "hequirect",
+                "half-equirectangular",
+                "vr180",
+            ],
+        ),
+        (ProjectionKind::Hammer, &["hammer", "hammer-aitoff"]),
+        (
+            ProjectionKind::Sinusoidal,
+            &["sinusoidal", "sanson-flamsteed"],
+        ),
+        (
+            ProjectionKind::Perspective,
+            &["perspective", "rectilinear", "flat", "gnomonic"],
+        ),
+        (ProjectionKind::Pannini, &["pannini", "panini"]),
     ];
 }
 
@@ -415,6 +486,15 @@ pub enum Projection {
     Octahedral(Octahedral),
     /// See [`EqualAreaOctahedral`].
     EqualAreaOctahedral(EqualAreaOctahedral),
+    /// See [`Cylinder`]: cylindrical, cylindrical equal-area or half equirectangular, by
+    /// its [`CylinderRule`].
+    Cylinder(Cylinder),
+    /// See [`Hammer`].
+    Hammer(Hammer),
+    /// See [`Sinusoidal`].
+    Sinusoidal(Sinusoidal),
+    /// See [`View`]: perspective or Pannini.
+    View(View),
 }
 
 macro_rules! delegate {
@@ -430,6 +510,10 @@ macro_rules! delegate {
             Projection::Fisheye($p) => $e,
             Projection::Octahedral($p) => $e,
             Projection::EqualAreaOctahedral($p) => $e,
+            Projection::Cylinder($p) => $e,
+            Projection::Hammer($p) => $e,
+            Projection::Sinusoidal($p) => $e,
+            Projection::View($p) => $e,
         }
     };
 }
@@ -448,6 +532,15 @@ impl Projection {
             Projection::Fisheye(_) => ProjectionKind::Fisheye,
             Projection::Octahedral(_) => ProjectionKind::Octahedral,
             Projection::EqualAreaOctahedral(_) => ProjectionKind::EqualAreaOctahedral,
+            Projection::Cylinder(c) => match c.rule() {
+                CylinderRule::Central => ProjectionKind::Cylindrical,
+                CylinderRule::EqualArea => ProjectionKind::CylindricalEqualArea,
+                CylinderRule::Equidistant => ProjectionKind::HalfEquirect,
+            },
+            Projection::Hammer(_) => ProjectionKind::Hammer,
+            Projection::Sinusoidal(_) => ProjectionKind::Sinusoidal,
+            Projection::View(v) if v.is_pannini() => ProjectionKind::Pannini,
+            Projection::View(_) => ProjectionKind::Perspective,
         }
     }
 
@@ -532,7 +625,11 @@ impl_from!(
     Angular(AngularMap),
     Fisheye(Fisheye),
     Octahedral(Octahedral),
-    EqualAreaOctahedral(EqualAreaOctahedral)
+    EqualAreaOctahedral(EqualAreaOctahedral),
+    Cylinder(Cylinder),
+    Hammer(Hammer),
+    Sinusoidal(Sinusoidal),
+    View(View)
 );
 
 /// The `[lo, hi]` range in `uv` of texel index `i` of `n`.

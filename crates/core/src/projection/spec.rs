@@ -5,17 +5,20 @@
 //! centre, or a paraboloid's front half looks along: `+x`, `-z`, or `x,y,z`), `up=DIR` (the
 //! picture's up, when it is not the one [`Frame::looking_along`] picks), `fov=DEG` and
 //! `lens=equidistant|equisolid|stereographic|orthographic` (fisheye), `max-lat=DEG`
-//! (Mercator).
+//! (Mercator), `hfov=DEG` and `vfov=DEG` (the fields of view of the cylinders, the half
+//! equirectangular and the views), `d=NUM` (Pannini's distance), `yaw=DEG`, `pitch=DEG` and
+//! `roll=DEG` (where a view looks: yaw to the right, pitch up, as [`View::frame_of`] says).
 //!
 //! [`Projection::spec`] gives every parameter of a built projection, and its text (the
 //! `Display` of [`ProjectionSpec`] or [`Projection`]) is canonical: the name, then the keys
-//! that apply in the order `fov`, `lens`, `max-lat`, `look`, `up`, numbers rounded to 1e-9
-//! (of a degree, or of a unit vector's component). [`ProjectionSpec::parse`] reads it back to
-//! the same projection, to that rounding.
+//! that apply in the order `fov`, `lens`, `max-lat`, `hfov`, `vfov`, `d`, `yaw`, `pitch`,
+//! `roll`, `look`, `up` (a view's zero angles left out), numbers rounded to 1e-9 (of a
+//! degree, or of a unit vector's component). [`ProjectionSpec::parse`] reads it back to the
+//! same projection, to that rounding.
 
 use super::{
-    AngularMap, DualParaboloid, Fisheye, Frame, Lens, Mercator, Projection, ProjectionKind,
-    SphereMap, UnknownProjection,
+    AngularMap, Cylinder, CylinderRule, DualParaboloid, Fisheye, Frame, Lens, Mercator, Projection,
+    ProjectionKind, SphereMap, UnknownProjection, View,
 };
 use crate::Choice;
 use glam::DVec3;
@@ -42,6 +45,11 @@ pub struct ProjectionSpec {
     fov: Option<f64>,
     lens: Option<Lens>,
     max_lat: Option<f64>,
+    hfov: Option<f64>,
+    vfov: Option<f64>,
+    distance: Option<f64>,
+    /// Yaw, pitch, roll.
+    aim: [Option<f64>; 3],
 }
 
 /// Parses a direction: `+x`, `-y`, `z`, or three numbers `x,y,z`.
@@ -103,9 +111,16 @@ impl ProjectionSpec {
                     )
                 }
                 "max-lat" | "maxlat" | "lat" => spec.max_lat = Some(num(v)?),
+                "hfov" | "h-fov" | "h_fov" => spec.hfov = Some(num(v)?),
+                "vfov" | "v-fov" | "v_fov" => spec.vfov = Some(num(v)?),
+                "d" | "distance" => spec.distance = Some(num(v)?),
+                "yaw" => spec.aim[0] = Some(num(v)?),
+                "pitch" => spec.aim[1] = Some(num(v)?),
+                "roll" => spec.aim[2] = Some(num(v)?),
                 other => {
                     return Err(format!(
-                        "unknown option '{other}' in '{s}' (known: look, up, fov, lens, max-lat)"
+                        "unknown option '{other}' in '{s}' (known: look, up, fov, lens, \
+                         max-lat, hfov, vfov, d, yaw, pitch, roll)"
                     ))
                 }
             }
@@ -130,6 +145,22 @@ impl ProjectionSpec {
         if spec.max_lat.is_some() {
             applies(kind == K::Mercator, "max-lat")?;
         }
+        let view = matches!(kind, K::Perspective | K::Pannini);
+        if spec.hfov.is_some() || spec.vfov.is_some() {
+            applies(
+                view || matches!(
+                    kind,
+                    K::Cylindrical | K::CylindricalEqualArea | K::HalfEquirect
+                ),
+                "hfov/vfov",
+            )?;
+        }
+        if spec.distance.is_some() {
+            applies(kind == K::Pannini, "d")?;
+        }
+        if spec.aim.iter().any(Option::is_some) {
+            applies(view, "yaw/pitch/roll")?;
+        }
         spec.build(None)?; // validate values now, before any work
         Ok(spec)
     }
@@ -143,6 +174,10 @@ impl ProjectionSpec {
             fov: None,
             lens: None,
             max_lat: None,
+            hfov: None,
+            vfov: None,
+            distance: None,
+            aim: [None; 3],
         }
     }
 
@@ -183,6 +218,54 @@ impl ProjectionSpec {
                 (None, Some((w, h))) => Mercator::from_extent(w, h).ok_or("empty picture")?.into(),
                 (None, None) => Mercator::default().into(),
             },
+            ProjectionKind::Cylindrical
+            | ProjectionKind::CylindricalEqualArea
+            | ProjectionKind::HalfEquirect => {
+                let (rule, h, v, vmax) = match self.kind {
+                    ProjectionKind::Cylindrical => (CylinderRule::Central, 360.0, 90.0, "< 180"),
+                    ProjectionKind::CylindricalEqualArea => {
+                        (CylinderRule::EqualArea, 360.0, 180.0, "≤ 180")
+                    }
+                    _ => (CylinderRule::Equidistant, 180.0, 180.0, "≤ 180"),
+                };
+                let (h, v) = (self.hfov.unwrap_or(h), self.vfov.unwrap_or(v));
+                Projection::Cylinder(Cylinder::new(rule, h, v).ok_or_else(|| {
+                    format!(
+                        "{}: hfov must be in (0, 360] degrees and vfov in (0, 180) or \
+                         (0, 180] ({vmax} here), not hfov={h}, vfov={v}",
+                        self.kind.name()
+                    )
+                })?)
+            }
+            ProjectionKind::Perspective | ProjectionKind::Pannini => {
+                let pannini = self.kind == ProjectionKind::Pannini;
+                let d = if pannini {
+                    self.distance.unwrap_or(1.0)
+                } else {
+                    0.0
+                };
+                let (h, v) = (
+                    self.hfov.unwrap_or(if pannini { 120.0 } else { 90.0 }),
+                    self.vfov.unwrap_or(90.0),
+                );
+                let [yaw, pitch, roll] = self.aim.map(|a| a.unwrap_or(0.0));
+                if d.is_nan() || d < 0.0 {
+                    return Err(format!("pannini: d must be 0 or more, not {d}"));
+                }
+                let view = if pannini {
+                    View::pannini(d, h, v, yaw, pitch, roll)
+                } else {
+                    View::perspective(h, v, yaw, pitch, roll)
+                };
+                Projection::View(view.ok_or_else(|| {
+                    format!(
+                        "{}: hfov must be in (0, {}) degrees and vfov in (0, 180), not \
+                         hfov={h}, vfov={v}",
+                        self.kind.name(),
+                        Num(View::max_hfov_deg(d))
+                    )
+                })?)
+            }
             k => k.default_projection(),
         })
     }
@@ -204,6 +287,21 @@ impl Projection {
             Projection::Paraboloid(p) => Some(*p.frame()),
             Projection::Mercator(p) => {
                 s.max_lat = Some(p.max_latitude_deg());
+                None
+            }
+            Projection::Cylinder(c) => {
+                s.hfov = Some(c.hfov_deg());
+                s.vfov = Some(c.vfov_deg());
+                None
+            }
+            Projection::View(v) => {
+                let [h, vf, yaw, pitch, roll] = v.angles_deg();
+                s.hfov = Some(h);
+                s.vfov = Some(vf);
+                if v.is_pannini() {
+                    s.distance = Some(v.distance());
+                }
+                s.aim = [yaw, pitch, roll].map(|a| (a != 0.0).then_some(a));
                 None
             }
             _ => None,
@@ -240,7 +338,7 @@ impl fmt::Display for Dir {
 
 impl fmt::Display for ProjectionSpec {
     /// The canonical text: the name, then the parameters given, in the order `fov`, `lens`,
-    /// `max-lat`, `look`, `up`.
+    /// `max-lat`, `hfov`, `vfov`, `d`, `yaw`, `pitch`, `roll`, `look`, `up`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.kind.name())?;
         if let Some(v) = self.fov {
@@ -251,6 +349,20 @@ impl fmt::Display for ProjectionSpec {
         }
         if let Some(v) = self.max_lat {
             write!(f, ":max-lat={}", Num(v))?;
+        }
+        if let Some(v) = self.hfov {
+            write!(f, ":hfov={}", Num(v))?;
+        }
+        if let Some(v) = self.vfov {
+            write!(f, ":vfov={}", Num(v))?;
+        }
+        if let Some(v) = self.distance {
+            write!(f, ":d={}", Num(v))?;
+        }
+        for (key, a) in ["yaw", "pitch", "roll"].iter().zip(self.aim) {
+            if let Some(v) = a {
+                write!(f, ":{key}={}", Num(v))?;
+            }
         }
         if let Some(d) = self.look {
             write!(f, ":look={}", Dir(d))?;
@@ -288,6 +400,20 @@ mod tests {
         assert!(ProjectionSpec::parse("sphere:look=0,0,0").is_err());
         assert!(ProjectionSpec::parse("sphere:look=+y:up=0,2,0").is_err());
         assert!(ProjectionSpec::parse("mercator:max-lat=95").is_err());
+        assert!(ProjectionSpec::parse("perspective:hfov=180").is_err());
+        assert!(ProjectionSpec::parse("pannini:d=-1").is_err());
+        assert!(ProjectionSpec::parse("pannini:d=1:hfov=360").is_err());
+        assert!(ProjectionSpec::parse("cylindrical:vfov=180").is_err());
+        assert!(ProjectionSpec::parse("cea:vfov=180").is_ok());
+        assert!(ProjectionSpec::parse("hammer:hfov=90")
+            .unwrap_err()
+            .contains("does not apply"));
+        assert!(ProjectionSpec::parse("cylindrical:yaw=10")
+            .unwrap_err()
+            .contains("does not apply"));
+        assert!(ProjectionSpec::parse("perspective:d=1")
+            .unwrap_err()
+            .contains("does not apply"));
         assert!(ProjectionSpec::parse("nope").unwrap_err().contains("known"));
     }
 
@@ -317,7 +443,19 @@ mod tests {
             .iter()
             .map(|k| k.default_projection())
             .collect();
-        cases.extend::<[Projection; 7]>([
+        cases.extend::<[Projection; 11]>([
+            Cylinder::new(CylinderRule::Central, 123.4, 56.7)
+                .unwrap()
+                .into(),
+            Cylinder::new(CylinderRule::EqualArea, 200.0, 100.0)
+                .unwrap()
+                .into(),
+            View::perspective(100.0, 60.0, 30.0, -20.0, 12.5)
+                .unwrap()
+                .into(),
+            View::pannini(0.7, 150.0, 80.0, 0.0, 45.0, 0.0)
+                .unwrap()
+                .into(),
             Fisheye::new(
                 Frame::looking_along(DVec3::Y).unwrap(),
                 Lens::Equisolid,

@@ -210,3 +210,39 @@ fn bilinear_taps_blend_as_bilinear_blend_does() {
     }
     assert!(mirrorball_core::bilinear_taps([&[0.0f32; 12][..]], 6, 3).is_none());
 }
+
+/// The panorama projections all look along −Z at their centre, with +X to the right and +Y
+/// up (as the lat-long does), and agree with the lat-long along the horizon and the
+/// central meridian where each is linear there.
+#[test]
+fn panorama_orientation() {
+    use mirrorball_core::ProjectionKind as K;
+    for kind in [
+        K::Cylindrical,
+        K::CylindricalEqualArea,
+        K::HalfEquirect,
+        K::Hammer,
+        K::Sinusoidal,
+        K::Perspective,
+        K::Pannini,
+    ] {
+        let p = kind.default_projection();
+        let at = |u: f64, v: f64| p.uv_to_dir(0, DVec2::new(u, v)).unwrap();
+        assert!(angle(at(0.5, 0.5), DVec3::NEG_Z) < 1e-12, "{kind}");
+        let (right, up) = (at(0.6, 0.5), at(0.5, 0.4));
+        assert!(right.x > 0.0 && right.y.abs() < 1e-12, "{kind}: {right}");
+        assert!(up.y > 0.0 && up.x.abs() < 1e-12, "{kind}: {up}");
+    }
+    // Along the horizon of the full-turn cylinders, Hammer's and the sinusoid's, u is
+    // longitude as in the lat-long only for the cylinders and the sinusoid.
+    for kind in [K::Cylindrical, K::CylindricalEqualArea, K::Sinusoidal] {
+        let p = kind.default_projection();
+        for u in [0.1, 0.3, 0.75, 0.9] {
+            let d = p.uv_to_dir(0, DVec2::new(u, 0.5)).unwrap();
+            let l = mirrorball_core::LatLong
+                .uv_to_dir(0, DVec2::new(u, 0.5))
+                .unwrap();
+            assert!(angle(d, l) < 1e-12, "{kind} at u = {u}");
+        }
+    }
+}

@@ -407,9 +407,11 @@ fn batch_lookups_agree_with_the_f64_methods() {
                     }
                     let e = (DVec2::new(out[i].u as f64, out[i].v as f64) - uv).length();
                     // The lat-long seam: u = 0 and u = 1 are the same meridian.
-                    let e = if p.kind() == mirrorball_core::ProjectionKind::LatLong
-                        || p.kind() == mirrorball_core::ProjectionKind::Mercator
-                    {
+                    use mirrorball_core::ProjectionKind as K;
+                    let e = if matches!(
+                        p.kind(),
+                        K::LatLong | K::Mercator | K::Cylindrical | K::CylindricalEqualArea
+                    ) {
                         e.min((e - 1.0).abs())
                     } else {
                         e

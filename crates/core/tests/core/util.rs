@@ -47,6 +47,37 @@ pub fn all_projections() -> Vec<Projection> {
         v.push(Fisheye::new(tilted, lens, fov).unwrap().into());
     }
     v.push(Mercator::new(60.0).unwrap().into());
+    use mirrorball_core::{Cylinder, CylinderRule, View};
+    v.push(
+        Cylinder::new(CylinderRule::Central, 150.0, 120.0)
+            .unwrap()
+            .into(),
+    );
+    v.push(
+        Cylinder::new(CylinderRule::EqualArea, 200.0, 100.0)
+            .unwrap()
+            .into(),
+    );
+    v.push(
+        Cylinder::new(CylinderRule::Equidistant, 300.0, 150.0)
+            .unwrap()
+            .into(),
+    );
+    v.push(
+        View::perspective(120.0, 70.0, 35.0, -50.0, 20.0)
+            .unwrap()
+            .into(),
+    );
+    v.push(
+        View::pannini(2.0, 220.0, 100.0, -100.0, 10.0, 30.0)
+            .unwrap()
+            .into(),
+    );
+    v.push(
+        View::pannini(0.4, 140.0, 60.0, 0.0, 80.0, 0.0)
+            .unwrap()
+            .into(),
+    );
     v
 }
 
@@ -63,7 +94,12 @@ pub fn inside(p: &Projection, layer: usize, uv: DVec2) -> bool {
             ProjectionKind::Sphere
             | ProjectionKind::Angular
             | ProjectionKind::Fisheye
-            | ProjectionKind::Paraboloid => ab.length() < 0.999,
+            | ProjectionKind::Paraboloid
+            | ProjectionKind::Hammer => ab.length() < 0.999,
+            // Away from the outline |a| = cos(πb/2).
+            ProjectionKind::Sinusoidal => {
+                ab.x.abs() < (std::f64::consts::FRAC_PI_2 * ab.y).cos() - 1e-3
+            }
             _ => true,
         }
     }

@@ -1,0 +1,275 @@
+//! The same layout as FFmpeg's `v360`: a direction-coded panorama (colour = ½ + 0.49·d,
+//! 16-bit) converted by Debian's `ffmpeg -vf v360=…` and by `mirrorball convert` with the
+//! matching options lands on the same pixels: the direction decoded from each output pixel
+//! of both agrees within one output pixel's angle.
+//!
+//! FFmpeg 5.1's faults, and how this test keeps clear of them:
+//! - its 16-bit bilinear path (AVX2) wraps values of 65533–65535 to 0–2: the codes here stay
+//!   within 0.01–0.99 of full scale;
+//! - it reads every input with align-corners scaling (pixel `i` of `w` at `2i/(w − 1) − 1`,
+//!   found by decoding its output, up to half a pixel off at the edges): the picture handed
+//!   to ffmpeg is coded at those positions (the same mirrorball projection evaluated at
+//!   `uv = (i/(w − 1), j/(h − 1))`), the one handed to mirrorball at the texel centres, so
+//!   that each tool is given the panorama it believes it reads.
+//!
+//! Skipped, loudly, where no `ffmpeg` is on the PATH (CI installs it).
+use crate::util::ok;
+use glam::{DVec2, DVec3};
+use mirrorball_core::projection::ProjectionSpec;
+use mirrorball_core::{Projection, WorldProjection};
+use std::path::Path;
+use std::process::Command;
+
+fn have_ffmpeg() -> bool {
+    let found = Command::new("ffmpeg").arg("-version").output().is_ok();
+    if !found {
+        eprintln!(
+            "\n!!!!!!!! SKIPPED: no ffmpeg on the PATH, so mirrorball's projections were NOT \
+             compared with v360 (apt-get install ffmpeg) !!!!!!!!\n"
+        );
+    }
+    found
+}
+
+fn ffmpeg(args: &[&str]) -> Vec<u8> {
+    let o = Command::new("ffmpeg")
+        .args(["-v", "error", "-nostdin", "-y"])
+        .args(args)
+        .output()
+        .expect("ffmpeg runs");
+    assert!(
+        o.status.success(),
+        "ffmpeg {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o.stdout
+}
+
+fn code(d: DVec3) -> [u16; 3] {
+    d.to_array()
+        .map(|c| ((0.5 + 0.49 * c) * 65535.0).round() as u16)
+}
+
+fn decode(c: [f64; 3]) -> Option<DVec3> {
+    if c.iter().all(|&v| v < 0.005) {
+        return None; // black: nothing there
+    }
+    DVec3::from_array(c.map(|v| (v - 0.5) / 0.49)).try_normalize()
+}
+
+/// A `w`×`h` 16-bit PNG of projection `p`, each pixel the code of its direction: at the
+/// texel centre, or (`align`) where FFmpeg 5.1 reads it.
+fn write_coded(path: &Path, p: &Projection, w: u32, h: u32, align: bool) {
+    let mut raw = Vec::with_capacity((w * h * 6) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let uv = if align {
+                DVec2::new(x as f64 / (w - 1) as f64, y as f64 / (h - 1) as f64)
+            } else {
+                DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64)
+            };
+            let d = p.uv_to_dir(0, uv).expect("a direction at every texel");
+            for c in code(d) {
+                raw.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    let rawp = path.with_extension("raw");
+    std::fs::write(&rawp, raw).unwrap();
+    let size = format!("{w}x{h}");
+    ffmpeg(&[
+        "-f",
+        "rawvideo",
+        "-pix_fmt",
+        "rgb48le",
+        "-s",
+        &size,
+        "-i",
+        rawp.to_str().unwrap(),
+        path.to_str().unwrap(),
+    ]);
+}
+
+/// One comparison: `v360=IN:OUT_OPTIONS` against `mirrorball convert --from FROM --to TO`.
+struct Case {
+    /// mirrorball's input projection and picture size.
+    from: &'static str,
+    in_size: (u32, u32),
+    /// v360's input and output with their options.
+    v360: &'static str,
+    /// mirrorball's output projection and `--size`.
+    to: &'static str,
+    size: u32,
+}
+
+/// The angle between the directions of neighbouring texel centres at `(x, y)`: one pixel.
+fn pixel_angle(p: &Projection, x: u32, y: u32, w: u32, h: u32) -> f64 {
+    let at = |x: i64, y: i64| {
+        (x >= 0 && y >= 0 && x < w as i64 && y < h as i64)
+            .then(|| {
+                let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                (p.density(0, uv) > 0.0)
+                    .then(|| p.uv_to_dir(0, uv))
+                    .flatten()
+            })
+            .flatten()
+    };
+    let (x, y) = (x as i64, y as i64);
+    let c = at(x, y).unwrap();
+    [(1, 0), (-1, 0), (0, 1), (0, -1)]
+        .iter()
+        .filter_map(|(dx, dy)| at(x + dx, y + dy))
+        .map(|n| c.angle_between(n))
+        .fold(0.0, f64::max)
+}
+
+fn compare(dir: &Path, case: &Case) {
+    let src = ProjectionSpec::parse(case.from)
+        .unwrap()
+        .build(Some(case.in_size))
+        .unwrap();
+    let dst = ProjectionSpec::parse(case.to).unwrap().build(None).unwrap();
+    let (iw, ih) = case.in_size;
+    let (w, h) = dst.layer_extent(case.size);
+    let (for_mb, for_ff) = (dir.join("in_mb.png"), dir.join("in_ff.png"));
+    write_coded(&for_mb, &src, iw, ih, false);
+    write_coded(&for_ff, &src, iw, ih, true);
+
+    let filter = format!("v360={}:interp=line:w={w}:h={h}", case.v360);
+    let ff = ffmpeg(&[
+        "-i",
+        for_ff.to_str().unwrap(),
+        "-vf",
+        &filter,
+        "-f",
+        "rawvideo",
+        "-pix_fmt",
+        "rgb48le",
+        "-",
+    ]);
+    assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
+    let out = dir.join("out_mb.png");
+    let size = case.size.to_string();
+    ok(&[
+        "convert",
+        for_mb.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--from",
+        case.from,
+        "--to",
+        case.to,
+        "--size",
+        &size,
+        "--precision",
+        "16",
+        "-q",
+    ]);
+    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
+    let img = &mb.layers[0];
+    assert_eq!((img.width(), img.height()), (w, h), "{}", case.to);
+
+    let (mut compared, mut inside, mut worst) = (0, 0, 0.0f64);
+    for y in 0..h {
+        for x in 0..w {
+            let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+            // Texels on or next to an outline (Hammer's, the sinusoid's) average only their
+            // inside part: leave them out, with those outside.
+            let near = [(0.0, 0.0), (1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)]
+                .iter()
+                .all(|(dx, dy)| {
+                    dst.density(0, uv + DVec2::new(dx / w as f64, dy / h as f64)) > 0.0
+                });
+            if !near {
+                continue;
+            }
+            inside += 1;
+            let k = ((y * w + x) * 6) as usize;
+            let f =
+                [0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0);
+            let px = img.get(x, y);
+            let m = [0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(px[c] as f64));
+            let (Some(df), Some(dm)) = (decode(f), decode(m)) else {
+                continue; // outside a view: black in both (checked below)
+            };
+            compared += 1;
+            let tol = pixel_angle(&dst, x, y, w, h);
+            let e = df.angle_between(dm);
+            worst = worst.max(e / tol);
+            assert!(
+                e <= tol,
+                "{} vs v360={}: texel ({x}, {y}) differs by {:.3}° (a pixel is {:.3}°): \
+                 ffmpeg {df}, mirrorball {dm}",
+                case.to,
+                case.v360,
+                e.to_degrees(),
+                tol.to_degrees()
+            );
+        }
+    }
+    eprintln!(
+        "{:>60} ↔ v360={:<60} {compared}/{inside} texels, worst {worst:.3} of a pixel",
+        case.to, case.v360
+    );
+    assert!(
+        compared * 10 >= inside * 9 || case.from.starts_with("perspective"),
+        "{}: only {compared} of {inside} texels compared",
+        case.to
+    );
+    assert!(compared > 100, "{}: {compared} texels compared", case.to);
+}
+
+#[test]
+fn projections_land_where_v360_puts_them() {
+    if !have_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let e = |v360: &'static str, to: &'static str, size: u32| Case {
+        from: "latlong",
+        in_size: (256, 128),
+        v360,
+        to,
+        size,
+    };
+    let cases = [
+        e("e:e", "latlong", 128),
+        e(
+            "e:flat:h_fov=100:v_fov=70:yaw=30:pitch=20:roll=10",
+            "perspective:hfov=100:vfov=70:yaw=30:pitch=20:roll=10",
+            96,
+        ),
+        e(
+            "e:cylindrical:h_fov=360:v_fov=100",
+            "cylindrical:hfov=360:vfov=100",
+            128,
+        ),
+        // v360's v_fov for cylindricalea is 180·sin(vfov/2): 180·sin 60° here.
+        e(
+            "e:cylindricalea:h_fov=180:v_fov=155.884572681",
+            "cylindrical-equal-area:hfov=180:vfov=120",
+            96,
+        ),
+        e("e:hammer", "hammer", 128),
+        e("e:sinusoidal", "sinusoidal", 128),
+        e("e:hequirect", "half-equirect", 96),
+        // v360's pannini takes d from h_fov and draws X, Y ∈ [−1, 1]: d = 1 reaches
+        // 2·2 atan(½) = 106.26° across, and 90° high.
+        e(
+            "e:pannini:h_fov=1",
+            "pannini:d=1:hfov=106.260204708:vfov=90",
+            96,
+        ),
+        e("e:fisheye:h_fov=180:v_fov=180", "fisheye:fov=180", 96),
+        // A photo put back: black (nothing) outside its frustum in both.
+        Case {
+            from: "perspective:hfov=100:vfov=70",
+            in_size: (100, 59),
+            v360: "flat:e:ih_fov=100:iv_fov=70",
+            to: "latlong",
+            size: 256,
+        },
+    ];
+    for case in &cases {
+        compare(dir.path(), case);
+    }
+}
