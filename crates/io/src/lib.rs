@@ -37,7 +37,7 @@ mod output;
 
 pub use alloc::HugePages;
 pub use apng::write_apng;
-pub use atomic::{atomic_write, interrupted};
+pub use atomic::{atomic_write, interrupted, write_together};
 pub use dds_io::write_dds;
 pub use error::{Error, Fault};
 pub use ktx1_io::{filament_sh_text, write_ktx1};
@@ -321,7 +321,12 @@ fn read_format(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
 /// Writes one flat image (EXR, HDR, PNG or JPEG), atomically. (Several files that belong
 /// together: [`OutputSet`].)
 pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
-    stage_image(path, image, opts, &mut WriteBuffers::default())?.commit()
+    atomic::land(stage_image(
+        path,
+        image,
+        opts,
+        &mut WriteBuffers::default(),
+    )?)
 }
 
 /// Writes one flat image as [`write_image`] does, to a temporary file beside `path` that
