@@ -1,6 +1,7 @@
 //! Lighting for gltf: the files, the convention and the roughness-to-mip rule.
 
-use crate::{mip_levels, not_written, BakeOptions, ChainSpec, Lighting};
+use crate::{mip_levels, not_written, BakeOptions, ChainSpec, Description, Lighting};
+use mirrorball_core::AxisMap;
 use mirrorball_io::Error;
 use std::path::{Path, PathBuf};
 
@@ -15,4 +16,15 @@ pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
 /// Writes gltf's files into `dir`.
 pub(crate) fn write(_l: &Lighting, dir: &Path, _opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
     Err(not_written(dir, "gltf"))
+}
+
+/// What gltf takes: not written yet ([`crate::unwritten`]).
+pub(crate) fn describe() -> Description {
+    crate::unwritten()
+}
+
+/// How gltf looks its cubes up, as [`crate::Engine::orientation`] says.
+pub(crate) fn orientation() -> AxisMap {
+    // Left as the identity for gltf's helper to decide.
+    AxisMap::IDENTITY
 }
