@@ -97,18 +97,27 @@ pub(crate) fn orientation(engine: Engine) -> AxisMap {
     }
 }
 
+/// `NAME_specular.dds`, `NAME_diffuse.dds`.
+pub(crate) fn file_names(opts: &BakeOptions) -> Vec<String> {
+    let stem = opts.stem();
+    vec![
+        format!("{stem}_specular.dds"),
+        format!("{stem}_diffuse.dds"),
+    ]
+}
+
 pub(crate) fn write(
     _engine: Engine,
     l: &Lighting,
     dir: &Path,
     opts: &BakeOptions,
 ) -> Result<Vec<PathBuf>, Error> {
-    let stem = opts.stem();
-    let specular = dir.join(format!("{stem}_specular.dds"));
+    let names = file_names(opts);
+    let specular = dir.join(&names[0]);
     mirrorball_io::write_dds(&specular, &faces(&l.specular), &cube_write(opts, vec![]))?;
     let mut files = vec![specular];
     if let Some(d) = &l.diffuse {
-        let diffuse = dir.join(format!("{stem}_diffuse.dds"));
+        let diffuse = dir.join(&names[1]);
         mirrorball_io::write_dds(
             &diffuse,
             &faces(std::slice::from_ref(d)),

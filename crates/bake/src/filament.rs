@@ -90,19 +90,28 @@ pub fn sh_txt(sh: &[[f64; 3]; 9]) -> String {
     out
 }
 
-pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+/// `NAME_ibl.ktx`, `NAME_skybox.ktx`, `sh.txt`, as cmgen names them.
+pub(crate) fn file_names(opts: &BakeOptions) -> Vec<String> {
     let stem = opts.stem();
+    vec![
+        format!("{stem}_ibl.ktx"),
+        format!("{stem}_skybox.ktx"),
+        "sh.txt".into(),
+    ]
+}
+
+pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+    let [ibl, skybox, txt] = <[String; 3]>::try_from(file_names(opts))
+        .expect("three files")
+        .map(|n| dir.join(n));
     let sh = prescaled(&l.sh9);
     let sh32: Vec<[f32; 3]> = sh.iter().map(|c| c.map(|v| v as f32)).collect();
-    let ibl = dir.join(format!("{stem}_ibl.ktx"));
     let with_sh = cube_write(
         opts,
         vec![("sh".into(), mirrorball_io::filament_sh_text(&sh32))],
     );
     mirrorball_io::write_ktx1(&ibl, &faces(&l.specular), &with_sh)?;
-    let skybox = dir.join(format!("{stem}_skybox.ktx"));
     mirrorball_io::write_ktx1(&skybox, &faces(&l.specular[..1]), &cube_write(opts, vec![]))?;
-    let txt = dir.join("sh.txt");
     write_text(&txt, &sh_txt(&sh))?;
     Ok(vec![ibl, skybox, txt])
 }

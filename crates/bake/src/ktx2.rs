@@ -54,6 +54,10 @@ pub(crate) fn orientation() -> AxisMap {
     AxisMap::IDENTITY
 }
 
+pub(crate) fn file_names(_opts: &BakeOptions) -> Vec<String> {
+    [SPECULAR, DIFFUSE, SH].map(String::from).to_vec()
+}
+
 pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
     let specular = dir.join(SPECULAR);
     mirrorball_io::write_ktx2(&specular, &faces(&l.specular), &cube_write(opts, vec![]))?;

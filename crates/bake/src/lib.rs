@@ -311,6 +311,17 @@ impl Engine {
         }
     }
 
+    /// The names of the files a bake writes into its folder, besides `README.md` (empty for
+    /// an engine whose writer is not in this build), for the checks before any work.
+    pub fn file_names(self, opts: &BakeOptions) -> Vec<String> {
+        match self {
+            Engine::Filament => filament::file_names(opts),
+            Engine::Unity | Engine::Unreal => dds::file_names(opts),
+            Engine::Ktx2 => ktx2::file_names(opts),
+            _ => Vec::new(),
+        }
+    }
+
     /// How to load the files in the engine's own code: the README's body.
     fn readme(self, opts: &BakeOptions, files: &[PathBuf]) -> String {
         match self {
@@ -363,6 +374,9 @@ fn write_engine(
         Engine::Ktx2 => ktx2::write(l, dir, opts),
     }
 }
+
+/// The note every bake writes beside its files.
+pub const README: &str = "README.md";
 
 /// A bake, checked against its engine before any work: the pipeline `mirrorball bake`
 /// runs (read and prepare the source, [`Bake::check`], [`Bake::lighting`], [`Bake::write`]).
@@ -463,7 +477,7 @@ impl Bake {
         let made = make_dir(dir)?;
         let result = mirrorball_io::write_together(|| {
             let files = write_engine(self.engine, lighting, dir, &self.opts)?;
-            write_text(&dir.join("README.md"), &self.readme(&files))
+            write_text(&dir.join(README), &self.readme(&files))
         });
         match result {
             Ok(((), files)) => Ok(files),
@@ -519,17 +533,21 @@ pub fn list() -> String {
     for e in ENGINES {
         let d = e.describe();
         let encodings: Vec<&str> = d.encodings.iter().map(|e| e.name()).collect();
-        let encodings = match encodings.split_first() {
-            Some((first, [])) => first.to_string(),
-            Some((first, rest)) => format!("{first} (default), {}", rest.join(", ")),
-            None => "(not written yet)".into(),
+        let Some((first, rest)) = encodings.split_first() else {
+            out += &format!("{e}\n  (not written yet)\n");
+            continue;
+        };
+        let encodings = match rest {
+            [] => first.to_string(),
+            _ => format!("{first} (default), {}", rest.join(", ")),
         };
         out += &format!(
-            "{e}\n  files:       {}\n  containers:  {}{}\n  encodings:   {encodings}\n  convention:  {}\n  roughness:   {}\n  diffuse:     {}\n",
+            "{e}\n  files:       {}\n  containers:  {}{}\n  encodings:   {encodings}\n  convention:  {}\n  cube turn:   the engine's direction (x, y, z) shows mirrorball's {}\n  roughness:   {}\n  diffuse:     {}\n",
             d.files,
             d.containers,
             if d.zstd { ", Zstandard supercompression" } else { "" },
             d.convention,
+            e.orientation(),
             d.rule,
             d.diffuse,
         );
