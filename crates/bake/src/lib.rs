@@ -527,6 +527,25 @@ fn make_dir(dir: &Path) -> Result<bool, Error> {
         .map(|()| true)
 }
 
+/// A lat-long map whose every texel holds its own direction as colour, `½ + ½·d` (so any
+/// axis flip, mirroring or turn shows): the input of the tests that check an engine sees
+/// the world the right way round.
+pub fn direction_coded(width: u32) -> EnvMap {
+    EnvMap::from_fn(
+        ProjectionKind::LatLong.default_projection(),
+        width,
+        3,
+        |d| {
+            [
+                (0.5 + 0.5 * d.x) as f32,
+                (0.5 + 0.5 * d.y) as f32,
+                (0.5 + 0.5 * d.z) as f32,
+                1.0,
+            ]
+        },
+    )
+}
+
 /// `--for list`: each engine with what it writes, one block an engine.
 pub fn list() -> String {
     let mut out = String::new();

@@ -101,7 +101,14 @@ impl Plan {
             .into_iter()
             .chain([mirrorball_bake::README.to_string()])
         {
-            files.output("a baked file", dir.join(name));
+            let path = dir.join(&name);
+            if path.is_dir() {
+                return Err(CliError::request(format!(
+                    "{}: a folder is where bake writes {name}; move it away",
+                    path.display()
+                )));
+            }
+            files.output("a baked file", path);
         }
         files.check()?;
         if a.samples == 0 || a.samples > 65536 {
