@@ -62,7 +62,7 @@ pub(crate) fn orientation() -> AxisMap {
 /// The nine coefficients Filament's `IndirectLight::Builder::irradiance(3, sh)` takes: for
 /// each, the basis constant Kᵢ times the coefficient of E/π (cmgen's pre-scaled SH), so
 /// that `Σ shᵢ Pᵢ(n)` is E(n)/π.
-pub fn prescaled(sh9: &Sh9) -> [[f64; 3]; 9] {
+pub(crate) fn prescaled(sh9: &Sh9) -> [[f64; 3]; 9] {
     let lambert = sh9.lambert();
     let mut out = [[0.0; 3]; 9];
     for (i, o) in out.iter_mut().enumerate() {
@@ -74,7 +74,7 @@ pub fn prescaled(sh9: &Sh9) -> [[f64; 3]; 9] {
 /// `sh.txt` as cmgen writes it (`outputSh`): one line per coefficient, band l then m from
 /// −l to l, `(r, g, b); // Llm, irradiance, pre-scaled base`, fifteen decimals, each number
 /// 18 wide; Filament's samples read it back with `sscanf("(%f,%f,%f)")`.
-pub fn sh_txt(sh: &[[f64; 3]; 9]) -> String {
+pub(crate) fn sh_txt(sh: &[[f64; 3]; 9]) -> String {
     let mut out = String::new();
     let mut i = 0;
     for l in 0..3i32 {
