@@ -167,3 +167,19 @@ pub(crate) fn readme(engine: Engine, _opts: &BakeOptions, files: &[PathBuf]) -> 
         ),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unity picks level `6 r (1.7 − 0.7 r)`: each level's roughness lands on its level.
+    #[test]
+    fn unity_roughness_inverts_its_level_rule() {
+        for m in 0..=6 {
+            let r = unity_roughness(m);
+            let level = UNITY_LOD_STEPS * r * (1.7 - 0.7 * r);
+            assert!((level - m as f64).abs() < 1e-12, "{m}: r = {r}");
+        }
+        assert_eq!(unity_roughness(9), 1.0);
+    }
+}
