@@ -34,7 +34,10 @@ const DIFFUSE_FACE: u32 = 32;
 /// The perceptual roughness Unity reads from level `m`: the inverse of
 /// `mip = r(1.7 − 0.7r) · 6`, clamped to 1 past level 6.
 pub(crate) fn unity_roughness(m: usize) -> f64 {
-    let t = (m as f64 / UNITY_LOD_STEPS).min(1.0);
+    let t = m as f64 / UNITY_LOD_STEPS;
+    if t >= 1.0 {
+        return 1.0;
+    }
     (1.7 - (2.89 - 2.8 * t).sqrt()) / 1.4
 }
 

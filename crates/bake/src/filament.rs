@@ -134,10 +134,10 @@ pub(crate) fn readme(_opts: &BakeOptions, files: &[PathBuf]) -> String {
          auto* skyBundle = new image::Ktx1Bundle(skyData, skySize);\n\
          Texture* sky = ktxreader::Ktx1Reader::createTexture(engine, skyBundle, false);\n\
          IndirectLight* light = IndirectLight::Builder()\n\
-                 .reflections(ibl)\n\
-                 .irradiance(3, sh)\n\
-                 .intensity(30000.0f)\n\
-                 .build(*engine);\n\
+         \x20       .reflections(ibl)\n\
+         \x20       .irradiance(3, sh)\n\
+         \x20       .intensity(30000.0f)\n\
+         \x20       .build(*engine);\n\
          Skybox* skybox = Skybox::Builder().environment(sky).build(*engine);\n\
          scene->setIndirectLight(light);\n\
          scene->setSkybox(skybox);\n\

@@ -511,7 +511,7 @@ impl Bake {
             names = names.join(", "),
             convention = d.convention,
             rule = d.rule,
-            diffuse = d.diffuse,
+            diffuse = d.diffuse.replace("NAME", &self.opts.stem()),
             body = self.engine.readme(&self.opts, files),
         )
     }
