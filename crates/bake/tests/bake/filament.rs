@@ -138,6 +138,43 @@ fn filament_files_read_back_by_an_independent_reader() {
             "level {m}: six faces of packed texels"
         );
     }
+    // The packed texels, decoded here (unsigned 11/11/10-bit floats: 5-bit exponent, bias
+    // 15, 6/6/5-bit mantissa; R in the low bits), against the float chain within the
+    // encoding's stated error (2⁻⁷ relative for R and G, 2⁻⁶ for B: half an ulp).
+    let unpack = |bits: u32, mbits: u32| {
+        let (m, e) = (bits & ((1 << mbits) - 1), bits >> mbits);
+        let frac = m as f64 / (1u32 << mbits) as f64;
+        if e == 0 {
+            frac * 2f64.powi(-14)
+        } else {
+            (1.0 + frac) * 2f64.powi(e as i32 - 15)
+        }
+    };
+    for (m, level) in ktx.textures().enumerate() {
+        let s = (size >> m).max(1);
+        for face in 0..6 {
+            let want = &lighting.specular[m].layers()[face];
+            let texels = &level[face * (s * s * 4) as usize..][..(s * s * 4) as usize];
+            for (i, px) in texels.chunks_exact(4).enumerate() {
+                let v = u32::from_le_bytes(px.try_into().unwrap());
+                let got = [
+                    unpack(v & 0x7ff, 6),
+                    unpack(v >> 11 & 0x7ff, 6),
+                    unpack(v >> 22, 5),
+                ];
+                let w = want.get(i as u32 % s, i as u32 / s);
+                for c in 0..3 {
+                    let tol = if c == 2 { 2f64.powi(-6) } else { 2f64.powi(-7) };
+                    let w = w[c] as f64;
+                    assert!(
+                        (got[c] - w).abs() <= w * tol + 1e-6,
+                        "level {m} face {face}: {} vs {w}",
+                        got[c]
+                    );
+                }
+            }
+        }
+    }
     assert_eq!(baked.spec.levels.len(), 5);
     // Filament's rule: level m of L holds r = 1 − √(1 − m/(L − 1)).
     for (m, &(_, r)) in baked.spec.levels.iter().enumerate() {
