@@ -471,14 +471,21 @@ impl Bake {
     }
 
     /// Writes the engine's files and `README.md` into `dir` (made if missing), all landing
-    /// together: on an error (or an interrupt) none is left and old files stay as they were.
+    /// together: on an error (or an interrupt) none is left and old files stay as they were,
+    /// and a folder made for them is removed again.
     /// `lighting` is in the engine's axes ([`Bake::lighting`]). Returns the files written.
     pub fn write(&self, lighting: &Lighting, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         let made = make_dir(dir)?;
+        if made {
+            mirrorball_io::made_folder(dir);
+        }
         let result = mirrorball_io::write_together(|| {
             let files = write_engine(self.engine, lighting, dir, &self.opts)?;
             write_text(&dir.join(README), &self.readme(&files))
         });
+        if made {
+            mirrorball_io::keep_folder(dir);
+        }
         match result {
             Ok(((), files)) => Ok(files),
             Err(e) => {

@@ -24,6 +24,9 @@ use std::sync::{Mutex, RwLock};
 
 /// Temporary files being written or waiting to be renamed.
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Folders made for outputs still being written ([`made_folder`]): removed by
+/// [`interrupted`] when it leaves them empty.
+static FOLDERS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Set by [`interrupted`] (under `PENDING`'s lock): no temporary file is made after it.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 /// Held shared while files are renamed into place, exclusively by [`interrupted`].
@@ -199,10 +202,32 @@ pub fn interrupted() -> usize {
         INTERRUPTED.store(true, Ordering::SeqCst);
         std::mem::take(&mut *pending)
     };
-    pending
+    let removed = pending
         .iter()
         .filter(|p| std::fs::remove_file(p).is_ok())
-        .count()
+        .count();
+    let folders = std::mem::take(&mut *FOLDERS.lock().unwrap_or_else(|e| e.into_inner()));
+    for dir in folders.iter().rev() {
+        let _ = std::fs::remove_dir(dir); // only when empty
+    }
+    removed
+}
+
+/// Marks `dir` as made for outputs now being written: an interrupt ([`interrupted`])
+/// removes it if it leaves it empty, until [`keep_folder`] says the outputs are in place.
+pub fn made_folder(dir: &Path) {
+    FOLDERS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(dir.to_path_buf());
+}
+
+/// `dir`, marked by [`made_folder`], holds what it was made for: an interrupt leaves it.
+pub fn keep_folder(dir: &Path) {
+    let mut folders = FOLDERS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(i) = folders.iter().rposition(|d| d == dir) {
+        folders.remove(i);
+    }
 }
 
 /// The first half of [`atomic_write`]: `write` fills a temporary file beside `path`, which

@@ -37,7 +37,7 @@ mod output;
 
 pub use alloc::HugePages;
 pub use apng::write_apng;
-pub use atomic::{atomic_write, interrupted, write_together};
+pub use atomic::{atomic_write, interrupted, keep_folder, made_folder, write_together};
 pub use dds_io::write_dds;
 pub use error::{Error, Fault};
 pub use ktx1_io::{filament_sh_text, write_ktx1};
