@@ -5,7 +5,7 @@ import { createServer } from 'node:http';
 import { readFile, stat } from 'node:fs/promises';
 import { execFileSync } from 'node:child_process';
 import { inflateSync } from 'node:zlib';
-import { mkdtempSync, rmSync, existsSync } from 'node:fs';
+import { mkdtempSync, rmSync, existsSync, readdirSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -97,11 +97,13 @@ export function directionCoded(file, width = 1024) {
   return file;
 }
 
-/// Bakes `input` for `engine` into `dir` (level 0 `size`²); returns the files written.
+/// Bakes `input` for `engine` into `dir` (level 0 `size`²) with `mirrorball bake`, as a
+/// user runs it; returns every file then in `dir` (with its subfolders).
 export function bake(engine, input, dir, size = 64) {
-  buildExamples();
-  const out = execFileSync(path.join(EXAMPLES, 'bake'), [engine, input, dir, String(size)], { encoding: 'utf8' });
-  return out.split('\n').filter(Boolean);
+  run(['bake', input, '--for', engine, dir, '--size', String(size), '--quiet']);
+  const walk = (d) => readdirSync(d, { withFileTypes: true })
+    .flatMap((e) => (e.isDirectory() ? walk(path.join(d, e.name)) : [path.join(d, e.name)]));
+  return walk(dir);
 }
 
 /// The library's own GGX prefilter of the lat-long `input` at perceptual `roughness`, about

@@ -9,7 +9,8 @@
 //!   (`REFLECTIONMAP_OPPOSITEZ`, `Materials/materialHelper.functions.js:778`,
 //!   `Shaders/ShadersInclude/pbrBlockReflection.js:39`), so both see mirrorball's world
 //!   (viewer along −Z) through the lookup `(x, y, −z)`: the cube Babylon gets shows, at
-//!   `d`, what mirrorball's shows at `(d.x, d.y, −d.z)` ([`babylon_cube`]).
+//!   `d`, what mirrorball's shows at `(d.x, d.y, −d.z)` ([`orientation`], applied by the
+//!   bake before [`write`]).
 //! - **Rows.** Each PNG is uploaded with `invertY` (`_OnImageReadyAsync`,
 //!   `Misc/environmentTextureTools.pure.js:358`) and drawn into the face by a full-screen
 //!   pass whose `vUV = 0` is the face's row `t = 0`: the picture's bottom row is `t = 0`,
@@ -25,8 +26,8 @@
 //!   ([`babylon_harmonics`], [`spherical_polynomial`]); no irradiance cube.
 //! - **Texels.** RGBD (`mirrorball_encode`'s, Babylon's `toRGBD`), 8-bit PNG.
 
-use crate::{mip_levels, BakeOptions, ChainSpec, Lighting};
-use mirrorball_core::{CubeFace, EnvMap, Image};
+use crate::{mip_levels, BakeOptions, ChainSpec, Description, Lighting};
+use mirrorball_core::{Axis, AxisMap, EnvMap};
 use mirrorball_filter::sh::Sh9;
 use mirrorball_io::{write_babylon_env, BabylonEnv, Encoding, Error, Rgba8Face};
 use std::f64::consts::PI;
@@ -42,24 +43,22 @@ const MINIMUM_VARIANCE: f64 = 0.0005;
 /// The `.env` file's name in the output folder.
 pub(crate) const FILE: &str = "environment.env";
 
-/// Refuses, before any work, what Babylon cannot read: a face edge that is not a power of
-/// two, an encoding other than RGBD.
-pub(crate) fn check(dir: &Path, opts: &BakeOptions, engine: &str) -> Result<(), Error> {
-    if !opts.size.is_power_of_two() {
-        return Err(Error::request(
-            dir,
-            format!(
-                "{engine} reads cube faces whose edge is a power of two, not {}",
-                opts.size
-            ),
-        ));
-    }
-    match opts.encoding {
-        None | Some(Encoding::Rgbd) => Ok(()),
-        Some(e) => Err(Error::request(
-            dir,
-            format!("{engine} takes RGBD PNG images, not {}", e.label()),
-        )),
+/// How Babylon looks its cubes up: at `(x, y, −z)` of mirrorball's world (the module
+/// documentation), so its cube shows at `e` what mirrorball's shows at `e` mirrored in z.
+pub(crate) fn orientation() -> AxisMap {
+    AxisMap::mirror(Axis::Z)
+}
+
+/// What Babylon takes.
+pub(crate) fn describe() -> Description {
+    Description {
+        files: "environment.env",
+        containers: "Babylon .env (JSON manifest, RGBD PNG faces per level down to 1x1)",
+        encodings: &[Encoding::Rgbd],
+        zstd: false,
+        convention: "Babylon samples at (x, y, -z) of mirrorball's world, left- or right-handed scene (@babylonjs/core 9.35 Materials/materialHelper.functions.js:778, Shaders/ShadersInclude/pbrBlockReflection.js:39); PNG rows upside down (Misc/environmentTextureTools.pure.js:358, invertY)",
+        rule: "lod = log2(width*(r^2 + 0.0005))*0.8 (pbrIBLFunctions.js:5, pbrHelperFunctions.js:9, pbrBlockReflection.js:95): level i at alpha = 2^(i/0.8)/width, level 0 a mirror (hdrFiltering.js:85)",
+        diffuse: "the manifest's spherical polynomial, from SH as Babylon makes it (Maths/sphericalPolynomial.pure.js:40, 375)",
     }
 }
 
@@ -92,30 +91,11 @@ pub(crate) fn shader_lod(roughness: f64, width: u32, scale: f64) -> f64 {
     (f64::from(width) * alpha).log2() * scale
 }
 
-/// `cube` as Babylon samples it: at `d`, what `cube` shows at `(d.x, d.y, −d.z)`. A texel
-/// permutation (texel centres go to texel centres), exact.
+/// `cube` (mirrorball's world axes) as Babylon samples it: at `d`, what `cube` shows at
+/// `(d.x, d.y, −d.z)`, texel for texel.
+#[cfg(test)]
 pub(crate) fn babylon_cube(cube: &EnvMap) -> EnvMap {
-    let n = cube.width();
-    let c = cube.channels();
-    let layers = CubeFace::ALL
-        .iter()
-        .map(|&face| {
-            let mut out = Image::new(n, n, c);
-            for y in 0..n {
-                for x in 0..n {
-                    let sc = 2.0 * (f64::from(x) + 0.5) / f64::from(n) - 1.0;
-                    let tc = 2.0 * (f64::from(y) + 0.5) / f64::from(n) - 1.0;
-                    let mut d = face.point(sc, tc);
-                    d.z = -d.z;
-                    let (src, s, t, ma) = CubeFace::select(d);
-                    let texel = |v: f64| ((v / ma + 1.0) * 0.5 * f64::from(n) - 0.5).round() as u32;
-                    out.set(x, y, cube.layers()[src as usize].get(texel(s), texel(t)));
-                }
-            }
-            out
-        })
-        .collect();
-    EnvMap::new(*cube.projection(), layers).expect("six square faces")
+    cube.transformed(&orientation()).expect("a cube")
 }
 
 /// The six PNG pictures of one level of a cube already in Babylon's directions: RGBD, each
@@ -138,17 +118,16 @@ pub(crate) fn rgbd_faces(cube: &EnvMap) -> [Rgba8Face; 6] {
     faces.try_into().expect("six faces")
 }
 
-/// Babylon's `SphericalHarmonics` of the radiance whose SH9 is `sh` (mirrorball's world and
-/// basis, `mirrorball_filter::sh`), after `convertIncidentRadianceToIrradiance` (its
+/// Babylon's `SphericalHarmonics` of the radiance whose SH9 is `sh` (mirrorball's basis,
+/// `mirrorball_filter::sh`, in Babylon's axes: [`Lighting::oriented`] turned it), after `convertIncidentRadianceToIrradiance` (its
 /// cosine kernel π, 2π/3, π/4, the same as [`Sh9::lambert`]'s times π): the irradiance E,
 /// `[l00, l1_1, l10, l11, l2_2, l2_1, l20, l21, l22][channel]`.
 ///
 /// Its basis (`SH3ylmBasisConstants`, `Maths/sphericalPolynomial.pure.js:40`) has the
-/// constants of ours with a minus sign on `y`, `x`, `yz`, `xz` (Condon–Shortley), and it is
-/// evaluated at Babylon's lookup direction `(x, y, −z)` (the module documentation), which
-/// flips `z`, `yz`, `xz`: coefficient `i` is ours times `SIGN[i]`.
+/// constants of ours with a minus sign on `y`, `x`, `yz`, `xz` (Condon–Shortley):
+/// coefficient `i` is ours times `SIGN[i]`.
 pub(crate) fn babylon_harmonics(sh: &Sh9) -> [[f64; 3]; 9] {
-    const SIGN: [f64; 9] = [1.0, -1.0, -1.0, -1.0, 1.0, 1.0, 1.0, 1.0, 1.0];
+    const SIGN: [f64; 9] = [1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0];
     let e = sh.lambert();
     std::array::from_fn(|i| e.coeffs[i].map(|c| c * PI * SIGN[i]))
 }
@@ -177,23 +156,23 @@ pub(crate) fn spherical_polynomial(irradiance: &[[f64; 3]; 9]) -> [[f64; 3]; 9] 
     })
 }
 
-/// Writes `environment.env` and its note into `dir`.
-pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    check(dir, opts, "Babylon.js")?;
+/// Writes `environment.env` into `dir`, from lighting already in Babylon's axes
+/// ([`orientation`]).
+pub(crate) fn write(l: &Lighting, dir: &Path, _opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
     let path = dir.join(FILE);
     let env = BabylonEnv {
         polynomial: spherical_polynomial(&babylon_harmonics(&l.sh9)),
         lod_generation_scale: LOD_GENERATION_SCALE,
-        levels: l
-            .specular
-            .iter()
-            .map(|level| rgbd_faces(&babylon_cube(level)))
-            .collect(),
+        levels: l.specular.iter().map(rgbd_faces).collect(),
     };
     write_babylon_env(&path, &env)?;
-    let note = dir.join("README.md");
-    let text = format!(
-        "# Babylon.js lighting from {source}\n\n\
+    Ok(vec![path])
+}
+
+/// The note's body: how Babylon loads it.
+pub(crate) fn readme(opts: &BakeOptions) -> String {
+    format!(
+        "## Loading it\n\n\
          `{FILE}`: a Babylon `.env` (RGBD PNG specular chain {size}² down to 1×1, level i \
          GGX at α = 2^(i/0.8)/{size}, as Babylon's shader reads it; diffuse light from its \
          spherical polynomial). Babylon's world (left-handed, or right-handed with \
@@ -204,19 +183,15 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
          scene.environmentTexture = env;\n\
          scene.createDefaultSkybox(env, true, 1000, 0); // optional background\n\
          ```\n",
-        source = if opts.source.is_empty() { "mirrorball" } else { &opts.source },
         size = opts.size,
-    );
-    mirrorball_io::atomic_write(&note, |w| {
-        std::io::Write::write_all(w, text.as_bytes()).map_err(|e| Error::io(&note, e))
-    })?;
-    Ok(vec![path, note])
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use mirrorball_core::glam::DVec3;
+    use mirrorball_core::CubeFace;
     use mirrorball_core::ProjectionKind;
 
     #[test]
@@ -280,7 +255,8 @@ mod tests {
             let r = radiance(d);
             [r[0] as f32, r[1] as f32, r[2] as f32, 1.0]
         });
-        let ours = spherical_polynomial(&babylon_harmonics(&mirrorball_filter::sh::project(&env)));
+        let sh = mirrorball_filter::sh::project(&env).transformed(&orientation());
+        let ours = spherical_polynomial(&babylon_harmonics(&sh));
         // Babylon's basis (SH3ylmBasisConstants × SH3ylmBasisTrigonometricTerms).
         let k = |a: f64| a.sqrt();
         let basis = |d: DVec3| {
@@ -365,7 +341,8 @@ mod round_trip {
             ..Default::default()
         };
         let spec = chain_spec(&opts);
-        let lighting = Lighting::from_env(&env, &spec, Default::default());
+        let world = Lighting::from_env(&env, &spec, Default::default());
+        let lighting = world.clone().oriented(&orientation());
         let dir = tempfile::tempdir().unwrap();
         let files = write(&lighting, dir.path(), &opts).unwrap();
         assert_eq!(files[0], dir.path().join(FILE));
@@ -377,7 +354,7 @@ mod round_trip {
         for (b, w) in back.polynomial.iter().flatten().zip(want.iter().flatten()) {
             assert!((b - w).abs() <= 1e-15 * w.abs().max(1.0), "{b} vs {w}");
         }
-        for (i, (faces, level)) in back.levels.iter().zip(&lighting.specular).enumerate() {
+        for (i, (faces, level)) in back.levels.iter().zip(&world.specular).enumerate() {
             let n = 16 >> i;
             let layers = faces
                 .iter()
@@ -407,7 +384,7 @@ mod round_trip {
         // The levels differ (a mirror down to roughness 1), so the comparison sees the order.
         let centre = |i: usize| {
             let c = 8 >> i;
-            lighting.specular[i].layers()[4].get(c, c)[2]
+            world.specular[i].layers()[4].get(c, c)[2]
         };
         assert!(centre(0) - centre(3) > 0.05);
     }

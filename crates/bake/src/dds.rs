@@ -1,24 +1,188 @@
-//! Lighting for Unity and Unreal: DDS cubes, each in its engine's convention.
+//! Lighting for Unity and Unreal: DDS cubes (BC6H by default), each turned into its
+//! engine's world. Direct3D samples a cube with the same face table and row order as
+//! OpenGL (ARCHITECTURE.md's cube convention), so the only difference is the world's axes:
+//!
+//! - **Unity**: left-handed, +Y up, +Z forward, +X right. Mirrorball's forward is −Z, so a
+//!   Unity direction `e` is mirrorball's `(e.x, e.y, −e.z)`: mirror z. Unity's shaders
+//!   sample reflection probes with the world reflected vector
+//!   (`UNITY_SAMPLE_TEXCUBE_LOD(unity_SpecCube0, reflUVW, mip)`), unflipped.
+//! - **Unreal**: left-handed, Z up, X forward, Y right. Mirrorball's forward, right and up
+//!   are −Z, +X, +Y, so an Unreal direction `e = (forward, right, up)` is mirrorball's
+//!   `(e.y, e.z, −e.x)`; Unreal's shaders sample with the world reflection vector
+//!   (`TextureCubeSampleLevel(…, ReflectionVector, Mip)`, ReflectionEnvironmentShared.ush).
+//!
+//! Roughness: Unity's `PerceptualRoughnessToMipmapLevel` (the render pipelines' core
+//! ImageBasedLighting.hlsl): `mip = r(1.7 − 0.7r) · UNITY_SPECCUBE_LOD_STEPS`, the steps
+//! being 6 ("the last mip index, we generate 7 mips of convolution"), so level `m` holds
+//! `r = (1.7 − √(2.89 − 2.8·m/6))/1.4`, and levels past 6 hold r = 1 ([`unity_roughness`]).
+//! Unreal: `ComputeReflectionCaptureMipFromRoughness` (ReflectionEnvironmentShared.ush):
+//! `RoughnessMapping::Ue4`.
 
-use crate::{mip_levels, not_written, BakeOptions, ChainSpec, Engine, Lighting};
-use mirrorball_core::Choice;
-use mirrorball_io::Error;
+use crate::{
+    chain_by, cube_write, faces, names, BakeOptions, ChainSpec, Description, Engine, Lighting,
+};
+use mirrorball_core::{Axis, AxisMap};
+use mirrorball_filter::RoughnessMapping;
+use mirrorball_io::{Encoding, Error};
 use std::path::{Path, PathBuf};
 
-/// The levels Unity or Unreal takes.
-pub(crate) fn chain_spec(_engine: Engine, opts: &BakeOptions) -> ChainSpec {
-    ChainSpec {
-        levels: mip_levels(opts.size, |i, n| i as f64 / (n.max(2) - 1) as f64),
-        diffuse_face: Some(32),
+/// Unity's `UNITY_SPECCUBE_LOD_STEPS`: the last mip level its shaders read.
+const UNITY_LOD_STEPS: f64 = 6.0;
+/// The diffuse cube's face edge.
+const DIFFUSE_FACE: u32 = 32;
+
+/// The perceptual roughness Unity reads from level `m`: the inverse of
+/// `mip = r(1.7 − 0.7r) · 6`, clamped to 1 past level 6.
+pub(crate) fn unity_roughness(m: usize) -> f64 {
+    let t = m as f64 / UNITY_LOD_STEPS;
+    if t >= 1.0 {
+        return 1.0;
+    }
+    (1.7 - (2.89 - 2.8 * t).sqrt()) / 1.4
+}
+
+/// Each engine's roughness per level.
+fn mapping(engine: Engine, levels: usize) -> RoughnessMapping {
+    match engine {
+        Engine::Unity => RoughnessMapping::Custom((0..levels).map(unity_roughness).collect()),
+        _ => RoughnessMapping::Ue4,
     }
 }
 
-/// Writes the engine's DDS files into `dir`.
+/// The full chain at the engine's roughness rule, and a 32² diffuse cube.
+pub(crate) fn chain_spec(engine: Engine, opts: &BakeOptions) -> ChainSpec {
+    let n = (32 - opts.size.max(1).leading_zeros()) as usize;
+    ChainSpec {
+        levels: chain_by(opts, &mapping(engine, n)),
+        diffuse_face: Some(DIFFUSE_FACE),
+    }
+}
+
+const ENCODINGS: &[Encoding] = &[
+    Encoding::Bc6hUnsigned,
+    Encoding::Bc6hSigned,
+    Encoding::Rgba16F,
+    Encoding::Rgba32F,
+];
+
+pub(crate) fn describe(engine: Engine) -> Description {
+    match engine {
+        Engine::Unity => Description {
+            files: "NAME_specular.dds (GGX chain to 1x1), NAME_diffuse.dds (irradiance/pi, 32²)",
+            containers: "DDS (DX10 header)",
+            encodings: ENCODINGS,
+            zstd: false,
+            convention: "left-handed, +Y up, +Z forward: z mirrored, (x, y, -z)",
+            rule: "mip = 6 * r * (1.7 - 0.7 r) (ImageBasedLighting.hlsl \
+                   PerceptualRoughnessToMipmapLevel; levels past 6 hold r = 1)",
+            diffuse: "NAME_diffuse.dds sampled at the normal (Unity makes its own SH from a probe)",
+        },
+        _ => Description {
+            files: "NAME_specular.dds (GGX chain to 1x1), NAME_diffuse.dds (irradiance/pi, 32²)",
+            containers: "DDS (DX10 header)",
+            encodings: ENCODINGS,
+            zstd: false,
+            convention: "left-handed, Z up, X forward, Y right: (y, z, -x)",
+            rule: "mip = levels - 2 + 1.2 log2(r) (ReflectionEnvironmentShared.ush \
+                   ComputeReflectionCaptureMipFromRoughness)",
+            diffuse: "NAME_diffuse.dds sampled at the normal (a Sky Light makes its own SH)",
+        },
+    }
+}
+
+/// The engine's axes (see the module documentation).
+pub(crate) fn orientation(engine: Engine) -> AxisMap {
+    match engine {
+        Engine::Unity => AxisMap::mirror(Axis::Z),
+        _ => {
+            AxisMap::new([(Axis::Y, 1), (Axis::Z, 1), (Axis::X, -1)]).expect("a signed permutation")
+        }
+    }
+}
+
+/// `NAME_specular.dds`, `NAME_diffuse.dds`.
+pub(crate) fn file_names(opts: &BakeOptions) -> Vec<String> {
+    let stem = opts.stem();
+    vec![
+        format!("{stem}_specular.dds"),
+        format!("{stem}_diffuse.dds"),
+    ]
+}
+
 pub(crate) fn write(
-    engine: Engine,
-    _l: &Lighting,
+    _engine: Engine,
+    l: &Lighting,
     dir: &Path,
-    _opts: &BakeOptions,
+    opts: &BakeOptions,
 ) -> Result<Vec<PathBuf>, Error> {
-    Err(not_written(dir, engine.name()))
+    let names = file_names(opts);
+    let specular = dir.join(&names[0]);
+    mirrorball_io::write_dds(&specular, &faces(&l.specular), &cube_write(opts, vec![]))?;
+    let mut files = vec![specular];
+    if let Some(d) = &l.diffuse {
+        let diffuse = dir.join(&names[1]);
+        mirrorball_io::write_dds(
+            &diffuse,
+            &faces(std::slice::from_ref(d)),
+            &cube_write(opts, vec![]),
+        )?;
+        files.push(diffuse);
+    }
+    Ok(files)
+}
+
+pub(crate) fn readme(engine: Engine, _opts: &BakeOptions, files: &[PathBuf]) -> String {
+    let n = names(files);
+    let (specular, diffuse) = (&n[0], n.get(1).map_or("", |s| s.as_str()));
+    match engine {
+        Engine::Unity => format!(
+            "## Loading it\n\n\
+             Put `{specular}` and `{diffuse}` under Assets/. In the texture importer: Texture \
+             Shape Cube, Mapping Auto, Convolution Type None (the mips are already \
+             convolved), sRGB off. The faces are already in Unity's left-handed world.\n\n\
+             ```csharp\n\
+             var probe = GetComponent<ReflectionProbe>();\n\
+             probe.mode = UnityEngine.Rendering.ReflectionProbeMode.Custom;\n\
+             probe.customBakedTexture = specularCubemap; // {specular}\n\
+             // or, for the sky: RenderSettings.defaultReflectionMode = DefaultReflectionMode.Custom;\n\
+             //                  RenderSettings.customReflectionTexture = specularCubemap;\n\
+             ```\n\n\
+             ```hlsl\n\
+             half mip = PerceptualRoughnessToMipmapLevel(perceptualRoughness); // 6 r (1.7 - 0.7 r)\n\
+             half3 spec = SAMPLE_TEXTURECUBE_LOD(_Specular, sampler_Specular, reflectDir, mip).rgb;\n\
+             half3 diff = SAMPLE_TEXTURECUBE(_Diffuse, sampler_Diffuse, normalWS).rgb; // E/pi\n\
+             ```\n"
+        ),
+        _ => format!(
+            "## Loading it\n\n\
+             Import `{specular}` and `{diffuse}` in the Content Browser (Import, or drag them \
+             in): each becomes a TextureCube; set Compression Settings HDR Compressed (BC6H) \
+             or HDR and keep its mips. The faces are already in Unreal's Z-up world.\n\n\
+             ```cpp\n\
+             USkyLightComponent* Sky = SkyLight->GetLightComponent();\n\
+             Sky->SourceType = ESkyLightSourceType::SLS_SpecifiedCubemap;\n\
+             Sky->SetCubemap(SpecularCube); // {specular}\n\
+             Sky->RecaptureSky();\n\
+             ```\n\n\
+             A Sky Light filters the cubemap again; a material that reads the chain as it is \
+             samples it with TextureSampleParameterCube at MipLevel = \
+             ComputeReflectionCaptureMipFromRoughness(Roughness, MipCount - 1).\n"
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unity picks level `6 r (1.7 − 0.7 r)`: each level's roughness lands on its level.
+    #[test]
+    fn unity_roughness_inverts_its_level_rule() {
+        for m in 0..=6 {
+            let r = unity_roughness(m);
+            let level = UNITY_LOD_STEPS * r * (1.7 - 0.7 * r);
+            assert!((level - m as f64).abs() < 1e-12, "{m}: r = {r}");
+        }
+        assert_eq!(unity_roughness(9), 1.0);
+    }
 }

@@ -22,9 +22,10 @@
 //! light the right way round in a right-handed scene (`useRightHandedSystem`, the usual
 //! setting for glTF). The light's `rotation` is the identity and its `intensity` 1.
 
-use crate::babylon::{babylon_cube, babylon_harmonics, level_roughness, rgbd_faces};
-use crate::{BakeOptions, ChainSpec, Lighting};
-use mirrorball_io::{write_gltf_ibl, Error, GltfIbl};
+use crate::babylon::{babylon_harmonics, level_roughness, rgbd_faces};
+use crate::{BakeOptions, ChainSpec, Description, Lighting};
+use mirrorball_core::AxisMap;
+use mirrorball_io::{write_gltf_ibl, Encoding, Error, GltfIbl};
 use std::path::{Path, PathBuf};
 
 /// The smallest specular level's edge (when level 0 is larger).
@@ -33,18 +34,57 @@ pub(crate) const LOWEST_EDGE: u32 = 16;
 /// The glTF file's name in the output folder.
 pub(crate) const FILE: &str = "lighting.gltf";
 
-/// Refuses, before any work, what the extension cannot hold (see [`crate::babylon::check`]).
-pub(crate) fn check(dir: &Path, opts: &BakeOptions) -> Result<(), Error> {
-    crate::babylon::check(dir, opts, "glTF's EXT_lights_image_based")?;
+/// Refuses, before any work, what the extension cannot hold beyond [`crate::Bake::new`]'s
+/// checks: a level 0 under 2×2.
+pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
     if opts.size < 2 {
-        return Err(Error::request(
-            dir,
+        return Err(
             "EXT_lights_image_based needs level 0 at least 2×2 (its loader divides by \
              log2 of the size)"
                 .into(),
-        ));
+        );
     }
     Ok(())
+}
+
+/// The light's faces are looked up as Babylon's `.env` faces are ([`crate::babylon`]).
+pub(crate) fn orientation() -> AxisMap {
+    crate::babylon::orientation()
+}
+
+/// What the extension holds.
+pub(crate) fn describe() -> Description {
+    Description {
+        files: "lighting.gltf, lighting_specular_L_{px,nx,py,ny,pz,nz}.png per level L",
+        containers: "glTF 2.0 JSON with EXT_lights_image_based, RGBD PNG faces",
+        encodings: &[Encoding::Rgbd],
+        zstd: false,
+        convention: "as Babylon's .env, whose loader is the extension's one implementation (EXT_lights_image_based.pure.js:82-105): samples at (x, y, -z); a right-handed scene sees it the right way round",
+        rule: "lodGenerationScale = (N-1)/log2(size): level i at alpha = 2^(i/scale)/size, roughness 1 at the last level (16x16)",
+        diffuse: "irradianceCoefficients: 9x3 SH of the irradiance E in Babylon's basis",
+    }
+}
+
+/// The files written, for the checks before any work.
+pub(crate) fn file_names(opts: &BakeOptions) -> Vec<String> {
+    let levels = chain_spec(opts).levels.len();
+    let stem = FILE.trim_end_matches(".gltf");
+    std::iter::once(FILE.to_string())
+        .chain((0..levels).flat_map(|l| {
+            ["px", "nx", "py", "ny", "pz", "nz"]
+                .into_iter()
+                .map(move |f| format!("{stem}_specular_{l}_{f}.png"))
+        }))
+        .collect()
+}
+
+/// The light's name: the source's file name.
+fn light_name(opts: &BakeOptions) -> String {
+    std::path::Path::new(&opts.source)
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("environment")
+        .to_string()
 }
 
 /// Babylon's loader's `lodGenerationScale` for `levels` levels of edge `size` down.
@@ -69,29 +109,24 @@ pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
     }
 }
 
-/// Writes `lighting.gltf`, its images and a note into `dir`.
+/// Writes `lighting.gltf` and its images into `dir`, from lighting already in Babylon's
+/// axes ([`orientation`]).
 pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    check(dir, opts)?;
     let ibl = GltfIbl {
-        name: Path::new(&opts.source)
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("environment")
-            .to_string(),
+        name: light_name(opts),
         intensity: 1.0,
         rotation: [0.0, 0.0, 0.0, 1.0],
         irradiance_coefficients: babylon_harmonics(&l.sh9),
-        levels: l
-            .specular
-            .iter()
-            .map(|level| rgbd_faces(&babylon_cube(level)))
-            .collect(),
+        levels: l.specular.iter().map(rgbd_faces).collect(),
     };
-    let mut files = write_gltf_ibl(&dir.join(FILE), &ibl)?;
-    let note = dir.join("README.md");
-    let n = l.specular.len();
-    let text = format!(
-        "# glTF image-based light from {name}\n\n\
+    write_gltf_ibl(&dir.join(FILE), &ibl)
+}
+
+/// The note's body: how a glTF viewer (Babylon's loader) takes it.
+pub(crate) fn readme(opts: &BakeOptions) -> String {
+    let n = chain_spec(opts).levels.len();
+    format!(
+        "## Loading it\n\n\
          `{FILE}`: glTF 2.0 with one `EXT_lights_image_based` light, referenced by the \
          default scene: {n} specular levels of six RGBD PNG faces ({size}² down to {low}²), \
          level i GGX at α = 2^(i·log2({size})/{last})/{size} (roughness 1 at the last level, \
@@ -105,16 +140,10 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
          Babylon's loader leaves the light's texture marked gamma-encoded (`gammaSpace` \
          true), so its shader darkens the light to radiance^2.2; the file's RGBD is linear, \
          as the extension says.\n",
-        name = ibl.name,
         size = opts.size,
         low = opts.size >> (n - 1),
         last = (n - 1).max(1),
-    );
-    mirrorball_io::atomic_write(&note, |w| {
-        std::io::Write::write_all(w, text.as_bytes()).map_err(|e| Error::io(&note, e))
-    })?;
-    files.push(note);
-    Ok(files)
+    )
 }
 
 #[cfg(test)]
@@ -157,10 +186,19 @@ mod tests {
             ..Default::default()
         };
         let spec = chain_spec(&opts);
-        let lighting = Lighting::from_env(&env, &spec, Default::default());
+        let lighting = Lighting::from_env(&env, &spec, Default::default()).oriented(&orientation());
         let dir = tempfile::tempdir().unwrap();
         let files = write(&lighting, dir.path(), &opts).unwrap();
-        assert_eq!(files.len(), 2 * 6 + 2);
+        assert_eq!(files.len(), 2 * 6 + 1);
+        let names: Vec<String> = files
+            .iter()
+            .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        let mut expected = file_names(&opts);
+        expected.sort();
+        let mut got = names.clone();
+        got.sort();
+        assert_eq!(got, expected);
         let back = mirrorball_io::read_gltf_ibl(&dir.path().join(FILE)).unwrap();
         assert_eq!(back.name, "coded.exr");
         assert_eq!((back.intensity, back.rotation), (1.0, [0.0, 0.0, 0.0, 1.0]));
@@ -173,15 +211,12 @@ mod tests {
         {
             assert!((b - w).abs() <= 1e-15 * w.abs().max(1.0), "{b} vs {w}");
         }
-        let made: Vec<_> = lighting
-            .specular
-            .iter()
-            .map(|level| rgbd_faces(&babylon_cube(level)))
-            .collect();
+        let made: Vec<_> = lighting.specular.iter().map(rgbd_faces).collect();
         assert_eq!(back.levels, made);
 
         for (size, encoding) in [
             (48, None),
+            (1, None),
             (32, Some(mirrorball_io::Encoding::Bc6hUnsigned)),
         ] {
             let bad = BakeOptions {
@@ -189,9 +224,14 @@ mod tests {
                 encoding,
                 ..Default::default()
             };
-            let e = check(dir.path(), &bad).unwrap_err();
-            assert_eq!(e.fault(), mirrorball_io::Fault::Request);
-            assert!(e.problem().contains("EXT_lights_image_based"), "{e}");
+            let e = crate::Bake::new(crate::Engine::Gltf, bad).unwrap_err();
+            assert_eq!(e.fault, mirrorball_core::Fault::Request);
+            assert!(
+                e.message.contains("power of two")
+                    || e.message.contains("EXT_lights_image_based")
+                    || e.message.contains("does not load"),
+                "{e}"
+            );
         }
     }
 }

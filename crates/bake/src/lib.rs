@@ -3,10 +3,14 @@
 //! in the containers and texel encodings its own loader takes, and a note saying how to
 //! load it.
 //!
-//! The flow: an [`Engine`] says what it needs ([`Engine::chain_spec`]: the specular levels'
-//! sizes and GGX roughness, the diffuse map's size); [`Lighting::from_env`] prefilters the
-//! source into that, in mirrorball's world axes (ARCHITECTURE.md's conventions); then
-//! [`write`] turns it into the engine's files. Each engine's rules have one home, its module.
+//! The flow ([`Bake`], what `mirrorball bake` calls): [`Bake::new`] checks the request
+//! against the engine before any work (size, texel encoding its loader takes); [`Bake::check`]
+//! checks the source can be held (BC6H unsigned of negative values); [`Bake::lighting`]
+//! prefilters it as the engine's [`ChainSpec`] says ([`Lighting::from_env`], in mirrorball's
+//! world axes) and turns it into the engine's axes ([`Engine::orientation`], an exact texel
+//! permutation); [`Bake::write`] writes the engine's files and a README.md into a folder,
+//! all landing together. Each engine's rules (files, encodings, convention, roughness-to-mip
+//! rule: [`Engine::describe`]) have one home, its module.
 #![warn(missing_docs)]
 
 mod babylon;
@@ -17,11 +21,49 @@ mod gltf;
 mod ktx2;
 mod three;
 
-use mirrorball_core::{EnvMap, ProjectionKind};
+use mirrorball_core::{AxisMap, Choice, EnvMap, Fault, ProjectionKind};
 use mirrorball_filter::sh::{self, Sh9};
-use mirrorball_filter::{Lobe, PrefilterOptions, Prefilterer};
-use mirrorball_io::{Effort, Encoding, Error};
+use mirrorball_filter::{Lobe, PrefilterOptions, Prefilterer, RoughnessMapping};
+use mirrorball_io::{CubeWrite, Effort, Encoding};
+use std::fmt;
 use std::path::{Path, PathBuf};
+
+/// Why a bake cannot be done or failed, and whose fault it is.
+#[derive(Debug)]
+pub struct Error {
+    /// The message, naming the file or setting and the problem.
+    pub message: String,
+    /// Whose fault: the request's (a setting the engine cannot take), the input's, the
+    /// system's.
+    pub fault: Fault,
+}
+
+impl Error {
+    /// The request's fault.
+    pub fn request(message: impl Into<String>) -> Error {
+        Error {
+            message: message.into(),
+            fault: Fault::Request,
+        }
+    }
+}
+
+impl From<mirrorball_io::Error> for Error {
+    fn from(e: mirrorball_io::Error) -> Error {
+        Error {
+            message: e.to_string(),
+            fault: e.fault(),
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Error {}
 
 /// An engine (or plain API) mirrorball bakes lighting for, named as `--for` takes it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -58,6 +100,18 @@ impl mirrorball_core::Choice for Engine {
 }
 mirrorball_core::choice_traits!(Engine);
 
+/// Every engine, in the order `--for list` prints them.
+pub const ENGINES: [Engine; 8] = [
+    Engine::Bevy,
+    Engine::Three,
+    Engine::Babylon,
+    Engine::Gltf,
+    Engine::Filament,
+    Engine::Unity,
+    Engine::Unreal,
+    Engine::Ktx2,
+];
+
 /// What an engine's lighting is made of, before any of it is made: the specular levels
 /// (each a cube face edge and a GGX perceptual roughness, in the order the engine stores
 /// them) and the diffuse (irradiance) cube's face edge, if the engine takes one.
@@ -67,6 +121,28 @@ pub struct ChainSpec {
     pub levels: Vec<(u32, f64)>,
     /// The diffuse cube's face edge, or `None` when the engine's diffuse light is SH only.
     pub diffuse_face: Option<u32>,
+}
+
+/// What an engine takes and how it reads it, for people (`--for list`, the README) and for
+/// the checks of a request: each engine's module says it once.
+#[derive(Clone, Debug)]
+pub struct Description {
+    /// The files written, for people (`NAME` is the source's file stem).
+    pub files: &'static str,
+    /// The containers.
+    pub containers: &'static str,
+    /// The texel encodings its loader takes, the default first; empty where the engine's
+    /// writer is not in this build.
+    pub encodings: &'static [Encoding],
+    /// Whether its loader takes Zstandard-supercompressed KTX2.
+    pub zstd: bool,
+    /// How the engine's axes and cube lookups differ from mirrorball's, with the source it
+    /// is read from.
+    pub convention: &'static str,
+    /// The roughness-to-level rule in words (the engine's own formula and where it is).
+    pub rule: &'static str,
+    /// What lights diffuse surfaces.
+    pub diffuse: &'static str,
 }
 
 /// How a bake is asked for, beyond the engine: the specular chain's level-0 face edge, the
@@ -81,6 +157,8 @@ pub struct BakeOptions {
     pub effort: Effort,
     /// Zstandard level for KTX2 supercompression, or `None`.
     pub zstd: Option<i32>,
+    /// The roughness of each level, or `None` for the engine's own rule.
+    pub mapping: Option<RoughnessMapping>,
     /// The source file's name, recorded in notes and metadata.
     pub source: String,
 }
@@ -92,13 +170,39 @@ impl Default for BakeOptions {
             encoding: None,
             effort: Effort::default(),
             zstd: None,
+            mapping: None,
             source: String::new(),
         }
     }
 }
 
-/// Prefiltered lighting in mirrorball's world axes (cube faces in OpenGL order and
-/// orientation), shaped as an engine's [`ChainSpec`] asked: what [`write`] turns into files.
+impl BakeOptions {
+    /// The encoding asked for, else `engine`'s default.
+    pub fn encoding_for(&self, engine: Engine) -> Encoding {
+        self.encoding
+            .or_else(|| engine.describe().encodings.first().copied())
+            .unwrap_or_default()
+    }
+
+    /// The source's file stem, for file names (`NAME_ibl.ktx`): `environment` when it has
+    /// none.
+    pub fn stem(&self) -> String {
+        Path::new(&self.source)
+            .file_stem()
+            .map(|s| s.to_string_lossy().replace("{face}", ""))
+            .map(|s| s.trim_matches(['_', '-', '.']).to_string())
+            .filter(|s| !s.is_empty())
+            .unwrap_or_else(|| "environment".into())
+    }
+}
+
+/// Largest level-0 face edge a bake takes.
+pub const MAX_SIZE: u32 = 4096;
+
+/// Prefiltered lighting, cube faces in OpenGL order and orientation: in mirrorball's world
+/// axes as [`Lighting::from_env`] makes it, in the engine's once [`Lighting::oriented`]
+/// (what each engine's writer gets). Shaped as an engine's [`ChainSpec`] asked.
+#[derive(Clone, Debug)]
 pub struct Lighting {
     /// The specular levels, cubes, level `i` GGX-prefiltered at `roughness[i]`.
     pub specular: Vec<EnvMap>,
@@ -147,18 +251,33 @@ impl Lighting {
             sh9: sh::project(env),
         }
     }
+
+    /// The same lighting seen through `map` (an engine's axes): every cube's texels moved
+    /// exactly ([`EnvMap::transformed`]), the SH turned with them.
+    pub fn oriented(self, map: &AxisMap) -> Lighting {
+        if map.is_identity() {
+            return self;
+        }
+        let turn = |e: EnvMap| e.transformed(map).expect("the lighting's maps are cubes");
+        Lighting {
+            specular: self.specular.into_iter().map(turn).collect(),
+            roughness: self.roughness,
+            diffuse: self.diffuse.map(turn),
+            sh9: self.sh9.transformed(map),
+        }
+    }
 }
 
 impl Engine {
-    /// Refuses, before any work, a bake this engine cannot take (a face edge or an encoding
-    /// its loader does not read); `dir` is the output folder, for the message.
-    pub fn check(self, dir: &Path, opts: &BakeOptions) -> Result<(), Error> {
+    /// Refuses, before any work, what this engine's own rules forbid beyond
+    /// [`Bake::new`]'s checks (which every engine shares: size, encodings, Zstandard).
+    pub fn check(self, opts: &BakeOptions) -> Result<(), Error> {
         match self {
-            Engine::Babylon => babylon::check(dir, opts, "Babylon.js"),
-            Engine::Gltf => gltf::check(dir, opts),
-            Engine::Three => three::check(opts).map_err(|e| Error::request(dir, e)),
+            Engine::Gltf => gltf::check(opts),
+            Engine::Three => three::check(opts),
             _ => Ok(()),
         }
+        .map_err(Error::request)
     }
 
     /// What this engine's lighting is made of, for a bake asked as `opts` says.
@@ -173,25 +292,311 @@ impl Engine {
             Engine::Ktx2 => ktx2::chain_spec(opts),
         }
     }
+
+    /// What the engine takes and how it reads it.
+    pub fn describe(self) -> Description {
+        match self {
+            Engine::Bevy => bevy::describe(),
+            Engine::Three => three::describe(),
+            Engine::Babylon => babylon::describe(),
+            Engine::Gltf => gltf::describe(),
+            Engine::Filament => filament::describe(),
+            Engine::Unity | Engine::Unreal => dds::describe(self),
+            Engine::Ktx2 => ktx2::describe(),
+        }
+    }
+
+    /// How a cube in mirrorball's world axes is turned for the engine: the engine, looking
+    /// up its cube at direction `e`, must see what mirrorball's world shows at
+    /// `orientation().source_of(e)`. The one place each engine's convention is applied
+    /// (`bake`, and `convert --for`).
+    pub fn orientation(self) -> AxisMap {
+        match self {
+            Engine::Bevy => bevy::orientation(),
+            Engine::Three => three::orientation(),
+            Engine::Babylon => babylon::orientation(),
+            Engine::Gltf => gltf::orientation(),
+            Engine::Filament => filament::orientation(),
+            Engine::Unity | Engine::Unreal => dds::orientation(self),
+            Engine::Ktx2 => ktx2::orientation(),
+        }
+    }
+
+    /// The names of the files a bake writes into its folder, besides `README.md` (empty for
+    /// an engine whose writer is not in this build), for the checks before any work.
+    pub fn file_names(self, opts: &BakeOptions) -> Vec<String> {
+        match self {
+            Engine::Three => three::file_names(),
+            Engine::Babylon => vec![babylon::FILE.to_string()],
+            Engine::Gltf => gltf::file_names(opts),
+            Engine::Filament => filament::file_names(opts),
+            Engine::Unity | Engine::Unreal => dds::file_names(opts),
+            Engine::Ktx2 => ktx2::file_names(opts),
+            _ => Vec::new(),
+        }
+    }
+
+    /// How to load the files in the engine's own code: the README's body.
+    fn readme(self, opts: &BakeOptions, files: &[PathBuf]) -> String {
+        match self {
+            Engine::Three => three::readme(opts),
+            Engine::Babylon => babylon::readme(opts),
+            Engine::Gltf => gltf::readme(opts),
+            Engine::Filament => filament::readme(opts, files),
+            Engine::Unity | Engine::Unreal => dds::readme(self, opts, files),
+            Engine::Ktx2 => ktx2::readme(opts, files),
+            _ => String::new(),
+        }
+    }
 }
 
-/// Writes `lighting` as `engine` loads it, into the folder `dir` (which exists); returns
-/// the files written.
+/// Writes `lighting` (in mirrorball's world axes) as `engine` loads it, into the folder
+/// `dir` (which exists): turned into the engine's axes, then its files. Returns the files
+/// written. (Without the README and the landing together: that is [`Bake::write`].)
 pub fn write(
     engine: Engine,
     lighting: &Lighting,
     dir: &Path,
     opts: &BakeOptions,
 ) -> Result<Vec<PathBuf>, Error> {
+    let opts = &BakeOptions {
+        encoding: Some(opts.encoding_for(engine)),
+        ..opts.clone()
+    };
+    let map = engine.orientation();
+    let turned;
+    let l = if map.is_identity() {
+        lighting
+    } else {
+        turned = lighting.clone().oriented(&map);
+        &turned
+    };
+    Ok(write_engine(engine, l, dir, opts)?)
+}
+
+/// The engine's own files, written by its module (`l` already in its axes).
+fn write_engine(
+    engine: Engine,
+    l: &Lighting,
+    dir: &Path,
+    opts: &BakeOptions,
+) -> Result<Vec<PathBuf>, mirrorball_io::Error> {
     match engine {
-        Engine::Bevy => bevy::write(lighting, dir, opts),
-        Engine::Three => three::write(lighting, dir, opts),
-        Engine::Babylon => babylon::write(lighting, dir, opts),
-        Engine::Gltf => gltf::write(lighting, dir, opts),
-        Engine::Filament => filament::write(lighting, dir, opts),
-        Engine::Unity | Engine::Unreal => dds::write(engine, lighting, dir, opts),
-        Engine::Ktx2 => ktx2::write(lighting, dir, opts),
+        Engine::Bevy => bevy::write(l, dir, opts),
+        Engine::Three => three::write(l, dir, opts),
+        Engine::Babylon => babylon::write(l, dir, opts),
+        Engine::Gltf => gltf::write(l, dir, opts),
+        Engine::Filament => filament::write(l, dir, opts),
+        Engine::Unity | Engine::Unreal => dds::write(engine, l, dir, opts),
+        Engine::Ktx2 => ktx2::write(l, dir, opts),
     }
+}
+
+/// The note every bake writes beside its files.
+pub const README: &str = "README.md";
+
+/// A bake, checked against its engine before any work: the pipeline `mirrorball bake`
+/// runs (read and prepare the source, [`Bake::check`], [`Bake::lighting`], [`Bake::write`]).
+#[derive(Clone, Debug)]
+pub struct Bake {
+    /// The engine.
+    pub engine: Engine,
+    /// As asked, with the encoding and mapping settled.
+    pub opts: BakeOptions,
+    /// What will be made.
+    pub spec: ChainSpec,
+}
+
+impl Bake {
+    /// Checks the request against the engine: a writer for it in this build, the size (a
+    /// power of two, `1..=MAX_SIZE`), an encoding its loader takes, supercompression only
+    /// where it reads it.
+    pub fn new(engine: Engine, mut opts: BakeOptions) -> Result<Bake, Error> {
+        let d = engine.describe();
+        if d.encodings.is_empty() {
+            return Err(Error::request(format!(
+                "baking for {engine} is not written yet"
+            )));
+        }
+        let s = opts.size;
+        if s == 0 || s > MAX_SIZE || !s.is_power_of_two() {
+            return Err(Error::request(format!(
+                "size {s}: a cube's mip chain halves exactly only from a power of two; give one of 1, 2, 4 … {MAX_SIZE}"
+            )));
+        }
+        let encoding = opts.encoding_for(engine);
+        if !d.encodings.contains(&encoding) {
+            let names: Vec<&str> = d.encodings.iter().map(|e| e.name()).collect();
+            return Err(Error::request(format!(
+                "{engine} does not load {} ({}); it takes {}",
+                encoding.name(),
+                d.containers,
+                names.join(", ")
+            )));
+        }
+        if opts.zstd.is_some() && !d.zstd {
+            return Err(Error::request(format!(
+                "{engine}: Zstandard supercompression is for KTX2, which {engine} does not load ({})",
+                d.containers
+            )));
+        }
+        engine.check(&opts)?;
+        opts.encoding = Some(encoding);
+        let spec = engine.chain_spec(&opts);
+        Ok(Bake { engine, opts, spec })
+    }
+
+    /// The texel encoding.
+    pub fn encoding(&self) -> Encoding {
+        self.opts.encoding_for(self.engine)
+    }
+
+    /// Refuses a source the encoding cannot hold (negative values as unsigned BC6H), right
+    /// after reading, before any prefiltering: GGX and Lambert of non-negative radiance are
+    /// non-negative, so the source decides.
+    pub fn check(&self, env: &EnvMap) -> Result<(), Error> {
+        let encoding = self.encoding();
+        for layer in env.layers() {
+            encoding.check(layer).map_err(|e| {
+                Error::request(format!(
+                    "{}: {} for {}: {e}",
+                    self.opts.source,
+                    encoding.name(),
+                    self.engine
+                ))
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Rows the prefilter makes, for a progress bar fed by [`PrefilterOptions::progress`].
+    pub fn rows(&self) -> u64 {
+        let specular: u64 = self.spec.levels.iter().map(|&(f, _)| 6 * f as u64).sum();
+        specular + self.spec.diffuse_face.map_or(0, |f| 6 * f as u64)
+    }
+
+    /// Texels of every cube made (four `f32` channels each), for the memory estimate.
+    pub fn texels(&self) -> u64 {
+        let sq = |f: u32| 6 * f as u64 * f as u64;
+        self.spec.levels.iter().map(|&(f, _)| sq(f)).sum::<u64>()
+            + self.spec.diffuse_face.map_or(0, sq)
+    }
+
+    /// The lighting, prefiltered from `env` (sanitized, checked) and turned into the
+    /// engine's axes.
+    pub fn lighting(&self, env: &EnvMap, opts: PrefilterOptions) -> Lighting {
+        Lighting::from_env(env, &self.spec, opts).oriented(&self.engine.orientation())
+    }
+
+    /// Writes the engine's files and `README.md` into `dir` (made if missing), all landing
+    /// together: on an error (or an interrupt) none is left and old files stay as they were,
+    /// and a folder made for them is removed again.
+    /// `lighting` is in the engine's axes ([`Bake::lighting`]). Returns the files written.
+    pub fn write(&self, lighting: &Lighting, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+        let made = make_dir(dir)?;
+        if made {
+            mirrorball_io::made_folder(dir);
+        }
+        let result = mirrorball_io::write_together(|| {
+            let files = write_engine(self.engine, lighting, dir, &self.opts)?;
+            write_text(&dir.join(README), &self.readme(&files))
+        });
+        if made {
+            mirrorball_io::keep_folder(dir);
+        }
+        match result {
+            Ok(((), files)) => Ok(files),
+            Err(e) => {
+                if made {
+                    let _ = std::fs::remove_dir(dir);
+                }
+                Err(e.into())
+            }
+        }
+    }
+
+    /// The README: what was baked, each file, the engine's rules, and how to load it.
+    fn readme(&self, files: &[PathBuf]) -> String {
+        let d = self.engine.describe();
+        let names: Vec<String> = names(files).iter().map(|n| format!("`{n}`")).collect();
+        format!(
+            "# Image-based lighting for {engine}\n\n\
+             Baked by mirrorball {version} from `{source}`: a {size}² GGX chain of {levels} levels, \
+             {encoding}.\n\n\
+             - Files: {names}\n\
+             - Convention: {convention}\n\
+             - Roughness to level: {rule}\n\
+             - Diffuse: {diffuse}\n\n{body}",
+            engine = self.engine,
+            version = env!("CARGO_PKG_VERSION"),
+            source = self.opts.source,
+            size = self.opts.size,
+            levels = self.spec.levels.len(),
+            encoding = self.encoding().label(),
+            names = names.join(", "),
+            convention = d.convention,
+            rule = d.rule,
+            diffuse = d.diffuse.replace("NAME", &self.opts.stem()),
+            body = self.engine.readme(&self.opts, files),
+        )
+    }
+}
+
+/// Makes `dir` (and its parents) when missing; `true` when it made the folder itself.
+fn make_dir(dir: &Path) -> Result<bool, Error> {
+    if dir.is_dir() {
+        return Ok(false);
+    }
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Error::from(mirrorball_io::Error::io(dir, e)))
+        .map(|()| true)
+}
+
+/// A lat-long map whose every texel holds its own direction as colour, `½ + ½·d` (so any
+/// axis flip, mirroring or turn shows): the input of the tests that check an engine sees
+/// the world the right way round.
+pub fn direction_coded(width: u32) -> EnvMap {
+    EnvMap::from_fn(
+        ProjectionKind::LatLong.default_projection(),
+        width,
+        3,
+        |d| {
+            [
+                (0.5 + 0.5 * d.x) as f32,
+                (0.5 + 0.5 * d.y) as f32,
+                (0.5 + 0.5 * d.z) as f32,
+                1.0,
+            ]
+        },
+    )
+}
+
+/// `--for list`: each engine with what it writes, one block an engine.
+pub fn list() -> String {
+    let mut out = String::new();
+    for e in ENGINES {
+        let d = e.describe();
+        let encodings: Vec<&str> = d.encodings.iter().map(|e| e.name()).collect();
+        let Some((first, rest)) = encodings.split_first() else {
+            out += &format!("{e}\n  (not written yet)\n");
+            continue;
+        };
+        let encodings = match rest {
+            [] => first.to_string(),
+            _ => format!("{first} (default), {}", rest.join(", ")),
+        };
+        out += &format!(
+            "{e}\n  files:       {}\n  containers:  {}{}\n  encodings:   {encodings}\n  convention:  {}\n  cube turn:   the engine's direction (x, y, z) shows mirrorball's {}\n  roughness:   {}\n  diffuse:     {}\n",
+            d.files,
+            d.containers,
+            if d.zstd { ", Zstandard supercompression" } else { "" },
+            d.convention,
+            e.orientation(),
+            d.rule,
+            d.diffuse,
+        );
+    }
+    out
 }
 
 /// The full mip chain of `size` down to 1×1, each level at the roughness `rule(i, n)`
@@ -201,7 +606,65 @@ pub(crate) fn mip_levels(size: u32, rule: impl Fn(usize, usize) -> f64) -> Vec<(
     (0..n).map(|i| ((size >> i).max(1), rule(i, n))).collect()
 }
 
+/// The full chain at `mapping`'s roughness (the user's mapping when given).
+pub(crate) fn chain_by(opts: &BakeOptions, mapping: &RoughnessMapping) -> Vec<(u32, f64)> {
+    let mapping = opts.mapping.as_ref().unwrap_or(mapping);
+    mip_levels(opts.size, |i, n| mapping.roughness(i, n))
+}
+
+/// Each level's faces, as the cube writers take them.
+pub(crate) fn faces(levels: &[EnvMap]) -> Vec<Vec<mirrorball_core::Image>> {
+    levels.iter().map(|l| l.layers().to_vec()).collect()
+}
+
+/// The description of an engine whose writer is not in this build: no encodings, so a
+/// bake for it is refused before any work.
+pub(crate) fn unwritten() -> Description {
+    Description {
+        files: "(not written yet)",
+        containers: "(not written yet)",
+        encodings: &[],
+        zstd: false,
+        convention: "(not written yet)",
+        rule: "(not written yet)",
+        diffuse: "(not written yet)",
+    }
+}
+
 /// The error of an engine whose writer is not in this build.
-pub(crate) fn not_written(dir: &Path, engine: &str) -> Error {
-    Error::request(dir, format!("baking for {engine} is not written yet"))
+pub(crate) fn not_written(dir: &Path, engine: &str) -> mirrorball_io::Error {
+    mirrorball_io::Error::request(dir, format!("baking for {engine} is not written yet"))
+}
+
+/// How each cube of a bake is written: its encoding, effort and supercompression, recorded
+/// as a cube map, with `metadata`.
+pub(crate) fn cube_write(opts: &BakeOptions, metadata: Vec<(String, String)>) -> CubeWrite {
+    CubeWrite {
+        encoding: opts.encoding.unwrap_or_default(),
+        effort: opts.effort,
+        zstd: opts.zstd,
+        declared: Some(mirrorball_io::MapInfo {
+            projection: ProjectionKind::Cube.default_projection(),
+            layout: None,
+        }),
+        metadata,
+    }
+}
+
+/// Writes `text` to `path`.
+pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), mirrorball_io::Error> {
+    mirrorball_io::atomic_write(path, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes())
+            .map_err(|e| mirrorball_io::Error::io(path, e))
+    })
+}
+
+/// The file names of `files`, for notes.
+pub(crate) fn names(files: &[PathBuf]) -> Vec<String> {
+    files
+        .iter()
+        .filter_map(|f| f.file_name())
+        .map(|n| n.to_string_lossy().into_owned())
+        .collect()
 }

@@ -30,14 +30,14 @@
 //! `(−x, y, z)`: `envMapRotation` and `backgroundRotation` are premultiplied by
 //! `diag(−1, 1, 1)` (`WebGLMaterials.js` 9 and 248–252, `WebGLBackground.js` 17 and
 //! 144–148), and a loaded `CompressedCubeTexture` is such a cube too. Both files are
-//! therefore written as the world mirrored in x ([`mirror_x`]), so that three's lookup at
-//! `(−x, y, z)` returns mirrorball's radiance in `(x, y, z)`. Faces are uploaded unchanged,
+//! therefore written as the world mirrored in x ([`orientation`], applied by the bake
+//! before [`write`]), so that three's lookup at `(−x, y, z)` returns mirrorball's radiance
+//! in `(x, y, z)`. Faces are uploaded unchanged,
 //! row 0 to `t = 0` (`CubeTexture` and `DataTexture` have `flipY` false).
 
-use crate::{BakeOptions, ChainSpec, Lighting};
-use mirrorball_core::Image;
+use crate::{BakeOptions, ChainSpec, Description, Lighting};
+use mirrorball_core::{Axis, AxisMap, Image};
 use mirrorball_io::{CubeWrite, Encoding, Error, WriteOptions};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Log2 of the face edge of three's roughest PMREM level (`PMREMGenerator.js` 25).
@@ -101,21 +101,37 @@ pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
     }
 }
 
-/// The cube whose lookup at `(−x, y, z)` gives `faces`' value at `(x, y, z)`, texel for
-/// texel: faces in OpenGL order and orientation (ARCHITECTURE.md). Negating x swaps the ±X
-/// faces and, on every face, negates the `s` coordinate (OpenGL 4.6 table 8.19: `sc` is
-/// `∓z` on ±X, whose images swap; `x` on ±Y and +Z, `−x` on −Z), `t` unchanged: each
-/// face is its partner mirrored left to right.
-pub(crate) fn mirror_x(faces: &[Image]) -> Vec<Image> {
-    const PARTNER: [usize; 6] = [1, 0, 2, 3, 4, 5];
-    PARTNER.iter().map(|&p| faces[p].flipped(true)).collect()
+/// How three looks its cubes up: at `(−x, y, z)` (the module documentation), so its cube
+/// shows at `e` what mirrorball's world shows at `e` mirrored in x.
+pub(crate) fn orientation() -> AxisMap {
+    AxisMap::mirror(Axis::X)
 }
 
-/// Writes three's files into `dir`: `pmrem.dds`, `cube/{px,nx,py,ny,pz,nz}.hdr` and the note.
+/// What three takes.
+pub(crate) fn describe() -> Description {
+    Description {
+        files: "pmrem.dds (three's own PMREM), cube/{px,nx,py,ny,pz,nz}.hdr (the plain cube)",
+        containers: "DDS (BC6H cube with mips, for DDSLoader), Radiance HDR faces (HDRCubeTextureLoader)",
+        encodings: &[Encoding::Bc6hUnsigned, Encoding::Bc6hSigned],
+        zstd: false,
+        convention: "three looks CubeTextures up at (-x, y, z) (src/renderers/webgl/WebGLMaterials.js 248-252, WebGLBackground.js 144-148, r187): both files are mirrored in x",
+        rule: "three's PMREM: faces size>>lod down to 8x8, level lod at roughness 1 - sqrt(1 - lod/maxLod) (PMREMGenerator.js 236-240), read at mip maxLod*r(2-r) (envmap_common_pars_fragment.glsl.js 12-18)",
+        diffuse: "the PMREM's last, roughness-1 level times pi (envmap_physical_pars_fragment.glsl.js 4-19)",
+    }
+}
+
+/// The files written, for the checks before any work.
+pub(crate) fn file_names() -> Vec<String> {
+    std::iter::once(PMREM_FILE.to_string())
+        .chain(CUBE_FACES.iter().map(|f| format!("{CUBE_DIR}/{f}")))
+        .collect()
+}
+
+/// Writes three's files into `dir`: `pmrem.dds` and `cube/{px,nx,py,ny,pz,nz}.hdr`, from
+/// lighting already in three's axes ([`orientation`]).
 pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    check(opts).map_err(|e| Error::request(dir, e))?;
     let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
-    let levels: Vec<Vec<Image>> = l.specular.iter().map(|m| mirror_x(m.layers())).collect();
+    let levels: Vec<Vec<Image>> = l.specular.iter().map(|m| m.layers().to_vec()).collect();
     let pmrem = dir.join(PMREM_FILE);
     mirrorball_io::write_dds(
         &pmrem,
@@ -135,33 +151,22 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
         mirrorball_io::write_image(&path, face, &WriteOptions::default())?;
         files.push(path);
     }
-
-    let note = dir.join("README.md");
-    let text = note_text(l, opts, encoding);
-    mirrorball_io::atomic_write(&note, |w| {
-        w.write_all(text.as_bytes())
-            .map_err(|e| Error::io(&note, e))
-    })?;
-    files.push(note);
     Ok(files)
 }
 
-/// The note: what each file is and the lines of three.js that load it.
-fn note_text(l: &Lighting, opts: &BakeOptions, encoding: Encoding) -> String {
-    let levels: Vec<String> = l
-        .specular
+/// The note's body: what each file is and the lines of three.js that load it.
+pub(crate) fn readme(opts: &BakeOptions) -> String {
+    let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
+    let levels: Vec<String> = chain_spec(opts)
+        .levels
         .iter()
-        .zip(&l.roughness)
         .enumerate()
-        .map(|(lod, (m, r))| format!("{lod}: {0}×{0} at {r:.4}", m.width()))
+        .map(|(lod, (face, r))| format!("{lod}: {face}×{face} at {r:.4}"))
         .collect();
-    let source = if opts.source.is_empty() {
-        String::new()
-    } else {
-        format!(" from `{}`", opts.source)
-    };
     format!(
-        r#"# Image-based lighting for three.js (r187){source}
+        r#"## Loading it
+
+In three.js (r187):
 
 - `{PMREM_FILE}`: the prefiltered radiance as three's own PMREM, a cube with mips,
   {label}, level `lod` GGX-prefiltered at perceptual roughness 1 − √(1 − lod/maxLod)

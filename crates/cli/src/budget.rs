@@ -83,6 +83,30 @@ pub fn parse_bytes(s: &str) -> Result<u64, String> {
     }
 }
 
+/// Refuses prefiltering `what` when it would not fit: the source `env` is held, the working
+/// cube of face `face` (bordered, with its pyramid, twice when bright texels are split off)
+/// is made, and `made` texels of four `f32` channels are the outputs (prefilter's chain, a
+/// bake's cubes).
+pub fn check_prefilter(
+    what: &str,
+    env: &mirrorball_core::EnvMap,
+    face: u64,
+    made: u64,
+    hint: &str,
+) -> Result<(), CliError> {
+    let working = f32_texels(6 * (face + 2) * (face + 2) * 4 / 3, 4) * 2;
+    let held = f32_texels(
+        env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
+        env.channels() as u64,
+    );
+    check(
+        what,
+        held,
+        working.saturating_add(f32_texels(made, 4)),
+        hint,
+    )
+}
+
 /// Bytes of `texels` texels of `channels` `f32` channels.
 pub fn f32_texels(texels: u64, channels: u64) -> u64 {
     texels.saturating_mul(channels).saturating_mul(4)

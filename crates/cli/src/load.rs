@@ -68,6 +68,23 @@ impl Source {
     }
 }
 
+/// Reads `input` as `plan` says and prepares it ([`Source::prepare`]), saying what was read
+/// and decided unless `quiet`: the first steps of `prefilter` and `bake`.
+pub fn read_prepared(
+    input: &str,
+    plan: &crate::commands::InputPlan,
+    quiet: bool,
+) -> Result<EnvMap, CliError> {
+    let limits = Limits::default();
+    let mut src = load(input, plan.from.as_ref(), plan.layout, &limits)?;
+    for line in src.prepare(input, plan.keep_invalid) {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    }
+    Ok(src.env)
+}
+
 /// Reads `input`: one file, or one per layer when the name holds `{face}`.
 pub fn load(
     input: &str,

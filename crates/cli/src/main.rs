@@ -59,6 +59,10 @@ enum Command {
     /// Prefiltered lighting: a Lambert, Phong or GGX mip chain (KTX2/DDS cube, or one
     /// image per level), spherical-harmonic coefficients (JSON) and a preview sheet (PNG).
     Prefilter(PrefilterArgs),
+    /// Engine-ready lighting: everything one engine needs for image-based lighting (its
+    /// containers, encodings, axes and roughness-to-mip rule) and a README.md saying how to
+    /// load it. `bake --for list` prints what each engine gets.
+    Bake(BakeArgs),
 }
 
 /// How to read an input file.
@@ -116,6 +120,11 @@ pub struct ConvertArgs {
     /// left-handed worlds). May be repeated.
     #[arg(long, value_name = "AXIS", value_parser = names::<mirrorball_core::Axis>())]
     flip: Vec<String>,
+    /// Turn the result into an engine's axes, as `bake --for` does (three mirrors x, bevy
+    /// and unity mirror z, unreal turns to Z up, …): exact for a cube, a rotation otherwise;
+    /// after --yaw, --pitch, --roll and --flip.
+    #[arg(long = "for", value_name = "ENGINE", value_parser = names::<mirrorball_bake::Engine>())]
+    engine: Option<String>,
     /// Exposure in stops (texels times 2^EV).
     #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
@@ -413,6 +422,45 @@ pub struct PrefilterArgs {
     quiet: bool,
 }
 
+#[derive(Args, Debug)]
+pub struct BakeArgs {
+    /// Input environment map (any projection; `{face}` reads one file per layer).
+    input: Option<String>,
+    /// The engine: bevy, three, babylon, gltf, filament, unity, unreal, ktx2; or list, to
+    /// print what each writes.
+    #[arg(long = "for", value_name = "ENGINE")]
+    engine: String,
+    /// The folder to write into (made if missing; its parent must exist).
+    out_dir: Option<String>,
+    /// Face edge of the specular chain's level 0, a power of two.
+    #[arg(long, default_value_t = 256)]
+    size: u32,
+    /// Texel encoding (default: the engine's; `bake --for list` shows which it takes).
+    #[arg(long, value_parser = names::<mirrorball_io::Encoding>())]
+    encoding: Option<String>,
+    /// How hard the BC6H encoder searches.
+    #[arg(long, default_value = "basic", value_parser = names::<mirrorball_io::Effort>())]
+    effort: String,
+    /// Zstandard level for KTX2 supercompression (default 3 where the engine reads it).
+    #[arg(long, value_name = "LEVEL", conflicts_with = "no_zstd")]
+    zstd: Option<i32>,
+    /// No supercompression.
+    #[arg(long)]
+    no_zstd: bool,
+    /// Roughness of each level instead of the engine's rule: linear, ue4, filament, or a
+    /// comma-separated list, one per level.
+    #[arg(long)]
+    mapping: Option<String>,
+    /// Importance samples per texel for the sharpest lobes.
+    #[arg(long, default_value_t = 128)]
+    samples: u32,
+    #[command(flatten)]
+    input_args: InputArgs,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
 /// On SIGINT, SIGTERM or SIGHUP: let a set of files being renamed into place land, remove
 /// every temporary file, and exit with 128 + the signal's number (130 for Ctrl-C), as
 /// shells do.
@@ -477,6 +525,7 @@ fn main() -> ExitCode {
         Command::Compare(a) => commands::compare::run(a),
         Command::Demo(a) => commands::demo::run(a),
         Command::Prefilter(a) => commands::prefilter::run(a),
+        Command::Bake(a) => commands::bake::run(a),
         Command::Analyze(a) => commands::analyze::run(a),
         Command::Render(a) => commands::render::run(*a),
     };

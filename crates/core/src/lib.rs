@@ -16,6 +16,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod axis_map;
 pub mod choice;
 pub mod color;
 mod envmap;
@@ -28,6 +29,7 @@ pub mod projection;
 mod remap;
 mod resample;
 
+pub use axis_map::AxisMap;
 pub use choice::{Choice, UnknownName};
 pub use envmap::{
     bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, bilinear_mix,

@@ -57,6 +57,17 @@ const K2: f64 = 1.092_548_430_592_079_2; // ½√(15/π)
 const K20: f64 = 0.315_391_565_252_520_05; // ¼√(5/π)
 const K22: f64 = 0.546_274_215_296_039_6; // ¼√(15/π)
 
+/// Each basis function's constant: `Yᵢ(d) = CONSTANTS[i] · Pᵢ(d)` with the polynomials
+/// `1, y, z, x, xy, yz, 3z² − 1, xz, x² − y²` (engines that store SH "pre-scaled" fold
+/// these into the coefficients).
+pub const CONSTANTS: [f64; 9] = [K0, K1, K1, K1, K2, K2, K20, K2, K22];
+
+/// The basis in words, for the documents that carry coefficients (the SH JSON).
+pub const BASIS_TEXT: &str = "real spherical harmonics, bands 0-2, index l(l+1)+m, orthonormal over the sphere, in world axes (+Y up, -Z ahead): Y0=0.282095, Y1=0.488603 y, Y2=0.488603 z, Y3=0.488603 x, Y4=1.092548 xy, Y5=1.092548 yz, Y6=0.315392 (3z^2-1), Y7=1.092548 xz, Y8=0.546274 (x^2-y^2)";
+
+/// How to read [`Sh9::lambert`]'s coefficients, for the same documents.
+pub const IRRADIANCE_TEXT: &str = "evaluate sum_i c_i Y_i(n) with irradiance_over_pi to get E(n)/pi, the radiance a white Lambertian surface with normal n reflects (Ramamoorthi & Hanrahan 2001: A0 = pi, A1 = 2pi/3, A2 = pi/4, divided by pi)";
+
 /// The nine basis functions at unit direction `d`.
 #[inline]
 pub fn basis(d: DVec3) -> [f64; 9] {
@@ -195,6 +206,33 @@ impl Sh9 {
             let s = f(band(i));
             for v in c.iter_mut() {
                 *v *= s;
+            }
+        }
+        out
+    }
+
+    /// The coefficients of the same function seen through `map`: `f'(d) = f(map.source_of(d))`
+    /// (an engine's axes). Exact: the nine functions are closed under orthogonal maps, and
+    /// the projection integral (Gauss–Legendre in z, 16 equal steps in longitude) is exact
+    /// for the products of two of them.
+    pub fn transformed(&self, map: &mirrorball_core::AxisMap) -> Sh9 {
+        if map.is_identity() {
+            return *self;
+        }
+        let mut out = Sh9::default();
+        let steps = 16;
+        for k in 0..steps {
+            let phi = 2.0 * PI * (k as f64 + 0.5) / steps as f64;
+            for (j, o) in out.coeffs.iter_mut().enumerate() {
+                for (c, oc) in o.iter_mut().enumerate() {
+                    // ∫ dφ ∫ dz: the φ sum is weighted 2π/steps.
+                    *oc += 2.0 * PI / steps as f64
+                        * mirrorball_core::quadrature::gauss_legendre(-1.0, 1.0, |z| {
+                            let r = (1.0 - z * z).max(0.0).sqrt();
+                            let d = DVec3::new(r * phi.cos(), z, r * phi.sin());
+                            self.eval(map.source_of(d))[c] * basis(d)[j]
+                        });
+                }
             }
         }
         out
@@ -358,6 +396,51 @@ pub fn project_reference(env: &EnvMap) -> Sh9 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Seen through any signed axis permutation, the SH evaluates at `d` as the original
+    /// does at `source_of(d)`; and it is what projecting the transformed map gives.
+    #[test]
+    fn transformed_sh_is_the_sh_of_the_transformed_map() {
+        use mirrorball_core::{Axis, AxisMap};
+        let mut sh = Sh9::default();
+        for (i, c) in sh.coeffs.iter_mut().enumerate() {
+            *c = [0.3 + i as f64, -0.7 * i as f64, (i * i) as f64 * 0.11 - 1.0];
+        }
+        let maps = [
+            AxisMap::mirror(Axis::X),
+            AxisMap::mirror(Axis::Z),
+            AxisMap::new([(Axis::Y, 1), (Axis::Z, 1), (Axis::X, -1)]).unwrap(),
+            AxisMap::new([(Axis::Z, -1), (Axis::X, 1), (Axis::Y, -1)]).unwrap(),
+        ];
+        for m in maps {
+            let t = sh.transformed(&m);
+            for d in [
+                DVec3::new(0.3, 0.4, -0.866).normalize(),
+                DVec3::new(-0.9, 0.1, 0.2).normalize(),
+                DVec3::Y,
+            ] {
+                let (a, b) = (t.eval(d), sh.eval(m.source_of(d)));
+                for k in 0..3 {
+                    assert!((a[k] - b[k]).abs() < 1e-11, "{m}: {a:?} vs {b:?}");
+                }
+            }
+        }
+        let proj = ProjectionKind::Cube.default_projection();
+        let env = EnvMap::from_fn(proj, 32, 3, |d| {
+            [
+                (1.0 + d.x + d.y * d.z) as f32,
+                (1.5 - d.z) as f32,
+                (1.0 + d.x * d.x) as f32,
+                1.0,
+            ]
+        });
+        let m = maps[2];
+        let moved = env.transformed(&m).unwrap();
+        let (a, b) = (project(&env).transformed(&m), project(&moved));
+        for (x, y) in a.coeffs.iter().flatten().zip(b.coeffs.iter().flatten()) {
+            assert!((x - y).abs() < 1e-5, "{x} vs {y}");
+        }
+    }
 
     /// The coefficients do not depend on how many threads made them (nor on how rayon
     /// split the rows): a prefilter run writes the same `.sh.json` every time.

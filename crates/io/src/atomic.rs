@@ -6,12 +6,15 @@
 //! - A set of files that belong together (six cube faces, a mip chain: an
 //!   [`crate::OutputSet`]) is renamed into place by [`commit_all`] under one guard: an interrupt waits for the set to land, and no
 //!   set starts landing after an interrupt, so a set is either all new or all old.
+//! - Files written inside [`write_together`] (any writer here: cubes, images, notes) wait
+//!   beside their destinations and land as one set when it ends, or not at all.
 //! - An output that is a symbolic link is written through (the file it points to is
 //!   replaced, the link kept), as `cp` does.
 //! - A temporary file is named `.NAME.PID.tmp`; a later run that writes `NAME` removes the
 //!   ones a killed run (SIGKILL, power loss) left, once their process is gone.
 
 use crate::Error;
+use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -21,6 +24,9 @@ use std::sync::{Mutex, RwLock};
 
 /// Temporary files being written or waiting to be renamed.
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Folders made for outputs still being written ([`made_folder`]): removed by
+/// [`interrupted`] when it leaves them empty.
+static FOLDERS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Set by [`interrupted`] (under `PENDING`'s lock): no temporary file is made after it.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 /// Held shared while files are renamed into place, exclusively by [`interrupted`].
@@ -31,9 +37,78 @@ type Leftovers = HashMap<String, Vec<PathBuf>>;
 /// Per folder already looked at, its [`Leftovers`].
 static LEFTOVERS: Mutex<Option<HashMap<PathBuf, Leftovers>>> = Mutex::new(None);
 
+thread_local! {
+    /// While [`write_together`] runs on this thread: the files it has staged.
+    static GATHERED: RefCell<Option<Vec<Staged>>> = const { RefCell::new(None) };
+}
+
+/// Runs `work`, and every file written meanwhile on this thread through this crate's
+/// writers ([`atomic_write`], [`crate::write_image`], the KTX2, DDS and KTX1 cube writers)
+/// is kept beside its destination, not renamed into place; when `work` succeeds they all
+/// land together ([`commit_all`]'s guard against interrupts), when it fails (or panics)
+/// none does and their temporary files are removed, every destination keeping its old
+/// file. Returns `work`'s value and the files written, in order. A call inside another
+/// lands its own files when it ends.
+///
+/// ```
+/// use std::io::Write;
+/// let dir = tempfile::tempdir().unwrap();
+/// let (a, b) = (dir.path().join("a.txt"), dir.path().join("b.txt"));
+/// let note = |p: &std::path::Path| {
+///     mirrorball_io::atomic_write(p, |w| w.write_all(b"x").map_err(|e| mirrorball_io::Error::io(p, e)))
+/// };
+/// let failed = mirrorball_io::write_together(|| {
+///     note(&a)?;
+///     assert!(!a.exists()); // written beside, not yet in place
+///     Err::<(), _>(mirrorball_io::Error::request(&b, "no room".into()))
+/// });
+/// assert!(failed.is_err());
+/// assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0); // nothing left
+/// let ((), files) = mirrorball_io::write_together(|| { note(&a)?; note(&b) }).unwrap();
+/// assert_eq!(files, [a.clone(), b.clone()]);
+/// assert!(a.exists() && b.exists());
+/// ```
+pub fn write_together<T>(
+    work: impl FnOnce() -> Result<T, Error>,
+) -> Result<(T, Vec<PathBuf>), Error> {
+    /// Puts back what was gathered before, also when `work` panics (dropping this call's
+    /// staged files, which removes them).
+    struct Restore(Option<Vec<Staged>>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let outer = self.0.take();
+            let _ = GATHERED.try_with(|g| *g.borrow_mut() = outer);
+        }
+    }
+    let restore = Restore(GATHERED.with(|g| g.borrow_mut().replace(Vec::new())));
+    let out = work();
+    let staged = GATHERED.with(|g| g.borrow_mut().take()).unwrap_or_default();
+    drop(restore);
+    let value = out?;
+    let paths = staged.iter().map(|s| s.path().to_path_buf()).collect();
+    commit_all(staged)?;
+    Ok((value, paths))
+}
+
+/// Renames `staged` into place now, or, inside [`write_together`], keeps it for the set.
+pub(crate) fn land(staged: Staged) -> Result<(), Error> {
+    let staged = GATHERED.with(|g| match g.borrow_mut().as_mut() {
+        Some(set) => {
+            set.push(staged);
+            None
+        }
+        None => Some(staged),
+    });
+    match staged {
+        Some(s) => s.commit(),
+        None => Ok(()),
+    }
+}
+
 /// Calls `write` with a buffered writer on a temporary file in `path`'s directory, flushes
-/// it, and renames it over `path`. On any error the temporary file is removed and `path` is
-/// left as it was: no reader ever sees a half-written output.
+/// it, and renames it over `path` (inside [`write_together`], when the set lands). On any
+/// error the temporary file is removed and `path` is left as it was: no reader ever sees a
+/// half-written output.
 ///
 /// The file is not synced to disk (`fsync`) before the rename, as `cp`, OpenEXR and image
 /// editors do not: a sync waits for the disk and guards only against the machine losing
@@ -55,7 +130,7 @@ pub fn atomic_write<F>(path: &Path, write: F) -> Result<(), Error>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<(), Error>,
 {
-    stage(path, write)?.commit()
+    land(stage(path, write)?)
 }
 
 /// A complete output written to a temporary file beside its destination, waiting to be
@@ -127,10 +202,32 @@ pub fn interrupted() -> usize {
         INTERRUPTED.store(true, Ordering::SeqCst);
         std::mem::take(&mut *pending)
     };
-    pending
+    let removed = pending
         .iter()
         .filter(|p| std::fs::remove_file(p).is_ok())
-        .count()
+        .count();
+    let folders = std::mem::take(&mut *FOLDERS.lock().unwrap_or_else(|e| e.into_inner()));
+    for dir in folders.iter().rev() {
+        let _ = std::fs::remove_dir(dir); // only when empty
+    }
+    removed
+}
+
+/// Marks `dir` as made for outputs now being written: an interrupt ([`interrupted`])
+/// removes it if it leaves it empty, until [`keep_folder`] says the outputs are in place.
+pub fn made_folder(dir: &Path) {
+    FOLDERS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(dir.to_path_buf());
+}
+
+/// `dir`, marked by [`made_folder`], holds what it was made for: an interrupt leaves it.
+pub fn keep_folder(dir: &Path) {
+    let mut folders = FOLDERS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(i) = folders.iter().rposition(|d| d == dir) {
+        folders.remove(i);
+    }
 }
 
 /// The first half of [`atomic_write`]: `write` fills a temporary file beside `path`, which

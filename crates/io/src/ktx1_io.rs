@@ -49,7 +49,12 @@ fn gl_format(encoding: Encoding) -> Option<[u32; 5]> {
 }
 
 /// The `sh` value cmgen writes: one line `r g b` per coefficient, in its order (band l,
-/// then m from −l to l).
+/// then m from −l to l), which Filament's `Ktx1Bundle::getSphericalHarmonics` reads back.
+/// The coefficients are cmgen's "pre-scaled" irradiance SH, as Filament's shader sums them
+/// (`iblSH[i]` times the bare polynomials 1, y, z, x, yx, yz, 3z² − 1, zx, x² − y², giving
+/// E/π): each basis constant times the coefficient of E/π, what `mirrorball-bake`'s
+/// Filament module makes (`filament::prescaled`, derived there from cmgen's
+/// `computeIrradianceSH3Bands`).
 pub fn filament_sh_text(sh: &[[f32; 3]]) -> String {
     sh.iter()
         .map(|c| format!("{} {} {}\n", c[0], c[1], c[2]))

@@ -40,7 +40,7 @@ mod rgba_png;
 
 pub use alloc::HugePages;
 pub use apng::write_apng;
-pub use atomic::{atomic_write, interrupted};
+pub use atomic::{atomic_write, interrupted, keep_folder, made_folder, write_together};
 pub use babylon_env::{read_babylon_env, write_babylon_env, BabylonEnv};
 pub use dds_io::write_dds;
 pub use error::{Error, Fault};
@@ -327,7 +327,12 @@ fn read_format(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
 /// Writes one flat image (EXR, HDR, PNG or JPEG), atomically. (Several files that belong
 /// together: [`OutputSet`].)
 pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {
-    stage_image(path, image, opts, &mut WriteBuffers::default())?.commit()
+    atomic::land(stage_image(
+        path,
+        image,
+        opts,
+        &mut WriteBuffers::default(),
+    )?)
 }
 
 /// Writes one flat image as [`write_image`] does, to a temporary file beside `path` that

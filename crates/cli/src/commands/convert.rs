@@ -9,7 +9,8 @@ use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
 use mirrorball_core::{
-    resample, Axis, Layout, Projection, ResampleOptions, Resampler, Rotation, WorldProjection,
+    resample, Axis, AxisMap, Layout, Projection, ProjectionKind, ResampleOptions, Resampler,
+    Rotation, WorldProjection,
 };
 use mirrorball_io::{ExrCompression, Format, OutputSet, Precision, WriteOptions};
 use std::path::PathBuf;
@@ -22,6 +23,9 @@ struct Plan {
     size: Option<u32>,
     save: SaveOptions,
     resample: ResampleOptions,
+    /// `--for`'s engine axes, for a cube output: applied exactly after resampling
+    /// (`EnvMap::transformed`); other outputs take it in `resample.rotation`.
+    orient: AxisMap,
 }
 
 pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
@@ -79,6 +83,17 @@ impl Plan {
             let axis = crate::choice::parse_flag::<Axis>("--flip", f)?;
             rotation = rotation.then(Rotation::mirror(axis));
         }
+        // The engine's axes come last: for a cube exactly, by moving texels; otherwise as
+        // the rotation it is.
+        let mut orient = AxisMap::IDENTITY;
+        if let Some(e) = &a.engine {
+            let engine = crate::choice::parse_flag::<mirrorball_bake::Engine>("--for", e)?;
+            if to.kind == ProjectionKind::Cube {
+                orient = engine.orientation();
+            } else {
+                rotation = rotation.then(engine.orientation().rotation());
+            }
+        }
         if !a.exposure.is_finite() {
             return Err(CliError::request("--exposure must be a finite number"));
         }
@@ -116,6 +131,7 @@ impl Plan {
                 max_samples: a.max_samples.max(1),
                 progress: None,
             },
+            orient,
         })
     }
 }
@@ -145,7 +161,9 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
         .unwrap_or_else(|| save::default_size(&src.env, dst.kind()));
     let (w, h) = dst.layer_extent(size);
     let rows = h as u64 * dst.layer_count() as u64;
-    let layer_files = save::layer_files(&a.output, dst.layer_count(), &plan.save);
+    // Turning a cube into an engine's axes moves texels between faces: the whole map first.
+    let layer_files = save::layer_files(&a.output, dst.layer_count(), &plan.save)
+        .filter(|_| plan.orient.is_identity());
     {
         let env = &src.env;
         let c = env.channels() as u64;
@@ -184,6 +202,12 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
                 plan.resample.progress = Some(counter);
                 resample(&src.env, dst, size, &plan.resample)
             });
+            let out = match plan.orient.is_identity() {
+                true => out,
+                false => out
+                    .transformed(&plan.orient)
+                    .expect("only cube outputs are oriented here"),
+            };
             let t_conv = t1.elapsed();
             drop(src);
             let t2 = Instant::now();

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 pub mod analyze;
+pub mod bake;
 pub mod compare;
 pub mod convert;
 pub mod demo;

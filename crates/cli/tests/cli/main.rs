@@ -2,6 +2,7 @@
 //! the bundled HDRs.
 mod analyze;
 mod bad_input;
+mod bake;
 mod commands;
 mod hostile;
 mod names;

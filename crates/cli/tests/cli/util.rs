@@ -34,12 +34,23 @@ pub fn ok(args: &[&str]) -> String {
     stderr(&o) + &stdout(&o)
 }
 
-/// Files in `dir`, sorted (to check nothing half-written is left).
+/// Files in `dir` and its folders (a folder listed as `name/`, then its files as
+/// `name/file`), sorted (to check nothing half-written is left).
 pub fn files(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
+    fn walk(dir: &Path, prefix: &str, v: &mut Vec<String>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let e = e.unwrap();
+            let name = format!("{prefix}{}", e.file_name().to_string_lossy());
+            if e.file_type().unwrap().is_dir() {
+                v.push(format!("{name}/"));
+                walk(&e.path(), &format!("{name}/"), v);
+            } else {
+                v.push(name);
+            }
+        }
+    }
+    let mut v = Vec::new();
+    walk(dir, "", &mut v);
     v.sort();
     v
 }

@@ -97,17 +97,7 @@ fn say(plan: &Plan, s: String) {
 /// The source, prepared (sanitized unless asked not to), and compressed as `--compress`
 /// says, with its energy report.
 fn read(plan: &Plan) -> Result<(EnvMap, Option<EnergyReport>), CliError> {
-    let limits = mirrorball_io::Limits::default();
-    let mut src = load::load(
-        &plan.source,
-        plan.input.from.as_ref(),
-        plan.input.layout,
-        &limits,
-    )?;
-    for line in src.prepare(&plan.source, plan.input.keep_invalid) {
-        say(plan, line);
-    }
-    let mut env = src.env;
+    let mut env = load::read_prepared(&plan.source, &plan.input, plan.quiet)?;
     let energy = (plan.compression != Compression::None).then(|| {
         let r = compress(&mut env, plan.compression);
         say(
@@ -185,20 +175,15 @@ fn check_memory(plan: &Plan, shape: &Chain, env: &EnvMap) -> Result<(), CliError
     let (w0, h0) = shape.extent;
     let out = &shape.projection;
     let face = plan.opts.cube_size.unwrap_or(shape.size.clamp(256, 4096)) as u64;
-    let working = budget::f32_texels(6 * (face + 2) * (face + 2) * 4 / 3, 4) * 2;
-    let chain = budget::f32_texels(w0 as u64 * h0 as u64 * out.layer_count() as u64 * 4 / 3, 4);
-    let held = budget::f32_texels(
-        env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
-        env.channels() as u64,
-    );
-    budget::check(
+    budget::check_prefilter(
         &format!(
             "prefiltering into {} {w0}x{h0}x{} (working cube {face}²)",
             out.name(),
             out.layer_count()
         ),
-        held,
-        working.saturating_add(chain),
+        env,
+        face,
+        w0 as u64 * h0 as u64 * out.layer_count() as u64 * 4 / 3,
         "a smaller --size or --cube-size",
     )
 }
