@@ -3,6 +3,7 @@ pub mod analyze;
 pub mod compare;
 pub mod convert;
 pub mod demo;
+pub mod frames;
 pub mod info;
 pub mod prefilter;
 pub mod render;
