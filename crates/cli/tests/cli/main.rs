@@ -3,6 +3,7 @@
 mod analyze;
 mod bad_input;
 mod commands;
+mod frames;
 mod hostile;
 mod names;
 mod prefilter;
