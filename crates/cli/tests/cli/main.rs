@@ -2,6 +2,7 @@
 //! the bundled HDRs.
 mod analyze;
 mod bad_input;
+mod batch_docs;
 mod commands;
 mod frames;
 mod hostile;
