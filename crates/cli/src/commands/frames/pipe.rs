@@ -206,9 +206,10 @@ impl SrgbTable {
     /// The code of linear `l`, clamped to `[0, scale]` (NaN gives 0).
     #[inline]
     pub fn code(&self, l: f32) -> u32 {
-        if !(l > mirrorball_core::color::SRGB_LINEAR_KNEE as f32) {
-            // The linear segment (and 0 for NaN and negatives).
-            return (l.max(0.0) * (12.92 * self.scale) + 0.5) as u32;
+        if l.is_nan() || l <= mirrorball_core::color::SRGB_LINEAR_KNEE as f32 {
+            // The linear segment (and 0 for NaN and negatives: `max` keeps 0 over NaN).
+            return (l.max(0.0) * (mirrorball_core::color::SRGB_SLOPE as f32 * self.scale) + 0.5)
+                as u32;
         }
         if l >= 1.0 {
             return self.scale as u32;
