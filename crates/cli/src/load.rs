@@ -162,7 +162,6 @@ pub fn load(
         .into_iter()
         .next()
         .ok_or_else(|| CliError::input(format!("{input}: no image")))?;
-    let (w, h) = (image.width(), image.height());
     // OpenEXR's `envmap` tag, when it alone says the projection: its pictures follow
     // OpenEXR's conventions (ImfEnvmap), turned into mirrorball's here.
     let tagged = from.is_none() && layout.is_none() && recorded.is_none() && format == Format::Exr;
@@ -191,6 +190,37 @@ pub fn load(
         }
         _ => {}
     }
+    let (env, decided) = interpret(
+        input,
+        image,
+        from,
+        layout,
+        recorded,
+        declared,
+        records_other,
+    )?;
+    Ok(Source {
+        env,
+        description,
+        decided,
+        invalid,
+    })
+}
+
+/// The map in one picture read from `input` (a file, or a raw frame from a pipe): its
+/// projection and layout as asked (`from`, `layout`), else as `recorded` in the file, else
+/// guessed from its shape (`declared` by the container helps the guess); `note` adds what
+/// the file says otherwise to the decision's words. Returns the map and those words.
+pub fn interpret(
+    input: &str,
+    image: Image,
+    from: Option<&ProjSpec>,
+    layout: Option<Layout>,
+    recorded: Option<mirrorball_io::MapInfo>,
+    declared: Option<ProjectionKind>,
+    records_other: impl Fn(&Projection) -> String,
+) -> Result<(EnvMap, String), CliError> {
+    let (w, h) = (image.width(), image.height());
     let (proj, layout, decided) = match (from, layout, recorded) {
         (Some(spec), Some(l), _) => {
             let proj = build_from(spec, w, h)?;
@@ -255,12 +285,7 @@ pub fn load(
     let env = layout
         .unpack_owned(image, proj)
         .map_err(|e| CliError::input(format!("{input}: {e}")))?;
-    Ok(Source {
-        env,
-        description,
-        decided,
-        invalid,
-    })
+    Ok((env, decided))
 }
 
 /// The projection `spec` names, for a `w`×`h` picture.

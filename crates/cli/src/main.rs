@@ -86,16 +86,34 @@ pub struct InputArgs {
     keep_invalid: bool,
 }
 
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct ConvertArgs {
     /// Input file (`{face}` in the name reads one file per layer: px nx py ny pz nz, or
-    /// front back).
+    /// front back); frames: a pattern (in/%05d.exr, 'in/*.exr'), or - for raw frames on
+    /// standard input.
+    #[arg(
+        required_unless_present = "manifest",
+        default_value = "",
+        hide_default_value = true
+    )]
     input: String,
     /// Output file; the extension picks the container: .exr .hdr .png .jpg .ktx2 .dds.
-    /// `{face}` in the name (or --layout separate) writes one file per layer.
+    /// `{face}` in the name (or --layout separate) writes one file per layer; frames: a
+    /// pattern (out/%05d.png), or - for raw frames on standard output.
+    #[arg(
+        required_unless_present = "manifest",
+        default_value = "",
+        hide_default_value = true
+    )]
     output: String,
     /// Output projection, `NAME[:key=value…]` (see --from).
-    #[arg(long, value_name = "PROJECTION")]
+    #[arg(
+        long,
+        value_name = "PROJECTION",
+        required_unless_present = "manifest",
+        default_value = "",
+        hide_default_value = true
+    )]
     to: String,
     /// Face edge (cubes), width (lat-long, Mercator, cylinders, Hammer, sinusoidal, views) or
     /// diameter (disk maps), in texels.
@@ -143,6 +161,8 @@ pub struct ConvertArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
+    #[command(flatten)]
+    frames: commands::frames::FramesArgs,
 }
 
 #[derive(Args, Debug)]

@@ -290,14 +290,15 @@ pub fn write(
 // ---------------------------------------------------------------------------------------
 // sRGB tables, from `mirrorball_core::color`'s transfer functions.
 
-/// Linear light of each 8-bit sRGB code.
-fn lut8() -> &'static [f32; 256] {
+/// Linear light of each 8-bit sRGB code (what PNG and JPEG samples decode to; raw 8-bit
+/// frames through the CLI's pipes too).
+pub fn lut8() -> &'static [f32; 256] {
     static LUT: OnceLock<[f32; 256]> = OnceLock::new();
     LUT.get_or_init(|| std::array::from_fn(|k| srgb_to_linear(k as f64 / 255.0) as f32))
 }
 
 /// Linear light of each 16-bit sRGB code.
-fn lut16() -> &'static [f32] {
+pub fn lut16() -> &'static [f32] {
     static LUT: OnceLock<Vec<f32>> = OnceLock::new();
     LUT.get_or_init(|| {
         (0..=u16::MAX)

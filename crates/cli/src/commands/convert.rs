@@ -16,16 +16,17 @@ use mirrorball_io::{ExrCompression, Format, OutputSet, Precision, WriteOptions};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Everything `convert` will do, checked before any work starts.
-struct Plan {
-    input: InputPlan,
-    to: ProjSpec,
-    size: Option<u32>,
-    save: SaveOptions,
-    resample: ResampleOptions,
+/// Everything `convert` will do, checked before any work starts (for each frame of a
+/// sequence too: `frames/`).
+pub(crate) struct Plan {
+    pub(crate) input: InputPlan,
+    pub(crate) to: ProjSpec,
+    pub(crate) size: Option<u32>,
+    pub(crate) save: SaveOptions,
+    pub(crate) resample: ResampleOptions,
     /// `--for`'s engine axes, for a cube output: applied exactly after resampling
     /// (`EnvMap::transformed`); other outputs take it in `resample.rotation`.
-    orient: AxisMap,
+    pub(crate) orient: AxisMap,
 }
 
 pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
@@ -38,7 +39,7 @@ fn parse_compression(c: &str) -> Result<ExrCompression, CliError> {
 }
 
 impl Plan {
-    fn new(a: &ConvertArgs) -> Result<Plan, CliError> {
+    pub(crate) fn new(a: &ConvertArgs) -> Result<Plan, CliError> {
         let input = InputPlan::new(&a.input_args)?;
         let to = ProjSpec::parse(&a.to).map_err(|e| bad("--to", e))?;
         let layout = a
@@ -137,6 +138,10 @@ impl Plan {
 }
 
 pub fn run(a: ConvertArgs) -> Result<(), CliError> {
+    // Sequences, pipes and manifests (`frames/`).
+    if let Some(done) = super::frames::route(&a) {
+        return done;
+    }
     let mut plan = Plan::new(&a)?;
     let t0 = Instant::now();
     let limits = mirrorball_io::Limits::default();

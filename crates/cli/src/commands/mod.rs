@@ -4,6 +4,7 @@ pub mod bake;
 pub mod compare;
 pub mod convert;
 pub mod demo;
+pub mod frames;
 pub mod info;
 pub mod prefilter;
 pub mod render;

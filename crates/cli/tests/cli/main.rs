@@ -3,7 +3,9 @@
 mod analyze;
 mod bad_input;
 mod bake;
+mod batch_docs;
 mod commands;
+mod frames;
 mod hostile;
 mod names;
 mod prefilter;

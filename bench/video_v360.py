@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""Frames per second turning a 4096x2048 lat-long stream into 6x1024² cube faces (and EAC,
+when mirrorball knows it): mirrorball through pipes, end to end as a user runs it,
+
+    ffmpeg -f rawvideo … -i in.raw -f rawvideo - |
+      mirrorball convert - - --in-size 4096x2048 --pix-fmt F --to cube --size 1024 --layout hstrip |
+      ffmpeg -f rawvideo … -i - -f null -
+
+against ffmpeg's own v360 filter doing the same (`ffmpeg -i in.raw -vf v360=e:c6x1 -f null -`),
+at 8 bits (rgb24) and 16 bits (rgb48le), side by side in one run, the runs interleaved.
+The input is a raw file of testsrc2 frames made once (so that decoding costs neither side
+anything); `-f null` on both sides, so that no encoder counts. mirrorball antialiases (its
+default --max-samples 4); v360 interpolates bilinearly (its default).
+
+Targets (issue 19): mirrorball at least 2x v360's frames per second at 16 bits, 1.5x at 8.
+
+    python3 bench/video_v360.py [--frames 24] [--reps 2] [--no-build] [--eac-to eac]
+"""
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+FFMPEG = "/usr/bin/ffmpeg"
+W, H, FACE = 4096, 2048, 1024
+TARGET = {"rgb24": 1.5, "rgb48le": 2.0}
+
+
+def sh(cmd, **kw):
+    return subprocess.run(cmd, shell=True, check=True, **kw)
+
+
+def make_input(path, pix_fmt, frames):
+    if path.exists() and path.stat().st_size == frames * W * H * (3 if pix_fmt == "rgb24" else 6):
+        return
+    sh(f"{FFMPEG} -v error -y -f lavfi -i testsrc2=size={W}x{H}:rate=30 -frames:v {frames} "
+       f"-pix_fmt {pix_fmt} -f rawvideo {path}")
+
+
+def timed(cmd):
+    t = time.perf_counter()
+    p = subprocess.run(cmd, shell=True, stderr=subprocess.PIPE, text=True)
+    dt = time.perf_counter() - t
+    if p.returncode != 0:
+        raise RuntimeError(f"{cmd}\n{p.stderr[-2000:]}")
+    return dt, p.stderr
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--frames", type=int, default=24)
+    ap.add_argument("--reps", type=int, default=2)
+    ap.add_argument("--no-build", action="store_true")
+    ap.add_argument("--eac-to", default="eac",
+                    help="mirrorball's --to for EAC (skipped when mirrorball refuses it)")
+    ap.add_argument("--data", default=str(ROOT / "bench" / "data"))
+    a = ap.parse_args()
+    mb = ROOT / "target" / "release" / "mirrorball"
+    if not a.no_build:
+        sh(f"cargo build --release -p mirrorball-cli --bin mirrorball", cwd=ROOT)
+    data = Path(a.data)
+    data.mkdir(parents=True, exist_ok=True)
+    print(f"{os.cpu_count()} CPUs; {a.frames} frames of {W}x{H}; best of {a.reps}")
+
+    # (name, mirrorball --to and layout, output frame size, v360 output options)
+    targets = [("cube 6x1024²", f"--to cube --size {FACE} --layout hstrip", (6 * FACE, FACE),
+                f"v360=input=e:output=c6x1:w={6 * FACE}:h={FACE}")]
+    probe = subprocess.run(f"{mb} convert - - --in-size 8x4 --pix-fmt rgb24 --to {a.eac_to} -q "
+                           "--size 16 < /dev/null", shell=True, stderr=subprocess.PIPE, text=True)
+    if "unknown" in probe.stderr or "--to" in probe.stderr:
+        print(f"EAC: mirrorball has no --to {a.eac_to} yet; cube only")
+    else:
+        targets.append(("EAC 3x2", f"--to {a.eac_to} --size {FACE}", None,
+                        f"v360=input=e:output=eac:w={3 * FACE}:h={2 * FACE}"))
+
+    rows = []
+    for pix_fmt in ["rgb24", "rgb48le"]:
+        src = data / f"testsrc2-{W}x{H}-{a.frames}.{pix_fmt}.raw"
+        make_input(src, pix_fmt, a.frames)
+        feed = f"{FFMPEG} -v error -f rawvideo -pix_fmt {pix_fmt} -s {W}x{H} -i {src}"
+        for name, to, size, v360 in targets:
+            best = {"mirrorball": 1e9, "v360": 1e9}
+            steady = 0.0
+            for _ in range(a.reps):
+                # The output frame size is what mirrorball says it writes.
+                if size is None:
+                    _, err = timed(f"{feed} -frames:v 1 -f rawvideo - | {mb} convert - - "
+                                   f"--in-size {W}x{H} --pix-fmt {pix_fmt} {to} > /dev/null")
+                    m = re.search(r"writing (\d+)x(\d+)", err)
+                    size = (int(m.group(1)), int(m.group(2)))
+                mcmd = (f"{feed} -f rawvideo - | {mb} convert - - --in-size {W}x{H} "
+                        f"--pix-fmt {pix_fmt} {to} | {FFMPEG} -v error -f rawvideo "
+                        f"-pix_fmt {pix_fmt} -s {size[0]}x{size[1]} -i - -f null -")
+                dt, err = timed(mcmd)
+                best["mirrorball"] = min(best["mirrorball"], dt)
+                m = re.search(r"in ([\d.]+)s \(([\d.]+) frames/s; planned in ([\d.]+)s\)", err)
+                if m:
+                    steady = max(steady, float(m.group(2)))
+                dt, _ = timed(f"{feed} -vf {v360} -f null -")
+                best["v360"] = min(best["v360"], dt)
+            fm = a.frames / best["mirrorball"]
+            fv = a.frames / best["v360"]
+            rows.append((name, pix_fmt, fm, steady, fv, fm / fv, TARGET[pix_fmt]))
+
+    print()
+    print(f"{'to':14} {'pixels':8} {'mirrorball':>11} {'(no plan)':>10} {'v360':>8} "
+          f"{'ratio':>6} {'target':>7}")
+    for name, pix_fmt, fm, steady, fv, r, t in rows:
+        print(f"{name:14} {pix_fmt:8} {fm:8.2f} f/s {steady:7.2f} f/s {fv:5.2f} f/s "
+              f"{r:5.2f}x {t:5.1f}x {'met' if r >= t else 'NOT met'}")
+    print("\nmirrorball f/s: end to end, wall clock, planning (once per run) included; "
+          "(no plan): mirrorball's own count after planning")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

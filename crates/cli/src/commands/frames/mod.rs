@@ -1,0 +1,94 @@
+//! `convert` over many pictures: frame sequences (printf patterns and globs), raw frames
+//! through pipes, and manifests of jobs sliced into shards for many machines.
+//!
+//! - `pattern.rs` — what a file argument names: one file, `%05d`, or a glob.
+//! - `pipe.rs` — raw frames on standard input and output, in ffmpeg's pixel formats.
+//! - `sequence.rs` — a sequence's plan (one `Remap` for all frames) and its sources and
+//!   sinks; `pipeline.rs` — the bounded loop that reads, converts and writes at once.
+//! - `manifest.rs` — JSON-lines or CSV manifests, each job a `convert` of its own;
+//!   `shard.rs` — `--shard i/n`; `log.rs` — the one JSON line per frame or job.
+
+mod log;
+mod manifest;
+mod pattern;
+mod pipe;
+mod pipeline;
+mod sequence;
+mod shard;
+
+use crate::choice::names;
+use crate::error::CliError;
+use crate::ConvertArgs;
+use clap::Args;
+use pattern::Pattern;
+pub use pipe::PixFmt;
+
+/// `convert`'s flags for frames, pipes and batches.
+#[derive(Args, Debug, Clone, Default)]
+pub struct FramesArgs {
+    /// Size of the raw frames read from standard input (input `-`), WIDTHxHEIGHT.
+    #[arg(long, value_name = "WxH")]
+    pub in_size: Option<String>,
+    /// Pixel format of raw frames through `-` (standard input and output), named as
+    /// ffmpeg's -pix_fmt: rgb24, rgb48le (sRGB-coded, as PNG), rgbf32le or gbrpf32le
+    /// (linear float).
+    #[arg(long, value_name = "FORMAT", value_parser = names::<PixFmt>())]
+    pub pix_fmt: Option<String>,
+    /// Pixel format of the frames written to standard output, when not --pix-fmt's.
+    #[arg(long, value_name = "FORMAT", value_parser = names::<PixFmt>())]
+    pub out_pix_fmt: Option<String>,
+    /// Run the jobs listed in FILE (JSON lines: {"input", "output", "options"}; or CSV:
+    /// input,output,options), each as `convert INPUT OUTPUT <these flags> <options>`.
+    #[arg(long, value_name = "FILE")]
+    pub manifest: Option<String>,
+    /// Run only slice I of N equal slices of the frames or the manifest's jobs, I counted
+    /// from 0 (Slurm: --array=0-(N-1) and $SLURM_ARRAY_TASK_ID; Kubernetes indexed Jobs:
+    /// $JOB_COMPLETION_INDEX).
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// Convert frames and jobs whose outputs exist again (by default they are skipped: an
+    /// output exists only once it is complete, being renamed into place when written).
+    #[arg(long)]
+    pub overwrite: bool,
+    /// Print one JSON line per frame or job (always for --manifest), on standard output, or
+    /// on standard error when standard output carries frames.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `a` here when it is a sequence, a pipe or a manifest; `None` when it is a plain
+/// conversion of one map.
+pub fn route(a: &ConvertArgs) -> Option<Result<(), CliError>> {
+    if a.frames.manifest.is_some() {
+        return Some(manifest::run(a));
+    }
+    let many = || -> Result<bool, CliError> {
+        Ok(a.input == "-"
+            || a.output == "-"
+            || Pattern::parse(&a.input)?.is_some()
+            || Pattern::output(&a.output)?.is_some())
+    };
+    match many() {
+        Ok(true) => Some(sequence::run(a)),
+        Ok(false) => single_only(a).err().map(Err),
+        Err(e) => Some(Err(e)),
+    }
+}
+
+/// Refuses the frames flags on a conversion of one file.
+fn single_only(a: &ConvertArgs) -> Result<(), CliError> {
+    let f = &a.frames;
+    let given = [
+        ("--in-size", f.in_size.is_some()),
+        ("--pix-fmt", f.pix_fmt.is_some()),
+        ("--out-pix-fmt", f.out_pix_fmt.is_some()),
+        ("--shard", f.shard.is_some()),
+    ];
+    match given.iter().find(|(_, g)| *g) {
+        Some((flag, _)) => Err(CliError::request(format!(
+            "{flag} is for frames: a pattern (%05d, *), - for a pipe, or --manifest; {} is one file",
+            a.input
+        ))),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,363 @@
+//! Raw video frames on standard input and output, back to back with no header, as ffmpeg's
+//! `-f rawvideo` reads and writes them; the pixel formats keep ffmpeg's names.
+//!
+//! Integer formats carry sRGB-coded values (as mirrorball reads and writes 8- and 16-bit
+//! PNG), so that a frame through a pipe and the same frame through a PNG file convert
+//! alike; float formats carry linear light.
+
+use crate::error::CliError;
+use mirrorball_core::color::linear_to_srgb;
+use mirrorball_core::{choice_traits, Choice, Image};
+use rayon::prelude::*;
+use std::io::{ErrorKind, Read, Write};
+use std::sync::OnceLock;
+
+/// A raw frame's pixel format, named as ffmpeg's `-pix_fmt`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixFmt {
+    /// 8-bit sRGB R, G, B interleaved.
+    Rgb24,
+    /// 16-bit little-endian sRGB R, G, B interleaved.
+    Rgb48le,
+    /// 32-bit little-endian float linear R, G, B interleaved (FFmpeg 6 and later).
+    Rgbf32le,
+    /// 32-bit little-endian float linear planes G, B, R (FFmpeg 5's float RGB).
+    Gbrpf32le,
+}
+
+impl Choice for PixFmt {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (PixFmt::Rgb24, &["rgb24"]),
+        (PixFmt::Rgb48le, &["rgb48le", "rgb48"]),
+        (PixFmt::Rgbf32le, &["rgbf32le", "rgbf32"]),
+        (PixFmt::Gbrpf32le, &["gbrpf32le", "gbrpf32"]),
+    ];
+}
+choice_traits!(PixFmt);
+
+/// Texels encoded or decoded per parallel task.
+const CHUNK: usize = 1 << 14;
+
+impl PixFmt {
+    /// Bytes of one pixel.
+    pub fn pixel_bytes(self) -> usize {
+        match self {
+            PixFmt::Rgb24 => 3,
+            PixFmt::Rgb48le => 6,
+            PixFmt::Rgbf32le | PixFmt::Gbrpf32le => 12,
+        }
+    }
+
+    /// Bytes of a `w`×`h` frame.
+    pub fn frame_bytes(self, w: u32, h: u32) -> usize {
+        w as usize * h as usize * self.pixel_bytes()
+    }
+
+    /// Decodes `bytes` (one `w`×`h` frame) into `img`, linear RGB.
+    pub fn decode(self, bytes: &[u8], img: &mut Image) {
+        let n = img.width() as usize * img.height() as usize;
+        debug_assert_eq!(img.channels(), 3);
+        debug_assert_eq!(bytes.len(), n * self.pixel_bytes());
+        let data = img.data_mut();
+        match self {
+            PixFmt::Rgb24 => {
+                let lut = mirrorball_io::srgb8_to_linear();
+                data.par_chunks_mut(CHUNK * 3)
+                    .zip(bytes.par_chunks(CHUNK * 3))
+                    .for_each(|(d, s)| {
+                        for (d, s) in d.iter_mut().zip(s) {
+                            *d = lut[*s as usize];
+                        }
+                    });
+            }
+            PixFmt::Rgb48le => {
+                let lut = mirrorball_io::srgb16_to_linear();
+                data.par_chunks_mut(CHUNK * 3)
+                    .zip(bytes.par_chunks(CHUNK * 6))
+                    .for_each(|(d, s)| {
+                        for (d, s) in d.iter_mut().zip(s.chunks_exact(2)) {
+                            *d = lut[u16::from_le_bytes([s[0], s[1]]) as usize];
+                        }
+                    });
+            }
+            PixFmt::Rgbf32le => data
+                .par_chunks_mut(CHUNK * 3)
+                .zip(bytes.par_chunks(CHUNK * 12))
+                .for_each(|(d, s)| {
+                    for (d, s) in d.iter_mut().zip(s.chunks_exact(4)) {
+                        *d = f32::from_le_bytes([s[0], s[1], s[2], s[3]]);
+                    }
+                }),
+            PixFmt::Gbrpf32le => {
+                let plane = n * 4;
+                // ffmpeg's plane order: G, B, R.
+                let (g, rest) = bytes.split_at(plane);
+                let (b, r) = rest.split_at(plane);
+                data.par_chunks_mut(CHUNK * 3)
+                    .enumerate()
+                    .for_each(|(k, d)| {
+                        let at = k * CHUNK * 4;
+                        for (i, t) in d.chunks_exact_mut(3).enumerate() {
+                            let o = at + i * 4;
+                            let f =
+                                |p: &[u8]| f32::from_le_bytes([p[o], p[o + 1], p[o + 2], p[o + 3]]);
+                            t[0] = f(r);
+                            t[1] = f(g);
+                            t[2] = f(b);
+                        }
+                    });
+            }
+        }
+    }
+
+    /// Encodes `img` (RGB or RGBA; alpha is dropped) as one frame into `out`.
+    pub fn encode(self, img: &Image, out: &mut Vec<u8>) {
+        let c = img.channels();
+        let n = img.width() as usize * img.height() as usize;
+        out.resize(n * self.pixel_bytes(), 0);
+        let src = img.data();
+        let px = self.pixel_bytes();
+        match self {
+            PixFmt::Rgb24 | PixFmt::Rgb48le | PixFmt::Rgbf32le => {
+                let table = match self {
+                    PixFmt::Rgb24 => Some(SrgbTable::get(255.0)),
+                    PixFmt::Rgb48le => Some(SrgbTable::get(65535.0)),
+                    _ => None,
+                };
+                out.par_chunks_mut(CHUNK * px)
+                    .zip(src.par_chunks(CHUNK * c))
+                    .for_each(|(d, s)| {
+                        for (d, s) in d.chunks_exact_mut(px).zip(s.chunks_exact(c)) {
+                            match (self, table) {
+                                (PixFmt::Rgb24, Some(t)) => {
+                                    for k in 0..3 {
+                                        d[k] = t.code(s[k]) as u8;
+                                    }
+                                }
+                                (PixFmt::Rgb48le, Some(t)) => {
+                                    for k in 0..3 {
+                                        d[2 * k..2 * k + 2]
+                                            .copy_from_slice(&(t.code(s[k]) as u16).to_le_bytes());
+                                    }
+                                }
+                                _ => {
+                                    for k in 0..3 {
+                                        d[4 * k..4 * k + 4].copy_from_slice(&s[k].to_le_bytes());
+                                    }
+                                }
+                            }
+                        }
+                    });
+            }
+            PixFmt::Gbrpf32le => {
+                let (g, rest) = out.split_at_mut(n * 4);
+                let (b, r) = rest.split_at_mut(n * 4);
+                for (plane, k) in [(g, 1), (b, 2), (r, 0)] {
+                    plane
+                        .par_chunks_mut(CHUNK * 4)
+                        .zip(src.par_chunks(CHUNK * c))
+                        .for_each(|(d, s)| {
+                            for (d, s) in d.chunks_exact_mut(4).zip(s.chunks_exact(c)) {
+                                d.copy_from_slice(&s[k].to_le_bytes());
+                            }
+                        });
+                }
+            }
+        }
+    }
+}
+
+/// The sRGB encoding scaled to integer codes, fast: linear on the standard's linear
+/// segment, and above it piecewise linear in the `f32` bit pattern, 2⁹ pieces per octave
+/// from 2⁻⁹ (below the knee, 0.0031308) to 1, 4609 entries. Within a piece the curve
+/// `1.055 L^(1/2.4)` bends by at most `h²/8 · |f''|`, with `h = L/2⁹`: `0.243/(8·2¹⁸) ≈
+/// 1.2·10⁻⁷` of the value, under 0.01 of a 16-bit code, so a code is the nearest one, or its
+/// neighbour for values within that of a code's boundary (the exact encoder, a `powf` per
+/// value, is io's, for files).
+pub struct SrgbTable {
+    /// Code value (scaled, not rounded) at the start of each piece, and one past the end.
+    at: Vec<f32>,
+    scale: f32,
+}
+
+/// The bit pattern of 2⁻⁹, where the table starts.
+const TABLE_FROM: u32 = 0x3b00_0000;
+/// Mantissa bits below a piece's index.
+const PIECE_SHIFT: u32 = 14;
+
+impl SrgbTable {
+    /// The table for codes `0..=scale` (255 or 65535).
+    pub fn get(scale: f32) -> &'static SrgbTable {
+        static T8: OnceLock<SrgbTable> = OnceLock::new();
+        static T16: OnceLock<SrgbTable> = OnceLock::new();
+        let cell = if scale <= 255.0 { &T8 } else { &T16 };
+        cell.get_or_init(|| {
+            let pieces = ((1.0f32.to_bits() - TABLE_FROM) >> PIECE_SHIFT) as usize;
+            let at = (0..=pieces)
+                .map(|k| {
+                    let l = f32::from_bits(TABLE_FROM + ((k as u32) << PIECE_SHIFT)) as f64;
+                    (linear_to_srgb(l) * scale as f64) as f32
+                })
+                .collect();
+            SrgbTable { at, scale }
+        })
+    }
+
+    /// The code of linear `l`, clamped to `[0, scale]` (NaN gives 0).
+    #[inline]
+    pub fn code(&self, l: f32) -> u32 {
+        if l.is_nan() || l <= mirrorball_core::color::SRGB_LINEAR_KNEE as f32 {
+            // The linear segment (and 0 for NaN and negatives: `max` keeps 0 over NaN).
+            return (l.max(0.0) * (mirrorball_core::color::SRGB_SLOPE as f32 * self.scale) + 0.5)
+                as u32;
+        }
+        if l >= 1.0 {
+            return self.scale as u32;
+        }
+        let rel = l.to_bits() - TABLE_FROM;
+        let k = (rel >> PIECE_SHIFT) as usize;
+        let t = (rel & ((1 << PIECE_SHIFT) - 1)) as f32 * (1.0 / (1 << PIECE_SHIFT) as f32);
+        let (a, b) = (self.at[k], self.at[k + 1]);
+        (a + (b - a) * t + 0.5) as u32
+    }
+}
+
+/// Reads one frame of `buf.len()` bytes: `Ok(false)` at the end of the stream before the
+/// frame's first byte, an input error when it ends inside the frame.
+pub fn read_frame(r: &mut impl Read, buf: &mut [u8], frame: u64) -> Result<bool, CliError> {
+    let mut got = 0;
+    while got < buf.len() {
+        match r.read(&mut buf[got..]) {
+            Ok(0) if got == 0 => return Ok(false),
+            Ok(0) => {
+                return Err(CliError::input(format!(
+                    "standard input ended {got} bytes into frame {frame}, which needs {} (check --in-size and --pix-fmt against the stream)",
+                    buf.len()
+                )))
+            }
+            Ok(k) => got += k,
+            Err(e) if e.kind() == ErrorKind::Interrupted => {}
+            Err(e) => {
+                return Err(CliError::system(format!(
+                    "reading frame {frame} from standard input: {e}"
+                )))
+            }
+        }
+    }
+    Ok(true)
+}
+
+/// Writes one encoded frame; a reader that has gone away is the system's fault, said so.
+pub fn write_frame(w: &mut impl Write, bytes: &[u8], frame: u64) -> Result<(), CliError> {
+    w.write_all(bytes).and_then(|_| w.flush()).map_err(|e| {
+        if e.kind() == ErrorKind::BrokenPipe {
+            CliError::system(format!(
+                "standard output was closed by its reader before frame {frame}"
+            ))
+        } else {
+            CliError::system(format!("writing frame {frame} to standard output: {e}"))
+        }
+    })
+}
+
+/// A `WxH` size.
+pub fn parse_size(flag: &str, s: &str) -> Result<(u32, u32), CliError> {
+    let bad = || {
+        CliError::request(format!(
+            "{flag}: '{s}' is not WIDTHxHEIGHT (for example 4096x2048)"
+        ))
+    };
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    );
+    if w == 0 || h == 0 || w > 65536 || h > 65536 {
+        return Err(CliError::request(format!(
+            "{flag}: {w}x{h} is outside 1..=65536 on a side"
+        )));
+    }
+    Ok((w, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fast_srgb_codes_are_the_nearest_or_a_neighbour() {
+        for scale in [255.0f32, 65535.0] {
+            let t = SrgbTable::get(scale);
+            let mut exact_hits = 0u64;
+            let n = 1_000_000;
+            for i in 0..=n {
+                let l = (i as f32 / n as f32).powi(2) * 1.01;
+                let exact = (linear_to_srgb(l.min(1.0) as f64) * scale as f64).round() as i64;
+                let fast = t.code(l) as i64;
+                assert!(
+                    (fast - exact).abs() <= 1,
+                    "{l}: {fast} vs {exact} of {scale}"
+                );
+                exact_hits += (fast == exact) as u64;
+            }
+            // Off by one only within a hair (0.01 of a code) of a code's boundary.
+            assert!(exact_hits as f64 > 0.99 * n as f64, "{exact_hits} of {n}");
+            assert_eq!(t.code(f32::NAN), 0);
+            assert_eq!(t.code(-1.0), 0);
+            assert_eq!(t.code(7.0), scale as u32);
+        }
+    }
+
+    #[test]
+    fn every_format_round_trips() {
+        let mut img = Image::new(5, 3, 3);
+        for (i, v) in img.data_mut().iter_mut().enumerate() {
+            *v = mirrorball_core::color::srgb_to_linear((i % 17) as f64 / 16.0) as f32;
+        }
+        for f in [
+            PixFmt::Rgb24,
+            PixFmt::Rgb48le,
+            PixFmt::Rgbf32le,
+            PixFmt::Gbrpf32le,
+        ] {
+            let mut bytes = Vec::new();
+            f.encode(&img, &mut bytes);
+            assert_eq!(bytes.len(), f.frame_bytes(5, 3));
+            let mut back = Image::new(5, 3, 3);
+            f.decode(&bytes, &mut back);
+            let tol = match f {
+                PixFmt::Rgb24 => 1.0 / 255.0,
+                PixFmt::Rgb48le => 1e-4,
+                _ => 0.0,
+            };
+            for (a, b) in img.data().iter().zip(back.data()) {
+                assert!((a - b).abs() <= tol, "{f}: {a} vs {b}");
+            }
+        }
+        // gbrpf32le is planar, G first.
+        let mut bytes = Vec::new();
+        PixFmt::Gbrpf32le.encode(&img, &mut bytes);
+        assert_eq!(&bytes[..4], &img.data()[1].to_le_bytes());
+    }
+
+    #[test]
+    fn a_stream_that_ends_inside_a_frame_is_refused() {
+        let mut buf = vec![0u8; 12];
+        let mut whole: &[u8] = &[1u8; 24];
+        assert!(read_frame(&mut whole, &mut buf, 0).unwrap());
+        assert!(read_frame(&mut whole, &mut buf, 1).unwrap());
+        assert!(!read_frame(&mut whole, &mut buf, 2).unwrap());
+        let mut short: &[u8] = &[1u8; 18];
+        assert!(read_frame(&mut short, &mut buf, 0).unwrap());
+        let e = read_frame(&mut short, &mut buf, 1).unwrap_err();
+        assert!(
+            e.message.contains("ended 6 bytes into frame 1"),
+            "{}",
+            e.message
+        );
+        assert_eq!(parse_size("--in-size", "4096x2048").unwrap(), (4096, 2048));
+        for bad in ["4096", "0x5", "ax2", "70000x2"] {
+            assert!(parse_size("--in-size", bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,505 @@
+//! A sequence of frames: from files (a pattern) or raw frames on standard input, to files
+//! (a printf pattern) or raw frames on standard output. The whole request is checked before
+//! the first frame is read; the first frame's shape plans one `Remap`, which converts every
+//! frame (a later frame of another shape is refused by name); frames go through the
+//! bounded pipeline of `pipeline.rs`. A frame's file is written to a temporary file and
+//! renamed into place (io's atomic writes), so an interrupt or a failure leaves whole
+//! frames only, and a frame whose output exists is skipped unless `--overwrite`: a rerun
+//! after a crash or a killed node carries on where it stopped.
+
+use super::log::{Log, Status};
+use super::pattern::{Frame, Pattern, Printf};
+use super::pipe::{self, PixFmt};
+use super::pipeline::{self, Meta, FRAMES_IN_FLIGHT};
+use super::shard::Shard;
+use crate::commands::convert::Plan;
+use crate::error::CliError;
+use crate::progress::with_progress;
+use crate::spec::bad;
+use crate::{budget, load, save, ConvertArgs};
+use mirrorball_core::{EnvMap, Image, Layout, Projection, Remap, WorldProjection};
+use serde_json::json;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+/// Where frames come from.
+enum Input {
+    /// Files, in frame order (this shard's).
+    Files(Vec<Frame>),
+    /// Raw frames of this size and format on standard input.
+    Pipe { w: u32, h: u32, fmt: PixFmt },
+}
+
+/// Where frames go.
+enum Output {
+    Files(Printf),
+    /// One file (a single input frame only).
+    File(String),
+    Pipe(PixFmt),
+}
+
+fn pix_fmt(flag: &str, given: Option<&str>) -> Result<Option<PixFmt>, CliError> {
+    given
+        .map(|s| crate::choice::parse_flag(flag, s))
+        .transpose()
+}
+
+/// `path`'s folder resolved, joined with its name: how two names of one file are told
+/// apart across a sequence without a system call per pair.
+fn resolved(path: &Path, dirs: &mut std::collections::HashMap<PathBuf, PathBuf>) -> PathBuf {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let real = dirs
+        .entry(dir.to_path_buf())
+        .or_insert_with(|| std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf()))
+        .clone();
+    real.join(path.file_name().unwrap_or_default())
+}
+
+pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
+    let f = &a.frames;
+    let shard = f.shard.as_deref().map(Shard::parse).transpose()?;
+    let in_fmt = pix_fmt("--pix-fmt", f.pix_fmt.as_deref())?;
+    let out_fmt = pix_fmt("--out-pix-fmt", f.out_pix_fmt.as_deref())?.or(in_fmt);
+    if a.input == a.output && a.input != "-" {
+        return Err(CliError::request(format!(
+            "{}: the output pattern is the input pattern, so each frame would overwrite itself; choose another name or folder",
+            a.output
+        )));
+    }
+    let input = if a.input == "-" {
+        if shard.is_some() {
+            return Err(CliError::request(
+                "--shard slices frames from files; standard input (-) is one stream, so give each machine its own stream instead",
+            ));
+        }
+        let (Some(size), Some(fmt)) = (f.in_size.as_deref(), in_fmt) else {
+            return Err(CliError::request(
+                "input -: raw frames need --in-size WIDTHxHEIGHT and --pix-fmt (rgb24, rgb48le, rgbf32le, gbrpf32le)",
+            ));
+        };
+        let (w, h) = pipe::parse_size("--in-size", size)?;
+        Input::Pipe { w, h, fmt }
+    } else {
+        if f.in_size.is_some() {
+            return Err(CliError::request(format!(
+                "--in-size is the size of raw frames on standard input; {} is read from files, which say their size",
+                a.input
+            )));
+        }
+        let mut frames = match Pattern::parse(&a.input)? {
+            Some(p) => p.expand(&a.input)?,
+            None => vec![Frame {
+                number: 0,
+                path: PathBuf::from(&a.input),
+            }],
+        };
+        if let Some(s) = shard {
+            frames = frames[s.range(frames.len())].to_vec();
+        }
+        Input::Files(frames)
+    };
+    let output = if a.output == "-" {
+        let fmt = out_fmt.ok_or_else(|| {
+            CliError::request("output -: raw frames need --pix-fmt (or --out-pix-fmt): rgb24, rgb48le, rgbf32le, gbrpf32le")
+        })?;
+        if a.precision.is_some() || a.mips {
+            return Err(CliError::request(
+                "output -: raw frames carry --pix-fmt's precision and no mips; leave out --precision and --mips",
+            ));
+        }
+        Output::Pipe(fmt)
+    } else {
+        match Pattern::output(&a.output)? {
+            Some(p) => Output::Files(p),
+            None => match &input {
+                Input::Files(fr) if fr.len() == 1 && Pattern::parse(&a.input)?.is_none() => {
+                    Output::File(a.output.clone())
+                }
+                _ => {
+                    return Err(CliError::request(format!(
+                        "{}: many frames need an output pattern with %d or %0Nd (out/%05d.exr), or - for standard output",
+                        a.output
+                    )))
+                }
+            },
+        }
+    };
+
+    // The request as one frame's conversion, checked by convert's own plan.
+    let mut probe = a.clone();
+    probe.input = match &input {
+        Input::Files(fr) => fr[0].path.to_string_lossy().into_owned(),
+        Input::Pipe { .. } => "-".into(),
+    };
+    probe.output = match &output {
+        Output::Files(p) => p.path(first_number(&input)).to_string_lossy().into_owned(),
+        Output::File(s) => s.clone(),
+        // A pipe's frames are packed pictures: checked as an EXR of the same layout.
+        Output::Pipe(_) => "frame.exr".into(),
+    };
+    let mut plan = Plan::new(&probe)?;
+    // `--for`'s engine axes: frames are made by one planned `Remap`, so a cube output takes
+    // them as the rotation they are (its texel centres map to texel centres).
+    if !plan.orient.is_identity() {
+        plan.resample.rotation = plan.resample.rotation.then(plan.orient.rotation());
+        plan.orient = mirrorball_core::AxisMap::IDENTITY;
+    }
+    let dst: Projection = plan.to.build(None).map_err(|e| bad("--to", e))?;
+    if matches!(output, Output::Pipe(_))
+        && dst.layer_count() > 1
+        && plan.save.layout == Some(Layout::Separate)
+    {
+        return Err(CliError::request(
+            "output -: a raw frame is one picture; give a packed --layout (hcross, vcross, hstrip, vstrip)",
+        ));
+    }
+
+    // Frames from files: outputs named, checked against every input, and those done already.
+    let log = Log {
+        on: f.json,
+        to_stderr: matches!(output, Output::Pipe(_)),
+    };
+    let outputs_of = |path: &Path| -> Vec<PathBuf> {
+        let s = path.to_string_lossy();
+        save::layer_files(&s, dst.layer_count(), &plan.save)
+            .unwrap_or_else(|| vec![path.to_path_buf()])
+    };
+    let mut skipped = 0u64;
+    let input = match input {
+        Input::Files(frames) => {
+            let mut dirs = std::collections::HashMap::new();
+            let inputs: HashSet<PathBuf> = frames
+                .iter()
+                .map(|fr| resolved(&fr.path, &mut dirs))
+                .collect();
+            let mut todo = Vec::with_capacity(frames.len());
+            for fr in frames {
+                let outs = match &output {
+                    Output::Files(p) => outputs_of(&p.path(fr.number)),
+                    Output::File(s) => outputs_of(Path::new(s)),
+                    Output::Pipe(_) => Vec::new(),
+                };
+                if let Some(o) = outs
+                    .iter()
+                    .find(|o| inputs.contains(&resolved(o, &mut dirs)))
+                {
+                    return Err(CliError::request(format!(
+                        "{}: frame {}'s output would overwrite an input frame; choose another name or folder",
+                        o.display(),
+                        fr.number
+                    )));
+                }
+                if !f.overwrite && !outs.is_empty() && outs.iter().all(|o| o.exists()) {
+                    skipped += 1;
+                    log.line(
+                        json!({"frame": fr.number, "input": fr.path, "output": outs[0]}),
+                        Status::Skipped,
+                        Default::default(),
+                        None,
+                    );
+                    continue;
+                }
+                todo.push(fr);
+            }
+            if todo.is_empty() {
+                if !a.quiet {
+                    eprintln!("every output exists already ({skipped} frame(s) skipped; --overwrite converts them again)");
+                }
+                return Ok(());
+            }
+            Input::Files(todo)
+        }
+        pipe => pipe,
+    };
+    convert_frames(a, &plan, dst, input, output, log, skipped)
+}
+
+fn first_number(input: &Input) -> u64 {
+    match input {
+        Input::Files(fr) => fr[0].number,
+        Input::Pipe { .. } => 0,
+    }
+}
+
+/// Reads frames one after another.
+struct Reader<'a> {
+    a: &'a ConvertArgs,
+    plan: &'a Plan,
+    input: Input,
+    /// Files: the next frame's position; pipe: frames read.
+    at: usize,
+    stdin: std::io::Stdin,
+    bytes: Vec<u8>,
+    /// The pipe's projection and layout, once decided by the first frame.
+    decided: Option<(Projection, Layout)>,
+    limits: mirrorball_io::Limits,
+}
+
+impl Reader<'_> {
+    fn next(&mut self, spare: Option<EnvMap>) -> Option<Result<(Meta, EnvMap), CliError>> {
+        match &self.input {
+            Input::Files(frames) => {
+                let fr = frames.get(self.at)?.clone();
+                self.at += 1;
+                Some(self.read_file(&fr))
+            }
+            Input::Pipe { w, h, fmt } => {
+                let (w, h, fmt) = (*w, *h, *fmt);
+                let n = self.at as u64;
+                let stdin = &mut self.stdin;
+                self.bytes.resize(fmt.frame_bytes(w, h), 0);
+                match pipe::read_frame(stdin, &mut self.bytes, n) {
+                    Ok(false) => return None,
+                    Ok(true) => {}
+                    Err(e) => return Some(Err(e)),
+                }
+                self.at += 1;
+                Some(self.decode(n, w, h, fmt, spare))
+            }
+        }
+    }
+
+    fn read_file(&self, fr: &Frame) -> Result<(Meta, EnvMap), CliError> {
+        let name = fr.path.to_string_lossy().into_owned();
+        let mut src = load::load(
+            &name,
+            self.plan.input.from.as_ref(),
+            self.plan.input.layout,
+            &self.limits,
+        )?;
+        let lines = src.prepare(&name, self.plan.input.keep_invalid);
+        if !self.a.quiet {
+            // What was decided, for the first frame; warnings for every frame.
+            lines
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| self.at == 1 || *i > 0)
+                .for_each(|(_, l)| eprintln!("{l}"));
+        }
+        Ok((meta(fr.number, name), src.env))
+    }
+
+    fn decode(
+        &mut self,
+        n: u64,
+        w: u32,
+        h: u32,
+        fmt: PixFmt,
+        spare: Option<EnvMap>,
+    ) -> Result<(Meta, EnvMap), CliError> {
+        let name = format!("frame {n} of standard input");
+        // A one-picture map's layer comes back whole; unpacked layouts are cut afresh.
+        let mut img = match (spare, self.decided) {
+            (Some(env), Some((_, Layout::Separate))) => env.into_layers().swap_remove(0),
+            _ => Image::new(w, h, 3),
+        };
+        fmt.decode(&self.bytes, &mut img);
+        let env = match self.decided {
+            Some((proj, layout)) => layout
+                .unpack_owned(img, proj)
+                .map_err(|e| CliError::input(format!("{name}: {e}")))?,
+            None => {
+                let (env, decided) = load::interpret(
+                    "-",
+                    img,
+                    self.plan.input.from.as_ref(),
+                    self.plan.input.layout,
+                    None,
+                    None,
+                    |_| String::new(),
+                )?;
+                let layout = match self.plan.input.layout {
+                    Some(l) => l,
+                    None => Layout::from_extent(w, h, env.layers().len())
+                        .map(|l| l.0)
+                        .unwrap_or(Layout::Separate),
+                };
+                if !self.a.quiet {
+                    eprintln!(
+                        "reading {w}x{h} {fmt} frames from standard input: {} — {decided}",
+                        env.projection().name()
+                    );
+                }
+                self.decided = Some((*env.projection(), layout));
+                env
+            }
+        };
+        Ok((meta(n, name), env))
+    }
+}
+
+fn meta(number: u64, input: String) -> Meta {
+    Meta { number, input }
+}
+
+fn convert_frames(
+    a: &ConvertArgs,
+    plan: &Plan,
+    dst: Projection,
+    input: Input,
+    output: Output,
+    log: Log,
+    skipped: u64,
+) -> Result<(), CliError> {
+    let total = match &input {
+        Input::Files(fr) => fr.len() as u64,
+        Input::Pipe { .. } => 0,
+    };
+    let mut reader = Reader {
+        a,
+        plan,
+        input,
+        at: 0,
+        stdin: std::io::stdin(),
+        bytes: Vec::new(),
+        decided: None,
+        limits: mirrorball_io::Limits::default(),
+    };
+    let t0 = Instant::now();
+    let Some(first) = reader.next(None) else {
+        return Err(CliError::input(
+            "standard input ended before the first frame",
+        ));
+    };
+    let (meta0, src0) = first?;
+    let size = plan
+        .size
+        .unwrap_or_else(|| save::default_size(&src0, dst.kind()));
+    let (w, h) = dst.layer_extent(size);
+    let c = src0.channels();
+    let remap = Remap::with_extent(
+        *src0.projection(),
+        (src0.width(), src0.height()),
+        src0.layers().len(),
+        dst,
+        (w, h),
+        &plan.resample,
+    );
+    let frame_bytes = |env_texels: u64| budget::f32_texels(env_texels, c as u64);
+    budget::check(
+        &format!("frames of {} {w}x{h}x{}", dst.name(), dst.layer_count()),
+        0,
+        (FRAMES_IN_FLIGHT + 1)
+            * (frame_bytes(
+                src0.width() as u64 * src0.height() as u64 * src0.layers().len() as u64,
+            ) + 2 * frame_bytes(w as u64 * h as u64 * dst.layer_count() as u64))
+            + remap.memory_bytes() as u64,
+        "a smaller --size",
+    )?;
+    let t_plan = t0.elapsed();
+    let packed = match &output {
+        Output::Pipe(fmt) => {
+            let layout = plan
+                .save
+                .layout
+                .unwrap_or_else(|| save::default_layout(dst.layer_count()));
+            let (gc, gr) = layout.grid(dst.layer_count());
+            let (pw, ph) = if layout == Layout::Separate {
+                (w, h)
+            } else {
+                (w * gc, h * gr)
+            };
+            if !a.quiet {
+                eprintln!(
+                    "writing {pw}x{ph} {fmt} frames to standard output: {} {w}x{h}{} ({layout})",
+                    dst.name(),
+                    times(dst.layer_count())
+                );
+            }
+            Some((layout, *fmt))
+        }
+        _ => None,
+    };
+
+    let fresh = || {
+        let layers = (0..dst.layer_count())
+            .map(|_| Image::new(w, h, c))
+            .collect();
+        EnvMap::new(dst, layers).expect("layers of the plan's shape")
+    };
+    let mut first = Some((meta0, src0));
+    let mut next = |spare: Option<EnvMap>| first.take().map(Ok).or_else(|| reader.next(spare));
+    let stdout = std::io::stdout();
+    let mut bytes = Vec::new();
+    let mut put = |m: &Meta, env: &EnvMap| -> Result<(), CliError> {
+        let t = Instant::now();
+        let out: String = match (&output, &packed) {
+            (Output::Pipe(_), Some((layout, fmt))) => {
+                let pic = if *layout == Layout::Separate || env.layers().len() == 1 {
+                    None
+                } else {
+                    Some(layout.pack(env).ok_or_else(|| {
+                        CliError::request(format!("--layout {layout} does not fit {}", dst.name()))
+                    })?)
+                };
+                fmt.encode(pic.as_ref().unwrap_or(&env.layers()[0]), &mut bytes);
+                pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
+                "-".into()
+            }
+            (Output::Files(p), _) => save_frame(env, &p.path(m.number), plan)?,
+            (Output::File(s), _) => save_frame(env, Path::new(s), plan)?,
+            _ => unreachable!("a pipe has its format"),
+        };
+        log.line(
+            json!({"frame": m.number, "input": m.input, "output": out}),
+            Status::Done,
+            t.elapsed(),
+            None,
+        );
+        Ok(())
+    };
+    let t1 = Instant::now();
+    let done = with_progress("frames", total, a.quiet, |counter| {
+        let done = AtomicU64::new(0);
+        let r = pipeline::run(
+            &mut next,
+            &remap,
+            &fresh,
+            &mut |m, e| {
+                put(m, e)?;
+                counter.fetch_add(1, Ordering::Relaxed);
+                Ok(())
+            },
+            &done,
+        );
+        (r, done.load(Ordering::Relaxed))
+    });
+    let (result, n) = done;
+    let secs = t1.elapsed().as_secs_f64();
+    if !a.quiet {
+        eprintln!(
+            "{n} frame(s) to {} {w}x{h}{} in {secs:.2}s ({:.2} frames/s; planned in {:.2}s){}",
+            dst.name(),
+            times(dst.layer_count()),
+            n as f64 / secs.max(1e-9),
+            t_plan.as_secs_f64(),
+            if skipped > 0 {
+                format!("; {skipped} skipped, their outputs exist")
+            } else {
+                String::new()
+            }
+        );
+    }
+    result
+}
+
+/// " x6" after a layer's size, for maps of several layers.
+fn times(layers: usize) -> String {
+    if layers > 1 {
+        format!(" x{layers}")
+    } else {
+        String::new()
+    }
+}
+
+/// Writes one frame's file(s) through io's atomic writes; the name for the log.
+fn save_frame(env: &EnvMap, path: &Path, plan: &Plan) -> Result<String, CliError> {
+    let s = path.to_string_lossy().into_owned();
+    save::save(env, &s, &plan.save)?;
+    Ok(s)
+}
