@@ -13,14 +13,19 @@ fn main() {
         std::process::exit(2);
     };
     let width: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1024);
-    let env = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), width, 3, |d| {
-        [
-            (0.5 + 0.5 * d.x) as f32,
-            (0.5 + 0.5 * d.y) as f32,
-            (0.5 + 0.5 * d.z) as f32,
-            1.0,
-        ]
-    });
+    let env = EnvMap::from_fn(
+        ProjectionKind::LatLong.default_projection(),
+        width,
+        3,
+        |d| {
+            [
+                (0.5 + 0.5 * d.x) as f32,
+                (0.5 + 0.5 * d.y) as f32,
+                (0.5 + 0.5 * d.z) as f32,
+                1.0,
+            ]
+        },
+    );
     let opts = mirrorball_io::WriteOptions {
         precision: Some(mirrorball_io::Precision::Float),
         ..Default::default()

@@ -162,6 +162,15 @@ impl Engine {
             Engine::Ktx2 => ktx2::chain_spec(opts),
         }
     }
+
+    /// Refuses, before any work, what this engine's files cannot be as `opts` asks (an
+    /// encoding its loader or shaders do not take, a size it cannot hold).
+    pub fn check(self, opts: &BakeOptions) -> Result<(), String> {
+        match self {
+            Engine::Bevy => bevy::check(opts),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Writes `lighting` as `engine` loads it, into the folder `dir` (which exists); returns
