@@ -213,12 +213,12 @@ fn note(opts: &BakeOptions, encoding: Encoding, levels: usize) -> String {
              EnvironmentMapLight {{\n        \
                  diffuse_map: asset_server.load(\"{DIFFUSE_FILE}\"),\n        \
                  specular_map: asset_server.load(\"{SPECULAR_FILE}\"),\n        \
-                 // texels are the source's values; intensity scales them to cd/m²\n        \
+                 // the texels are the source's values; intensity scales them to cd/m²\n        \
                  intensity: 1.0,\n        \
                  ..default()\n    \
              }},\n    \
              Skybox {{\n        \
-                 image: asset_server.load(\"{SPECULAR_FILE}\"),\n        \
+                 image: Some(asset_server.load(\"{SPECULAR_FILE}\")),\n        \
                  brightness: 1.0,\n        \
                  ..default()\n    \
              }},\n\
