@@ -24,14 +24,16 @@
 //!   [`Lighting::diffuse`] is. One level of 32×32: Bevy samples it at level 0 only
 //!   (`environment_map.wesl:260`), and 32 is its filter's size (`generate.rs`, the 32×32
 //!   diffuse image) and the IBL sampler's `-cubeMapResolution 32` in `info.txt`.
-//! - **Encodings.** `bevy_image`'s KTX2 loader takes RGBA16F, RGB9E5, B10G11R11 and BC6H
-//!   (`ktx2_format_to_texture_format`). Not RGBA32F: wgpu's `Rgba32Float` is not filterable
-//!   without a device feature, and Bevy samples through a filtering sampler. Not RGBD/RGBM:
-//!   Bevy's shaders do not decode them. The default is RGB9E5, the encoding of Bevy's own
-//!   environment maps (`assets/environment_maps/pisa_*_rgb9e5_zstd.ktx2`): half the bytes of
-//!   RGBA16F at about its precision (2⁻¹⁰ of a texel's largest channel), and it loads on
-//!   every backend, where BC6H (a quarter again) is refused by the loader on a GPU without
-//!   BC formats (WebGL2, most phones: "Format not supported by this GPU").
+//! - **Encodings.** `bevy_image` 0.20.1's KTX2 loader maps RGBA16F, B10G11R11, RGB9E5 and
+//!   BC6H to wgpu formats (`src/ktx2.rs:1271`, `:1283-1284`, `:1319-1320`). Not RGBA32F:
+//!   wgpu's `Rgba32Float` is not filterable without a device feature, and Bevy samples
+//!   through a filtering sampler. Not RGBD/RGBM: Bevy's shaders do not decode them. The
+//!   default is RGB9E5, the encoding of Bevy's own environment maps
+//!   (`assets/environment_maps/pisa_*_rgb9e5_zstd.ktx2`): half the bytes of RGBA16F at about
+//!   its precision (2⁻¹⁰ of a texel's largest channel), and it loads on every backend,
+//!   where BC6H (a quarter of RGB9E5's bytes: ask for it on desktop) is refused by the
+//!   loader where the GPU has no BC formats (`src/ktx2.rs:250`, "Format not supported by
+//!   this GPU": most phones, and WebGL2 without `EXT_texture_compression_bptc`).
 //!
 //! Zstandard supercompression (`opts.zstd`) is read by Bevy's default 3D features
 //! (`zstd_rust`).

@@ -410,6 +410,29 @@ fn the_default_loads_without_compressed_formats() {
     assert!(ktx2_buffer_to_image(&bytes, CompressedImageFormats::NONE, false).is_err());
 }
 
+/// Each cube records who wrote it, its orientation as KTX2 defines it, and what it holds
+/// (Bevy reads none of it: `ktx2_buffer_to_image` ignores key/value data).
+#[test]
+fn the_cubes_record_their_writer_and_content() {
+    let (_dir, files) = bake(None, Some(3));
+    for (name, content) in [("specular.ktx2", "GGX"), ("diffuse.ktx2", "Lambert")] {
+        let bytes = std::fs::read(file(&files, name)).unwrap();
+        let reader = ktx2::Reader::new(&bytes[..]).unwrap();
+        let kv: std::collections::HashMap<&str, String> = reader
+            .key_value_data()
+            .map(|(k, v)| (k, String::from_utf8_lossy(v).trim_end_matches('\0').into()))
+            .collect();
+        assert!(kv["KTXwriter"].starts_with("mirrorball "), "{name}: {kv:?}");
+        assert_eq!(kv["KTXorientation"], "rd", "{name}");
+        assert_eq!(kv["mirrorball:engine"], "bevy", "{name}");
+        assert!(kv["mirrorball:content"].contains(content), "{name}: {kv:?}");
+        assert!(
+            kv["mirrorball:content"].contains("z mirrored"),
+            "{name}: {kv:?}"
+        );
+    }
+}
+
 /// The note says how to load the files in Bevy.
 #[test]
 fn the_note_names_the_files_and_the_component() {
