@@ -131,8 +131,7 @@ pub struct Description {
     pub files: &'static str,
     /// The containers.
     pub containers: &'static str,
-    /// The texel encodings its loader takes, the default first; empty where the engine's
-    /// writer is not in this build.
+    /// The texel encodings its loader takes, the default first.
     pub encodings: &'static [Encoding],
     /// Whether its loader takes Zstandard-supercompressed KTX2.
     pub zstd: bool,
@@ -273,6 +272,7 @@ impl Engine {
     /// [`Bake::new`]'s checks (which every engine shares: size, encodings, Zstandard).
     pub fn check(self, opts: &BakeOptions) -> Result<(), Error> {
         match self {
+            Engine::Bevy => bevy::check(opts),
             Engine::Gltf => gltf::check(opts),
             Engine::Three => three::check(opts),
             _ => Ok(()),
@@ -322,30 +322,30 @@ impl Engine {
         }
     }
 
-    /// The names of the files a bake writes into its folder, besides `README.md` (empty for
-    /// an engine whose writer is not in this build), for the checks before any work.
+    /// The names of the files a bake writes into its folder, besides `README.md`, for the
+    /// checks before any work.
     pub fn file_names(self, opts: &BakeOptions) -> Vec<String> {
         match self {
+            Engine::Bevy => bevy::file_names(),
             Engine::Three => three::file_names(),
             Engine::Babylon => vec![babylon::FILE.to_string()],
             Engine::Gltf => gltf::file_names(opts),
             Engine::Filament => filament::file_names(opts),
             Engine::Unity | Engine::Unreal => dds::file_names(opts),
             Engine::Ktx2 => ktx2::file_names(opts),
-            _ => Vec::new(),
         }
     }
 
     /// How to load the files in the engine's own code: the README's body.
     fn readme(self, opts: &BakeOptions, files: &[PathBuf]) -> String {
         match self {
+            Engine::Bevy => bevy::readme(opts),
             Engine::Three => three::readme(opts),
             Engine::Babylon => babylon::readme(opts),
             Engine::Gltf => gltf::readme(opts),
             Engine::Filament => filament::readme(opts, files),
             Engine::Unity | Engine::Unreal => dds::readme(self, opts, files),
             Engine::Ktx2 => ktx2::readme(opts, files),
-            _ => String::new(),
         }
     }
 }
@@ -413,11 +413,6 @@ impl Bake {
     /// where it reads it.
     pub fn new(engine: Engine, mut opts: BakeOptions) -> Result<Bake, Error> {
         let d = engine.describe();
-        if d.encodings.is_empty() {
-            return Err(Error::request(format!(
-                "baking for {engine} is not written yet"
-            )));
-        }
         let s = opts.size;
         if s == 0 || s > MAX_SIZE || !s.is_power_of_two() {
             return Err(Error::request(format!(
@@ -577,13 +572,10 @@ pub fn list() -> String {
     for e in ENGINES {
         let d = e.describe();
         let encodings: Vec<&str> = d.encodings.iter().map(|e| e.name()).collect();
-        let Some((first, rest)) = encodings.split_first() else {
-            out += &format!("{e}\n  (not written yet)\n");
-            continue;
-        };
-        let encodings = match rest {
-            [] => first.to_string(),
-            _ => format!("{first} (default), {}", rest.join(", ")),
+        let encodings = match encodings.split_first() {
+            Some((first, [])) => first.to_string(),
+            Some((first, rest)) => format!("{first} (default), {}", rest.join(", ")),
+            None => String::new(),
         };
         out += &format!(
             "{e}\n  files:       {}\n  containers:  {}{}\n  encodings:   {encodings}\n  convention:  {}\n  cube turn:   the engine's direction (x, y, z) shows mirrorball's {}\n  roughness:   {}\n  diffuse:     {}\n",
@@ -615,25 +607,6 @@ pub(crate) fn chain_by(opts: &BakeOptions, mapping: &RoughnessMapping) -> Vec<(u
 /// Each level's faces, as the cube writers take them.
 pub(crate) fn faces(levels: &[EnvMap]) -> Vec<Vec<mirrorball_core::Image>> {
     levels.iter().map(|l| l.layers().to_vec()).collect()
-}
-
-/// The description of an engine whose writer is not in this build: no encodings, so a
-/// bake for it is refused before any work.
-pub(crate) fn unwritten() -> Description {
-    Description {
-        files: "(not written yet)",
-        containers: "(not written yet)",
-        encodings: &[],
-        zstd: false,
-        convention: "(not written yet)",
-        rule: "(not written yet)",
-        diffuse: "(not written yet)",
-    }
-}
-
-/// The error of an engine whose writer is not in this build.
-pub(crate) fn not_written(dir: &Path, engine: &str) -> mirrorball_io::Error {
-    mirrorball_io::Error::request(dir, format!("baking for {engine} is not written yet"))
 }
 
 /// How each cube of a bake is written: its encoding, effort and supercompression, recorded
