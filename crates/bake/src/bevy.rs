@@ -235,7 +235,7 @@ pub(crate) fn readme(opts: &BakeOptions) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mirrorball_core::{CubeFace, ProjectionKind};
+    use mirrorball_core::{CubeFace, EnvMap, ProjectionKind};
 
     /// `mirror_z` is `B(x, y, z) = C(x, y, −z)` at every texel centre of every face.
     #[test]
