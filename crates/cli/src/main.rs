@@ -59,6 +59,9 @@ enum Command {
     /// Prefiltered lighting: a Lambert, Phong or GGX mip chain (KTX2/DDS cube, or one
     /// image per level), spherical-harmonic coefficients (JSON) and a preview sheet (PNG).
     Prefilter(PrefilterArgs),
+    /// The viewport in a browser: a local web server (127.0.0.1, a token in the printed URL)
+    /// drawing a scene or an environment with WebGL2 as `render` draws it.
+    Studio(commands::studio::StudioArgs),
 }
 
 /// How to read an input file.
@@ -475,6 +478,7 @@ fn main() -> ExitCode {
         Command::Prefilter(a) => commands::prefilter::run(a),
         Command::Analyze(a) => commands::analyze::run(a),
         Command::Render(a) => commands::render::run(*a),
+        Command::Studio(a) => commands::studio::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

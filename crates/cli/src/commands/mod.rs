@@ -6,6 +6,7 @@ pub mod demo;
 pub mod info;
 pub mod prefilter;
 pub mod render;
+pub mod studio;
 
 use crate::error::CliError;
 use crate::spec::{bad, ProjSpec};
