@@ -7,6 +7,7 @@ import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
 import { createInterface } from 'node:readline';
 import { readFileSync, writeFileSync } from 'node:fs';
+import { deflateSync, crc32 } from 'node:zlib';
 import path from 'node:path';
 import { browser, mirrorball, run, tempDir, readPng, ROOT } from './lib.mjs';
 
@@ -159,6 +160,26 @@ function cpu(scene, args) {
   return png;
 }
 
+/** Writes RGBA8 `data` (`w`×`h`, top row first) as a PNG. */
+function writePng(file, w, h, data) {
+  const chunk = (type, body) => {
+    const b = Buffer.alloc(12 + body.length);
+    b.writeUInt32BE(body.length, 0);
+    b.write(type, 4, 'latin1');
+    body.copy(b, 8);
+    b.writeUInt32BE(crc32(b.subarray(4, 8 + body.length)), 8 + body.length);
+    return b;
+  };
+  const ihdr = Buffer.alloc(13);
+  ihdr.writeUInt32BE(w, 0);
+  ihdr.writeUInt32BE(h, 4);
+  ihdr.set([8, 6, 0, 0, 0], 8);
+  const raw = Buffer.alloc(h * (4 * w + 1));
+  for (let y = 0; y < h; y++) raw.set(data.subarray(4 * w * y, 4 * w * (y + 1)), y * (4 * w + 1) + 1);
+  const sig = Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
+  writeFileSync(file, Buffer.concat([sig, chunk('IHDR', ihdr), chunk('IDAT', deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]));
+}
+
 /** Covered pixels whose eight neighbours are covered too (away from the silhouette rim). */
 function inner(coverage, w, h) {
   const ok = new Uint8Array(w * h);
@@ -223,6 +244,21 @@ for (const [object, body] of Object.entries(SCENES)) {
             }
           }
           const share = within / n;
+          if (process.env.STUDIO_SHOTS) {
+            // GPU | CPU | difference ×16 (red where the inner covered pixels differ by more than 2).
+            const diff = new Uint8Array(w * h * 4);
+            for (let i = 0; i < w * h; i++) {
+              const d = Math.max(...[0, 1, 2].map((c) => Math.abs(gpu.data[4 * i + c] - full.data[4 * i + c])));
+              diff.set(d > 2 && mask[i] ? [255, 0, 0, 255] : [16 * d, 16 * d, 16 * d, 255], 4 * i);
+            }
+            const both = new Uint8Array(3 * w * h * 4);
+            for (let y = 0; y < h; y++) {
+              both.set(Uint8Array.from(gpu.data.slice(4 * w * y, 4 * w * (y + 1))), 12 * w * y);
+              both.set(full.data.subarray(4 * w * y, 4 * w * (y + 1)), 12 * w * y + 4 * w);
+              both.set(diff.subarray(4 * w * y, 4 * w * (y + 1)), 12 * w * y + 8 * w);
+            }
+            writePng(path.join(process.env.STUDIO_SHOTS, `compare-${object}-${proj}-${mode}.png`), 3 * w, h, both);
+          }
           rows.push({ object, proj, mode, covered: n, share, worst, background: bgWithin / bg, logs: logs.slice(0, 3) });
           console.log(
             `${object} ${proj} mode ${mode}: ${(100 * share).toFixed(2)}% of ${n} covered pixels within 2/255 (worst ${worst}), background ${((100 * bgWithin) / bg).toFixed(2)}%`,

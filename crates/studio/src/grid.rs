@@ -13,7 +13,7 @@
 //! the core's `(u, v, layer)` (layer −1 where the map does not cover it), and the
 //! generating `(u, v, layer)`.
 
-use mirrorball_core::glam::{DVec2, DVec3};
+use mirrorball_core::glam::DVec2;
 use mirrorball_core::{Projection, WorldProjection};
 
 /// The most grid lines a side.
@@ -50,7 +50,7 @@ pub fn encode(p: &Projection, n: u32) -> Vec<u8> {
             continue;
         };
         let d32 = d.as_vec3();
-        let reference = p.dir_to_uv(DVec3::from(d32.as_dvec3()));
+        let reference = p.dir_to_uv(d32.as_dvec3());
         let (ru, rv, rl) = match reference {
             Some((l, t)) => (t.x as f32, t.y as f32, l as f32),
             None => (0.0, 0.0, -1.0),

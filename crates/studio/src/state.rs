@@ -28,7 +28,7 @@ pub enum Opened {
     Scene(Box<SceneView>),
     /// An environment map: replaces the scene's environment (world-attached, bilinear,
     /// intensity 1 if the scene had none).
-    Environment { name: String, map: EnvMap },
+    Environment { name: String, map: Box<EnvMap> },
 }
 
 /// Everything loaded.
@@ -59,12 +59,12 @@ impl State {
             Opened::Environment { name, map } => {
                 let env = match self.view.scene.environment.take() {
                     Some(e) => Environment {
-                        map: Arc::new(map),
+                        map: Arc::new(*map),
                         cache: Default::default(),
                         ..e
                     },
                     None => Environment {
-                        map: Arc::new(map),
+                        map: Arc::new(*map),
                         attach: Attach::World,
                         filter: mirrorball_render::Filter::Bilinear,
                         intensity: 1.0,

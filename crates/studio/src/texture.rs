@@ -42,7 +42,7 @@ pub fn encode(map: &EnvMap, precision: Precision) -> Vec<u8> {
     header["texelHeight"] = ph.into();
     header["precision"] = precision.name().into();
     let mut json = header.to_string().into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let layers = map.layers();

@@ -100,6 +100,37 @@ export function parseGrid(buffer) {
   return { count, frame, values: new Float32Array(buffer, 40, 9 * count) };
 }
 
+/** The viewport's vertex attributes, in the order of `triangleVertices`' floats. */
+export const ATTRIBUTES = ['aPos', 'aP0', 'aP1', 'aP2', 'aN0', 'aN1', 'aN2'];
+
+/**
+ * A parsed mesh as the viewport draws it: three vertices a triangle, each with its own
+ * position and its triangle's three corners' positions and normals (viewport.vert):
+ * `ATTRIBUTES.length` × 3 floats a vertex.
+ */
+export function triangleVertices(mesh) {
+  const { positions: p, normals: n, indices } = mesh;
+  const stride = ATTRIBUTES.length * 3;
+  const out = new Float32Array((indices.length / 3) * 3 * stride);
+  let o = 0;
+  for (let t = 0; t < indices.length; t += 3) {
+    const corners = [indices[t], indices[t + 1], indices[t + 2]];
+    for (const own of corners) {
+      out.set(p.subarray(3 * own, 3 * own + 3), o);
+      o += 3;
+      for (const k of corners) {
+        out.set(p.subarray(3 * k, 3 * k + 3), o);
+        o += 3;
+      }
+      for (const k of corners) {
+        out.set(n.subarray(3 * k, 3 * k + 3), o);
+        o += 3;
+      }
+    }
+  }
+  return out;
+}
+
 const HEADER = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2DArray;\n';
 
 function compile(gl, type, source) {
@@ -122,8 +153,7 @@ export function link(gl, vs, fs) {
   const p = gl.createProgram();
   gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, vs));
   gl.attachShader(p, compile(gl, gl.FRAGMENT_SHADER, fs));
-  gl.bindAttribLocation(p, 0, 'aPos');
-  gl.bindAttribLocation(p, 1, 'aNrm');
+  ATTRIBUTES.forEach((name, i) => gl.bindAttribLocation(p, i, name));
   gl.linkProgram(p);
   if (!gl.getProgramParameter(p, gl.LINK_STATUS)) {
     throw new Error(`program: ${gl.getProgramInfoLog(p)}`);
@@ -156,6 +186,8 @@ export async function viewportProgram(gl, { kind, layers, mode, background }) {
     (await glsl('bilinear.glsl')) +
     '\n' +
     (await glsl('display.glsl')) +
+    '\n' +
+    (await glsl('interpolate.glsl')) +
     '\n' +
     (await glsl('viewport.frag'));
   return link(gl, vs, fs);

@@ -83,21 +83,16 @@ async function loadMeshes() {
     const mesh = G.parseMesh(await (await G.api(`/api/mesh/${o.mesh}`)).arrayBuffer());
     const vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
-    for (const [loc, data] of [
-      [0, mesh.positions],
-      [1, mesh.normals],
-    ]) {
-      const b = gl.createBuffer();
-      gl.bindBuffer(gl.ARRAY_BUFFER, b);
-      gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW);
+    const b = gl.createBuffer();
+    gl.bindBuffer(gl.ARRAY_BUFFER, b);
+    gl.bufferData(gl.ARRAY_BUFFER, G.triangleVertices(mesh), gl.STATIC_DRAW);
+    const stride = G.ATTRIBUTES.length * 12;
+    G.ATTRIBUTES.forEach((_, loc) => {
       gl.enableVertexAttribArray(loc);
-      gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, 0, 0);
-    }
-    const ib = gl.createBuffer();
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib);
-    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, mesh.indices, gl.STATIC_DRAW);
+      gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, stride, 12 * loc);
+    });
     gl.bindVertexArray(null);
-    view.meshes.push({ vao, count: mesh.indices.length, material: o.material });
+    view.meshes.push({ vao, vertices: mesh.indices.length, material: o.material });
   }
 }
 
@@ -204,7 +199,7 @@ async function draw() {
   for (const m of view.meshes) {
     gl.uniform3fv(u('uTint'), m.material.tint);
     gl.bindVertexArray(m.vao);
-    gl.drawElements(gl.TRIANGLES, m.count, gl.UNSIGNED_INT, 0);
+    gl.drawArrays(gl.TRIANGLES, 0, m.vertices);
   }
   gl.bindVertexArray(null);
 }

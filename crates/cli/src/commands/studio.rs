@@ -116,7 +116,7 @@ impl CliHost {
         map.sanitize();
         Ok(Opened::Environment {
             name: name.to_string(),
-            map,
+            map: Box::new(map),
         })
     }
 }

@@ -23,7 +23,7 @@ impl TestHost {
         let map = EnvMap::new(proj, vec![img]).map_err(|e| e.to_string())?;
         Ok(Opened::Environment {
             name: name.into(),
-            map,
+            map: Box::new(map),
         })
     }
 }

@@ -54,7 +54,10 @@ fn a_bad_file_on_the_command_line_is_an_error_before_serving() {
     let good = std::fs::read(latlong_exr(dir.path())).unwrap();
     std::fs::write(&cut, &good[..100]).unwrap();
     let e = mirrorball_studio::Studio::default()
-        .start(std::sync::Arc::new(crate::host::TestHost), &[cut.clone()])
+        .start(
+            std::sync::Arc::new(crate::host::TestHost),
+            std::slice::from_ref(&cut),
+        )
         .err()
         .expect("refused");
     assert!(e.starts_with(&cut.display().to_string()), "{e}");

@@ -1,11 +1,20 @@
-// The viewport's fragment stage (prepended as viewport.vert, then bilinear.glsl and
-// display.glsl): the mode's reflected direction, as mirrorball-render's render/shade.rs
+// The viewport's fragment stage (prepended as viewport.vert, then bilinear.glsl,
+// display.glsl and interpolate.glsl): the mode's reflected direction, as mirrorball-render's render/shade.rs
 // (`Prepared::shade`, `env_color`) and render/texgen.rs (`texgen_read`), read through the
 // projection's envUv, shown as display.glsl says. The background is the camera's rays
 // (render/background.rs, camera.rs `Rays::ray`).
-in vec3 vPos;
-in vec3 vNrm;
-in vec3 vR;
+flat in vec4 vClip0;
+flat in vec4 vClip1;
+flat in vec4 vClip2;
+flat in vec3 vP0;
+flat in vec3 vP1;
+flat in vec3 vP2;
+flat in vec3 vN0;
+flat in vec3 vN1;
+flat in vec3 vN2;
+flat in vec3 vC0;
+flat in vec3 vC1;
+flat in vec3 vC2;
 
 uniform mat4 uView;
 uniform vec3 uEye;
@@ -17,7 +26,6 @@ uniform vec3 uTint;
 // and the viewport's size in pixels.
 uniform vec3 uRayRight;
 uniform vec3 uRayUp;
-uniform vec2 uViewportSize;
 
 out vec4 outColor;
 
@@ -41,6 +49,10 @@ void main() {
     vec3 dir = uPersp ? normalizeOrZero(uForward + uRayRight * ndc.x + uRayUp * ndc.y) : uForward;
     outColor = vec4(display(lookup(attach(dir))), 1.0);
 #else
+    vec3 b = cornerWeights(vClip0, vClip1, vClip2);
+    vec3 vPos = b.x * vP0 + b.y * vP1 + b.z * vP2;
+    vec3 vNrm = b.x * vN0 + b.y * vN1 + b.z * vN2;
+    vec3 vR = b.x * vC0 + b.y * vC1 + b.z * vC2;
     vec3 c;
 #if MODE == 3
     vec3 n = normalizeOrZero(vNrm);
