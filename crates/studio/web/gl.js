@@ -251,6 +251,7 @@ export async function checkProjection(gl, { kind, spec, n = 64, tolerance = 1e-4
   for (let i = 0; i < count; i++) dirs.set(values.subarray(9 * i, 9 * i + 3), 3 * i);
   const got = await envUvOnGpu(gl, kind, frame, dirs);
   let worst = 0;
+  let worstAt = null;
   let seams = 0;
   let failed = 0;
   const failures = [];
@@ -270,9 +271,10 @@ export async function checkProjection(gl, { kind, spec, n = 64, tolerance = 1e-4
       if (failures.length < 10) {
         failures.push({ dir: Array.from(dirs.subarray(3 * i, 3 * i + 3)), got: Array.from(g), core: Array.from(values.subarray(9 * i + 3, 9 * i + 9)) });
       }
-    } else {
-      worst = Math.max(worst, e);
+    } else if (e > worst) {
+      worst = e;
+      worstAt = { dir: Array.from(dirs.subarray(3 * i, 3 * i + 3)), got: Array.from(g), core: Array.from(values.subarray(9 * i + 3, 9 * i + 9)) };
     }
   }
-  return { count, worst, seams, failed, failures };
+  return { count, worst, worstAt, seams, failed, failures };
 }
