@@ -14,6 +14,7 @@ use crate::guard::Guard;
 use crate::state::{gpu_kind, State};
 use crate::{geometry, grid, texture, web, Host};
 use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State as Shared};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::{self, Next};
@@ -326,10 +327,25 @@ async fn grid_of(Query(q): Query<HashMap<String, String>>) -> Response {
 async fn upload(
     Shared(app): Shared<AppState>,
     Query(q): Query<HashMap<String, String>>,
-    body: Bytes,
+    body: Result<Bytes, BytesRejection>,
 ) -> Response {
     let Some(name) = q.get("name").cloned() else {
         return bad(StatusCode::BAD_REQUEST, "an upload needs ?name=FILE");
+    };
+    let body = match body {
+        Ok(b) => b,
+        Err(e) => {
+            let message = if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
+                format!(
+                    "{name}: larger than the upload limit of {} MiB (mirrorball studio --max-upload)",
+                    app.options.upload_limit >> 20
+                )
+            } else {
+                format!("{name}: the upload did not arrive whole: {e}")
+            };
+            app.state.lock().expect("state").error(message.clone());
+            return bad(e.status(), message);
+        }
     };
     let host = app.host.clone();
     let read = tokio::task::spawn_blocking(move || {

@@ -43,7 +43,14 @@ fn an_upload_over_the_limit_is_refused_and_serving_goes_on() {
         &vec![0u8; (1 << 20) + 1],
     );
     assert_eq!(a.status, 413, "{}", a.text());
-    assert_eq!(own(&r, "GET", "/api/state", b"").status, 200);
+    let message = json(&a)["error"].as_str().unwrap().to_string();
+    assert_eq!(
+        message,
+        "big.exr: larger than the upload limit of 1 MiB (mirrorball studio --max-upload)"
+    );
+    let s = own(&r, "GET", "/api/state", b"");
+    assert_eq!(s.status, 200);
+    assert_eq!(json(&s)["errors"][0], message.as_str());
     r.stop();
 }
 
