@@ -63,6 +63,9 @@ enum Command {
     /// containers, encodings, axes and roughness-to-mip rule) and a README.md saying how to
     /// load it. `bake --for list` prints what each engine gets.
     Bake(BakeArgs),
+    /// The viewport in a browser: a local web server (127.0.0.1, a token in the printed URL)
+    /// drawing a scene or an environment with WebGL2 as `render` draws it.
+    Studio(commands::studio::StudioArgs),
 }
 
 /// How to read an input file.
@@ -548,6 +551,7 @@ fn main() -> ExitCode {
         Command::Bake(a) => commands::bake::run(a),
         Command::Analyze(a) => commands::analyze::run(a),
         Command::Render(a) => commands::render::run(*a),
+        Command::Studio(a) => commands::studio::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

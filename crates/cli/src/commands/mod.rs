@@ -8,6 +8,7 @@ pub mod frames;
 pub mod info;
 pub mod prefilter;
 pub mod render;
+pub mod studio;
 
 use crate::error::CliError;
 use crate::spec::{bad, ProjSpec};

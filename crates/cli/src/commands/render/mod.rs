@@ -27,21 +27,8 @@ use std::time::Instant;
 pub fn run(a: RenderArgs) -> Result<(), CliError> {
     let plan = RenderPlan::new(&a)?;
     output::files(&plan).check()?;
-    let environment = match &plan.env_file {
-        Some(f) => Some(load_environment(&plan, f)?),
-        None => None,
-    };
-    let objects = plan
-        .objects
-        .iter()
-        .map(load_object)
-        .collect::<Result<Vec<_>, _>>()?;
-    let triangles: usize = objects.iter().map(|o| o.mesh.triangles.len()).sum();
-    let scene = Scene {
-        objects,
-        environment,
-        background: plan.background,
-    };
+    let scene = load_scene(&plan)?;
+    let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangles.len()).sum();
     let started = Instant::now();
     let results = render_frames(&plan, &scene);
     let secs = started.elapsed().as_secs_f64();
@@ -67,6 +54,34 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// The plan's environment and objects, loaded.
+fn load_scene(plan: &RenderPlan) -> Result<Scene, CliError> {
+    let environment = match &plan.env_file {
+        Some(f) => Some(load_environment(plan, f)?),
+        None => None,
+    };
+    let objects = plan
+        .objects
+        .iter()
+        .map(load_object)
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Scene {
+        objects,
+        environment,
+        background: plan.background,
+    })
+}
+
+/// What `mirrorball render` with `a` would draw, loaded, with its camera, settings,
+/// exposure and tone curve: what `mirrorball studio` shows.
+pub fn studio_scene(
+    a: &RenderArgs,
+) -> Result<(Scene, Camera, Settings, f32, tone::Tone), CliError> {
+    let plan = RenderPlan::new(a)?;
+    let scene = load_scene(&plan)?;
+    Ok((scene, plan.camera, plan.settings, plan.exposure, plan.tone))
 }
 
 /// The environment map `file`, sanitized unless asked not to, converted as `--env-as` says.

@@ -1,0 +1,163 @@
+//! `mirrorball studio`: the viewport in a browser, served by `mirrorball_studio` on
+//! 127.0.0.1. Files are read here, as `render` reads scenes and `convert` reads
+//! environments, so that the page shows the CLI's messages; the URL (with its token) is the
+//! first line of standard output.
+
+use crate::error::CliError;
+use crate::load;
+use crate::RenderArgs;
+use clap::{Args, Parser};
+use mirrorball_studio::{Host, Opened, SceneView, Studio};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+#[derive(Args, Debug)]
+pub struct StudioArgs {
+    /// A scene file (.json or .toml, as `render` reads it) and/or an environment map (any
+    /// file `convert` reads).
+    files: Vec<String>,
+    /// Port on 127.0.0.1 (0: any free one).
+    #[arg(long, default_value_t = 0)]
+    port: u16,
+    /// Do not open the browser (the URL is printed either way).
+    #[arg(long)]
+    no_open: bool,
+    /// The largest file the page may upload, in MiB.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(1..=65536))]
+    max_upload: u64,
+}
+
+pub fn run(a: StudioArgs) -> Result<(), CliError> {
+    let files: Vec<PathBuf> = a.files.iter().map(PathBuf::from).collect();
+    let scenes = files.iter().filter(|f| is_scene(f)).count();
+    if scenes > 1 {
+        return Err(CliError::request("studio: give at most one scene file"));
+    }
+    // The scene first, then the environment laid on it.
+    let mut ordered = files.clone();
+    ordered.sort_by_key(|f| !is_scene(f));
+    let studio = Studio {
+        port: a.port,
+        upload_limit: (a.max_upload << 20) as usize,
+        ..Studio::default()
+    };
+    let running = studio
+        .start(Arc::new(CliHost), &ordered)
+        .map_err(CliError::input)?;
+    let mut out = std::io::stdout();
+    let _ = writeln!(out, "{}", running.url);
+    let _ = out.flush();
+    eprintln!(
+        "mirrorball studio: serving on 127.0.0.1:{} (Ctrl-C stops it)",
+        running.port
+    );
+    if !a.no_open {
+        mirrorball_studio::open_browser(&running.url);
+    }
+    running.wait().map_err(CliError::system)
+}
+
+fn is_scene(p: &Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("json") || e.eq_ignore_ascii_case("toml"))
+}
+
+/// `mirrorball render`'s arguments, as `render ARGS…` would parse them.
+#[derive(Parser)]
+struct AsRender {
+    #[command(flatten)]
+    args: RenderArgs,
+}
+
+/// The scene `render` would draw with `scene` (or its defaults) at one sample a pixel (the
+/// viewport's).
+fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
+    let mut argv: Vec<std::ffi::OsString> =
+        vec!["render".into(), "--quiet".into(), "--ss".into(), "1".into()];
+    match scene {
+        Some(s) => argv.push(s.into()),
+        // `render` wants an environment for a mirror: the scene waiting for one is planned
+        // with a material that needs none, then made a mirror.
+        None => argv.extend(["--material", "cheap-chrome", "--no-background"].map(Into::into)),
+    }
+    let mut args = AsRender::try_parse_from(argv)
+        .map_err(|e| CliError::request(e.to_string()))?
+        .args;
+    args.given = vec!["ss".into()];
+    let (mut scene_data, camera, settings, exposure, tone) = super::render::studio_scene(&args)?;
+    if scene.is_none() {
+        scene_data.background = true;
+        for o in &mut scene_data.objects {
+            o.material = mirrorball_render::Material::mirror();
+        }
+    }
+    Ok(SceneView {
+        name: scene.map_or("a mirror sphere".into(), |s| s.display().to_string()),
+        scene: scene_data,
+        camera,
+        settings,
+        exposure,
+        tone,
+    })
+}
+
+/// Reads files as the CLI's commands do.
+struct CliHost;
+
+impl CliHost {
+    /// The environment map at `path`, called `name` in messages.
+    fn environment(path: &Path, name: &str) -> Result<Opened, String> {
+        let shown = path.display().to_string();
+        let src = load::load(&shown, None, None, &mirrorball_io::Limits::default())
+            .map_err(|e| e.to_string().replace(&shown, name))?;
+        let mut map = src.env;
+        map.sanitize();
+        Ok(Opened::Environment {
+            name: name.to_string(),
+            map: Box::new(map),
+        })
+    }
+}
+
+impl Host for CliHost {
+    fn open(&self, path: &Path) -> Result<Opened, String> {
+        if is_scene(path) {
+            let v = scene_view(Some(path)).map_err(|e| e.to_string())?;
+            return Ok(Opened::Scene(Box::new(v)));
+        }
+        CliHost::environment(path, &path.display().to_string())
+    }
+
+    fn upload(&self, name: &str, bytes: &[u8]) -> Result<Opened, String> {
+        // Only the name's extension is used: the file is written to a folder of its own.
+        let ext = Path::new(name)
+            .extension()
+            .and_then(|e| e.to_str())
+            .filter(|e| e.chars().all(|c| c.is_ascii_alphanumeric()))
+            .unwrap_or("bin");
+        if is_scene(Path::new(name)) {
+            return Err(format!(
+                "{name}: scene files are opened from the command line (`mirrorball studio {name}`): \
+                 the files a scene names are read only when named there"
+            ));
+        }
+        let dir = std::env::temp_dir().join(format!(
+            "mirrorball-studio-{}-{}",
+            std::process::id(),
+            mirrorball_studio::guard::new_token()?
+        ));
+        std::fs::create_dir(&dir).map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
+        let path = dir.join(format!("upload.{ext}"));
+        let result = std::fs::write(&path, bytes)
+            .map_err(|e| format!("{name}: cannot store the upload: {e}"))
+            .and_then(|()| CliHost::environment(&path, name));
+        let _ = std::fs::remove_dir_all(&dir);
+        result
+    }
+
+    fn default_scene(&self) -> SceneView {
+        scene_view(None).expect("render's defaults make a scene")
+    }
+}

@@ -1,0 +1,43 @@
+//! `mirrorball studio`: a web server on the loopback interface and the WebGL2 page it
+//! embeds, which draws environment-mapped objects the way the CPU renderer
+//! (`mirrorball-render`) does.
+//!
+//! The server does what the core crates do and sends the page what it needs to draw:
+//! the scene (camera, objects, environment, as `mirrorball render` reads a scene file),
+//! the meshes flattened into world space, and the environment's texels in its own or
+//! another projection, each layer padded by one texel that the core's seam rule fills
+//! ([`texture`]). The page draws with WebGL2; each projection's direction → texture
+//! coordinates has one home, a `.glsl` file under `web/glsl/`.
+//!
+//! - [`guard`]: who may talk to the server (the token, the Host and Origin headers).
+//! - [`state`]: what is loaded, and what the page is told about it (JSON).
+//! - [`texture`], [`geometry`], [`grid`]: the binary payloads.
+//! - [`server`]: the routes.
+//!
+//! Reading files is the embedding program's business ([`Host`]): the `mirrorball` binary
+//! reads scenes and environments as its `render` and `convert` commands do, with their
+//! messages, and this crate never opens a file by itself.
+
+pub mod geometry;
+pub mod grid;
+pub mod guard;
+pub mod server;
+pub mod state;
+pub mod texture;
+mod web;
+
+pub use server::{open_browser, Running, Studio};
+pub use state::{Opened, SceneView};
+
+use std::path::Path;
+
+/// Reads what the studio shows: the files named on the command line and the uploads. Its
+/// errors are the messages a person reads (on the command line, or on the page).
+pub trait Host: Send + Sync + 'static {
+    /// Reads the file `path` named on the command line: a scene file or an environment.
+    fn open(&self, path: &Path) -> Result<Opened, String>;
+    /// Reads an uploaded file called `name` whose contents are `bytes`.
+    fn upload(&self, name: &str, bytes: &[u8]) -> Result<Opened, String>;
+    /// The scene shown before any scene is opened (an environment alone is shown on it).
+    fn default_scene(&self) -> SceneView;
+}

@@ -1,0 +1,388 @@
+//! The routes, on 127.0.0.1 only, every request through the [`Guard`].
+//!
+//! | route | what |
+//! | --- | --- |
+//! | `GET /` | the page (`?view=viewport`: the viewport alone, at the camera's size) |
+//! | `GET /web/NAME` | the page's scripts and shaders, embedded in the binary |
+//! | `GET /api/state` | what is loaded, as JSON ([`State::describe`]) |
+//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float` | the environment's texels ([`texture`]) |
+//! | `GET /api/mesh/I` | object `I` in world space ([`geometry`]) |
+//! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
+//! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit) |
+
+use crate::guard::Guard;
+use crate::state::{gpu_kind, State};
+use crate::{geometry, grid, texture, web, Host};
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State as Shared};
+use axum::http::{header, HeaderValue, StatusCode};
+use axum::middleware::{self, Next};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use mirrorball_core::projection::ProjectionSpec;
+use mirrorball_core::{resample, EnvMap, ResampleOptions};
+use serde::Deserialize;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+/// How to start the studio.
+#[derive(Clone, Debug)]
+pub struct Studio {
+    /// The port on 127.0.0.1 (0: any free one).
+    pub port: u16,
+    /// The largest upload, in bytes.
+    pub upload_limit: usize,
+    /// The largest conversion the page may ask for (face edge, width or diameter).
+    pub max_size: u32,
+}
+
+impl Default for Studio {
+    fn default() -> Self {
+        Studio {
+            port: 0,
+            upload_limit: 256 << 20,
+            max_size: 4096,
+        }
+    }
+}
+
+/// A studio serving in the background.
+pub struct Running {
+    /// The URL to open, with the token.
+    pub url: String,
+    pub port: u16,
+    pub token: String,
+    stop: Option<tokio::sync::oneshot::Sender<()>>,
+    thread: Option<std::thread::JoinHandle<Result<(), String>>>,
+}
+
+impl Running {
+    /// Serves until the process ends (or the server fails).
+    pub fn wait(mut self) -> Result<(), String> {
+        match self.thread.take().map(|t| t.join()) {
+            Some(Ok(r)) => r,
+            Some(Err(_)) => Err("the server thread panicked".into()),
+            None => Ok(()),
+        }
+    }
+
+    /// Stops serving and waits for the server to finish.
+    pub fn stop(mut self) {
+        if let Some(s) = self.stop.take() {
+            let _ = s.send(());
+        }
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// What every handler shares.
+struct App {
+    host: Arc<dyn Host>,
+    state: Mutex<State>,
+    guard: Guard,
+    options: Studio,
+    /// The last conversion asked for, by its query.
+    converted: Mutex<Option<(String, Arc<EnvMap>)>>,
+}
+
+type AppState = Arc<App>;
+
+impl Studio {
+    /// Reads `files` (a scene and/or an environment, in order) through `host`, binds the
+    /// port and serves in a thread of its own. A file that cannot be read, or a port that
+    /// cannot be bound, is an error before anything is served.
+    pub fn start(&self, host: Arc<dyn Host>, files: &[PathBuf]) -> Result<Running, String> {
+        let mut state = State::new(host.default_scene());
+        for f in files {
+            state.apply(host.open(f)?);
+        }
+        let listener = std::net::TcpListener::bind(("127.0.0.1", self.port))
+            .map_err(|e| format!("cannot listen on 127.0.0.1:{}: {e}", self.port))?;
+        let port = listener.local_addr().map_err(|e| e.to_string())?.port();
+        listener.set_nonblocking(true).map_err(|e| e.to_string())?;
+        let token = crate::guard::new_token()?;
+        let url = format!("http://127.0.0.1:{port}/?token={token}");
+        let app = Arc::new(App {
+            host,
+            state: Mutex::new(state),
+            guard: Guard {
+                port,
+                token: token.clone(),
+            },
+            options: self.clone(),
+            converted: Mutex::new(None),
+        });
+        let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+        let thread = std::thread::Builder::new()
+            .name("studio".into())
+            .spawn(move || serve(app, listener, stopped))
+            .map_err(|e| e.to_string())?;
+        Ok(Running {
+            url,
+            port,
+            token,
+            stop: Some(stop),
+            thread: Some(thread),
+        })
+    }
+}
+
+/// Serves `listener` until `stopped`.
+fn serve(
+    app: AppState,
+    listener: std::net::TcpListener,
+    stopped: tokio::sync::oneshot::Receiver<()>,
+) -> Result<(), String> {
+    let rt = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_io()
+        .build()
+        .map_err(|e| e.to_string())?;
+    rt.block_on(async move {
+        let listener = tokio::net::TcpListener::from_std(listener).map_err(|e| e.to_string())?;
+        let limit = app.options.upload_limit;
+        let router = Router::new()
+            .route("/", get(index))
+            .route("/web/{*name}", get(asset))
+            .route("/api/state", get(state))
+            .route("/api/environment", get(environment))
+            .route("/api/mesh/{i}", get(mesh))
+            .route("/api/grid", get(grid_of))
+            .route(
+                "/api/upload",
+                post(upload).layer(DefaultBodyLimit::max(limit)),
+            )
+            .layer(middleware::from_fn_with_state(app.clone(), guarded))
+            .with_state(app);
+        axum::serve(listener, router)
+            .with_graceful_shutdown(async {
+                let _ = stopped.await;
+            })
+            .await
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// Refuses what the guard refuses; marks every answer as not to be cached or sniffed.
+async fn guarded(Shared(app): Shared<AppState>, req: Request, next: Next) -> Response {
+    if let Err((status, why)) = app.guard.check(req.headers(), req.uri().query()) {
+        return (status, why).into_response();
+    }
+    let mut r = next.run(req).await;
+    let h = r.headers_mut();
+    h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    h.insert(
+        "x-content-type-options",
+        HeaderValue::from_static("nosniff"),
+    );
+    h.insert("referrer-policy", HeaderValue::from_static("no-referrer"));
+    h.insert("x-frame-options", HeaderValue::from_static("DENY"));
+    r
+}
+
+fn bad(status: StatusCode, message: impl Into<String>) -> Response {
+    (status, Json(serde_json::json!({ "error": message.into() }))).into_response()
+}
+
+fn binary(bytes: Vec<u8>) -> Response {
+    ([(header::CONTENT_TYPE, "application/octet-stream")], bytes).into_response()
+}
+
+async fn index() -> Response {
+    web::get("index.html").map_or_else(|| bad(StatusCode::NOT_FOUND, "no page"), web::respond)
+}
+
+async fn asset(UrlPath(name): UrlPath<String>) -> Response {
+    web::get(&name).map_or_else(
+        || bad(StatusCode::NOT_FOUND, format!("no {name}")),
+        web::respond,
+    )
+}
+
+async fn state(Shared(app): Shared<AppState>) -> Response {
+    let s = app.state.lock().expect("state");
+    Json(s.describe()).into_response()
+}
+
+#[derive(Deserialize)]
+struct EnvQuery {
+    projection: Option<String>,
+    size: Option<u32>,
+    precision: Option<String>,
+}
+
+async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -> Response {
+    let precision = match q
+        .precision
+        .as_deref()
+        .unwrap_or("half")
+        .parse::<texture::Precision>()
+    {
+        Ok(p) => p,
+        Err(e) => return bad(StatusCode::BAD_REQUEST, format!("precision: {e}")),
+    };
+    let map = {
+        let s = app.state.lock().expect("state");
+        match &s.view.scene.environment {
+            Some(e) => e.map.clone(),
+            None => return bad(StatusCode::NOT_FOUND, "no environment is loaded"),
+        }
+    };
+    let projection = q.projection.unwrap_or_else(|| "native".into());
+    let work = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, (StatusCode, String)> {
+        let map = if projection == "native" {
+            map
+        } else {
+            convert(&app, &map, &projection, q.size)?
+        };
+        if gpu_kind(map.projection()).is_none() {
+            return Err((
+                StatusCode::UNPROCESSABLE_ENTITY,
+                format!(
+                    "the viewport does not draw {} maps yet (latlong, cube, sphere, paraboloid)",
+                    map.projection().name()
+                ),
+            ));
+        }
+        Ok(texture::encode(&map, precision))
+    });
+    match work.await {
+        Ok(Ok(b)) => binary(b),
+        Ok(Err((s, m))) => bad(s, m),
+        Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+    }
+}
+
+/// `map` in the projection `spec` at `size` (default: the core's resolution match), the
+/// last one kept.
+fn convert(
+    app: &App,
+    map: &Arc<EnvMap>,
+    spec: &str,
+    size: Option<u32>,
+) -> Result<Arc<EnvMap>, (StatusCode, String)> {
+    let req = |m: String| (StatusCode::BAD_REQUEST, m);
+    let p = ProjectionSpec::parse(spec)
+        .and_then(|s| s.build(None))
+        .map_err(|e| req(format!("projection: {e}")))?;
+    let size = size.unwrap_or_else(|| map.width().max(map.height()).min(app.options.max_size));
+    if !(1..=app.options.max_size).contains(&size) {
+        return Err(req(format!(
+            "size {size} is outside 1..={}",
+            app.options.max_size
+        )));
+    }
+    let key = format!("{:p} {p} {size}", Arc::as_ptr(map));
+    if let Some((k, m)) = app.converted.lock().expect("cache").as_ref() {
+        if *k == key {
+            return Ok(m.clone());
+        }
+    }
+    let out = Arc::new(resample(map, p, size, &ResampleOptions::default()));
+    *app.converted.lock().expect("cache") = Some((key, out.clone()));
+    Ok(out)
+}
+
+async fn mesh(Shared(app): Shared<AppState>, UrlPath(i): UrlPath<usize>) -> Response {
+    let object = {
+        let s = app.state.lock().expect("state");
+        s.view.scene.objects.get(i).cloned()
+    };
+    match object {
+        Some(o) => match tokio::task::spawn_blocking(move || geometry::encode(&o)).await {
+            Ok(b) => binary(b),
+            Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+        },
+        None => bad(StatusCode::NOT_FOUND, format!("no object {i}")),
+    }
+}
+
+async fn grid_of(Query(q): Query<HashMap<String, String>>) -> Response {
+    let spec = q.get("projection").map_or("latlong", String::as_str);
+    let p = match ProjectionSpec::parse(spec).and_then(|s| s.build(None)) {
+        Ok(p) => p,
+        Err(e) => return bad(StatusCode::BAD_REQUEST, format!("projection: {e}")),
+    };
+    let n = match q.get("n").map(|n| n.parse::<u32>()) {
+        None => 64,
+        Some(Ok(n)) if (1..=grid::MAX_N).contains(&n) => n,
+        Some(_) => {
+            return bad(
+                StatusCode::BAD_REQUEST,
+                format!("n must be 1..={}", grid::MAX_N),
+            )
+        }
+    };
+    match tokio::task::spawn_blocking(move || grid::encode(&p, n)).await {
+        Ok(b) => binary(b),
+        Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+    }
+}
+
+async fn upload(
+    Shared(app): Shared<AppState>,
+    Query(q): Query<HashMap<String, String>>,
+    body: Result<Bytes, BytesRejection>,
+) -> Response {
+    let Some(name) = q.get("name").cloned() else {
+        return bad(StatusCode::BAD_REQUEST, "an upload needs ?name=FILE");
+    };
+    let body = match body {
+        Ok(b) => b,
+        Err(e) => {
+            let message = if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
+                format!(
+                    "{name}: larger than the upload limit of {} MiB (mirrorball studio --max-upload)",
+                    app.options.upload_limit >> 20
+                )
+            } else {
+                format!("{name}: the upload did not arrive whole: {e}")
+            };
+            app.state.lock().expect("state").error(message.clone());
+            return bad(e.status(), message);
+        }
+    };
+    let host = app.host.clone();
+    let read = tokio::task::spawn_blocking(move || {
+        let opened = host.upload(&name, &body);
+        (name, opened)
+    })
+    .await;
+    let mut s = app.state.lock().expect("state");
+    match read {
+        Ok((_, Ok(opened))) => {
+            s.apply(opened);
+            Json(s.describe()).into_response()
+        }
+        Ok((_, Err(message))) => {
+            s.error(message.clone());
+            bad(StatusCode::UNPROCESSABLE_ENTITY, message)
+        }
+        Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+    }
+}
+
+/// Opens `url` in the desktop's browser (`xdg-open`, `open`, `start`); failing to is not an
+/// error (the URL is printed).
+pub fn open_browser(url: &str) {
+    let mut cmd = if cfg!(target_os = "macos") {
+        std::process::Command::new("open")
+    } else if cfg!(windows) {
+        let mut c = std::process::Command::new("cmd");
+        c.args(["/C", "start", ""]);
+        c
+    } else {
+        std::process::Command::new("xdg-open")
+    };
+    let _ = cmd
+        .arg(url)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn();
+}

@@ -1,0 +1,214 @@
+//! What the studio has loaded, and what the page is told about it.
+
+use mirrorball_core::glam::{DVec3, Mat3};
+use mirrorball_core::{Choice, EnvMap, Projection};
+use mirrorball_render::tone::Tone;
+use mirrorball_render::{
+    Attach, Camera, CameraLens, Environment, Indexing, Material, Scene, Settings,
+};
+use serde_json::{json, Value};
+use std::sync::Arc;
+
+/// A scene as `mirrorball render` would draw it: objects, environment, camera, the
+/// settings, and the display's exposure and tone curve.
+#[derive(Clone)]
+pub struct SceneView {
+    /// What it was read from (a file's name).
+    pub name: String,
+    pub scene: Scene,
+    pub camera: Camera,
+    pub settings: Settings,
+    pub exposure: f32,
+    pub tone: Tone,
+}
+
+/// What a file held.
+pub enum Opened {
+    /// A scene file: replaces the scene.
+    Scene(Box<SceneView>),
+    /// An environment map: replaces the scene's environment (world-attached, bilinear,
+    /// intensity 1 if the scene had none).
+    Environment { name: String, map: Box<EnvMap> },
+}
+
+/// Everything loaded.
+pub struct State {
+    pub view: SceneView,
+    /// Messages for the page (the newest last): files that could not be read.
+    pub errors: Vec<String>,
+    /// Bumped on every change, so that the page knows to fetch again.
+    pub generation: u64,
+}
+
+/// The most messages kept for the page.
+const MAX_ERRORS: usize = 20;
+
+impl State {
+    pub fn new(view: SceneView) -> State {
+        State {
+            view,
+            errors: Vec::new(),
+            generation: 1,
+        }
+    }
+
+    /// Takes in what a file held.
+    pub fn apply(&mut self, opened: Opened) {
+        match opened {
+            Opened::Scene(v) => self.view = *v,
+            Opened::Environment { name, map } => {
+                let env = match self.view.scene.environment.take() {
+                    Some(e) => Environment {
+                        map: Arc::new(*map),
+                        cache: Default::default(),
+                        ..e
+                    },
+                    None => Environment {
+                        map: Arc::new(*map),
+                        attach: Attach::World,
+                        filter: mirrorball_render::Filter::Bilinear,
+                        intensity: 1.0,
+                        cache: Default::default(),
+                    },
+                };
+                self.view.scene.environment = Some(env);
+                self.view.name = format!("{} with {name}", self.view.name);
+            }
+        }
+        self.generation += 1;
+    }
+
+    /// Records a message for the page.
+    pub fn error(&mut self, message: String) {
+        self.errors.push(message);
+        if self.errors.len() > MAX_ERRORS {
+            self.errors.remove(0);
+        }
+        self.generation += 1;
+    }
+
+    /// The page's description of everything loaded.
+    pub fn describe(&self) -> Value {
+        json!({
+            "generation": self.generation,
+            "scene": describe_scene(&self.view),
+            "errors": self.errors,
+        })
+    }
+}
+
+/// A column-major 4×4 matrix as 16 numbers.
+fn mat(m: mirrorball_core::glam::Mat4) -> Vec<f32> {
+    m.to_cols_array().to_vec()
+}
+
+fn describe_scene(v: &SceneView) -> Value {
+    let c = &v.camera;
+    let (fov, ortho) = match c.lens {
+        CameraLens::Perspective { fov_y_deg } => (Some(fov_y_deg), None),
+        CameraLens::Orthographic { half_height } => (None, Some(half_height)),
+    };
+    let mut notes = Vec::new();
+    let objects: Vec<Value> = (v.scene.objects.iter().enumerate())
+        .map(|(i, o)| {
+            let material = match &o.material {
+                Material::Mirror { tint } => json!({"kind": "mirror", "tint": tint}),
+                m => {
+                    notes.push(format!(
+                        "object {i}: the viewport draws the {} material as a mirror",
+                        m.kind().name()
+                    ));
+                    json!({"kind": "mirror", "tint": [1.0, 1.0, 1.0]})
+                }
+            };
+            json!({
+                "mesh": i,
+                "vertices": o.mesh.positions.len(),
+                "triangles": o.mesh.triangles.len(),
+                "material": material,
+            })
+        })
+        .collect();
+    if v.settings.indexing == Indexing::Cone {
+        notes.push("mode 4 (cones) is drawn as mode 3 by the viewport".into());
+    }
+    if v.settings.supersample != 1 {
+        notes.push(format!(
+            "the viewport draws 1 sample a pixel (the scene asks for {0}×{0})",
+            v.settings.supersample
+        ));
+    }
+    let environment = v.scene.environment.as_ref().map(|e| {
+        if e.filter != mirrorball_render::Filter::Bilinear {
+            notes.push(format!(
+                "the viewport reads the environment bilinearly (the scene asks for {})",
+                e.filter.name()
+            ));
+        }
+        let mut d = describe_map(&e.map);
+        d["attach"] = json!(e.attach.name());
+        d["intensity"] = json!(e.intensity);
+        d
+    });
+    json!({
+        "name": v.name,
+        "camera": {
+            "eye": c.eye.to_array(), "target": c.target.to_array(), "up": c.up.to_array(),
+            "fov": fov, "orthoHalfHeight": ortho, "near": c.near, "far": c.far,
+            "width": c.width, "height": c.height,
+            "view": mat(c.view()), "projection": mat(c.projection()),
+        },
+        "indexing": v.settings.indexing.name(),
+        "mode": v.settings.indexing.number(),
+        "background": v.scene.background,
+        "exposure": v.exposure,
+        "tone": v.tone.name(),
+        "objects": objects,
+        "environment": environment,
+        "notes": notes,
+    })
+}
+
+/// An environment map's projection, its frame and its size, for the page.
+pub fn describe_map(map: &EnvMap) -> Value {
+    let p = map.projection();
+    json!({
+        "projection": p.name(),
+        "spec": p.to_string(),
+        "gpu": gpu_kind(p).is_some(),
+        "frame": frame_of(p).map(|m| m.to_cols_array().to_vec()),
+        "layers": map.layers().len(),
+        "width": map.width(),
+        "height": map.height(),
+    })
+}
+
+/// The projections the viewport's shaders know (`web/glsl/NAME.glsl`).
+pub fn gpu_kind(p: &Projection) -> Option<&'static str> {
+    match p {
+        Projection::LatLong(_) => Some("latlong"),
+        Projection::Cube(_) => Some("cube"),
+        Projection::Sphere(_) => Some("sphere"),
+        Projection::Paraboloid(_) => Some("paraboloid"),
+        _ => None,
+    }
+}
+
+/// The frame of a disk map's layer 0 as the columns (right, up, axis), where the shader's
+/// `radial.glsl` measures angles from the axis: a sphere map's centre looks against its
+/// camera's view (core `SphereMap::new`), a paraboloid's front half along its `look`.
+pub fn frame_of(p: &Projection) -> Option<Mat3> {
+    let cols =
+        |r: DVec3, u: DVec3, f: DVec3| Mat3::from_cols(r.as_vec3(), u.as_vec3(), f.as_vec3());
+    match p {
+        Projection::Sphere(s) => {
+            let e = s.eye();
+            Some(cols(e.right, e.up, -e.forward))
+        }
+        Projection::Paraboloid(d) => {
+            let f = d.frame();
+            Some(cols(f.right, f.up, f.forward))
+        }
+        _ => None,
+    }
+}

@@ -1,0 +1,5 @@
+//! The studio's server, through real requests to a running server.
+
+mod host;
+mod security;
+mod serving;

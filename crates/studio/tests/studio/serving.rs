@@ -1,0 +1,173 @@
+//! What the server gives the page, and how it takes bad files.
+
+use crate::host::{latlong_exr, own, start};
+
+fn json(a: &crate::host::Answer) -> serde_json::Value {
+    serde_json::from_slice(&a.body).unwrap_or_else(|_| panic!("not JSON: {}", a.text()))
+}
+
+#[test]
+fn a_truncated_exr_upload_is_refused_with_the_readers_message_and_serving_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = std::fs::read(latlong_exr(dir.path())).unwrap();
+    let r = start(&[]);
+    let a = own(
+        &r,
+        "POST",
+        "/api/upload?name=cut.exr",
+        &good[..good.len() / 2],
+    );
+    assert_eq!(a.status, 422, "{}", a.text());
+    let message = json(&a)["error"].as_str().unwrap().to_string();
+    // The reader's own message, under the upload's name.
+    assert!(message.starts_with("cut.exr"), "{message}");
+    let s = json(&own(&r, "GET", "/api/state", b""));
+    assert_eq!(s["errors"][0], message.as_str());
+    assert!(s["scene"]["environment"].is_null());
+    // Still serving: the whole file is taken.
+    let a = own(&r, "POST", "/api/upload?name=map.exr", &good);
+    assert_eq!(a.status, 200, "{}", a.text());
+    let s = json(&a);
+    assert_eq!(s["scene"]["environment"]["projection"], "latlong");
+    assert_eq!(s["scene"]["environment"]["width"], 16);
+    r.stop();
+}
+
+#[test]
+fn an_upload_over_the_limit_is_refused_and_serving_goes_on() {
+    let r = start(&[]);
+    let a = own(
+        &r,
+        "POST",
+        "/api/upload?name=big.exr",
+        &vec![0u8; (1 << 20) + 1],
+    );
+    assert_eq!(a.status, 413, "{}", a.text());
+    let message = json(&a)["error"].as_str().unwrap().to_string();
+    assert_eq!(
+        message,
+        "big.exr: larger than the upload limit of 1 MiB (mirrorball studio --max-upload)"
+    );
+    let s = own(&r, "GET", "/api/state", b"");
+    assert_eq!(s.status, 200);
+    assert_eq!(json(&s)["errors"][0], message.as_str());
+    r.stop();
+}
+
+#[test]
+fn a_bad_file_on_the_command_line_is_an_error_before_serving() {
+    let dir = tempfile::tempdir().unwrap();
+    let cut = dir.path().join("cut.exr");
+    let good = std::fs::read(latlong_exr(dir.path())).unwrap();
+    std::fs::write(&cut, &good[..100]).unwrap();
+    let e = mirrorball_studio::Studio::default()
+        .start(
+            std::sync::Arc::new(crate::host::TestHost),
+            std::slice::from_ref(&cut),
+        )
+        .err()
+        .expect("refused");
+    assert!(e.starts_with(&cut.display().to_string()), "{e}");
+}
+
+#[test]
+fn the_environment_comes_padded_in_its_own_and_other_projections() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = start(&[latlong_exr(dir.path())]);
+    let a = own(
+        &r,
+        "GET",
+        "/api/environment?projection=native&precision=float",
+        b"",
+    );
+    assert_eq!(a.status, 200, "{}", a.text());
+    assert_eq!(&a.body[..4], b"MBTX");
+    let n = u32::from_le_bytes(a.body[4..8].try_into().unwrap()) as usize;
+    let h: serde_json::Value = serde_json::from_slice(&a.body[8..8 + n]).unwrap();
+    assert_eq!(
+        (h["texelWidth"].as_u64(), h["texelHeight"].as_u64()),
+        (Some(18), Some(10))
+    );
+    assert_eq!(a.body.len(), 8 + n + 18 * 10 * 16);
+    // Texel (0, 0) of the map is at (1, 1) of the padded layer; (−1, 0) wraps to (15, 0).
+    let f = |x: usize, y: usize, c: usize| {
+        let i = 8 + n + ((y * 18 + x) * 4 + c) * 4;
+        f32::from_le_bytes(a.body[i..i + 4].try_into().unwrap())
+    };
+    assert_eq!((f(1, 1, 0), f(1, 1, 1)), (0.0, 0.0));
+    assert_eq!((f(0, 1, 0), f(0, 1, 1)), (15.0 / 16.0, 0.0));
+    let a = own(
+        &r,
+        "GET",
+        "/api/environment?projection=cube&size=8&precision=half",
+        b"",
+    );
+    assert_eq!(a.status, 200, "{}", a.text());
+    let n = u32::from_le_bytes(a.body[4..8].try_into().unwrap()) as usize;
+    let h: serde_json::Value = serde_json::from_slice(&a.body[8..8 + n]).unwrap();
+    assert_eq!(
+        (h["projection"].as_str(), h["layers"].as_u64()),
+        (Some("cube"), Some(6))
+    );
+    assert_eq!(a.body.len(), 8 + n + 6 * 10 * 10 * 8);
+    for bad in [
+        "projection=cube&size=0",
+        "projection=nonsense",
+        "precision=double",
+        "projection=octahedral",
+    ] {
+        let a = own(&r, "GET", &format!("/api/environment?{bad}"), b"");
+        assert!(
+            a.status == 400 || a.status == 422,
+            "{bad}: {} {}",
+            a.status,
+            a.text()
+        );
+        assert!(json(&a)["error"].is_string());
+    }
+    r.stop();
+}
+
+#[test]
+fn meshes_come_in_world_space() {
+    let r = start(&[]);
+    let a = own(&r, "GET", "/api/mesh/0", b"");
+    assert_eq!(a.status, 200);
+    let u = |i: usize| u32::from_le_bytes(a.body[4 * i..4 * i + 4].try_into().unwrap());
+    let f = |i: usize| f32::from_le_bytes(a.body[4 * i..4 * i + 4].try_into().unwrap());
+    let (n, t) = (u(0) as usize, u(1) as usize);
+    assert_eq!(a.body.len(), 8 + 24 * n + 12 * t);
+    // The sphere of radius 1 moved up by 0.5: every vertex at distance 1 from (0, 0.5, 0),
+    // its normal pointing away from there.
+    for i in 0..n {
+        let p = [f(2 + 3 * i), f(3 + 3 * i) - 0.5, f(4 + 3 * i)];
+        let q = [
+            f(2 + 3 * n + 3 * i),
+            f(3 + 3 * n + 3 * i),
+            f(4 + 3 * n + 3 * i),
+        ];
+        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        assert!((r - 1.0).abs() < 1e-5, "vertex {i} at radius {r}");
+        assert!(
+            p.iter().zip(q).all(|(a, b)| (a / r - b).abs() < 1e-3),
+            "normal {i}"
+        );
+    }
+    assert_eq!(own(&r, "GET", "/api/mesh/1", b"").status, 404);
+    r.stop();
+}
+
+#[test]
+fn the_grid_holds_the_cores_answers() {
+    let r = start(&[]);
+    let a = own(&r, "GET", "/api/grid?projection=cube&n=8", b"");
+    assert_eq!(a.status, 200);
+    let count = u32::from_le_bytes(a.body[..4].try_into().unwrap()) as usize;
+    assert_eq!(count, 6 * 81);
+    assert_eq!(a.body.len(), 40 + 36 * count);
+    assert_eq!(
+        own(&r, "GET", "/api/grid?projection=cube&n=100000", b"").status,
+        400
+    );
+    r.stop();
+}

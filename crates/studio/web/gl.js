@@ -1,0 +1,280 @@
+// The studio's WebGL2 machinery, shared by the page (studio.js) and the browser tests: the
+// server's payloads (crates/studio/src/texture.rs, geometry.rs, grid.rs), the programs
+// assembled from the .glsl files (each formula's one home), the projection check.
+
+const token = new URLSearchParams(location.search).get('token') || '';
+
+/** fetch() of the studio's own `path`, with the token. */
+export async function api(path, options = {}) {
+  const headers = Object.assign({ 'x-mirrorball-token': token }, options.headers || {});
+  const r = await fetch(path, Object.assign({}, options, { headers }));
+  if (!r.ok) {
+    let message = `${r.status} ${r.statusText}`;
+    try {
+      const j = await r.json();
+      if (j.error) message = j.error;
+    } catch (_) {
+      /* not JSON */
+    }
+    throw new Error(message);
+  }
+  return r;
+}
+
+const sources = new Map();
+/** The embedded shader file `name` (under web/glsl/). */
+export async function glsl(name) {
+  if (!sources.has(name)) {
+    sources.set(name, api(`/web/glsl/${name}`).then((r) => r.text()));
+  }
+  return sources.get(name);
+}
+
+/** The projections the shaders know, by the server's name for them. */
+export const KINDS = ['latlong', 'cube', 'sphere', 'paraboloid'];
+const DISKS = new Set(['sphere', 'paraboloid']);
+
+/** The GLSL of projection `kind`'s envUv (with the disk maps' shared machine). */
+export async function projectionSource(kind) {
+  if (!KINDS.includes(kind)) throw new Error(`the viewport does not draw ${kind} maps`);
+  const own = await glsl(`${kind}.glsl`);
+  return DISKS.has(kind) ? (await glsl('radial.glsl')) + '\n' + own : own;
+}
+
+/** An environment payload (texture.rs): its JSON header and texels. */
+export function parseTexture(buffer) {
+  const bytes = new Uint8Array(buffer);
+  const magic = String.fromCharCode(...bytes.subarray(0, 4));
+  if (magic !== 'MBTX') throw new Error('not an environment payload');
+  const n = new DataView(buffer).getUint32(4, true);
+  const header = JSON.parse(new TextDecoder().decode(bytes.subarray(8, 8 + n)));
+  const at = 8 + n;
+  const data =
+    header.precision === 'float' ? new Float32Array(buffer, at) : new Uint16Array(buffer, at);
+  return { header, data };
+}
+
+/** The texture array of a parsed environment payload. */
+export function environmentTexture(gl, { header, data }) {
+  const t = gl.createTexture();
+  gl.bindTexture(gl.TEXTURE_2D_ARRAY, t);
+  const float = header.precision === 'float';
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  gl.texImage3D(
+    gl.TEXTURE_2D_ARRAY,
+    0,
+    float ? gl.RGBA32F : gl.RGBA16F,
+    header.texelWidth,
+    header.texelHeight,
+    header.layers,
+    0,
+    gl.RGBA,
+    float ? gl.FLOAT : gl.HALF_FLOAT,
+    data,
+  );
+  for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) {
+    gl.texParameteri(gl.TEXTURE_2D_ARRAY, p, gl.NEAREST);
+  }
+  for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) {
+    gl.texParameteri(gl.TEXTURE_2D_ARRAY, p, gl.CLAMP_TO_EDGE);
+  }
+  return t;
+}
+
+/** A mesh payload (geometry.rs). */
+export function parseMesh(buffer) {
+  const v = new DataView(buffer);
+  const n = v.getUint32(0, true);
+  const t = v.getUint32(4, true);
+  return {
+    positions: new Float32Array(buffer, 8, 3 * n),
+    normals: new Float32Array(buffer, 8 + 12 * n, 3 * n),
+    indices: new Uint32Array(buffer, 8 + 24 * n, 3 * t),
+  };
+}
+
+/** A grid payload (grid.rs): count, the frame, and nine floats a direction. */
+export function parseGrid(buffer) {
+  const count = new DataView(buffer).getUint32(0, true);
+  const frame = Array.from(new Float32Array(buffer, 4, 9));
+  return { count, frame, values: new Float32Array(buffer, 40, 9 * count) };
+}
+
+/** The viewport's vertex attributes, in the order of `triangleVertices`' floats. */
+export const ATTRIBUTES = ['aPos', 'aP0', 'aP1', 'aP2', 'aN0', 'aN1', 'aN2'];
+
+/**
+ * A parsed mesh as the viewport draws it: three vertices a triangle, each with its own
+ * position and its triangle's three corners' positions and normals (viewport.vert):
+ * `ATTRIBUTES.length` × 3 floats a vertex.
+ */
+export function triangleVertices(mesh) {
+  const { positions: p, normals: n, indices } = mesh;
+  const stride = ATTRIBUTES.length * 3;
+  const out = new Float32Array((indices.length / 3) * 3 * stride);
+  let o = 0;
+  for (let t = 0; t < indices.length; t += 3) {
+    const corners = [indices[t], indices[t + 1], indices[t + 2]];
+    for (const own of corners) {
+      out.set(p.subarray(3 * own, 3 * own + 3), o);
+      o += 3;
+      for (const k of corners) {
+        out.set(p.subarray(3 * k, 3 * k + 3), o);
+        o += 3;
+      }
+      for (const k of corners) {
+        out.set(n.subarray(3 * k, 3 * k + 3), o);
+        o += 3;
+      }
+    }
+  }
+  return out;
+}
+
+const HEADER = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2DArray;\n';
+
+function compile(gl, type, source) {
+  const s = gl.createShader(type);
+  gl.shaderSource(s, source);
+  gl.compileShader(s);
+  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) {
+    const log = gl.getShaderInfoLog(s);
+    const numbered = source
+      .split('\n')
+      .map((l, i) => `${i + 1}: ${l}`)
+      .join('\n');
+    throw new Error(`shader: ${log}\n${numbered}`);
+  }
+  return s;
+}
+
+/** A linked program of vertex and fragment sources. */
+export function link(gl, vs, fs) {
+  const p = gl.createProgram();
+  gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, vs));
+  gl.attachShader(p, compile(gl, gl.FRAGMENT_SHADER, fs));
+  ATTRIBUTES.forEach((name, i) => gl.bindAttribLocation(p, i, name));
+  gl.linkProgram(p);
+  if (!gl.getProgramParameter(p, gl.LINK_STATUS)) {
+    throw new Error(`program: ${gl.getProgramInfoLog(p)}`);
+  }
+  return p;
+}
+
+/**
+ * What mode 1 generates for a map of `kind` with `layers` layers (mirrorball-render's
+ * render/texgen.rs, `Texgen::of`): 0 GL_SPHERE_MAP's (s, t) for a sphere map, 2 a
+ * single-layer map's own (u, v), 1 GL_REFLECTION_MAP's direction otherwise.
+ */
+export function texgenOf(kind, layers) {
+  if (kind === 'sphere') return 0;
+  return layers === 1 ? 2 : 1;
+}
+
+/** The viewport's program for `kind`, indexing `mode` (1–3), objects or the background. */
+export async function viewportProgram(gl, { kind, layers, mode, background }) {
+  const defines =
+    `#define MODE ${mode}\n#define TEXGEN ${texgenOf(kind, layers)}\n` +
+    `#define BACKGROUND ${background ? 1 : 0}\n`;
+  const proj = await projectionSource(kind);
+  const vs = HEADER + defines + proj + '\n' + (await glsl('texgen.glsl')) + '\n' + (await glsl('viewport.vert'));
+  const fs =
+    HEADER +
+    defines +
+    proj +
+    '\n' +
+    (await glsl('bilinear.glsl')) +
+    '\n' +
+    (await glsl('display.glsl')) +
+    '\n' +
+    (await glsl('interpolate.glsl')) +
+    '\n' +
+    (await glsl('viewport.frag'));
+  return link(gl, vs, fs);
+}
+
+/**
+ * Runs projection `kind`'s envUv (frame `frame`: 9 numbers, column-major, for disk maps) on
+ * `dirs` (3 floats each) in a float render target; returns (u, v, layer) per direction.
+ */
+export async function envUvOnGpu(gl, kind, frame, dirs) {
+  if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('no EXT_color_buffer_float');
+  const count = dirs.length / 3;
+  const width = Math.min(count, 1024);
+  const height = Math.ceil(count / width);
+  const input = new Float32Array(width * height * 4);
+  for (let i = 0; i < count; i++) input.set(dirs.subarray(3 * i, 3 * i + 3), 4 * i);
+  const tex = (data) => {
+    const t = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, t);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, width, height, 0, gl.RGBA, gl.FLOAT, data);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    return t;
+  };
+  const src = tex(input);
+  const dst = tex(null);
+  const fb = gl.createFramebuffer();
+  gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+  gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, dst, 0);
+  const vs =
+    HEADER +
+    'void main() { vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2)) * 2.0 - 1.0; gl_Position = vec4(p, 0.0, 1.0); }\n';
+  const fs =
+    HEADER +
+    (await projectionSource(kind)) +
+    '\nuniform highp sampler2D uDirs;\nout vec4 outUv;\n' +
+    'void main() { vec3 d = texelFetch(uDirs, ivec2(gl_FragCoord.xy), 0).xyz; outUv = vec4(envUv(d), 1.0); }\n';
+  const p = link(gl, vs, fs);
+  gl.useProgram(p);
+  gl.activeTexture(gl.TEXTURE0);
+  gl.bindTexture(gl.TEXTURE_2D, src);
+  gl.uniform1i(gl.getUniformLocation(p, 'uDirs'), 0);
+  if (frame) gl.uniformMatrix3fv(gl.getUniformLocation(p, 'uFrame'), false, new Float32Array(frame));
+  gl.viewport(0, 0, width, height);
+  gl.drawArrays(gl.TRIANGLES, 0, 3);
+  const out = new Float32Array(width * height * 4);
+  gl.readPixels(0, 0, width, height, gl.RGBA, gl.FLOAT, out);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  return out;
+}
+
+/**
+ * Checks projection `spec`'s shader against the core on the server's grid of `n` cells a
+ * side: each direction's (u, v, layer) must be the core's, or (on a seam, where two are
+ * right) the one the direction was made from, within `tolerance` in u and v.
+ */
+export async function checkProjection(gl, { kind, spec, n = 64, tolerance = 1e-4 }) {
+  const buf = await (await api(`/api/grid?projection=${encodeURIComponent(spec)}&n=${n}`)).arrayBuffer();
+  const { count, frame, values } = parseGrid(buf);
+  const dirs = new Float32Array(3 * count);
+  for (let i = 0; i < count; i++) dirs.set(values.subarray(9 * i, 9 * i + 3), 3 * i);
+  const got = await envUvOnGpu(gl, kind, frame, dirs);
+  let worst = 0;
+  let worstAt = null;
+  let seams = 0;
+  let failed = 0;
+  const failures = [];
+  for (let i = 0; i < count; i++) {
+    const g = got.subarray(4 * i, 4 * i + 3);
+    const err = (k) => {
+      const r = values.subarray(9 * i + k, 9 * i + k + 3);
+      if (r[2] !== g[2]) return Infinity;
+      if (r[2] < 0) return 0;
+      return Math.max(Math.abs(r[0] - g[0]), Math.abs(r[1] - g[1]));
+    };
+    const e0 = err(3);
+    const e = Math.min(e0, err(6));
+    if (e < e0) seams++;
+    if (e > tolerance) {
+      failed++;
+      if (failures.length < 10) {
+        failures.push({ dir: Array.from(dirs.subarray(3 * i, 3 * i + 3)), got: Array.from(g), core: Array.from(values.subarray(9 * i + 3, 9 * i + 9)) });
+      }
+    } else if (e > worst) {
+      worst = e;
+      worstAt = { dir: Array.from(dirs.subarray(3 * i, 3 * i + 3)), got: Array.from(g), core: Array.from(values.subarray(9 * i + 3, 9 * i + 9)) };
+    }
+  }
+  return { count, worst, worstAt, seams, failed, failures };
+}

@@ -1,0 +1,313 @@
+// The studio page: the viewport (WebGL2) over what the server has loaded, its controls, file
+// picker and drop target, orbit and zoom. `?view=viewport`: the viewport alone, at the scene
+// camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode and the
+// projection the environment is converted to. `window.studio` is the page's handle for
+// tests and later views (simulator, overlays) to plug into.
+
+const params = new URLSearchParams(location.search);
+const token = params.get('token') || '';
+const G = await import(`./gl.js?token=${encodeURIComponent(token)}`);
+
+const embed = params.get('view') === 'viewport';
+if (embed) {
+  document.body.classList.add('embed');
+  document.getElementById('controls').hidden = true;
+  document.getElementById('messages').hidden = true;
+  document.querySelector('main').style.padding = '0';
+}
+
+const canvas = document.getElementById('viewport');
+const gl = canvas.getContext('webgl2', {
+  antialias: false,
+  alpha: true,
+  premultipliedAlpha: false,
+  preserveDrawingBuffer: true,
+});
+
+const view = {
+  state: null,
+  mode: null,
+  projection: params.get('projection') || 'native',
+  size: params.get('size') ? Number(params.get('size')) : null,
+  env: null, // { header, texture }
+  meshes: [], // { vao, count }
+  programs: new Map(),
+  // The orbit: null until the person moves the camera (then the view matrix is made here).
+  orbit: null,
+  generation: 0,
+};
+
+function show(messages) {
+  const m = document.getElementById('messages');
+  m.replaceChildren(
+    ...messages.map(([cls, text]) => {
+      const p = document.createElement('p');
+      p.className = cls;
+      p.textContent = text;
+      return p;
+    }),
+  );
+}
+
+function report(error) {
+  const notes = view.state?.scene?.notes || [];
+  const errors = view.state?.errors || [];
+  const message = error ? String(error.message || error) : null;
+  show([
+    ...errors.map((e) => ['error', e]),
+    ...(message && !errors.includes(message) ? [['error', message]] : []),
+    ...notes.map((n) => ['note', n]),
+  ]);
+}
+
+async function loadState() {
+  view.state = await (await G.api('/api/state')).json();
+  const s = view.state.scene;
+  document.getElementById('scene-name').textContent = s.name;
+  if (view.mode === null) view.mode = Number(params.get('mode') || Math.min(s.mode, 3));
+  document.getElementById('mode').value = String(view.mode);
+  document.getElementById('projection').value = view.projection;
+  canvas.width = s.camera.width;
+  canvas.height = s.camera.height;
+  canvas.style.width = `${s.camera.width}px`;
+  canvas.style.height = `${s.camera.height}px`;
+  await loadMeshes();
+  await loadEnvironment();
+  report();
+}
+
+async function loadMeshes() {
+  for (const m of view.meshes) gl.deleteVertexArray(m.vao);
+  view.meshes = [];
+  for (const o of view.state.scene.objects) {
+    const mesh = G.parseMesh(await (await G.api(`/api/mesh/${o.mesh}`)).arrayBuffer());
+    const vao = gl.createVertexArray();
+    gl.bindVertexArray(vao);
+    const b = gl.createBuffer();
+    gl.bindBuffer(gl.ARRAY_BUFFER, b);
+    gl.bufferData(gl.ARRAY_BUFFER, G.triangleVertices(mesh), gl.STATIC_DRAW);
+    const stride = G.ATTRIBUTES.length * 12;
+    G.ATTRIBUTES.forEach((_, loc) => {
+      gl.enableVertexAttribArray(loc);
+      gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, stride, 12 * loc);
+    });
+    gl.bindVertexArray(null);
+    view.meshes.push({ vao, vertices: mesh.indices.length, material: o.material });
+  }
+}
+
+async function loadEnvironment() {
+  if (view.env) gl.deleteTexture(view.env.texture);
+  view.env = null;
+  if (!view.state.scene.environment) return;
+  let q = `projection=${encodeURIComponent(view.projection)}&precision=float`;
+  if (view.size) q += `&size=${view.size}`;
+  const parsed = G.parseTexture(await (await G.api(`/api/environment?${q}`)).arrayBuffer());
+  view.env = { header: parsed.header, texture: G.environmentTexture(gl, parsed) };
+}
+
+async function program(background) {
+  const h = view.env.header;
+  const kind = h.projection;
+  const key = `${kind} ${h.layers} ${view.mode} ${background}`;
+  if (!view.programs.has(key)) {
+    view.programs.set(key, await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background }));
+  }
+  return view.programs.get(key);
+}
+
+/** gluLookAt(eye, target, up), column-major: mirrorball-render's camera.rs `Camera::view`. */
+function lookAt(eye, target, up) {
+  const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const norm = (a) => {
+    const l = Math.hypot(...a);
+    return a.map((x) => x / l);
+  };
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const f = norm(sub(target, eye));
+  const s = norm(cross(f, up));
+  const u = cross(s, f);
+  return [s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0, -dot(s, eye), -dot(u, eye), dot(f, eye), 1];
+}
+
+/** The camera now: the scene's, or the orbited one. */
+function camera() {
+  const c = view.state.scene.camera;
+  if (!view.orbit) return { eye: c.eye, view: c.view };
+  const { yaw, pitch, distance } = view.orbit;
+  const t = c.target;
+  const eye = [
+    t[0] + distance * Math.cos(pitch) * Math.sin(yaw),
+    t[1] + distance * Math.sin(pitch),
+    t[2] + distance * Math.cos(pitch) * Math.cos(yaw),
+  ];
+  return { eye, view: lookAt(eye, t, c.up) };
+}
+
+async function draw() {
+  const s = view.state.scene;
+  const c = s.camera;
+  gl.viewport(0, 0, canvas.width, canvas.height);
+  gl.clearColor(0, 0, 0, 0);
+  gl.clearDepth(1);
+  gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+  if (!view.env) return;
+  const cam = camera();
+  const v = cam.view;
+  // Rows of the view matrix: right, up, back (camera.rs `Camera::basis`).
+  const right = [v[0], v[4], v[8]];
+  const up = [v[1], v[5], v[9]];
+  const forward = [-v[2], -v[6], -v[10]];
+  const persp = c.fov !== null;
+  const aspect = c.width / c.height;
+  const ty = persp ? Math.tan((c.fov * Math.PI) / 360) : c.orthoHalfHeight;
+  const env = s.environment;
+  const h = view.env.header;
+  const tone = { clamp: 0, reinhard: 1, aces: 2 }[s.tone];
+  const setCommon = (p) => {
+    gl.useProgram(p);
+    const u = (n) => gl.getUniformLocation(p, n);
+    gl.uniformMatrix4fv(u('uView'), false, new Float32Array(v));
+    gl.uniformMatrix4fv(u('uProj'), false, new Float32Array(c.projection));
+    gl.uniform3fv(u('uEye'), cam.eye);
+    gl.uniform1i(u('uPersp'), persp ? 1 : 0);
+    gl.uniform3fv(u('uForward'), forward);
+    gl.uniform1i(u('uAttachEye'), env.attach === 'eye' ? 1 : 0);
+    if (h.frame) gl.uniformMatrix3fv(u('uFrame'), false, new Float32Array(h.frame));
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, view.env.texture);
+    gl.uniform1i(u('uEnv'), 0);
+    gl.uniform2i(u('uEnvSize'), h.width, h.height);
+    gl.uniform1f(u('uIntensity'), env.intensity);
+    gl.uniform1f(u('uExposureScale'), Math.pow(2, s.exposure));
+    gl.uniform1i(u('uTone'), tone);
+    gl.uniform3fv(u('uRayRight'), right.map((x) => x * ty * aspect));
+    gl.uniform3fv(u('uRayUp'), up.map((x) => x * ty));
+    gl.uniform2f(u('uViewportSize'), canvas.width, canvas.height);
+    return u;
+  };
+  if (s.background) {
+    gl.disable(gl.DEPTH_TEST);
+    setCommon(await program(true));
+    gl.bindVertexArray(null);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
+  gl.enable(gl.DEPTH_TEST);
+  gl.depthFunc(gl.LESS);
+  const u = setCommon(await program(false));
+  for (const m of view.meshes) {
+    gl.uniform3fv(u('uTint'), m.material.tint);
+    gl.bindVertexArray(m.vao);
+    gl.drawArrays(gl.TRIANGLES, 0, m.vertices);
+  }
+  gl.bindVertexArray(null);
+}
+
+let drawing = null;
+/** Draws (one draw at a time; a request while drawing draws again after it). */
+function redraw() {
+  drawing = (drawing || Promise.resolve()).then(draw).catch(report);
+  return drawing;
+}
+
+/** The viewport's pixels, RGBA, top row first. */
+function pixels() {
+  const w = canvas.width;
+  const h = canvas.height;
+  const raw = new Uint8Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, raw);
+  const out = new Uint8Array(w * h * 4);
+  for (let y = 0; y < h; y++) out.set(raw.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
+  return { width: w, height: h, data: out };
+}
+
+async function upload(file) {
+  try {
+    await G.api(`/api/upload?name=${encodeURIComponent(file.name)}`, { method: 'POST', body: file });
+    view.programs.clear();
+    await loadState();
+    await redraw();
+  } catch (e) {
+    view.state = await (await G.api('/api/state')).json();
+    report(e);
+  }
+}
+
+document.getElementById('file').addEventListener('change', (e) => {
+  if (e.target.files[0]) upload(e.target.files[0]);
+});
+for (const t of ['dragenter', 'dragover']) {
+  document.addEventListener(t, (e) => {
+    e.preventDefault();
+    document.body.id = 'drop';
+  });
+}
+document.addEventListener('dragleave', () => (document.body.id = ''));
+document.addEventListener('drop', (e) => {
+  e.preventDefault();
+  document.body.id = '';
+  if (e.dataTransfer.files[0]) upload(e.dataTransfer.files[0]);
+});
+document.getElementById('mode').addEventListener('change', (e) => {
+  view.mode = Number(e.target.value);
+  redraw();
+});
+document.getElementById('projection').addEventListener('change', async (e) => {
+  view.projection = e.target.value;
+  try {
+    await loadEnvironment();
+    report();
+  } catch (err) {
+    report(err);
+  }
+  redraw();
+});
+
+function startOrbit() {
+  if (view.orbit) return;
+  const c = view.state.scene.camera;
+  const d = [c.eye[0] - c.target[0], c.eye[1] - c.target[1], c.eye[2] - c.target[2]];
+  const distance = Math.hypot(...d);
+  view.orbit = { yaw: Math.atan2(d[0], d[2]), pitch: Math.asin(d[1] / distance), distance };
+}
+function orbitBy(dyaw, dpitch, zoom = 1) {
+  if (embed) return;
+  startOrbit();
+  const o = view.orbit;
+  o.yaw += dyaw;
+  o.pitch = Math.max(-1.55, Math.min(1.55, o.pitch + dpitch));
+  o.distance = Math.max(0.05, o.distance * zoom);
+  redraw();
+}
+let dragging = null;
+canvas.addEventListener('pointerdown', (e) => {
+  dragging = [e.clientX, e.clientY];
+  canvas.setPointerCapture(e.pointerId);
+});
+canvas.addEventListener('pointermove', (e) => {
+  if (!dragging) return;
+  const [x, y] = dragging;
+  dragging = [e.clientX, e.clientY];
+  orbitBy(-(e.clientX - x) * 0.01, (e.clientY - y) * 0.01);
+});
+canvas.addEventListener('pointerup', () => (dragging = null));
+canvas.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  orbitBy(0, 0, Math.exp(e.deltaY * 0.001));
+});
+document.addEventListener('keydown', (e) => {
+  const k = { ArrowLeft: [0.05, 0], ArrowRight: [-0.05, 0], ArrowUp: [0, 0.05], ArrowDown: [0, -0.05] }[e.key];
+  if (k) orbitBy(k[0], k[1]);
+  if (e.key === '+' || e.key === '=') orbitBy(0, 0, 0.9);
+  if (e.key === '-') orbitBy(0, 0, 1 / 0.9);
+});
+
+const ready = (async () => {
+  if (!gl) throw new Error('this browser has no WebGL2');
+  await loadState();
+  await redraw();
+})();
+ready.catch(report);
+
+window.studio = { ready, redraw, pixels, view, gl, G };

@@ -1,0 +1,316 @@
+// `mirrorball studio` in headless Chromium: the server started as a person starts it (the
+// URL read from its first line), the projections' shaders checked against the core on a
+// dense grid, a bad upload shown on the page, and the embed view's pixels against
+// `mirrorball render` of the same scene.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { createInterface } from 'node:readline';
+import { readFileSync, writeFileSync } from 'node:fs';
+import { deflateSync, crc32 } from 'node:zlib';
+import path from 'node:path';
+import { browser, mirrorball, run, tempDir, readPng, ROOT } from './lib.mjs';
+
+/** Starts `mirrorball studio --no-open --port 0 FILES…`; resolves to its URL and a stop. */
+export async function studio(files = []) {
+  const proc = spawn(mirrorball(), ['studio', '--no-open', '--port', '0', ...files], {
+    cwd: ROOT,
+    stdio: ['ignore', 'pipe', 'pipe'],
+  });
+  let stderr = '';
+  proc.stderr.on('data', (d) => (stderr += d));
+  const url = await new Promise((ok, fail) => {
+    const lines = createInterface({ input: proc.stdout });
+    lines.once('line', ok);
+    proc.once('exit', (code) => fail(new Error(`studio exited (${code}): ${stderr}`)));
+  });
+  return { url, stop: () => proc.kill('SIGTERM'), stderr: () => stderr };
+}
+
+let chromium;
+let work;
+const VENICE = path.join(ROOT, 'assets', 'env', 'venice.exr');
+
+before(async () => {
+  chromium = await browser();
+  work = tempDir('mirrorball-studio-');
+});
+after(async () => {
+  await chromium?.close();
+  work?.remove();
+});
+
+async function open(url) {
+  const page = await chromium.newPage({ deviceScaleFactor: 1 });
+  const logs = [];
+  page.on('console', (m) => logs.push(m.text()));
+  page.on('pageerror', (e) => logs.push(String(e)));
+  await page.goto(url);
+  await page.waitForFunction(() => window.studio, null, { timeout: 60000 });
+  await page.evaluate(() => window.studio.ready);
+  return { page, logs };
+}
+
+test('the printed URL is the first line, and the page refuses to load without its token', async () => {
+  const s = await studio();
+  try {
+    assert.match(s.url, /^http:\/\/127\.0\.0\.1:\d+\/\?token=[0-9a-f]{32}$/);
+    const r = await fetch(s.url.replace(/\?token=.*/, ''));
+    assert.equal(r.status, 401);
+    assert.equal((await fetch(s.url)).status, 200);
+  } finally {
+    s.stop();
+  }
+});
+
+test("each projection's shader gives the core's texture coordinates on a dense grid", async () => {
+  const s = await studio();
+  const { page } = await open(s.url);
+  try {
+    const specs = [
+      ['latlong', 'latlong'],
+      ['cube', 'cube'],
+      ['sphere', 'sphere'],
+      ['sphere', 'sphere:look=+x'],
+      ['paraboloid', 'paraboloid'],
+      ['paraboloid', 'paraboloid:look=0,1,0'],
+    ];
+    for (const [kind, spec] of specs) {
+      const r = await page.evaluate(
+        ([kind, spec]) => {
+          const c = document.createElement('canvas');
+          const gl = c.getContext('webgl2');
+          return window.studio.G.checkProjection(gl, { kind, spec, n: 128 });
+        },
+        [kind, spec],
+      );
+      console.log(`${spec}: ${r.count} directions, worst ${r.worst.toExponential(2)} at ${JSON.stringify(r.worstAt)}, ${r.seams} on seams, ${r.failed} failed`);
+      assert.ok(r.count > 10000, `${spec}: ${r.count} directions`);
+      assert.equal(r.failed, 0, `${spec}: ${JSON.stringify(r.failures.slice(0, 3))}`);
+      assert.ok(r.worst <= 1e-4);
+    }
+  } finally {
+    await page.close();
+    s.stop();
+  }
+});
+
+test("a truncated EXR picked on the page shows the CLI's message, and the studio keeps serving", async () => {
+  const s = await studio();
+  const { page } = await open(s.url);
+  try {
+    const good = readFileSync(VENICE);
+    const cut = path.join(work.dir, 'cut.exr');
+    writeFileSync(cut, good.subarray(0, good.length >> 1));
+    await page.setInputFiles('#file', cut);
+    await page.waitForSelector('#messages .error', { timeout: 30000 });
+    const shown = await page.textContent('#messages .error');
+    assert.match(shown, /^cut\.exr/);
+    await page.screenshot({ path: path.join(process.env.STUDIO_SHOTS || work.dir, 'studio-error.png') });
+    // The CLI says the same of the same file.
+    let cli = '';
+    try {
+      run(['info', cut]);
+    } catch (e) {
+      cli = String(e.message);
+    }
+    const reason = shown.replace(/^cut\.exr:?\s*/, '');
+    assert.ok(cli.includes(reason.slice(0, 30)), `page: ${shown}\nCLI: ${cli}`);
+    await page.setInputFiles('#file', VENICE);
+    await page.waitForFunction(() => window.studio.view.env !== null, null, { timeout: 60000 });
+    await page.evaluate(() => window.studio.redraw());
+    const px = await page.evaluate(() => Array.from(window.studio.pixels().data.slice(0, 4)));
+    assert.equal(px[3], 255, 'the background is drawn');
+  } finally {
+    await page.close();
+    s.stop();
+  }
+});
+
+test('the page switches projection and mode, and orbits by dragging', async () => {
+  const s = await studio([VENICE]);
+  const { page } = await open(s.url);
+  try {
+    const grab = () => page.evaluate(() => Array.from(window.studio.pixels().data));
+    const meanDiff = (a, b) => a.reduce((acc, v, i) => acc + Math.abs(v - b[i]), 0) / a.length;
+    const latlong = await grab();
+    // Another projection of the same environment draws nearly the same picture.
+    await page.selectOption('#projection', 'cube');
+    await page.waitForFunction(() => window.studio.view.env?.header.projection === 'cube');
+    await page.evaluate(() => window.studio.redraw());
+    const cube = await grab();
+    const d = meanDiff(latlong, cube);
+    assert.ok(d > 0 && d < 3, `lat-long against cube: mean difference ${d}`);
+    // Mode 2 on the default sphere differs from mode 3 (per-vertex reflection is coarser).
+    await page.selectOption('#mode', '2');
+    await page.evaluate(() => window.studio.redraw());
+    const mode2 = await grab();
+    assert.ok(meanDiff(cube, mode2) > 0, 'mode 2 draws like mode 3');
+    await page.screenshot({ path: path.join(process.env.STUDIO_SHOTS || work.dir, 'studio-page-cube-mode2.png') });
+    // Dragging to the left turns the camera about the target: a different picture, the
+    // sphere still in the middle (the pixel at the centre is the sphere's, not the sky's).
+    const box = await page.locator('#viewport').boundingBox();
+    const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];
+    await page.mouse.move(cx, cy);
+    await page.mouse.down();
+    await page.mouse.move(cx - 80, cy, { steps: 4 });
+    await page.mouse.up();
+    await page.evaluate(() => window.studio.redraw());
+    const orbited = await grab();
+    assert.ok(meanDiff(mode2, orbited) > 2, 'dragging did not turn the camera');
+    assert.ok(await page.evaluate(() => window.studio.view.orbit.yaw !== 0));
+    await page.screenshot({ path: path.join(process.env.STUDIO_SHOTS || work.dir, 'studio-page-orbited.png') });
+  } finally {
+    await page.close();
+    s.stop();
+  }
+});
+
+// The same pictures as the CPU renderer.
+const SCENES = {
+  sphere: {
+    meshes: [{ mesh: 'sphere', tessellation: 12 }],
+    camera: { eye: [0, 0.4, 3.2], target: [0, 0, 0], fov: 40, width: 160, height: 120 },
+  },
+  door: {
+    meshes: [
+      {
+        mesh: 'quad',
+        tessellation: 1,
+        model: [0.34202, 0, -0.93969, 0, 0, 1, 0, 0, 0.93969, 0, 0.34202, 0, 0, 0, 0, 1],
+      },
+    ],
+    camera: { eye: [0, 0, 2.2], target: [0, 0, 0], fov: 60, width: 128, height: 128 },
+  },
+};
+const PROJECTIONS = [
+  ['latlong', 256],
+  ['cube', 64],
+  ['sphere', 128],
+  ['paraboloid', 96],
+];
+
+/** 8-bit RGBA of `mirrorball render SCENE ARGS…`. */
+function cpu(scene, args) {
+  const out = path.join(work.dir, `cpu-${Math.random().toString(36).slice(2)}.png`);
+  run(['render', scene, '-o', out, '--quiet', '--ss', '1', ...args]);
+  const png = readPng(readFileSync(out));
+  assert.equal(png.channels, 4);
+  return png;
+}
+
+/** Writes RGBA8 `data` (`w`×`h`, top row first) as a PNG. */
+function writePng(file, w, h, data) {
+  const chunk = (type, body) => {
+    const b = Buffer.alloc(12 + body.length);
+    b.writeUInt32BE(body.length, 0);
+    b.write(type, 4, 'latin1');
+    body.copy(b, 8);
+    b.writeUInt32BE(crc32(b.subarray(4, 8 + body.length)), 8 + body.length);
+    return b;
+  };
+  const ihdr = Buffer.alloc(13);
+  ihdr.writeUInt32BE(w, 0);
+  ihdr.writeUInt32BE(h, 4);
+  ihdr.set([8, 6, 0, 0, 0], 8);
+  const raw = Buffer.alloc(h * (4 * w + 1));
+  for (let y = 0; y < h; y++) raw.set(data.subarray(4 * w * y, 4 * w * (y + 1)), y * (4 * w + 1) + 1);
+  const sig = Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
+  writeFileSync(file, Buffer.concat([sig, chunk('IHDR', ihdr), chunk('IDAT', deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]));
+}
+
+/** Covered pixels whose eight neighbours are covered too (away from the silhouette rim). */
+function inner(coverage, w, h) {
+  const ok = new Uint8Array(w * h);
+  for (let y = 1; y < h - 1; y++) {
+    for (let x = 1; x < w - 1; x++) {
+      let all = true;
+      for (let dy = -1; dy <= 1 && all; dy++) for (let dx = -1; dx <= 1; dx++) all &&= coverage[(y + dy) * w + x + dx] > 0;
+      ok[y * w + x] = all ? 1 : 0;
+    }
+  }
+  return ok;
+}
+
+for (const [object, body] of Object.entries(SCENES)) {
+  test(`the embed view draws the ${object} as mirrorball render does (modes 1–3, four projections)`, async () => {
+    const scene = path.join(work.dir, `${object}.json`);
+    writeFileSync(
+      scene,
+      JSON.stringify({
+        ...body,
+        environment: { file: VENICE, projection: 'latlong', attach: 'world', filter: 'bilinear' },
+        material: { kind: 'mirror' },
+        background: true,
+      }),
+    );
+    const s = await studio([scene]);
+    const rows = [];
+    try {
+      for (const [proj, size] of PROJECTIONS) {
+        for (const mode of [1, 2, 3]) {
+          const { page, logs } = await open(`${s.url}&view=viewport&mode=${mode}&projection=${proj}&size=${size}`);
+          const gpu = await page.evaluate(() => {
+            const p = window.studio.pixels();
+            return { width: p.width, height: p.height, data: Array.from(p.data) };
+          });
+          if (mode === 3 || object === 'door') {
+            await page.screenshot({ path: path.join(process.env.STUDIO_SHOTS || work.dir, `studio-${object}-${proj}-${mode}.png`) });
+          }
+          await page.close();
+          const args = ['--mode', String(mode), '--env-as', proj, '--env-size', String(size)];
+          const full = cpu(scene, args);
+          const cover = cpu(scene, [...args, '--no-background']);
+          const { width: w, height: h } = full;
+          assert.equal(gpu.width, w);
+          assert.equal(gpu.height, h);
+          const coverage = new Uint8Array(w * h).map((_, i) => cover.data[4 * i + 3]);
+          const mask = inner(coverage, w, h);
+          let n = 0;
+          let within = 0;
+          let worst = 0;
+          let bg = 0;
+          let bgWithin = 0;
+          for (let i = 0; i < w * h; i++) {
+            const d = Math.max(...[0, 1, 2].map((c) => Math.abs(gpu.data[4 * i + c] - full.data[4 * i + c])));
+            if (mask[i]) {
+              n++;
+              if (d <= 2) within++;
+              worst = Math.max(worst, d);
+            } else if (!coverage[i]) {
+              bg++;
+              if (d <= 2) bgWithin++;
+            }
+          }
+          const share = within / n;
+          if (process.env.STUDIO_SHOTS) {
+            // GPU | CPU | difference ×16 (red where the inner covered pixels differ by more than 2).
+            const diff = new Uint8Array(w * h * 4);
+            for (let i = 0; i < w * h; i++) {
+              const d = Math.max(...[0, 1, 2].map((c) => Math.abs(gpu.data[4 * i + c] - full.data[4 * i + c])));
+              diff.set(d > 2 && mask[i] ? [255, 0, 0, 255] : [16 * d, 16 * d, 16 * d, 255], 4 * i);
+            }
+            const both = new Uint8Array(3 * w * h * 4);
+            for (let y = 0; y < h; y++) {
+              both.set(Uint8Array.from(gpu.data.slice(4 * w * y, 4 * w * (y + 1))), 12 * w * y);
+              both.set(full.data.subarray(4 * w * y, 4 * w * (y + 1)), 12 * w * y + 4 * w);
+              both.set(diff.subarray(4 * w * y, 4 * w * (y + 1)), 12 * w * y + 8 * w);
+            }
+            writePng(path.join(process.env.STUDIO_SHOTS, `compare-${object}-${proj}-${mode}.png`), 3 * w, h, both);
+          }
+          rows.push({ object, proj, mode, covered: n, share, worst, background: bgWithin / bg, logs: logs.slice(0, 3) });
+          console.log(
+            `${object} ${proj} mode ${mode}: ${(100 * share).toFixed(2)}% of ${n} covered pixels within 2/255 (worst ${worst}), background ${((100 * bgWithin) / bg).toFixed(2)}%`,
+          );
+        }
+      }
+    } finally {
+      s.stop();
+    }
+    for (const r of rows) {
+      assert.ok(r.covered > 200, `${r.object} ${r.proj} mode ${r.mode}: only ${r.covered} covered pixels`);
+      assert.ok(r.share >= 0.99, `${r.object} ${r.proj} mode ${r.mode}: ${(100 * r.share).toFixed(2)}% within 2/255 ${r.logs}`);
+      assert.ok(r.background >= 0.99, `${r.object} ${r.proj} mode ${r.mode}: background ${(100 * r.background).toFixed(2)}%`);
+    }
+  });
+}
