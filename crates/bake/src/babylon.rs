@@ -319,7 +319,6 @@ mod tests {
 #[cfg(test)]
 mod round_trip {
     use super::*;
-    use mirrorball_core::ProjectionKind;
     use mirrorball_encode::Encoding;
     use mirrorball_io::read_babylon_env;
 
@@ -328,14 +327,7 @@ mod round_trip {
     /// inverse) and decoded: the prefiltered levels again, within RGBD's 8-bit steps.
     #[test]
     fn the_env_reads_back_as_the_levels_and_polynomial_it_was_made_from() {
-        let env = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 128, 3, |d| {
-            [
-                (0.5 + 0.5 * d.x) as f32,
-                (0.5 + 0.5 * d.y) as f32,
-                (0.5 + 0.5 * d.z) as f32,
-                1.0,
-            ]
-        });
+        let env = crate::direction_coded(128);
         let opts = BakeOptions {
             size: 16,
             ..Default::default()

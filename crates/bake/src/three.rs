@@ -62,7 +62,8 @@ pub(crate) fn lod_to_roughness(lod: u32, max_lod: u32) -> f64 {
     }
 }
 
-/// Refuses what three cannot load or what has no PMREM levels, before any work.
+/// Refuses a size that has no PMREM levels, before any work (the encodings and Zstandard
+/// three cannot load are refused by [`crate::Bake::new`], from [`describe`]).
 pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
     let size = opts.size;
     if !size.is_power_of_two() || size < 2 << LOD_MIN {
@@ -71,20 +72,6 @@ pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
              {0}×{0} faces, 2^LOD_MIN with LOD_MIN = {LOD_MIN}); {size} was asked",
             2 << LOD_MIN
         ));
-    }
-    if let Some(e) = opts.encoding {
-        if !matches!(e, Encoding::Bc6hUnsigned | Encoding::Bc6hSigned) {
-            return Err(format!(
-                "three.js's DDSLoader reads HDR cubes only as BC6H; {} cannot be loaded \
-                 (use bc6h or bc6h-sf16)",
-                e.label()
-            ));
-        }
-    }
-    if opts.zstd.is_some() {
-        return Err(
-            "three.js's PMREM is a DDS file, which has no Zstandard supercompression".into(),
-        );
     }
     Ok(())
 }

@@ -7,18 +7,6 @@ use mirrorball_core::glam::DVec3;
 use mirrorball_core::{EnvMap, Image, ProjectionKind};
 use mirrorball_io::Encoding;
 
-/// A lat-long map whose colour is ½ + ½·d: every mirroring shows.
-fn direction_coded() -> EnvMap {
-    EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 256, 3, |d| {
-        [
-            (0.5 + 0.5 * d.x) as f32,
-            (0.5 + 0.5 * d.y) as f32,
-            (0.5 + 0.5 * d.z) as f32,
-            1.0,
-        ]
-    })
-}
-
 /// Directions spread over the sphere (a Fibonacci lattice).
 fn directions(n: usize) -> Vec<DVec3> {
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
@@ -104,7 +92,7 @@ fn u32_at(bytes: &[u8], i: usize) -> u32 {
 
 #[test]
 fn files_read_as_three_reads_them_show_the_world_at_minus_x() {
-    let env = direction_coded();
+    let env = mirrorball_bake::direction_coded(256);
     let opts = BakeOptions {
         size: 32,
         ..Default::default()
