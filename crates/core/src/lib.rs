@@ -44,7 +44,7 @@ pub use projection::{
     Octahedral, Projection, ProjectionKind, RadialMap, Sinusoidal, SphereMap, UnknownProjection,
     View, WorldProjection,
 };
-pub use remap::{Remap, RemapError};
+pub use remap::{Remap, RemapError, RemapRows};
 pub use resample::{resample, resample_to_extent, Axis, ResampleOptions, Resampler, Rotation};
 
 pub use glam;

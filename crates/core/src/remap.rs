@@ -269,14 +269,10 @@ impl Remap {
 
     /// Converts `src`, which must have the projection and size the plan was made for.
     pub fn apply(&self, src: &EnvMap) -> Result<EnvMap, RemapError> {
-        self.check_source(src)?;
-        let pyr = Pyramid::new(src, self.job.levels - 1);
+        let rows = self.rows(src)?;
         let (w, h, c) = (self.job.w, self.job.h, src.channels());
         let layers = (0..self.job.dst.layer_count())
-            .map(|layer| {
-                let fill = self.row_filler(&pyr, layer, c);
-                Image::par_rows(w, h, c, |y, row| fill(y, row))
-            })
+            .map(|layer| Image::par_rows(w, h, c, |y, row| rows.row_into(layer, y, row)))
             .collect();
         EnvMap::new(self.job.dst, layers).map_err(|_| RemapError::Output)
     }
@@ -296,35 +292,23 @@ impl Remap {
     }
 
     fn fill(&self, src: &EnvMap, out: &mut EnvMap) {
-        let pyr = Pyramid::new(src, self.job.levels - 1);
-        let c = src.channels();
-        let w = self.job.w as usize;
+        let rows = RemapRows::new(self, src);
+        let w = rows.row_len();
         for (layer, img) in out.layers_mut().iter_mut().enumerate() {
-            let fill = self.row_filler(&pyr, layer, c);
             img.data_mut()
-                .par_chunks_mut(w * c)
+                .par_chunks_mut(w)
                 .enumerate()
-                .for_each(|(y, row)| fill(y, row));
+                .for_each(|(y, row)| rows.row_into(layer, y, row));
         }
     }
 
-    /// The function that fills output row `y` of `layer` from `pyr` (`c` channels), with the
-    /// per-layer work (each source layer's data, the row tables) hoisted out of it.
-    fn row_filler<'a>(
-        &'a self,
-        pyr: &'a Pyramid<'a>,
-        layer: usize,
-        c: usize,
-    ) -> impl Fn(usize, &mut [f32]) + Sync + Send + 'a {
-        let base = pyr.level(0);
-        let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
-        for (p, l) in planes.iter_mut().zip(base) {
-            *p = l.data();
-        }
-        move |y, row| match c {
-            3 => self.fill_row::<3>(pyr, &planes, layer, y, row),
-            _ => self.fill_row::<4>(pyr, &planes, layer, y, row),
-        }
+    /// Prepares `src` (the projection and size the plan was made for) to be converted a row
+    /// at a time, in any order and from any thread, into the caller's buffers: for
+    /// consumers that use each output row at once (an encoder), so that the whole output
+    /// map need never exist. Its mip levels, when the plan reads any, are made here.
+    pub fn rows<'a>(&'a self, src: &'a EnvMap) -> Result<RemapRows<'a>, RemapError> {
+        self.check_source(src)?;
+        Ok(RemapRows::new(self, src))
     }
 
     /// Fills output row `y` of `layer`: the bilinear pass, then the taps, then exposure.
@@ -369,6 +353,52 @@ impl Remap {
                     *v *= scale;
                 }
             }
+        }
+    }
+}
+
+/// A source made ready for a [`Remap`]: output rows made one at a time (see
+/// [`Remap::rows`]), each exactly as [`Remap::apply_into`] makes it.
+pub struct RemapRows<'a> {
+    remap: &'a Remap,
+    pyr: Pyramid<'a>,
+    planes: [&'a [f32]; MAX_LAYERS],
+    c: usize,
+}
+
+impl<'a> RemapRows<'a> {
+    fn new(remap: &'a Remap, src: &'a EnvMap) -> RemapRows<'a> {
+        let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
+        for (p, l) in planes.iter_mut().zip(src.layers()) {
+            *p = l.data();
+        }
+        RemapRows {
+            remap,
+            pyr: Pyramid::new(src, remap.job.levels - 1),
+            planes,
+            c: src.channels(),
+        }
+    }
+
+    /// Floats in one output row (width × the source's channels).
+    pub fn row_len(&self) -> usize {
+        self.remap.job.w as usize * self.c
+    }
+
+    /// Makes row `y` of output layer `layer` into `row` ([`RemapRows::row_len`] floats).
+    ///
+    /// # Panics
+    /// If `layer` or `y` is outside the plan's output, or `row` is not one row long.
+    pub fn row_into(&self, layer: usize, y: usize, row: &mut [f32]) {
+        assert!(layer < self.remap.texels.len() && y < self.remap.job.h as usize);
+        assert_eq!(row.len(), self.row_len());
+        match self.c {
+            3 => self
+                .remap
+                .fill_row::<3>(&self.pyr, &self.planes, layer, y, row),
+            _ => self
+                .remap
+                .fill_row::<4>(&self.pyr, &self.planes, layer, y, row),
         }
     }
 }

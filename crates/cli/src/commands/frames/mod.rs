@@ -2,7 +2,8 @@
 //! through pipes, and manifests of jobs sliced into shards for many machines.
 //!
 //! - `pattern.rs` — what a file argument names: one file, `%05d`, or a glob.
-//! - `pipe.rs` — raw frames on standard input and output, in ffmpeg's pixel formats.
+//! - `pipe.rs` — raw frames on standard input and output, in ffmpeg's pixel formats;
+//!   `packing.rs` — where each texel of a packed output frame comes from, planned once.
 //! - `sequence.rs` — a sequence's plan (one `Remap` for all frames) and its sources and
 //!   sinks; `pipeline.rs` — the bounded loop that reads, converts and writes at once.
 //! - `manifest.rs` — JSON-lines or CSV manifests, each job a `convert` of its own;
@@ -10,6 +11,7 @@
 
 mod log;
 mod manifest;
+mod packing;
 mod pattern;
 mod pipe;
 mod pipeline;

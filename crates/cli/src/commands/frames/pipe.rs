@@ -5,6 +5,7 @@
 //! PNG), so that a frame through a pipe and the same frame through a PNG file convert
 //! alike; float formats carry linear light.
 
+use super::packing::Packing;
 use crate::error::CliError;
 use mirrorball_core::color::linear_to_srgb;
 use mirrorball_core::{choice_traits, Choice, Image};
@@ -111,58 +112,49 @@ impl PixFmt {
     }
 
     /// Encodes `img` (RGB or RGBA; alpha is dropped) as one frame into `out`.
+    #[cfg(test)]
     pub fn encode(self, img: &Image, out: &mut Vec<u8>) {
-        let c = img.channels();
-        let n = img.width() as usize * img.height() as usize;
-        out.resize(n * self.pixel_bytes(), 0);
-        let src = img.data();
+        Packing::single(img.width(), img.height()).encode_layers(
+            self,
+            std::slice::from_ref(img),
+            out,
+        );
+    }
+
+    /// Encodes texels (`c` channels each, the first three R, G, B) into `dst`, this
+    /// interleaved format's bytes for as many pixels; `table`: the format's sRGB codes.
+    #[inline]
+    pub(super) fn encode_texels(
+        self,
+        table: Option<&SrgbTable>,
+        src: &[f32],
+        c: usize,
+        dst: &mut [u8],
+    ) {
         let px = self.pixel_bytes();
-        match self {
-            PixFmt::Rgb24 | PixFmt::Rgb48le | PixFmt::Rgbf32le => {
-                let table = match self {
-                    PixFmt::Rgb24 => Some(SrgbTable::get(255.0)),
-                    PixFmt::Rgb48le => Some(SrgbTable::get(65535.0)),
-                    _ => None,
-                };
-                out.par_chunks_mut(CHUNK * px)
-                    .zip(src.par_chunks(CHUNK * c))
-                    .for_each(|(d, s)| {
-                        for (d, s) in d.chunks_exact_mut(px).zip(s.chunks_exact(c)) {
-                            match (self, table) {
-                                (PixFmt::Rgb24, Some(t)) => {
-                                    for k in 0..3 {
-                                        d[k] = t.code(s[k]) as u8;
-                                    }
-                                }
-                                (PixFmt::Rgb48le, Some(t)) => {
-                                    for k in 0..3 {
-                                        d[2 * k..2 * k + 2]
-                                            .copy_from_slice(&(t.code(s[k]) as u16).to_le_bytes());
-                                    }
-                                }
-                                _ => {
-                                    for k in 0..3 {
-                                        d[4 * k..4 * k + 4].copy_from_slice(&s[k].to_le_bytes());
-                                    }
-                                }
-                            }
-                        }
-                    });
-            }
-            PixFmt::Gbrpf32le => {
-                let (g, rest) = out.split_at_mut(n * 4);
-                let (b, r) = rest.split_at_mut(n * 4);
-                for (plane, k) in [(g, 1), (b, 2), (r, 0)] {
-                    plane
-                        .par_chunks_mut(CHUNK * 4)
-                        .zip(src.par_chunks(CHUNK * c))
-                        .for_each(|(d, s)| {
-                            for (d, s) in d.chunks_exact_mut(4).zip(s.chunks_exact(c)) {
-                                d.copy_from_slice(&s[k].to_le_bytes());
-                            }
-                        });
+        match (self, table) {
+            (PixFmt::Rgb24, Some(t)) => {
+                for (d, s) in dst.chunks_exact_mut(px).zip(src.chunks_exact(c)) {
+                    for k in 0..3 {
+                        d[k] = t.code(s[k]) as u8;
+                    }
                 }
             }
+            (PixFmt::Rgb48le, Some(t)) => {
+                for (d, s) in dst.chunks_exact_mut(px).zip(src.chunks_exact(c)) {
+                    for k in 0..3 {
+                        d[2 * k..2 * k + 2].copy_from_slice(&(t.code(s[k]) as u16).to_le_bytes());
+                    }
+                }
+            }
+            (PixFmt::Rgbf32le, _) => {
+                for (d, s) in dst.chunks_exact_mut(px).zip(src.chunks_exact(c)) {
+                    for k in 0..3 {
+                        d[4 * k..4 * k + 4].copy_from_slice(&s[k].to_le_bytes());
+                    }
+                }
+            }
+            _ => unreachable!("an interleaved format with its table"),
         }
     }
 }

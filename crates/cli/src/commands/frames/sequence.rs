@@ -8,6 +8,7 @@
 //! after a crash or a killed node carries on where it stopped.
 
 use super::log::{Log, Status};
+use super::packing::Packing;
 use super::pattern::{Frame, Pattern, Printf};
 use super::pipe::{self, PixFmt};
 use super::pipeline::{self, Meta, FRAMES_IN_FLIGHT};
@@ -411,7 +412,12 @@ fn convert_frames(
                     times(dst.layer_count())
                 );
             }
-            Some((layout, *fmt))
+            // Where every packed texel comes from, once: frames are encoded from the layers.
+            let packing = Packing::new(layout, dst, (w, h)).ok_or_else(|| {
+                CliError::request(format!("--layout {layout} does not fit {}", dst.name()))
+            })?;
+            debug_assert_eq!(packing.extent(), (pw, ph));
+            Some((packing, *fmt))
         }
         _ => None,
     };
@@ -429,15 +435,8 @@ fn convert_frames(
     let mut put = |m: &Meta, env: &EnvMap| -> Result<(), CliError> {
         let t = Instant::now();
         let out: String = match (&output, &packed) {
-            (Output::Pipe(_), Some((layout, fmt))) => {
-                let pic = if *layout == Layout::Separate || env.layers().len() == 1 {
-                    None
-                } else {
-                    Some(layout.pack(env).ok_or_else(|| {
-                        CliError::request(format!("--layout {layout} does not fit {}", dst.name()))
-                    })?)
-                };
-                fmt.encode(pic.as_ref().unwrap_or(&env.layers()[0]), &mut bytes);
+            (Output::Pipe(_), Some((packing, fmt))) => {
+                packing.encode_layers(*fmt, env.layers(), &mut bytes);
                 pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
                 "-".into()
             }

@@ -1,0 +1,362 @@
+//! Where each texel of a raw output frame comes from, worked out once per run: a frame is
+//! encoded straight into the output bytes from its layers, or from each output row as the
+//! planned `Remap` makes it, so that no packed copy of the frame (75 MB of `f32` for a
+//! 6×1024² cube) is made per frame.
+//!
+//! The positions are `Layout::pack`'s own: the plan packs, once, a map whose texels hold
+//! their own layer and position, and reads the runs back off the packed picture, so any
+//! layout `pack` knows (cells turned or not) is encoded as `pack` would place it.
+
+use super::pipe::{PixFmt, SrgbTable};
+use mirrorball_core::{EnvMap, Image, Layout, Projection, RemapRows, WorldProjection};
+use rayon::prelude::*;
+
+/// A piece of one packed row taken from one layer: `len` texels written from packed column
+/// `at` on, read from texel `(x, y)` of `layer` on in steps of `(dx, dy)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Run {
+    at: u32,
+    len: u32,
+    layer: u32,
+    x: u32,
+    y: u32,
+    dx: i32,
+    dy: i32,
+}
+
+impl Run {
+    /// Whether the run is a piece of one layer row, in order or reversed.
+    fn along_row(&self) -> bool {
+        self.dy == 0 && self.dx.abs() == 1
+    }
+}
+
+/// Where every texel of a packed `width`×`height` frame comes from.
+#[derive(Clone, Debug)]
+pub struct Packing {
+    width: u32,
+    height: u32,
+    layer_width: u32,
+    /// Per packed row, where its runs start in `runs` (`height + 1` entries).
+    row_starts: Vec<u32>,
+    runs: Vec<Run>,
+    /// Some texels come from no layer (a cross's empty cells): they are zero, as `pack`
+    /// leaves them.
+    gaps: bool,
+    /// Every run lies along a layer row, so rows made one at a time can be encoded.
+    #[cfg_attr(not(test), allow(dead_code))] // read by encode_rows, not yet in the pipeline
+    along_rows: bool,
+}
+
+impl Packing {
+    /// The packing of `dst`'s `w`×`h` layers by `layout` (a single layer, or `Separate`,
+    /// is the layer itself); `None` if the layout does not fit `dst`.
+    pub fn new(layout: Layout, dst: Projection, (w, h): (u32, u32)) -> Option<Packing> {
+        let n = dst.layer_count();
+        if n == 1 || layout == Layout::Separate {
+            return (n == 1).then(|| Packing::single(w, h));
+        }
+        // Every texel says where it is: (layer + 1, x, y), exact in `f32` (sides ≤ 2^16);
+        // the packed picture's zeros are cells no layer fills.
+        let layers = (0..n)
+            .map(|l| {
+                let mut img = Image::new(w, h, 3);
+                img.data_mut()
+                    .par_chunks_mut(w as usize * 3)
+                    .enumerate()
+                    .for_each(|(y, row)| {
+                        for (x, t) in row.chunks_exact_mut(3).enumerate() {
+                            t.copy_from_slice(&[(l + 1) as f32, x as f32, y as f32]);
+                        }
+                    });
+                img
+            })
+            .collect();
+        let probe = EnvMap::new(dst, layers).ok()?;
+        let pic = layout.pack(&probe)?;
+        drop(probe);
+        let (pw, ph) = (pic.width(), pic.height());
+        let mut runs: Vec<Run> = Vec::new();
+        let mut row_starts = Vec::with_capacity(ph as usize + 1);
+        let mut gaps = false;
+        for (r, row) in pic.data().chunks_exact(pw as usize * 3).enumerate() {
+            row_starts.push(runs.len() as u32);
+            let first = runs.len();
+            for (at, t) in row.chunks_exact(3).enumerate() {
+                if t[0] == 0.0 {
+                    gaps = true;
+                    continue;
+                }
+                let (layer, x, y) = (t[0] as u32 - 1, t[1] as u32, t[2] as u32);
+                if let Some(run) = runs[first..].last_mut() {
+                    let next = run.at + run.len == at as u32 && run.layer == layer;
+                    let (dx, dy) = (x as i32 - run.x as i32, y as i32 - run.y as i32);
+                    if next && run.len == 1 && dx.abs() + dy.abs() == 1 {
+                        (run.dx, run.dy) = (dx, dy);
+                        run.len = 2;
+                        continue;
+                    }
+                    let end = (
+                        run.x as i32 + run.dx * run.len as i32,
+                        run.y as i32 + run.dy * run.len as i32,
+                    );
+                    if next && run.len > 1 && end == (x as i32, y as i32) {
+                        run.len += 1;
+                        continue;
+                    }
+                }
+                debug_assert!(r < ph as usize);
+                runs.push(Run {
+                    at: at as u32,
+                    len: 1,
+                    layer,
+                    x,
+                    y,
+                    dx: 1,
+                    dy: 0,
+                });
+            }
+        }
+        row_starts.push(runs.len() as u32);
+        let along_rows = runs.iter().all(Run::along_row);
+        Some(Packing {
+            width: pw,
+            height: ph,
+            layer_width: w,
+            row_starts,
+            runs,
+            gaps,
+            along_rows,
+        })
+    }
+
+    /// A frame that is one `w`×`h` layer.
+    pub fn single(w: u32, h: u32) -> Packing {
+        let runs = (0..h)
+            .map(|y| Run {
+                at: 0,
+                len: w,
+                layer: 0,
+                x: 0,
+                y,
+                dx: 1,
+                dy: 0,
+            })
+            .collect();
+        Packing {
+            width: w,
+            height: h,
+            layer_width: w,
+            row_starts: (0..=h).collect(),
+            runs,
+            gaps: false,
+            along_rows: true,
+        }
+    }
+
+    /// The packed frame's width and height.
+    pub fn extent(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Whether [`Packing::encode_rows`] can encode this packing (every run lies along a
+    /// layer row: strips, crosses, a single layer).
+    #[cfg_attr(not(test), allow(dead_code))] // not yet in the pipeline
+    pub fn along_rows(&self) -> bool {
+        self.along_rows
+    }
+
+    /// Encodes `layers` (the packing's, RGB or RGBA: alpha is dropped) as one `fmt` frame
+    /// into `out`, texel for texel as `fmt` would encode `Layout::pack`'s picture.
+    pub fn encode_layers(&self, fmt: PixFmt, layers: &[Image], out: &mut Vec<u8>) {
+        let c = layers[0].channels();
+        let w = self.layer_width as usize;
+        self.encode_with(fmt, c, out, |run, _row, gathered, put| {
+            let data = layers[run.layer as usize].data();
+            if run.dx == 1 && run.dy == 0 {
+                let i = (run.y as usize * w + run.x as usize) * c;
+                return put(&data[i..i + run.len as usize * c]);
+            }
+            put(gather(run, c, gathered, |y| {
+                &data[y * w * c..(y + 1) * w * c]
+            }))
+        });
+    }
+
+    /// Encodes the frame whose rows `rows` makes (a `Remap` of the packing's layers) into
+    /// `out`, each row made and encoded by one thread while it is in its cache. Only for a
+    /// packing [`along_rows`](Packing::along_rows).
+    #[cfg_attr(not(test), allow(dead_code))] // not yet in the pipeline
+    pub fn encode_rows(&self, fmt: PixFmt, rows: &RemapRows, out: &mut Vec<u8>) {
+        assert!(
+            self.along_rows,
+            "a packing with turned cells is encoded from layers"
+        );
+        let c = rows.row_len() / self.layer_width as usize;
+        self.encode_with(fmt, c, out, |run, row, gathered, put| {
+            row.resize(rows.row_len(), 0.0);
+            rows.row_into(run.layer as usize, run.y as usize, row);
+            if run.dx == 1 {
+                let i = run.x as usize * c;
+                return put(&row[i..i + run.len as usize * c]);
+            }
+            let row = &row[..];
+            put(gather(run, c, gathered, |_| row))
+        });
+    }
+
+    /// Encodes every packed row in parallel, the texels of each run (in the run's order,
+    /// `c` channels each) handed to `put` by `texels(run, scratch row, scratch run, put)`.
+    fn encode_with<F>(&self, fmt: PixFmt, c: usize, out: &mut Vec<u8>, texels: F)
+    where
+        F: Fn(&Run, &mut Vec<f32>, &mut Vec<f32>, &mut dyn FnMut(&[f32])) + Sync,
+    {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let px = fmt.pixel_bytes();
+        out.resize(w * h * px, 0);
+        let table = fmt.table();
+        let runs_of =
+            |r: usize| &self.runs[self.row_starts[r] as usize..self.row_starts[r + 1] as usize];
+        let init = || (Vec::new(), Vec::new());
+        match fmt {
+            PixFmt::Gbrpf32le => {
+                let (g, rest) = out.split_at_mut(w * h * 4);
+                let (b, r) = rest.split_at_mut(w * h * 4);
+                g.par_chunks_mut(w * 4)
+                    .zip(b.par_chunks_mut(w * 4))
+                    .zip(r.par_chunks_mut(w * 4))
+                    .enumerate()
+                    .for_each_init(init, |(row, gathered), (y, ((g, b), r))| {
+                        if self.gaps {
+                            for p in [&mut *g, &mut *b, &mut *r] {
+                                p.fill(0);
+                            }
+                        }
+                        for run in runs_of(y) {
+                            let span = run.at as usize * 4..(run.at + run.len) as usize * 4;
+                            texels(run, row, gathered, &mut |s| {
+                                for (plane, k) in [(&mut *g, 1), (&mut *b, 2), (&mut *r, 0)] {
+                                    for (d, s) in plane[span.clone()]
+                                        .chunks_exact_mut(4)
+                                        .zip(s.chunks_exact(c))
+                                    {
+                                        d.copy_from_slice(&s[k].to_le_bytes());
+                                    }
+                                }
+                            });
+                        }
+                    });
+            }
+            _ => out.par_chunks_mut(w * px).enumerate().for_each_init(
+                init,
+                |(row, gathered), (y, bytes)| {
+                    if self.gaps {
+                        bytes.fill(0);
+                    }
+                    for run in runs_of(y) {
+                        let d = &mut bytes[run.at as usize * px..(run.at + run.len) as usize * px];
+                        texels(run, row, gathered, &mut |s| {
+                            fmt.encode_texels(table, s, c, d)
+                        });
+                    }
+                },
+            ),
+        }
+    }
+}
+
+/// The texels of `run` in its order, copied into `into` from the layer rows `row(y)` gives.
+fn gather<'s, 'r>(
+    run: &Run,
+    c: usize,
+    into: &'s mut Vec<f32>,
+    row: impl Fn(usize) -> &'r [f32],
+) -> &'s [f32] {
+    into.clear();
+    for k in 0..run.len as i64 {
+        let x = (run.x as i64 + run.dx as i64 * k) as usize;
+        let y = (run.y as i64 + run.dy as i64 * k) as usize;
+        into.extend_from_slice(&row(y)[x * c..(x + 1) * c]);
+    }
+    into
+}
+
+impl PixFmt {
+    /// The sRGB code table of an integer format.
+    fn table(self) -> Option<&'static SrgbTable> {
+        match self {
+            PixFmt::Rgb24 => Some(SrgbTable::get(255.0)),
+            PixFmt::Rgb48le => Some(SrgbTable::get(65535.0)),
+            PixFmt::Rgbf32le | PixFmt::Gbrpf32le => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mirrorball_core::{ProjectionKind, Remap};
+
+    /// Layers of `dst` with distinct texels, partly outside `[0, 1]` and NaN.
+    fn layers(dst: Projection, w: u32, h: u32) -> Vec<Image> {
+        (0..dst.layer_count())
+            .map(|l| {
+                let mut img = Image::new(w, h, 3);
+                for (i, v) in img.data_mut().iter_mut().enumerate() {
+                    *v = match (i * 7 + l * 13) % 97 {
+                        0 => f32::NAN,
+                        1 => -0.5,
+                        k => k as f32 / 80.0,
+                    };
+                }
+                img
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_packed_bytes_are_the_packed_picture_encoded() {
+        let cube = ProjectionKind::Cube.default_projection();
+        let (w, h) = (5, 5);
+        let env = EnvMap::new(cube, layers(cube, w, h)).unwrap();
+        for layout in [
+            Layout::HorizontalCross,
+            Layout::VerticalCross,
+            Layout::HorizontalStrip,
+            Layout::VerticalStrip,
+        ] {
+            let pic = layout.pack(&env).unwrap();
+            let p = Packing::new(layout, cube, (w, h)).unwrap();
+            assert_eq!(p.extent(), (pic.width(), pic.height()), "{layout}");
+            assert!(p.along_rows(), "{layout}");
+            for fmt in [
+                PixFmt::Rgb24,
+                PixFmt::Rgb48le,
+                PixFmt::Rgbf32le,
+                PixFmt::Gbrpf32le,
+            ] {
+                let (mut want, mut got) = (Vec::new(), vec![7u8; 3]);
+                fmt.encode(&pic, &mut want);
+                p.encode_layers(fmt, env.layers(), &mut got);
+                assert!(want == got, "{layout} {fmt}: bytes differ");
+                // Rows made by a Remap and encoded as they are made: the same bytes as
+                // the Remap's layers encoded.
+                let ll = ProjectionKind::LatLong.default_projection();
+                let plan = Remap::with_extent(ll, (16, 8), 1, cube, (w, h), &Default::default());
+                let src = EnvMap::from_fn(ll, 16, 3, |d| [d.x as f32 + 0.5, d.y as f32, 0.3, 1.0]);
+                let made = plan.apply(&src).unwrap();
+                let (mut want, mut got) = (Vec::new(), Vec::new());
+                p.encode_layers(fmt, made.layers(), &mut want);
+                p.encode_rows(fmt, &plan.rows(&src).unwrap(), &mut got);
+                assert!(want == got, "{layout} {fmt}: rows differ");
+            }
+        }
+        // One layer: the layer itself; a cube without a packed layout does not fit.
+        let ll = ProjectionKind::LatLong.default_projection();
+        assert_eq!(
+            Packing::new(Layout::Separate, ll, (8, 4)).unwrap().extent(),
+            (8, 4)
+        );
+        assert!(Packing::new(Layout::Separate, cube, (8, 8)).is_none());
+    }
+}
