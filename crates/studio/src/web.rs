@@ -19,6 +19,7 @@ const FILES: &[(&str, &str, &str)] = files![
     "index.html": "html",
     "studio.js": "js",
     "gl.js": "js",
+    "sim.js": "js",
     "glsl/latlong.glsl": "glsl",
     "glsl/cube.glsl": "glsl",
     "glsl/radial.glsl": "glsl",
@@ -30,6 +31,9 @@ const FILES: &[(&str, &str, &str)] = files![
     "glsl/texgen.glsl": "glsl",
     "glsl/viewport.vert": "glsl",
     "glsl/viewport.frag": "glsl",
+    "glsl/sim-record.glsl": "glsl",
+    "glsl/sim-surface.frag": "glsl",
+    "glsl/sim-map.frag": "glsl",
 ];
 
 /// The embedded file `name`: its content type and contents.

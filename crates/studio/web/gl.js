@@ -131,7 +131,7 @@ export function triangleVertices(mesh) {
   return out;
 }
 
-const HEADER = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2DArray;\n';
+export const HEADER = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2DArray;\n';
 
 function compile(gl, type, source) {
   const s = gl.createShader(type);
