@@ -5,24 +5,11 @@
 // checked against the core on the server's direction grid.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn, execFileSync } from 'node:child_process';
-import { createInterface } from 'node:readline';
-import { readFileSync, writeFileSync } from 'node:fs';
+import { execFileSync } from 'node:child_process';
+import { writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, mirrorball, run, tempDir, ROOT } from './lib.mjs';
+import { browser, run, tempDir, studio, openStudio, ROOT } from './lib.mjs';
 import { uvToDir, heatOf } from '../../crates/studio/web/sim.js';
-
-/** Starts `mirrorball studio --no-open --port 0 FILES…`; resolves to its URL and a stop. */
-async function studio(files = []) {
-  const proc = spawn(mirrorball(), ['studio', '--no-open', '--port', '0', ...files], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
-  let stderr = '';
-  proc.stderr.on('data', (d) => (stderr += d));
-  const url = await new Promise((ok, fail) => {
-    createInterface({ input: proc.stdout }).once('line', ok);
-    proc.once('exit', (code) => fail(new Error(`studio exited (${code}): ${stderr}`)));
-  });
-  return { url, stop: () => proc.kill('SIGTERM') };
-}
 
 let chromium;
 let work;
@@ -38,15 +25,10 @@ after(async () => {
 });
 
 async function open(url) {
-  const page = await chromium.newPage({ deviceScaleFactor: 1 });
-  const logs = [];
-  page.on('pageerror', (e) => logs.push(String(e)));
-  await page.goto(url);
-  await page.waitForFunction(() => window.studio, null, { timeout: 60000 });
-  await page.evaluate(() => window.studio.ready);
+  const { page, logs } = await openStudio(chromium, url);
   const errors = await page.$$eval('#messages .error', (es) => es.map((e) => e.textContent));
   assert.deepEqual(errors, [], 'the page shows errors');
-  assert.deepEqual(logs, []);
+  assert.deepEqual(logs.filter((l) => /error/i.test(l)), []);
   return page;
 }
 
