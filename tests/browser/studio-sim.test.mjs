@@ -224,3 +224,45 @@ test('a view set on the page reopens from its URL with the same pixels', async (
     s.stop();
   }
 });
+
+test("the door's triangle edges in texture space enclose every texel it read (mode 1, straight; mode 2, curved)", async () => {
+  const s = await studio([scene('door')]);
+  try {
+    for (const mode of [1, 2]) {
+      const page = await open(`${s.url}&mode=${mode}&projection=latlong&size=256`);
+      const r = await page.evaluate(() => {
+        const sim = window.studio.sim;
+        return { corners: sim.edgeLines.corners.map((c) => Array.from(c)), lines: sim.edgeLines.lines, record: Array.from(sim.record) };
+      });
+      await page.close();
+      assert.equal(r.corners.length, 2, 'the door is two triangles');
+      if (mode === 1) {
+        // Mode 1 makes (u, v) per vertex: the rasteriser interpolates them linearly, so every
+        // pixel's (u, v) lies in one of the two uv triangles, and the edges are 6 straight lines.
+        assert.equal(r.lines.length, 6);
+        const inside = (p, c) => {
+          const [a, b, d] = [0, 1, 2].map((k) => [c[3 * k], c[3 * k + 1]]);
+          const x = (q, e, f) => (e[0] - q[0]) * (f[1] - q[1]) - (e[1] - q[1]) * (f[0] - q[0]);
+          const s1 = x(p, a, b), s2 = x(p, b, d), s3 = x(p, d, a);
+          const eps = 1e-6; // f32 (u, v) on an edge
+          return (s1 >= -eps && s2 >= -eps && s3 >= -eps) || (s1 <= eps && s2 <= eps && s3 <= eps);
+        };
+        let n = 0;
+        for (let i = 0; i < r.record.length / 4; i++) {
+          if (!(r.record[4 * i + 3] > 0)) continue;
+          n++;
+          const p = [r.record[4 * i], r.record[4 * i + 1]];
+          assert.ok(r.corners.some((c) => inside(p, c)), `pixel ${i}: (u, v) ${p} outside the corners' triangles`);
+        }
+        assert.ok(n > 3000);
+      } else {
+        // Mode 2 interpolates directions: each edge is a curve of 17 samples (or pieces of one).
+        assert.ok(r.lines.length >= 6);
+        const points = r.lines.reduce((a, l) => a + l.length, 0);
+        assert.ok(points >= 6 * 17 - 6, `${points} points`);
+      }
+    }
+  } finally {
+    s.stop();
+  }
+});

@@ -8,6 +8,9 @@
 // vector (red). The heat map: per covered pixel, the angle between the direction the mode
 // looked up (its texel's uvToDir) and mode 3's exact reflected direction (likewise).
 
+/** The most triangles whose texture-space edges the map shows (the first ones drawn). */
+const EDGE_TRIANGLES = 4096;
+
 /** Environment payload kind -> the layout of its picture: grid (columns, rows), cell per layer. */
 export function layoutOf(kind) {
   // The cube as core's horizontal cross (crates/core/src/layout.rs `HCROSS`): +Y above,
@@ -157,6 +160,8 @@ export function attach(studio) {
   const sim = {
     marks: params.get('marks') !== '0',
     heat: params.get('heat') === '1',
+    edges: params.get('edges') !== '0',
+    edgeLines: null, // { corners, lines } of the last frame, modes 1-2
     record: null, // the last record pass: Float32Array, bottom row first
     heatStats: null,
     hover: null,
@@ -179,6 +184,7 @@ export function attach(studio) {
     panel.innerHTML = `
       <div class="sim-controls">
         <label><input id="sim-marks" type="checkbox"> texels read</label>
+        <label><input id="sim-edges" type="checkbox"> triangle edges (modes 1, 2)</label>
         <label><input id="sim-heat" type="checkbox"> error vs mode 3</label>
       </div>
       <canvas id="sim-map"></canvas>
@@ -196,6 +202,12 @@ export function attach(studio) {
     sim.overlay = overlay;
     const marks = document.getElementById('sim-marks');
     const heat = document.getElementById('sim-heat');
+    const edgeBox = document.getElementById('sim-edges');
+    edgeBox.checked = sim.edges;
+    edgeBox.addEventListener('change', () => {
+      sim.edges = edgeBox.checked;
+      studio.redraw();
+    });
     marks.checked = sim.marks;
     heat.checked = sim.heat;
     marks.addEventListener('change', () => {
@@ -223,6 +235,131 @@ export function attach(studio) {
       sim.programs.set(key, G.link(gl, vs, fs.join('\n')));
     }
     return sim.programs.get(key);
+  }
+
+  /**
+   * viewport.vert under `mode`, its per-vertex values (vC0, vC1, vC2: what the rasteriser
+   * interpolates) captured by transform feedback: the corners of each triangle's edges.
+   */
+  async function cornerProgram(mode, kind, layers) {
+    const key = `corners ${kind} ${layers} ${mode}`;
+    if (!sim.programs.has(key)) {
+      const defines = `#define MODE ${mode}\n#define TEXGEN ${G.texgenOf(kind, layers)}\n#define BACKGROUND 0\n`;
+      const proj = await G.projectionSource(kind);
+      const vs = G.HEADER + defines + proj + '\n' + (await G.glsl('texgen.glsl')) + '\n' + (await G.glsl('viewport.vert'));
+      const p = G.link(gl, vs, G.HEADER + 'out vec4 o;\nvoid main() { o = vec4(0.0); }\n');
+      gl.transformFeedbackVaryings(p, ['vC0', 'vC1', 'vC2'], gl.INTERLEAVED_ATTRIBS);
+      gl.linkProgram(p);
+      if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(`program: ${gl.getProgramInfoLog(p)}`);
+      sim.programs.set(key, p);
+    }
+    return sim.programs.get(key);
+  }
+
+  /**
+   * The triangles' edges on the map picture for modes 1-2: polylines of picture positions.
+   * Where the vertex stage makes (u, v) (mode 1 with a sphere map or a single-layer map) the
+   * rasteriser interpolates them linearly, so an edge is the straight line between its
+   * corners' texels, straight through the picture even across the lat-long seam (Zimmons'
+   * artefact); where it makes directions, each point of the edge is envUv of the
+   * interpolated direction (samples run through the shader's own envUv, G.envUvOnGpu), and
+   * the edge breaks where consecutive samples land in different layers or jump the seam.
+   */
+  async function edges(mode) {
+    const h = view.env.header;
+    const layers = [];
+    const tf = gl.createTransformFeedback();
+    const buffers = [];
+    await studio.draw({
+      framebuffer: sim.targets.record.fb,
+      background: false,
+      program: () => cornerProgram(mode, h.projection, h.layers),
+      drawMesh: (m) => {
+        const count = Math.min(m.vertices, 3 * EDGE_TRIANGLES);
+        const b = gl.createBuffer();
+        gl.bindBuffer(gl.TRANSFORM_FEEDBACK_BUFFER, b);
+        gl.bufferData(gl.TRANSFORM_FEEDBACK_BUFFER, count * 36, gl.STREAM_READ);
+        gl.bindTransformFeedback(gl.TRANSFORM_FEEDBACK, tf);
+        gl.bindBufferBase(gl.TRANSFORM_FEEDBACK_BUFFER, 0, b);
+        gl.enable(gl.RASTERIZER_DISCARD);
+        gl.beginTransformFeedback(gl.TRIANGLES);
+        gl.drawArrays(gl.TRIANGLES, 0, count);
+        gl.endTransformFeedback();
+        gl.disable(gl.RASTERIZER_DISCARD);
+        gl.bindBufferBase(gl.TRANSFORM_FEEDBACK_BUFFER, 0, null);
+        gl.bindTransformFeedback(gl.TRANSFORM_FEEDBACK, null);
+        buffers.push([b, count]);
+      },
+    });
+    const corners = [];
+    for (const [b, count] of buffers) {
+      const out = new Float32Array(count * 9);
+      gl.bindBuffer(gl.TRANSFORM_FEEDBACK_BUFFER, b);
+      gl.getBufferSubData(gl.TRANSFORM_FEEDBACK_BUFFER, 0, out);
+      gl.deleteBuffer(b);
+      // Each vertex carries its triangle's three corners: one vertex a triangle suffices.
+      for (let t = 0; t < count; t += 3) corners.push(out.subarray(9 * t, 9 * t + 9));
+    }
+    gl.bindBuffer(gl.TRANSFORM_FEEDBACK_BUFFER, null);
+    gl.deleteTransformFeedback(tf);
+    const uvMade = mode === 1 && G.texgenOf(h.projection, h.layers) !== 1;
+    const m = sim.map;
+    const at = (uvl) => {
+      const cell = m.cells[Math.round(uvl[2])];
+      return cell ? [(cell[0] + uvl[0]) * m.texel[0], (cell[1] + uvl[1]) * m.texel[1]] : null;
+    };
+    if (uvMade) {
+      for (const c of corners) {
+        for (let k = 0; k < 3; k++) {
+          const a = [c[3 * k], c[3 * k + 1], 0];
+          const b = [c[3 * ((k + 1) % 3)], c[3 * ((k + 1) % 3) + 1], 0];
+          if ([...a, ...b].every(Number.isFinite)) layers.push([at(a), at(b)]);
+        }
+      }
+      return { corners, lines: layers };
+    }
+    const steps = 16;
+    const dirs = new Float32Array(corners.length * 3 * (steps + 1) * 3);
+    let o = 0;
+    for (const c of corners) {
+      for (let k = 0; k < 3; k++) {
+        const j = (k + 1) % 3;
+        for (let s = 0; s <= steps; s++) {
+          const f = s / steps;
+          for (let q = 0; q < 3; q++) dirs[o++] = (1 - f) * c[3 * k + q] + f * c[3 * j + q];
+        }
+      }
+    }
+    // Mode 2's corners are world directions; attached to the eye, the environment's
+    // direction is the view's rotation of it (viewport.frag `attach`). Mode 1's are already
+    // the environment's. envUv is scale-invariant: no normalising needed.
+    if (mode === 2 && view.state.scene.environment.attach === 'eye') {
+      const v = studio.camera().view;
+      for (let i = 0; i < dirs.length; i += 3) {
+        const [x, y, z] = [dirs[i], dirs[i + 1], dirs[i + 2]];
+        dirs[i] = v[0] * x + v[4] * y + v[8] * z;
+        dirs[i + 1] = v[1] * x + v[5] * y + v[9] * z;
+        dirs[i + 2] = v[2] * x + v[6] * y + v[10] * z;
+      }
+    }
+    const uv = dirs.length ? await G.envUvOnGpu(gl, h.projection, h.frame, dirs) : new Float32Array(0);
+    for (let e = 0; e < dirs.length / 3 / (steps + 1); e++) {
+      let line = [];
+      let last = null;
+      for (let s = 0; s <= steps; s++) {
+        const i = 4 * (e * (steps + 1) + s);
+        const uvl = [uv[i], uv[i + 1], uv[i + 2]];
+        const p = uvl[2] >= 0 && Number.isFinite(uvl[0]) ? at(uvl) : null;
+        if (!p || (last && (last[2] !== uvl[2] || Math.abs(last[0] - uvl[0]) > 0.5))) {
+          if (line.length > 1) layers.push(line);
+          line = [];
+        }
+        if (p) line.push(p);
+        last = p ? uvl : null;
+      }
+      if (line.length > 1) layers.push(line);
+    }
+    return { corners, lines: layers };
   }
 
   async function surfaceProgram(kind, layers) {
@@ -384,6 +521,16 @@ export function attach(studio) {
     off.getContext('2d').putImageData(image, 0, 0);
     ctx.imageSmoothingEnabled = false;
     ctx.drawImage(off, 0, 0, mapCanvas.width, mapCanvas.height);
+    if (sim.edgeLines) {
+      ctx.strokeStyle = 'rgba(120, 255, 255, 0.8)';
+      ctx.lineWidth = 1;
+      ctx.beginPath();
+      for (const line of sim.edgeLines.lines) {
+        ctx.moveTo(line[0][0] * zoom, line[0][1] * zoom);
+        for (const p of line.slice(1)) ctx.lineTo(p[0] * zoom, p[1] * zoom);
+      }
+      ctx.stroke();
+    }
     if (sim.hover?.texel) {
       const [x, y] = sim.hover.texel;
       ctx.strokeStyle = '#ff50c8';
@@ -466,6 +613,7 @@ export function attach(studio) {
     }
     p.set('marks', sim.marks ? '1' : '0');
     p.set('heat', sim.heat ? '1' : '0');
+    p.set('edges', sim.edges ? '1' : '0');
     history.replaceState(null, '', `${location.pathname}?${p}`);
   }
 
@@ -488,6 +636,7 @@ export function attach(studio) {
       sim.heatStats = heatOf(h.projection, h.frame, sim.record, exact);
     }
     await mapPicture();
+    sim.edgeLines = sim.edges && view.mode !== 3 ? await edges(view.mode) : null;
     if (sim.hover) sim.hoverAt(...sim.hover.pixel);
     paintMap();
     paintHeat();
