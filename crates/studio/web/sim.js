@@ -533,11 +533,14 @@ export function attach(studio) {
     }
     if (sim.hover?.texel) {
       const [x, y] = sim.hover.texel;
-      ctx.strokeStyle = '#ff50c8';
-      ctx.lineWidth = Math.max(2, zoom / 2);
-      ctx.beginPath();
-      ctx.arc((x + 0.5) * zoom, (y + 0.5) * zoom, Math.max(6, 2 * zoom), 0, 2 * Math.PI);
-      ctx.stroke();
+      // Yellow on black, to stand out from the pink marks around it.
+      for (const [colour, width] of [['#000', 4], ['#ffe040', 2]]) {
+        ctx.strokeStyle = colour;
+        ctx.lineWidth = width;
+        ctx.beginPath();
+        ctx.arc((x + 0.5) * zoom, (y + 0.5) * zoom, Math.max(6, 2 * zoom), 0, 2 * Math.PI);
+        ctx.stroke();
+      }
     }
   }
 
