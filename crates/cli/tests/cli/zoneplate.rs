@@ -35,6 +35,7 @@
 //!
 //! Skipped, loudly, where no `ffmpeg` is on the PATH (CI installs it).
 use crate::util::ok;
+use crate::v360::{code, have_ffmpeg};
 use glam::{DVec2, DVec3};
 use mirrorball_core::projection::ProjectionSpec;
 use mirrorball_core::quadrature::gauss_legendre;
@@ -133,28 +134,12 @@ fn plate(d: DVec3) -> f64 {
     0.5 + 0.4 * (K * t * t).cos()
 }
 
-fn code(d: DVec3) -> [u16; 3] {
-    d.to_array()
-        .map(|c| ((0.5 + 0.49 * c) * 65535.0).round() as u16)
-}
-
 fn decode(c: &[u8]) -> Option<DVec3> {
     let v = [0, 2, 4].map(|o| u16::from_le_bytes([c[o], c[o + 1]]) as f64 / 65535.0);
     if v.iter().all(|&x| x < 0.005) {
         return None; // black: nothing there
     }
     DVec3::from_array(v.map(|x| (x - 0.5) / 0.49)).try_normalize()
-}
-
-fn have_ffmpeg() -> bool {
-    let found = Command::new("ffmpeg").arg("-version").output().is_ok();
-    if !found {
-        eprintln!(
-            "\n!!!!!!!! SKIPPED: no ffmpeg on the PATH, so mirrorball's antialiasing was NOT \
-             compared with v360's (apt-get install ffmpeg) !!!!!!!!\n"
-        );
-    }
-    found
 }
 
 /// The lat-long source's direction at pixel `(x, y)`, where mirrorball (`align` false) or
