@@ -20,7 +20,7 @@ use mirrorball_core::{Projection, WorldProjection};
 use std::path::Path;
 use std::process::Command;
 
-fn have_ffmpeg() -> bool {
+pub(crate) fn have_ffmpeg() -> bool {
     let found = Command::new("ffmpeg").arg("-version").output().is_ok();
     if !found {
         eprintln!(
@@ -45,7 +45,8 @@ fn ffmpeg(args: &[&str]) -> Vec<u8> {
     o.stdout
 }
 
-fn code(d: DVec3) -> [u16; 3] {
+/// The 16-bit code of direction `d`: `½ + 0.49·d` of full scale.
+pub(crate) fn code(d: DVec3) -> [u16; 3] {
     d.to_array()
         .map(|c| ((0.5 + 0.49 * c) * 65535.0).round() as u16)
 }
