@@ -40,7 +40,7 @@ pub use image::Image;
 pub use layout::{guess, Guess, Layout};
 pub use projection::{
     AngularMap, ContinuousCube, CubeFace, CubeMap, Cylinder, CylinderRule, DirRun, DualParaboloid,
-    EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,
+    Eac, EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,
     Octahedral, Projection, ProjectionKind, RadialMap, Sinusoidal, SphereMap, UnknownProjection,
     View, WorldProjection,
 };
