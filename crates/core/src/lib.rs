@@ -37,10 +37,10 @@ pub use envmap::{
 };
 pub use fault::Fault;
 pub use image::Image;
-pub use layout::{guess, Guess, Layout};
+pub use layout::{guess, CellGrid, CubeCells, Guess, Layout};
 pub use projection::{
     AngularMap, ContinuousCube, CubeFace, CubeMap, Cylinder, CylinderRule, DirRun, DualParaboloid,
-    EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,
+    Eac, EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,
     Octahedral, Projection, ProjectionKind, RadialMap, Sinusoidal, SphereMap, UnknownProjection,
     View, WorldProjection,
 };

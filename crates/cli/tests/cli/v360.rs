@@ -274,3 +274,141 @@ fn projections_land_where_v360_puts_them() {
         compare(dir.path(), case);
     }
 }
+
+/// One comparison of a packed cube output: `v360=e:OUT` against `mirrorball convert --to TO
+/// --layout LAYOUT --size N` from the same lat-long.
+struct Packed {
+    v360: &'static str,
+    to: &'static str,
+    layout: &'static str,
+    size: u32,
+}
+
+fn compare_packed(dir: &Path, case: &Packed) {
+    let src = ProjectionSpec::parse("latlong")
+        .unwrap()
+        .build(Some((256, 128)))
+        .unwrap();
+    let layout: mirrorball_core::Layout = case.layout.parse().unwrap();
+    let (w, h) = layout.extent(6, case.size, case.size);
+    let (for_mb, for_ff) = (dir.join("in_mb.png"), dir.join("in_ff.png"));
+    write_coded(&for_mb, &src, 256, 128, false);
+    write_coded(&for_ff, &src, 256, 128, true);
+    let filter = format!("v360=e:{}:interp=line:w={w}:h={h}", case.v360);
+    let ff = ffmpeg(&[
+        "-i",
+        for_ff.to_str().unwrap(),
+        "-vf",
+        &filter,
+        "-f",
+        "rawvideo",
+        "-pix_fmt",
+        "rgb48le",
+        "-",
+    ]);
+    assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
+    let out = dir.join("out_mb.png");
+    let size = case.size.to_string();
+    ok(&[
+        "convert",
+        for_mb.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--from",
+        "latlong",
+        "--to",
+        case.to,
+        "--layout",
+        case.layout,
+        "--size",
+        &size,
+        "--precision",
+        "16",
+        "-q",
+    ]);
+    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
+    let img = &mb.layers[0];
+    assert_eq!((img.width(), img.height()), (w, h), "{}", case.layout);
+    let ffd = |x: u32, y: u32| {
+        let k = ((y * w + x) * 6) as usize;
+        decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
+    };
+    let (mut compared, mut worst) = (0, 0.0f64);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let (Some(df), Some(dm)) = (
+                ffd(x, y),
+                decode(
+                    [0, 1, 2]
+                        .map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64)),
+                ),
+            ) else {
+                panic!("{}: texel ({x}, {y}) is black", case.layout);
+            };
+            // One pixel: ffmpeg's own neighbours, leaving out those across a seam between
+            // cells (more than twice as far as the nearest).
+            let near: Vec<f64> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .filter_map(|(dx, dy)| ffd((x as i64 + dx) as u32, (y as i64 + dy) as u32))
+                .map(|n| df.angle_between(n))
+                .collect();
+            let min = near.iter().cloned().fold(f64::INFINITY, f64::min);
+            let tol = near
+                .iter()
+                .cloned()
+                .filter(|&a| a <= 2.0 * min)
+                .fold(0.0, f64::max);
+            let e = df.angle_between(dm);
+            worst = worst.max(e / tol);
+            compared += 1;
+            assert!(
+                e <= tol,
+                "{} {} vs v360=e:{}: texel ({x}, {y}) differs by {:.3}° (a pixel is {:.3}°): \
+                 ffmpeg {df}, mirrorball {dm}",
+                case.to,
+                case.layout,
+                case.v360,
+                e.to_degrees(),
+                tol.to_degrees()
+            );
+        }
+    }
+    eprintln!(
+        "{:>40} {:<40} ↔ v360=e:{:<50} {compared} texels, worst {worst:.3} of a pixel",
+        case.to, case.layout, case.v360
+    );
+}
+
+#[test]
+fn cube_layouts_land_where_v360_puts_them() {
+    if !have_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let p = |v360, to, layout, size| Packed {
+        v360,
+        to,
+        layout,
+        size,
+    };
+    let cases = [
+        p("eac", "eac", "eac", 48),
+        p("c3x2", "cube", "c3x2", 48),
+        p("c6x1", "cube", "c6x1", 32),
+        p("c1x6", "cube", "c1x6", 32),
+        p(
+            "c3x2:out_forder=fbudlr:out_frot=123012",
+            "cube",
+            "c3x2:forder=fbudlr:frot=123012",
+            40,
+        ),
+        p(
+            "c6x1:out_forder=udfblr:out_frot=321032",
+            "cube",
+            "c6x1:forder=udfblr:frot=321032",
+            32,
+        ),
+    ];
+    for case in &cases {
+        compare_packed(dir.path(), case);
+    }
+}

@@ -16,6 +16,7 @@ mod continuous_cube;
 mod cube;
 mod cylindrical;
 pub mod derivative;
+mod eac;
 pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
@@ -28,6 +29,7 @@ pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap,
 pub use continuous_cube::ContinuousCube;
 pub use cube::{CubeFace, CubeMap, FaceLanes};
 pub use cylindrical::{Cylinder, CylinderRule};
+pub use eac::Eac;
 pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
 pub use perspective::View;
@@ -275,11 +277,13 @@ pub enum ProjectionKind {
     Perspective,
     /// Pannini view.
     Pannini,
+    /// Equi-angular cube map (YouTube's EAC, v360's `eac`).
+    Eac,
 }
 
 impl ProjectionKind {
     /// Every kind, in the order the documentation lists them.
-    pub const ALL: [ProjectionKind; 17] = [
+    pub const ALL: [ProjectionKind; 18] = [
         ProjectionKind::LatLong,
         ProjectionKind::Cube,
         ProjectionKind::Sphere,
@@ -297,6 +301,7 @@ impl ProjectionKind {
         ProjectionKind::Sinusoidal,
         ProjectionKind::Perspective,
         ProjectionKind::Pannini,
+        ProjectionKind::Eac,
     ];
 
     /// The canonical command-line name (the canonical name of [`Choice`]).
@@ -330,6 +335,7 @@ impl ProjectionKind {
             ProjectionKind::Pannini => {
                 Projection::View(View::pannini(1.0, 120.0, 90.0, 0.0, 0.0, 0.0).expect("valid"))
             }
+            ProjectionKind::Eac => Projection::Eac(Eac),
         }
     }
 }
@@ -420,6 +426,15 @@ impl Choice for ProjectionKind {
             &["perspective", "rectilinear", "flat", "gnomonic"],
         ),
         (ProjectionKind::Pannini, &["pannini", "panini"]),
+        (
+            ProjectionKind::Eac,
+            &[
+                "eac",
+                "equi-angular-cube",
+                "equiangular-cube",
+                "equi-angular-cubemap",
+            ],
+        ),
     ];
 }
 
@@ -495,6 +510,8 @@ pub enum Projection {
     Sinusoidal(Sinusoidal),
     /// See [`View`]: perspective or Pannini.
     View(View),
+    /// See [`Eac`].
+    Eac(Eac),
 }
 
 macro_rules! delegate {
@@ -514,6 +531,7 @@ macro_rules! delegate {
             Projection::Hammer($p) => $e,
             Projection::Sinusoidal($p) => $e,
             Projection::View($p) => $e,
+            Projection::Eac($p) => $e,
         }
     };
 }
@@ -541,6 +559,7 @@ impl Projection {
             Projection::Sinusoidal(_) => ProjectionKind::Sinusoidal,
             Projection::View(v) if v.is_pannini() => ProjectionKind::Pannini,
             Projection::View(_) => ProjectionKind::Perspective,
+            Projection::Eac(_) => ProjectionKind::Eac,
         }
     }
 
@@ -629,7 +648,8 @@ impl_from!(
     Cylinder(Cylinder),
     Hammer(Hammer),
     Sinusoidal(Sinusoidal),
-    View(View)
+    View(View),
+    Eac(Eac)
 );
 
 /// The `[lo, hi]` range in `uv` of texel index `i` of `n`.
