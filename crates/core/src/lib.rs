@@ -44,6 +44,7 @@ pub use projection::{
     Octahedral, Projection, ProjectionKind, RadialMap, Sinusoidal, SphereMap, UnknownProjection,
     View, WorldProjection,
 };
+pub use projection::{DualFisheye, FisheyeLens, LensModel};
 pub use remap::{Remap, RemapError};
 pub use resample::{resample, resample_to_extent, Axis, ResampleOptions, Resampler, Rotation};
 

@@ -10,7 +10,10 @@
 //!   found by decoding its output, up to half a pixel off at the edges): the picture handed
 //!   to ffmpeg is coded at those positions (the same mirrorball projection evaluated at
 //!   `uv = (i/(w − 1), j/(h − 1))`), the one handed to mirrorball at the texel centres, so
-//!   that each tool is given the panorama it believes it reads.
+//!   that each tool is given the panorama it believes it reads. Its `dfisheye` input is
+//!   read another way (`xyz_to_dfisheye`: pixel `i` of a half `ew` wide at `2i/ew − 1`, its
+//!   top-left corner), so a dual fisheye is coded at `uv = (i/w, j/h)`;
+//! - a dual fisheye's texels outside both circles are coded with the nearest rim's direction.
 //!
 //! Skipped, loudly, where no `ffmpeg` is on the PATH (CI installs it).
 use crate::util::ok;
@@ -62,13 +65,17 @@ fn decode(c: [f64; 3]) -> Option<DVec3> {
 /// texel centre, or (`align`) where FFmpeg 5.1 reads it.
 fn write_coded(path: &Path, p: &Projection, w: u32, h: u32, align: bool) {
     let mut raw = Vec::with_capacity((w * h * 6) as usize);
+    let dfisheye = matches!(p, Projection::DualFisheye(_));
     for y in 0..h {
         for x in 0..w {
-            let uv = if align {
+            let uv = if align && dfisheye {
+                DVec2::new(x as f64 / w as f64, y as f64 / h as f64)
+            } else if align {
                 DVec2::new(x as f64 / (w - 1) as f64, y as f64 / (h - 1) as f64)
             } else {
                 DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64)
             };
+            let uv = p.nearest_covered(0, uv);
             let d = p.uv_to_dir(0, uv).expect("a direction at every texel");
             for c in code(d) {
                 raw.extend_from_slice(&c.to_le_bytes());
@@ -261,6 +268,24 @@ fn projections_land_where_v360_puts_them() {
             96,
         ),
         e("e:fisheye:h_fov=180:v_fov=180", "fisheye:fov=180", 96),
+        e("e:dfisheye:h_fov=180:v_fov=180", "dfisheye", 128),
+        e("e:dfisheye:h_fov=200:v_fov=200", "dfisheye:fov=200", 128),
+        Case {
+            from: "dfisheye",
+            in_size: (256, 128),
+            v360: "dfisheye:e:ih_fov=180:iv_fov=180",
+            to: "latlong",
+            size: 128,
+        },
+        // Where both lenses see, mirrorball blends them (v360 takes the nearer axis's):
+        // both are codes of about the same direction.
+        Case {
+            from: "dfisheye:fov=200",
+            in_size: (256, 128),
+            v360: "dfisheye:e:ih_fov=200:iv_fov=200",
+            to: "latlong",
+            size: 128,
+        },
         // A photo put back: black (nothing) outside its frustum in both.
         Case {
             from: "perspective:hfov=100:vfov=70",

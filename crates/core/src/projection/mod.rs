@@ -17,6 +17,7 @@ mod cube;
 mod cylindrical;
 pub mod derivative;
 mod eac;
+mod dual_fisheye;
 pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
@@ -30,13 +31,14 @@ pub use continuous_cube::ContinuousCube;
 pub use cube::{CubeFace, CubeMap, FaceLanes};
 pub use cylindrical::{Cylinder, CylinderRule};
 pub use eac::Eac;
+pub use dual_fisheye::{DualFisheye, FisheyeLens, LensModel};
 pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
 pub use perspective::View;
 pub use pseudo::{Hammer, Sinusoidal};
 pub use spec::{parse_dir, ProjectionSpec};
 
-use crate::{Choice, UnknownName};
+use crate::{Choice, Image, UnknownName};
 use glam::{DVec2, DVec3};
 use std::fmt;
 use std::str::FromStr;
@@ -238,6 +240,14 @@ pub trait WorldProjection {
             y.clamp(0, h as i64 - 1) as u32,
         )
     }
+
+    /// For reading `layers` (this projection's) as the source of a conversion: where two
+    /// parts of the map see the same directions (a dual fisheye's overlap), the layers with
+    /// those parts blended, which every lookup then reads; `None` (the default: nothing seen
+    /// twice) reads them as they are. Called once per source map, before its lookups.
+    fn blend_overlap(&self, _layers: &[Image]) -> Option<Vec<Image>> {
+        None
+    }
 }
 
 /// The names of the projections, as the command line spells them.
@@ -279,6 +289,8 @@ pub enum ProjectionKind {
     Pannini,
     /// Equi-angular cube map (YouTube's EAC, v360's `eac`).
     Eac,
+    /// Dual fisheye: two lenses back to back in one 2:1 picture.
+    DualFisheye,
 }
 
 impl ProjectionKind {
@@ -302,6 +314,7 @@ impl ProjectionKind {
         ProjectionKind::Perspective,
         ProjectionKind::Pannini,
         ProjectionKind::Eac,
+        ProjectionKind::DualFisheye,
     ];
 
     /// The canonical command-line name (the canonical name of [`Choice`]).
@@ -336,6 +349,7 @@ impl ProjectionKind {
                 Projection::View(View::pannini(1.0, 120.0, 90.0, 0.0, 0.0, 0.0).expect("valid"))
             }
             ProjectionKind::Eac => Projection::Eac(Eac),
+            ProjectionKind::DualFisheye => Projection::DualFisheye(DualFisheye::default()),
         }
     }
 }
@@ -435,6 +449,10 @@ impl Choice for ProjectionKind {
                 "equi-angular-cubemap",
             ],
         ),
+        (
+            ProjectionKind::DualFisheye,
+            &["dual-fisheye", "dfisheye", "dualfisheye", "dual_fisheye"],
+        ),
     ];
 }
 
@@ -479,6 +497,9 @@ impl FromStr for ProjectionKind {
 
 /// Any world projection, with its parameters. Implements [`WorldProjection`] by delegating
 /// to the named type inside.
+// The dual fisheye (two lenses, each with its frame) is the largest variant, a few hundred
+// bytes: `Projection` stays `Copy` and is passed by reference in the loops.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
     /// See [`LatLong`].
@@ -512,6 +533,8 @@ pub enum Projection {
     View(View),
     /// See [`Eac`].
     Eac(Eac),
+    /// See [`DualFisheye`].
+    DualFisheye(DualFisheye),
 }
 
 macro_rules! delegate {
@@ -532,6 +555,7 @@ macro_rules! delegate {
             Projection::Sinusoidal($p) => $e,
             Projection::View($p) => $e,
             Projection::Eac($p) => $e,
+            Projection::DualFisheye($p) => $e,
         }
     };
 }
@@ -560,6 +584,7 @@ impl Projection {
             Projection::View(v) if v.is_pannini() => ProjectionKind::Pannini,
             Projection::View(_) => ProjectionKind::Perspective,
             Projection::Eac(_) => ProjectionKind::Eac,
+            Projection::DualFisheye(_) => ProjectionKind::DualFisheye,
         }
     }
 
@@ -625,6 +650,9 @@ impl WorldProjection for Projection {
     fn wrap_texel(&self, layer: usize, x: i64, y: i64, w: u32, h: u32) -> (usize, u32, u32) {
         delegate!(self, p => p.wrap_texel(layer, x, y, w, h))
     }
+    fn blend_overlap(&self, layers: &[Image]) -> Option<Vec<Image>> {
+        delegate!(self, p => p.blend_overlap(layers))
+    }
 }
 
 macro_rules! impl_from {
@@ -649,7 +677,8 @@ impl_from!(
     Hammer(Hammer),
     Sinusoidal(Sinusoidal),
     View(View),
-    Eac(Eac)
+    Eac(Eac),
+    DualFisheye(DualFisheye)
 );
 
 /// The `[lo, hi]` range in `uv` of texel index `i` of `n`.
