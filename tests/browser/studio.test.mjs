@@ -4,28 +4,10 @@
 // `mirrorball render` of the same scene.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { createInterface } from 'node:readline';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { deflateSync, crc32 } from 'node:zlib';
 import path from 'node:path';
-import { browser, mirrorball, run, tempDir, readPng, ROOT } from './lib.mjs';
-
-/** Starts `mirrorball studio --no-open --port 0 FILES…`; resolves to its URL and a stop. */
-export async function studio(files = []) {
-  const proc = spawn(mirrorball(), ['studio', '--no-open', '--port', '0', ...files], {
-    cwd: ROOT,
-    stdio: ['ignore', 'pipe', 'pipe'],
-  });
-  let stderr = '';
-  proc.stderr.on('data', (d) => (stderr += d));
-  const url = await new Promise((ok, fail) => {
-    const lines = createInterface({ input: proc.stdout });
-    lines.once('line', ok);
-    proc.once('exit', (code) => fail(new Error(`studio exited (${code}): ${stderr}`)));
-  });
-  return { url, stop: () => proc.kill('SIGTERM'), stderr: () => stderr };
-}
+import { browser, run, tempDir, readPng, ROOT, studio } from './lib.mjs';
 
 let chromium;
 let work;
