@@ -181,6 +181,7 @@ async function draw(pass = {}) {
     gl.uniform3fv(u('uForward'), forward);
     gl.uniform1i(u('uAttachEye'), env.attach === 'eye' ? 1 : 0);
     if (h.frame) gl.uniformMatrix3fv(u('uFrame'), false, new Float32Array(h.frame));
+    if (h.params) gl.uniform4fv(u('uParams'), new Float32Array(h.params));
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, view.env.texture);
     gl.uniform1i(u('uEnv'), 0);

@@ -182,6 +182,11 @@ impl RadialMap {
     pub fn lens(&self) -> Lens {
         self.lens
     }
+    /// The lens constant `k = f(θ_max)` (θ_max, sin(θ_max/2), tan(θ_max/2) or sin θ_max):
+    /// `ρ = f(θ)/k`.
+    pub fn lens_constant(&self) -> f64 {
+        self.k
+    }
     /// Half the field of view, radians.
     pub fn theta_max(&self) -> f64 {
         self.theta_max
