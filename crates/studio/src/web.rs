@@ -19,6 +19,7 @@ const FILES: &[(&str, &str, &str)] = files![
     "index.html": "html",
     "studio.js": "js",
     "gl.js": "js",
+    "panels.js": "js",
     "glsl/latlong.glsl": "glsl",
     "glsl/cube.glsl": "glsl",
     "glsl/radial.glsl": "glsl",
