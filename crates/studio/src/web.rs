@@ -21,6 +21,7 @@ const FILES: &[(&str, &str, &str)] = files![
     "gl.js": "js",
     "sim.js": "js",
     "glsl/math.glsl": "glsl",
+    "panels.js": "js",
     "glsl/latlong.glsl": "glsl",
     "glsl/cubeface.glsl": "glsl",
     "glsl/cube.glsl": "glsl",
