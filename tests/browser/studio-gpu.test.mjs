@@ -23,6 +23,7 @@ after(async () => {
 // parameters the shaders take from the server (frames, lenses, fields of view).
 const SPECS = [
   ['continuous-cube', 'continuous-cube'],
+  ['eac', 'eac'],
   ['mercator', 'mercator'],
   ['mercator', 'mercator:max-lat=60'],
   ['angular', 'angular'],

@@ -253,16 +253,20 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
     };
     let projection = q.projection.unwrap_or_else(|| "native".into());
     let work = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, (StatusCode, String)> {
-        let map = if projection == "native" {
-            map
-        } else {
+        let map = if projection != "native" {
             convert(&app, &map, &projection, q.size)?
+        } else if gpu_kind(map.projection()).is_none() {
+            // A projection without a shader (the dual fisheye) is drawn from its exact
+            // lat-long conversion; the header's kind says so.
+            convert(&app, &map, "latlong", q.size)?
+        } else {
+            map
         };
         if gpu_kind(map.projection()).is_none() {
             return Err((
                 StatusCode::UNPROCESSABLE_ENTITY,
                 format!(
-                    "the viewport does not draw {} maps yet (latlong, cube, sphere, paraboloid)",
+                    "the viewport does not draw {} maps",
                     map.projection().name()
                 ),
             ));

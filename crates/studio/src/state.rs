@@ -201,7 +201,11 @@ pub fn gpu_kind(p: &Projection) -> Option<&'static str> {
         | Projection::Cylinder(_)
         | Projection::Hammer(_)
         | Projection::Sinusoidal(_)
-        | Projection::View(_) => Some(p.name()),
+        | Projection::View(_)
+        | Projection::Eac(_) => Some(p.name()),
+        // Two lenses with their own centres, rolls and distortion: the server sends the
+        // page a lat-long conversion of it instead (server.rs `texture`).
+        Projection::DualFisheye(_) => None,
     }
 }
 

@@ -26,6 +26,7 @@ const FILES: &[(&str, &str, &str)] = files![
     "glsl/cubeface.glsl": "glsl",
     "glsl/cube.glsl": "glsl",
     "glsl/continuous_cube.glsl": "glsl",
+    "glsl/eac.glsl": "glsl",
     "glsl/mercator.glsl": "glsl",
     "glsl/radial.glsl": "glsl",
     "glsl/lens.glsl": "glsl",

@@ -41,6 +41,7 @@ const SOURCES = {
   sphere: ['radial', 'lens', 'sphere'],
   paraboloid: ['radial', 'lens', 'paraboloid'],
   'continuous-cube': ['cubeface', 'continuous_cube'],
+  eac: ['cubeface', 'eac'],
   mercator: ['mercator'],
   angular: ['radial', 'lens', 'fisheye'],
   fisheye: ['radial', 'lens', 'fisheye'],

@@ -16,8 +16,8 @@ mod continuous_cube;
 mod cube;
 mod cylindrical;
 pub mod derivative;
-mod eac;
 mod dual_fisheye;
+mod eac;
 pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
@@ -30,8 +30,8 @@ pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap,
 pub use continuous_cube::ContinuousCube;
 pub use cube::{CubeFace, CubeMap, FaceLanes};
 pub use cylindrical::{Cylinder, CylinderRule};
-pub use eac::Eac;
 pub use dual_fisheye::{DualFisheye, FisheyeLens, LensModel};
+pub use eac::Eac;
 pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
 pub use perspective::View;
@@ -295,7 +295,7 @@ pub enum ProjectionKind {
 
 impl ProjectionKind {
     /// Every kind, in the order the documentation lists them.
-    pub const ALL: [ProjectionKind; 18] = [
+    pub const ALL: [ProjectionKind; 19] = [
         ProjectionKind::LatLong,
         ProjectionKind::Cube,
         ProjectionKind::Sphere,
