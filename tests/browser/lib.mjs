@@ -3,7 +3,8 @@
 // baked for the test, and headless Chromium (Debian's package) with WebGL2 on SwiftShader.
 import { createServer } from 'node:http';
 import { readFile, stat } from 'node:fs/promises';
-import { execFileSync } from 'node:child_process';
+import { execFileSync, spawn } from 'node:child_process';
+import { createInterface } from 'node:readline';
 import { inflateSync } from 'node:zlib';
 import { mkdtempSync, rmSync, existsSync, readdirSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -214,4 +215,34 @@ export function mirrorChecks(r, { eye, forward, fov, toWorld }) {
     const got = [0, 1, 2].map((k) => r.pixels[(py * r.w + px) * 4 + k] / 255);
     return { what, got, want: seen.map((c) => 0.5 + 0.5 * c) };
   });
+}
+
+/// Starts `mirrorball studio --no-open --port 0 FILES…` as a person starts it; resolves to
+/// the URL it prints first, a stop and its standard error so far.
+export async function studio(files = []) {
+  const proc = spawn(mirrorball(), ['studio', '--no-open', '--port', '0', ...files], {
+    cwd: ROOT,
+    stdio: ['ignore', 'pipe', 'pipe'],
+  });
+  let stderr = '';
+  proc.stderr.on('data', (d) => (stderr += d));
+  const url = await new Promise((ok, fail) => {
+    const lines = createInterface({ input: proc.stdout });
+    lines.once('line', ok);
+    proc.once('exit', (code) => fail(new Error(`studio exited (${code}): ${stderr}`)));
+  });
+  return { url, stop: () => proc.kill('SIGTERM'), stderr: () => stderr };
+}
+
+/// A new page of `chromium` at the studio's `url`, once the page is ready; `logs` collects
+/// its console messages and errors.
+export async function openStudio(chromium, url) {
+  const page = await chromium.newPage({ deviceScaleFactor: 1 });
+  const logs = [];
+  page.on('console', (m) => logs.push(m.text()));
+  page.on('pageerror', (e) => logs.push(String(e)));
+  await page.goto(url);
+  await page.waitForFunction(() => window.studio, null, { timeout: 60000 });
+  await page.evaluate(() => window.studio.ready);
+  return { page, logs };
 }

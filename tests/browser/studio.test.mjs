@@ -4,28 +4,10 @@
 // `mirrorball render` of the same scene.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { createInterface } from 'node:readline';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { deflateSync, crc32 } from 'node:zlib';
 import path from 'node:path';
-import { browser, mirrorball, run, tempDir, readPng, ROOT } from './lib.mjs';
-
-/** Starts `mirrorball studio --no-open --port 0 FILES…`; resolves to its URL and a stop. */
-export async function studio(files = []) {
-  const proc = spawn(mirrorball(), ['studio', '--no-open', '--port', '0', ...files], {
-    cwd: ROOT,
-    stdio: ['ignore', 'pipe', 'pipe'],
-  });
-  let stderr = '';
-  proc.stderr.on('data', (d) => (stderr += d));
-  const url = await new Promise((ok, fail) => {
-    const lines = createInterface({ input: proc.stdout });
-    lines.once('line', ok);
-    proc.once('exit', (code) => fail(new Error(`studio exited (${code}): ${stderr}`)));
-  });
-  return { url, stop: () => proc.kill('SIGTERM'), stderr: () => stderr };
-}
+import { browser, run, tempDir, readPng, studio, openStudio, ROOT } from './lib.mjs';
 
 let chromium;
 let work;
@@ -40,16 +22,7 @@ after(async () => {
   work?.remove();
 });
 
-async function open(url) {
-  const page = await chromium.newPage({ deviceScaleFactor: 1 });
-  const logs = [];
-  page.on('console', (m) => logs.push(m.text()));
-  page.on('pageerror', (e) => logs.push(String(e)));
-  await page.goto(url);
-  await page.waitForFunction(() => window.studio, null, { timeout: 60000 });
-  await page.evaluate(() => window.studio.ready);
-  return { page, logs };
-}
+const open = (url) => openStudio(chromium, url);
 
 test('the printed URL is the first line, and the page refuses to load without its token', async () => {
   const s = await studio();

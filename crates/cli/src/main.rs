@@ -81,8 +81,9 @@ pub struct InputArgs {
     /// yaw=DEG pitch=DEG roll=DEG (views: right, up, about the view axis).
     #[arg(long, value_name = "PROJECTION")]
     from: Option<String>,
-    /// Layout of the input's layers.
-    #[arg(long = "in-layout", value_name = "LAYOUT", value_parser = names::<Layout>())]
+    /// Layout of the input's layers: hcross, vcross, hstrip, vstrip, separate, or v360's
+    /// c3x2, c6x1, c1x6 (with `:forder=rludfb:frot=000000`) and eac.
+    #[arg(long = "in-layout", value_name = "LAYOUT")]
     in_layout: Option<String>,
     /// Keep NaN, infinite and negative texels instead of replacing them by 0.
     #[arg(long)]
@@ -123,8 +124,9 @@ pub struct ConvertArgs {
     /// Default: about the source's resolution.
     #[arg(long)]
     size: Option<u32>,
-    /// Layout of the output's layers.
-    #[arg(long, value_name = "LAYOUT", value_parser = names::<Layout>())]
+    /// Layout of the output's layers: hcross, vcross, hstrip, vstrip, separate, or v360's
+    /// c3x2, c6x1, c1x6 (with `:forder=rludfb:frot=000000`) and eac (EAC's default).
+    #[arg(long, value_name = "LAYOUT")]
     layout: Option<String>,
     #[command(flatten)]
     input_args: InputArgs,

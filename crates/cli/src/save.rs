@@ -19,7 +19,8 @@ pub struct SaveOptions {
     pub mips: bool,
 }
 
-/// The layout used when the user names none.
+/// The layout used when the user names none (by layer count; an EAC map's is v360's `eac`:
+/// [`Layout::default_for`]).
 pub fn default_layout(layers: usize) -> Layout {
     match layers {
         6 => Layout::HorizontalCross,
@@ -151,7 +152,11 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
         return Ok(vec![path.to_path_buf()]);
     }
     let n = env.layers().len();
-    let layout = output_layout(out, n, opts);
+    let kind = env.projection().kind();
+    let layout = match opts.layout {
+        None if kind == ProjectionKind::Eac && !out.contains(FACE) => Layout::default_for(kind),
+        _ => output_layout(out, n, opts),
+    };
     if let Some(paths) = layer_files(out, n, opts) {
         // Renamed into place together: a failed or interrupted run leaves the set as it was.
         let mut set = OutputSet::new(&per_layer_write(&opts.write, *env.projection()));

@@ -12,9 +12,15 @@
 //!     −Y                   −Y
 //!                          −Z (rotated 180°)
 //! ```
+//!
+//! FFmpeg `v360`'s cube arrangements are [`Layout::Cells`] ([`CubeCells`]): `c3x2`, `c6x1`,
+//! `c1x6` with v360's face order and rotation strings, and `eac`, v360's equi-angular
+//! arrangement with its padding. See [`CubeCells`] for how v360's cells relate to OpenGL's
+//! faces.
 
-use crate::projection::{Projection, ProjectionKind, WorldProjection};
+use crate::projection::{CubeFace, Eac, Projection, ProjectionKind, WorldProjection};
 use crate::{Choice, EnvMap, Image};
+use glam::DVec3;
 use std::fmt;
 use std::str::FromStr;
 
@@ -32,6 +38,291 @@ pub enum Layout {
     HorizontalStrip,
     /// All layers in a column, in layer order.
     VerticalStrip,
+    /// Six cube faces in FFmpeg `v360`'s cells: its `c3x2`, `c6x1`, `c1x6` and `eac`.
+    Cells(CubeCells),
+}
+
+/// The grid of a [`CubeCells`] layout, in cells `(columns, rows)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CellGrid {
+    /// Three across, two down (`c3x2`, `eac`).
+    C3x2,
+    /// Six across.
+    C6x1,
+    /// Six down.
+    C1x6,
+}
+
+impl CellGrid {
+    fn dims(self) -> (u32, u32) {
+        match self {
+            CellGrid::C3x2 => (3, 2),
+            CellGrid::C6x1 => (6, 1),
+            CellGrid::C1x6 => (1, 6),
+        }
+    }
+    fn name(self) -> &'static str {
+        match self {
+            CellGrid::C3x2 => "c3x2",
+            CellGrid::C6x1 => "c6x1",
+            CellGrid::C1x6 => "c1x6",
+        }
+    }
+}
+
+/// FFmpeg `v360`'s cube layouts (`libavfilter/vf_v360.c`: `cube_to_xyz`, `xyz_to_cube`,
+/// `rotate_cube_face`, `prepare_eac_in/out`, `eac_to_xyz`).
+///
+/// Cells are numbered left to right, top to bottom. Cell `i` shows the face of letter `i` of
+/// v360's `forder` (`r l u d f b`: right, left, up, down, front, back; ours +X −X +Y −Y −Z
+/// +Z, since v360's `(x, y, z)` is our `(x, −y, −z)`), turned by digit `i` of `frot`
+/// (quarter turns clockwise as seen: v360's `ROT_90` for `1`). Derived from `cube_to_xyz`:
+/// with cell coordinates `(c, d)` ∈ `[−1, 1]²` (right, down), v360 first undoes the turn,
+/// `(c, d)` → `(d, −c)`, `(−c, −d)`, `(−d, c)` for `1`, `2`, `3`, giving `(c′, d′)`; then a
+/// side face (r l f b) shows OpenGL's `(s, t) = (−c′, d′)` and the up and down faces show
+/// `(c′, −d′)`: v360's cells are OpenGL's faces mirrored, read as a panorama reads. These are
+/// signed permutations of the coordinates, so pixel centres land on pixel centres and
+/// packing is an exact rearrangement.
+///
+/// `eac` is `c3x2` with `forder=lfrdbu`, `frot=000313` (v360 spells the same table out in
+/// `eac_to_xyz`) and v360's fixed padding: the picture of faces of `n` texels is
+/// `(3n + 4)×(2n + 8)`, two texels of border at the picture's left and right edges and above
+/// and below each row of faces. v360 fills a border texel by continuing the face coordinate
+/// linearly past the edge (`uf = 2·uf` where `|uf| > ½`: face coordinate `±(1 + δ)` at
+/// distance `δ` past the edge in the face's `[−1, 1]`, not the tangent); [`Layout::pack`]
+/// looks the map up in that texel's direction, bilinearly. Reading ignores the border.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct CubeCells {
+    /// The grid.
+    pub grid: CellGrid,
+    /// The OpenGL face in each cell.
+    pub faces: [CubeFace; 6],
+    /// Quarter turns (clockwise as seen) of each cell, v360's `frot` digits.
+    pub turns: [u8; 6],
+    /// v360's `eac` padding: two texels of border (see above).
+    pub eac_pad: bool,
+}
+
+/// v360's face letters and the OpenGL face of each.
+const LETTERS: [(char, CubeFace); 6] = [
+    ('r', CubeFace::PosX),
+    ('l', CubeFace::NegX),
+    ('u', CubeFace::PosY),
+    ('d', CubeFace::NegY),
+    ('f', CubeFace::NegZ),
+    ('b', CubeFace::PosZ),
+];
+const RLUDFB: [CubeFace; 6] = [
+    CubeFace::PosX,
+    CubeFace::NegX,
+    CubeFace::PosY,
+    CubeFace::NegY,
+    CubeFace::NegZ,
+    CubeFace::PosZ,
+];
+
+impl CubeCells {
+    /// v360's defaults for a grid: `forder=rludfb`, `frot=000000`, no padding.
+    pub const fn v360(grid: CellGrid) -> CubeCells {
+        CubeCells {
+            grid,
+            faces: RLUDFB,
+            turns: [0; 6],
+            eac_pad: false,
+        }
+    }
+
+    /// v360's `eac`: `c3x2:forder=lfrdbu:frot=000313` with its two-texel padding.
+    pub const EAC: CubeCells = CubeCells {
+        grid: CellGrid::C3x2,
+        faces: [
+            CubeFace::NegX,
+            CubeFace::NegZ,
+            CubeFace::PosX,
+            CubeFace::NegY,
+            CubeFace::PosZ,
+            CubeFace::PosY,
+        ],
+        turns: [0, 0, 0, 3, 1, 3],
+        eac_pad: true,
+    };
+
+    /// The picture size for faces of `n` texels.
+    pub fn extent(&self, n: u32) -> (u32, u32) {
+        let (c, r) = self.grid.dims();
+        if self.eac_pad {
+            (c * n + 4, r * (n + 4))
+        } else {
+            (c * n, r * n)
+        }
+    }
+
+    /// The face size of a `w`×`h` picture in this layout, if it is one.
+    pub fn face_size(&self, w: u32, h: u32) -> Option<u32> {
+        let (c, _) = self.grid.dims();
+        let n = if self.eac_pad {
+            w.checked_sub(4)? / c
+        } else {
+            w / c
+        };
+        (n > 0 && self.extent(n) == (w, h)).then_some(n)
+    }
+
+    /// The top-left texel of cell `i`'s face, for faces of `n` texels.
+    fn origin(&self, i: usize, n: u32) -> (u32, u32) {
+        let (c, _) = self.grid.dims();
+        let (col, row) = (i as u32 % c, i as u32 / c);
+        if self.eac_pad {
+            (2 + col * n, 2 + row * (n + 4))
+        } else {
+            (col * n, row * n)
+        }
+    }
+
+    /// The face coordinates `(s, t)` shown at cell coordinates `(c, d)` of cell `i`, as
+    /// doubled integers (`2x + 1 − n` for texel `x` of `n`) or as reals: a signed
+    /// permutation (see the type's documentation).
+    fn to_face<T: Copy + std::ops::Neg<Output = T>>(&self, i: usize, c: T, d: T) -> (T, T) {
+        let (c, d) = match self.turns[i] & 3 {
+            0 => (c, d),
+            1 => (d, -c),
+            2 => (-c, -d),
+            _ => (-d, c),
+        };
+        match self.faces[i] {
+            CubeFace::PosY | CubeFace::NegY => (c, -d),
+            _ => (-c, d),
+        }
+    }
+
+    /// For each texel `(x, y)` of each cell's face, the face texel it shows:
+    /// `f(cell, picture x, picture y, face texel x, face texel y)`.
+    fn each_texel(&self, n: u32, mut f: impl FnMut(usize, u32, u32, u32, u32)) {
+        let n2 = n as i64;
+        for i in 0..6 {
+            let (ox, oy) = self.origin(i, n);
+            for y in 0..n {
+                for x in 0..n {
+                    let (c, d) = (2 * x as i64 + 1 - n2, 2 * y as i64 + 1 - n2);
+                    let (s, t) = self.to_face(i, c, d);
+                    f(
+                        i,
+                        ox + x,
+                        oy + y,
+                        ((s + n2 - 1) / 2) as u32,
+                        ((t + n2 - 1) / 2) as u32,
+                    );
+                }
+            }
+        }
+    }
+
+    /// The direction v360 gives border texel `(px, py)` of a padded `eac` picture of faces
+    /// of `n` texels, for a map of projection `p` (EAC's faces are equi-angular inside the
+    /// edge; past it both EAC and the cube continue the gnomonic coordinate linearly).
+    fn border_dir(&self, p: &Projection, n: u32, px: u32, py: u32) -> DVec3 {
+        let (cols, _) = self.grid.dims();
+        let nf = n as f64;
+        // Position in face widths from the left edge of the faces, and the cell.
+        let fx = (px as f64 + 0.5 - 2.0) / nf;
+        let col = (fx.floor().max(0.0) as u32).min(cols - 1);
+        let row = py / (n + 4);
+        let fy = (py as f64 + 0.5 - 2.0 - (row * (n + 4)) as f64) / nf;
+        let (c, d) = (2.0 * (fx - col as f64) - 1.0, 2.0 * fy - 1.0);
+        let i = (row * cols + col) as usize;
+        let (s, t) = self.to_face(i, c, d);
+        let warp = |a: f64| {
+            if a.abs() > 1.0 {
+                a
+            } else if p.kind() == ProjectionKind::Eac {
+                Eac::unwarp(a)
+            } else {
+                a
+            }
+        };
+        self.faces[i].point(warp(s), warp(t)).normalize()
+    }
+
+    fn parse(grid: CellGrid, opts: &str) -> Result<CubeCells, String> {
+        let mut cells = CubeCells::v360(grid);
+        for opt in opts.split(':').filter(|o| !o.is_empty()) {
+            let (key, value) = opt
+                .split_once('=')
+                .ok_or_else(|| format!("'{opt}' is not KEY=VALUE (forder, frot, pad)"))?;
+            match key.trim().to_ascii_lowercase().as_str() {
+                "forder" => {
+                    let letters: Vec<char> = value.trim().to_ascii_lowercase().chars().collect();
+                    if letters.len() != 6 {
+                        return Err(format!(
+                            "forder={value}: needs six face letters, one per cell (r l u d f b)"
+                        ));
+                    }
+                    for (i, ch) in letters.iter().enumerate() {
+                        let face = LETTERS
+                            .iter()
+                            .find(|(l, _)| l == ch)
+                            .map(|(_, f)| *f)
+                            .ok_or_else(|| {
+                                format!("forder={value}: '{ch}' is not a face letter (r l u d f b)")
+                            })?;
+                        if letters[..i].contains(ch) {
+                            return Err(format!(
+                                "forder={value}: face '{ch}' appears twice; each face once"
+                            ));
+                        }
+                        cells.faces[i] = face;
+                    }
+                }
+                "frot" => {
+                    let digits: Vec<char> = value.trim().chars().collect();
+                    if digits.len() != 6 || digits.iter().any(|d| !('0'..='3').contains(d)) {
+                        return Err(format!(
+                            "frot={value}: needs six digits 0-3 (quarter turns), one per cell"
+                        ));
+                    }
+                    for (i, d) in digits.iter().enumerate() {
+                        cells.turns[i] = *d as u8 - b'0';
+                    }
+                }
+                "pad" => {
+                    let p: f64 = value.trim().parse().map_err(|_| {
+                        format!("pad={value}: not a number (a fraction of the cell, 0 to 0.1)")
+                    })?;
+                    if !(0.0..=0.1).contains(&p) {
+                        return Err(format!(
+                            "pad={value}: outside 0 to 0.1 (the fraction of each cell left as a border, v360's range)"
+                        ));
+                    }
+                    if p != 0.0 {
+                        return Err(format!(
+                            "pad={value}: only pad=0 is supported for c3x2, c6x1 and c1x6 (eac has its own padding)"
+                        ));
+                    }
+                }
+                other => return Err(format!("unknown option '{other}' (forder, frot, pad)")),
+            }
+        }
+        Ok(cells)
+    }
+}
+
+impl fmt::Display for CubeCells {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if *self == CubeCells::EAC {
+            return f.write_str("eac");
+        }
+        f.write_str(self.grid.name())?;
+        if *self != CubeCells::v360(self.grid) {
+            let letters: String = self
+                .faces
+                .iter()
+                .map(|face| LETTERS.iter().find(|(_, f)| f == face).map_or('?', |l| l.0))
+                .collect();
+            let turns: String = self.turns.iter().map(|t| (b'0' + t) as char).collect();
+            write!(f, ":forder={letters}:frot={turns}")?;
+        }
+        Ok(())
+    }
 }
 
 /// Cell `(column, row)` of each cube face (OpenGL order) and whether it is turned 180°.
@@ -68,7 +359,33 @@ impl Layout {
             Layout::Separate => true,
             Layout::HorizontalCross | Layout::VerticalCross => layers == 6,
             Layout::HorizontalStrip | Layout::VerticalStrip => true,
+            Layout::Cells(_) => layers == 6,
         }
+    }
+
+    /// v360's `eac` arrangement (see [`CubeCells`]): the default layout of an EAC map.
+    pub const fn eac() -> Layout {
+        Layout::Cells(CubeCells::EAC)
+    }
+
+    /// The layout a map of `kind` gets when none is named: v360's `eac` for EAC, a
+    /// horizontal cross for the cubes, side by side for the paraboloid, else separate.
+    pub fn default_for(kind: ProjectionKind) -> Layout {
+        match kind.default_projection().layer_count() {
+            _ if kind == ProjectionKind::Eac => Layout::eac(),
+            6 => Layout::HorizontalCross,
+            2 => Layout::HorizontalStrip,
+            _ => Layout::Separate,
+        }
+    }
+
+    /// The picture size of this layout for layers of `w`×`h` texels.
+    pub fn extent(self, layers: usize, w: u32, h: u32) -> (u32, u32) {
+        if let Layout::Cells(c) = self {
+            return c.extent(w);
+        }
+        let (gc, gr) = self.grid(layers);
+        (gc * w, gr * h)
     }
 
     /// Grid size in cells `(columns, rows)` for `layers` layers.
@@ -80,6 +397,7 @@ impl Layout {
             Layout::VerticalCross => (3, 4),
             Layout::HorizontalStrip => (n, 1),
             Layout::VerticalStrip => (1, n),
+            Layout::Cells(c) => c.grid.dims(),
         }
     }
 
@@ -91,6 +409,7 @@ impl Layout {
             Layout::VerticalCross => VCROSS[i],
             Layout::HorizontalStrip => (i as u32, 0, false),
             Layout::VerticalStrip => (0, i as u32, false),
+            Layout::Cells(_) => unreachable!("cells are packed texel by texel"),
         }
     }
 
@@ -114,6 +433,13 @@ impl Layout {
                 return Some((l, w / c, h / r));
             }
         }
+        if layers == 6 {
+            for cells in [CubeCells::EAC, CubeCells::v360(CellGrid::C3x2)] {
+                if let Some(n) = cells.face_size(w, h) {
+                    return Some((Layout::Cells(cells), n, n));
+                }
+            }
+        }
         None
     }
 
@@ -125,6 +451,9 @@ impl Layout {
             return None;
         }
         let (cw, ch) = (env.width(), env.height());
+        if let Layout::Cells(cells) = self {
+            return Some(pack_cells(&cells, env));
+        }
         let (gc, gr) = self.grid(n);
         let mut out = Image::new(cw * gc, ch * gr, env.channels());
         for (i, layer) in env.layers().iter().enumerate() {
@@ -164,6 +493,9 @@ impl Layout {
         }
         let (gc, gr) = self.grid(n);
         let (w, h) = (image.width(), image.height());
+        if let Layout::Cells(cells) = self {
+            return unpack_cells(&cells, image, projection);
+        }
         if w % gc != 0 || h % gr != 0 || w / gc != h / gr {
             return Err(format!(
                 "a {} layout of {} layers needs a {}:{} picture of square cells; {}x{} is not",
@@ -207,27 +539,113 @@ impl Choice for Layout {
             ],
         ),
         (Layout::VerticalStrip, &["vstrip", "vertical-strip"]),
+        (
+            Layout::Cells(CubeCells::v360(CellGrid::C3x2)),
+            &["c3x2", "cube3x2"],
+        ),
+        (
+            Layout::Cells(CubeCells::v360(CellGrid::C6x1)),
+            &["c6x1", "cube6x1"],
+        ),
+        (
+            Layout::Cells(CubeCells::v360(CellGrid::C1x6)),
+            &["c1x6", "cube1x6"],
+        ),
+        (Layout::Cells(CubeCells::EAC), &["eac"]),
     ];
 }
 
 impl Layout {
     /// The command-line name (the canonical name of [`Choice`]).
+    /// For [`Layout::Cells`], the grid's name (`Display` adds v360's strings).
     pub fn name(self) -> &'static str {
-        Choice::name(self)
+        match self {
+            Layout::Cells(c) if c == CubeCells::EAC => "eac",
+            Layout::Cells(c) => c.grid.name(),
+            _ => Choice::name(self),
+        }
     }
 }
 
 impl fmt::Display for Layout {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        match self {
+            Layout::Cells(c) => c.fmt(f),
+            _ => f.write_str(self.name()),
+        }
     }
 }
 
 impl FromStr for Layout {
     type Err = String;
+    /// A layout's name; v360's `c3x2`, `c6x1` and `c1x6` take v360's strings after it:
+    /// `c3x2:forder=lfrdbu:frot=000313` (`pad=0` is accepted; no other padding yet).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Layout::parse_name(s).map_err(|e| format!("unknown layout '{s}' (known: {})", e.list()))
+        let (head, opts) = s.split_once(':').unwrap_or((s, ""));
+        let layout = Layout::parse_name(head)
+            .map_err(|e| format!("unknown layout '{head}' (known: {})", e.list()))?;
+        match layout {
+            _ if opts.is_empty() => Ok(layout),
+            Layout::Cells(c) if c != CubeCells::EAC => CubeCells::parse(c.grid, opts)
+                .map(Layout::Cells)
+                .map_err(|e| format!("layout '{s}': {e}")),
+            _ => Err(format!(
+                "layout '{s}': {head} takes no options (forder, frot and pad are for c3x2, c6x1, c1x6)"
+            )),
+        }
     }
+}
+
+/// [`Layout::pack`] for v360's cells: each face texel moved to its cell, then (for `eac`)
+/// the border looked up.
+fn pack_cells(cells: &CubeCells, env: &EnvMap) -> Image {
+    let n = env.width();
+    let (w, h) = cells.extent(n);
+    let ch = env.channels();
+    let mut out = Image::new(w, h, ch);
+    let layers = env.layers();
+    let mut inside = vec![!cells.eac_pad; if cells.eac_pad { (w * h) as usize } else { 0 }];
+    cells.each_texel(n, |i, px, py, fx, fy| {
+        out.set(px, py, layers[cells.faces[i] as usize].get(fx, fy));
+        if cells.eac_pad {
+            inside[(py * w + px) as usize] = true;
+        }
+    });
+    if cells.eac_pad {
+        let p = env.projection();
+        for py in 0..h {
+            for px in 0..w {
+                if !inside[(py * w + px) as usize] {
+                    let v = env.sample(cells.border_dir(p, n, px, py));
+                    out.set(px, py, &v[..ch]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// [`Layout::unpack`] for v360's cells.
+fn unpack_cells(
+    cells: &CubeCells,
+    image: &Image,
+    projection: Projection,
+) -> Result<EnvMap, String> {
+    let (w, h) = (image.width(), image.height());
+    let n = cells.face_size(w, h).ok_or_else(|| {
+        let (a, b) = cells.extent(1);
+        let shape = if cells.eac_pad {
+            "(3n + 4)x(2n + 8) for faces of n texels".to_string()
+        } else {
+            format!("{}n x {}n", a, b)
+        };
+        format!("a {cells} layout needs a picture of {shape}; {w}x{h} is not")
+    })?;
+    let mut faces = vec![Image::new(n, n, image.channels()); 6];
+    cells.each_texel(n, |i, px, py, fx, fy| {
+        faces[cells.faces[i] as usize].set(fx, fy, image.get(px, py));
+    });
+    EnvMap::new(projection, faces).map_err(|e| e.to_string())
 }
 
 /// A guess at projection and layout from a picture's size (and a declared projection, such
@@ -286,4 +704,98 @@ pub fn guess(w: u32, h: u32, declared: Option<ProjectionKind>) -> Option<Guess> 
         );
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::projection::CubeMap;
+
+    /// A cube whose every texel holds its own (face, x, y), so any misplacement shows.
+    fn labelled(n: u32) -> EnvMap {
+        let faces = (0..6)
+            .map(|f| {
+                let mut img = Image::new(n, n, 3);
+                for y in 0..n {
+                    for x in 0..n {
+                        img.set(x, y, &[f as f32, x as f32, y as f32]);
+                    }
+                }
+                img
+            })
+            .collect();
+        EnvMap::new(Projection::Cube(CubeMap), faces).unwrap()
+    }
+
+    #[test]
+    fn cells_pack_and_unpack_with_every_turn_and_order() {
+        let env = labelled(5);
+        for grid in [CellGrid::C3x2, CellGrid::C6x1, CellGrid::C1x6] {
+            for turn in 0..4u8 {
+                let mut cells = CubeCells::v360(grid);
+                cells.turns = [turn, (turn + 1) % 4, (turn + 2) % 4, turn, 3 - turn, 1];
+                cells.faces.rotate_left(turn as usize);
+                let layout = Layout::Cells(cells);
+                let img = layout.pack(&env).unwrap();
+                assert_eq!((img.width(), img.height()), cells.extent(5));
+                assert_eq!(
+                    Layout::from_extent(img.width(), img.height(), 6).map(|l| l.1),
+                    Some(5)
+                );
+                assert_eq!(layout.unpack(&img, *env.projection()).unwrap(), env);
+                // The text reads back as the same layout.
+                assert_eq!(layout.to_string().parse::<Layout>().unwrap(), layout);
+            }
+        }
+        let img = Layout::eac().pack(&env).unwrap();
+        assert_eq!((img.width(), img.height()), (3 * 5 + 4, 2 * 5 + 8));
+        assert_eq!(Layout::eac().unpack(&img, *env.projection()).unwrap(), env);
+    }
+
+    #[test]
+    fn a_turned_cell_shows_its_face_turned_clockwise() {
+        // v360's ROT_90 (`frot` 1) in `cube_to_xyz`: cell (c, d) shows face (d, −c) before
+        // the mirror, so the face's top row lands in the cell's right column.
+        let env = labelled(4);
+        let mut cells = CubeCells::v360(CellGrid::C6x1);
+        cells.turns[4] = 1; // cell 4 holds front, −Z
+        let img = Layout::Cells(cells).pack(&env).unwrap();
+        // Unturned, −Z's cell is mirrored left to right: cell x shows face x' = 3 − x.
+        let plain = Layout::Cells(CubeCells::v360(CellGrid::C6x1))
+            .pack(&env)
+            .unwrap();
+        assert_eq!(plain.get(16, 1), &[5.0, 3.0, 1.0]);
+        // Turned: the mirrored face's top row (t = 0) runs down the cell's right column.
+        for y in 0..4 {
+            let px = img.get(16 + 3, y);
+            assert_eq!((px[0], px[2]), (5.0, 0.0), "row {y}");
+        }
+    }
+
+    #[test]
+    fn bad_cell_strings_are_refused_by_name() {
+        for (s, says) in [
+            ("c3x2:forder=rludfx", "'x' is not a face letter"),
+            ("c3x2:forder=rrudfb", "appears twice"),
+            ("c3x2:forder=rlud", "six face letters"),
+            ("c6x1:frot=0005", "six digits 0-3"),
+            ("c6x1:frot=000004", "six digits 0-3"),
+            ("c1x6:pad=0.9", "outside 0 to 0.1"),
+            ("c1x6:pad=NaN", "outside 0 to 0.1"),
+            ("c1x6:pad=x", "not a number"),
+            ("c3x2:spin=1", "unknown option 'spin'"),
+            ("eac:frot=000000", "takes no options"),
+            ("hcross:frot=000000", "takes no options"),
+        ] {
+            let e = s.parse::<Layout>().unwrap_err();
+            assert!(e.contains(says), "{s}: {e}");
+        }
+        assert_eq!(
+            "c3x2:forder=rludfb:frot=000000:pad=0"
+                .parse::<Layout>()
+                .unwrap(),
+            Layout::Cells(CubeCells::v360(CellGrid::C3x2))
+        );
+        assert_eq!("eac".parse::<Layout>().unwrap().to_string(), "eac");
+    }
 }

@@ -37,13 +37,14 @@ pub use envmap::{
 };
 pub use fault::Fault;
 pub use image::Image;
-pub use layout::{guess, Guess, Layout};
+pub use layout::{guess, CellGrid, CubeCells, Guess, Layout};
 pub use projection::{
     AngularMap, ContinuousCube, CubeFace, CubeMap, Cylinder, CylinderRule, DirRun, DualParaboloid,
-    EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,
+    Eac, EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,
     Octahedral, Projection, ProjectionKind, RadialMap, Sinusoidal, SphereMap, UnknownProjection,
     View, WorldProjection,
 };
+pub use projection::{DualFisheye, FisheyeLens, LensModel};
 pub use remap::{Remap, RemapError, RemapRows};
 pub use resample::{resample, resample_to_extent, Axis, ResampleOptions, Resampler, Rotation};
 

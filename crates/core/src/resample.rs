@@ -158,16 +158,24 @@ const BILINEAR_MAX_RATIO: f64 = 4.0;
 /// resampler's lookups alone: each 2×2 block weighted by the density at the texel centres
 /// (cheap, and exact enough for a bilinear read). `mirrorball-filter`'s `MipChain` is the
 /// public, energy-exact pyramid (exact texel solid angles, odd sizes split fractionally).
+///
+/// Its base is the source's layers, or what [`WorldProjection::blend_overlap`] makes of them
+/// (a dual fisheye's overlap blended): every lookup of the resampler and of `Remap` reads
+/// here, so the blend reaches them all and no other projection's reads change.
 pub(crate) struct Pyramid<'a> {
-    base: &'a [Image],
+    base: std::borrow::Cow<'a, [Image]>,
     levels: Vec<Vec<Image>>,
 }
 
 impl<'a> Pyramid<'a> {
     pub(crate) fn new(src: &'a EnvMap, depth: usize) -> Pyramid<'a> {
+        let base = match src.projection().blend_overlap(src.layers()) {
+            Some(blended) => std::borrow::Cow::Owned(blended),
+            None => std::borrow::Cow::Borrowed(src.layers()),
+        };
         let mut levels: Vec<Vec<Image>> = Vec::new();
         for _ in 0..depth {
-            let prev = levels.last().map(|l| l.as_slice()).unwrap_or(src.layers());
+            let prev = levels.last().map(|l| l.as_slice()).unwrap_or(&base);
             if prev[0].width() == 1 && prev[0].height() == 1 {
                 break;
             }
@@ -178,16 +186,13 @@ impl<'a> Pyramid<'a> {
                 .collect();
             levels.push(next);
         }
-        Pyramid {
-            base: src.layers(),
-            levels,
-        }
+        Pyramid { base, levels }
     }
 
     #[inline]
     pub(crate) fn level(&self, l: usize) -> &[Image] {
         if l == 0 || self.levels.is_empty() {
-            self.base
+            &self.base
         } else {
             &self.levels[(l - 1).min(self.levels.len() - 1)]
         }

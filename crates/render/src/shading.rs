@@ -12,6 +12,9 @@ use mirrorball_core::{EnvMap, SphereMap};
 pub const PHONG_MAP_SIZE: u32 = 256;
 
 /// What a material reads besides the environment itself.
+// Made once a scene; its maps' projections (up to a dual fisheye's few hundred bytes) make
+// the variants differ in size, which costs nothing here.
+#[allow(clippy::large_enum_variant)]
 pub(crate) enum MaterialMaps {
     /// Nothing.
     None,

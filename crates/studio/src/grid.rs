@@ -8,8 +8,9 @@
 //! direction and, where a seam makes two answers right, the texture coordinates it was made
 //! from.
 //!
-//! The payload, little-endian: `u32` count, the disk maps' frame (nine `f32`, column-major,
-//! as the page's `uFrame`; zeros for other maps), then per direction nine `f32`: the direction,
+//! The payload, little-endian: `u32` count, the map's frame (nine `f32`, column-major, as
+//! the page's `uFrame`; zeros for maps without one), its `uParams` (four `f32`,
+//! `state::params_of`), then per direction nine `f32`: the direction,
 //! the core's `(u, v, layer)` (layer −1 where the map does not cover it), and the
 //! generating `(u, v, layer)`.
 
@@ -28,7 +29,14 @@ pub fn encode(p: &Projection, n: u32) -> Vec<u8> {
                 points.push((layer, DVec2::new(i as f64 / n as f64, j as f64 / n as f64)));
             }
         }
-        if matches!(p, Projection::Sphere(_) | Projection::Paraboloid(_)) {
+        if matches!(
+            p,
+            Projection::Sphere(_)
+                | Projection::Paraboloid(_)
+                | Projection::Angular(_)
+                | Projection::Fisheye(_)
+                | Projection::Hammer(_)
+        ) {
             for k in 0..4 * n {
                 let a = std::f64::consts::TAU * k as f64 / (4 * n) as f64;
                 for r in [1.0, 1.0 - 1e-6, 1.0 - 1e-3] {
@@ -38,10 +46,10 @@ pub fn encode(p: &Projection, n: u32) -> Vec<u8> {
             }
         }
     }
-    let mut out = Vec::with_capacity(40 + points.len() * 36);
+    let mut out = Vec::with_capacity(56 + points.len() * 36);
     out.extend_from_slice(&0u32.to_le_bytes());
     let frame = crate::state::frame_of(p).map_or([0.0; 9], |m| m.to_cols_array());
-    for v in frame {
+    for v in frame.into_iter().chain(crate::state::params_of(p)) {
         out.extend_from_slice(&v.to_le_bytes());
     }
     let mut count = 0u32;

@@ -12,6 +12,7 @@
 //! - [`guard`]: who may talk to the server (the token, the Host and Origin headers).
 //! - [`state`]: what is loaded, and what the page is told about it (JSON).
 //! - [`texture`], [`geometry`], [`grid`]: the binary payloads.
+//! - [`lighting`]: the prefiltered GGX chain and the irradiance's SH9.
 //! - [`server`]: the routes.
 //!
 //! Reading files is the embedding program's business ([`Host`]): the `mirrorball` binary
@@ -21,6 +22,7 @@
 pub mod geometry;
 pub mod grid;
 pub mod guard;
+pub mod lighting;
 pub mod server;
 pub mod state;
 pub mod texture;

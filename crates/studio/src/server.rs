@@ -8,11 +8,13 @@
 //! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float` | the environment's texels ([`texture`]) |
 //! | `GET /api/mesh/I` | object `I` in world space ([`geometry`]) |
 //! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
+//! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
+//! | `GET /api/lighting/progress` | `{"done", "total", "busy"}`: rows of the prefilter running |
 //! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit) |
 
 use crate::guard::Guard;
 use crate::state::{gpu_kind, State};
-use crate::{geometry, grid, texture, web, Host};
+use crate::{geometry, grid, lighting, texture, web, Host};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State as Shared};
@@ -26,6 +28,7 @@ use mirrorball_core::{resample, EnvMap, ResampleOptions};
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// How to start the studio.
@@ -88,6 +91,17 @@ struct App {
     options: Studio,
     /// The last conversion asked for, by its query.
     converted: Mutex<Option<(String, Arc<EnvMap>)>>,
+    /// The last prefiltered lighting, by its request, and the running one's progress.
+    lit: Mutex<Option<(String, Arc<Vec<u8>>)>>,
+    lit_progress: Progress,
+}
+
+/// Rows done of the prefilter running, of how many.
+#[derive(Default)]
+struct Progress {
+    done: Arc<AtomicU64>,
+    total: AtomicU64,
+    busy: AtomicBool,
 }
 
 type AppState = Arc<App>;
@@ -116,6 +130,8 @@ impl Studio {
             },
             options: self.clone(),
             converted: Mutex::new(None),
+            lit: Mutex::new(None),
+            lit_progress: Progress::default(),
         });
         let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
         let thread = std::thread::Builder::new()
@@ -153,6 +169,8 @@ fn serve(
             .route("/api/environment", get(environment))
             .route("/api/mesh/{i}", get(mesh))
             .route("/api/grid", get(grid_of))
+            .route("/api/lighting", get(lighting_of))
+            .route("/api/lighting/progress", get(lighting_progress))
             .route(
                 "/api/upload",
                 post(upload).layer(DefaultBodyLimit::max(limit)),
@@ -235,16 +253,20 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
     };
     let projection = q.projection.unwrap_or_else(|| "native".into());
     let work = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, (StatusCode, String)> {
-        let map = if projection == "native" {
-            map
-        } else {
+        let map = if projection != "native" {
             convert(&app, &map, &projection, q.size)?
+        } else if gpu_kind(map.projection()).is_none() {
+            // A projection without a shader (the dual fisheye) is drawn from its exact
+            // lat-long conversion; the header's kind says so.
+            convert(&app, &map, "latlong", q.size)?
+        } else {
+            map
         };
         if gpu_kind(map.projection()).is_none() {
             return Err((
                 StatusCode::UNPROCESSABLE_ENTITY,
                 format!(
-                    "the viewport does not draw {} maps yet (latlong, cube, sphere, paraboloid)",
+                    "the viewport does not draw {} maps",
                     map.projection().name()
                 ),
             ));
@@ -286,6 +308,67 @@ fn convert(
     let out = Arc::new(resample(map, p, size, &ResampleOptions::default()));
     *app.converted.lock().expect("cache") = Some((key, out.clone()));
     Ok(out)
+}
+
+#[derive(Deserialize)]
+struct LightingQuery {
+    size: Option<u32>,
+    mapping: Option<String>,
+}
+
+/// The environment prefiltered, on a blocking thread (the server keeps answering, the page
+/// keeps drawing); one prefilter at a time, the last result kept.
+async fn lighting_of(Shared(app): Shared<AppState>, Query(q): Query<LightingQuery>) -> Response {
+    let (size, mapping) = match lighting::request(q.size, q.mapping.as_deref()) {
+        Ok(r) => r,
+        Err(e) => return bad(StatusCode::BAD_REQUEST, e),
+    };
+    let map = {
+        let s = app.state.lock().expect("state");
+        match &s.view.scene.environment {
+            Some(e) => e.map.clone(),
+            None => return bad(StatusCode::NOT_FOUND, "no environment is loaded"),
+        }
+    };
+    let key = format!("{:p} {size} {}", Arc::as_ptr(&map), mapping.name());
+    if let Some((k, b)) = app.lit.lock().expect("lit").as_ref() {
+        if *k == key {
+            return binary(b.to_vec());
+        }
+    }
+    let p = &app.lit_progress;
+    if p.busy.swap(true, Ordering::SeqCst) {
+        return bad(
+            StatusCode::CONFLICT,
+            "a prefilter is already running: ask again when it is done",
+        );
+    }
+    p.done.store(0, Ordering::SeqCst);
+    p.total.store(lighting::rows(size), Ordering::SeqCst);
+    let done = p.done.clone();
+    let work = tokio::task::spawn_blocking(move || {
+        lighting::encode(&lighting::prefilter(&map, size, mapping, done))
+    })
+    .await;
+    p.busy.store(false, Ordering::SeqCst);
+    match work {
+        Ok(b) => {
+            let b = Arc::new(b);
+            *app.lit.lock().expect("lit") = Some((key, b.clone()));
+            binary(b.to_vec())
+        }
+        Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+    }
+}
+
+async fn lighting_progress(Shared(app): Shared<AppState>) -> Response {
+    let p = &app.lit_progress;
+    Json(serde_json::json!({
+        "done": p.done.load(Ordering::SeqCst),
+        "total": p.total.load(Ordering::SeqCst),
+        "busy": p.busy.load(Ordering::SeqCst),
+    }))
+    .into_response()
 }
 
 async fn mesh(Shared(app): Shared<AppState>, UrlPath(i): UrlPath<usize>) -> Response {

@@ -1,7 +1,7 @@
 //! What the studio has loaded, and what the page is told about it.
 
 use mirrorball_core::glam::{DVec3, Mat3};
-use mirrorball_core::{Choice, EnvMap, Projection};
+use mirrorball_core::{Choice, CylinderRule, EnvMap, Frame, Lens, Projection, RadialMap};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{
     Attach, Camera, CameraLens, Environment, Indexing, Material, Scene, Settings,
@@ -177,38 +177,102 @@ pub fn describe_map(map: &EnvMap) -> Value {
         "spec": p.to_string(),
         "gpu": gpu_kind(p).is_some(),
         "frame": frame_of(p).map(|m| m.to_cols_array().to_vec()),
+        "params": params_of(p),
         "layers": map.layers().len(),
         "width": map.width(),
         "height": map.height(),
     })
 }
 
-/// The projections the viewport's shaders know (`web/glsl/NAME.glsl`).
+/// The projections the viewport's shaders know, by the name the page loads their GLSL under
+/// (`gl.js` `projectionSource`: `web/glsl/`, one file per projection's direction → uv).
 pub fn gpu_kind(p: &Projection) -> Option<&'static str> {
     match p {
-        Projection::LatLong(_) => Some("latlong"),
-        Projection::Cube(_) => Some("cube"),
-        Projection::Sphere(_) => Some("sphere"),
-        Projection::Paraboloid(_) => Some("paraboloid"),
-        _ => None,
+        Projection::LatLong(_)
+        | Projection::Cube(_)
+        | Projection::Sphere(_)
+        | Projection::Paraboloid(_)
+        | Projection::ContinuousCube(_)
+        | Projection::Mercator(_)
+        | Projection::Angular(_)
+        | Projection::Fisheye(_)
+        | Projection::Octahedral(_)
+        | Projection::EqualAreaOctahedral(_)
+        | Projection::Cylinder(_)
+        | Projection::Hammer(_)
+        | Projection::Sinusoidal(_)
+        | Projection::View(_)
+        | Projection::Eac(_) => Some(p.name()),
+        // Two lenses with their own centres, rolls and distortion: the server sends the
+        // page a lat-long conversion of it instead (server.rs `texture`).
+        Projection::DualFisheye(_) => None,
     }
 }
 
-/// The frame of a disk map's layer 0 as the columns (right, up, axis), where the shader's
-/// `radial.glsl` measures angles from the axis: a sphere map's centre looks against its
-/// camera's view (core `SphereMap::new`), a paraboloid's front half along its `look`.
+/// The frame the shader measures a map's directions in, as the columns (right, up, axis):
+/// a sphere map's centre looks against its camera's view (core `SphereMap::new`), a
+/// paraboloid's front half, an angular map's or a fisheye's centre along its `look`, a
+/// view's centre along its forward axis (`View::frame_of`).
 pub fn frame_of(p: &Projection) -> Option<Mat3> {
     let cols =
         |r: DVec3, u: DVec3, f: DVec3| Mat3::from_cols(r.as_vec3(), u.as_vec3(), f.as_vec3());
+    let radial = |f: &Frame| cols(f.right, f.up, f.forward);
     match p {
         Projection::Sphere(s) => {
             let e = s.eye();
             Some(cols(e.right, e.up, -e.forward))
         }
-        Projection::Paraboloid(d) => {
-            let f = d.frame();
-            Some(cols(f.right, f.up, f.forward))
-        }
+        Projection::Paraboloid(d) => Some(radial(d.frame())),
+        Projection::Angular(a) => Some(radial(a.radial().frame())),
+        Projection::Fisheye(f) => Some(radial(f.radial().frame())),
+        Projection::View(v) => Some(radial(v.frame())),
         _ => None,
     }
+}
+
+/// The shader's `uParams` for a map with parameters beyond its frame (zeros otherwise):
+///
+/// | projection | `uParams` |
+/// | --- | --- |
+/// | Mercator | `Y_max`, `tanh Y_max` (= sin φ_max) |
+/// | angular, fisheye | lens (0 equidistant, 1 equisolid, 2 stereographic, 3 orthographic), `k = f(θ_max)`, `cos θ_max` |
+/// | cylinders | rule (0 central, 1 equal-area, 2 equidistant), `2/H`, `1/g(V/2)` |
+/// | views | Pannini's `d`, `1/X_max`, `1/Y_max`, `cos(hfov/2)` |
+pub fn params_of(p: &Projection) -> [f32; 4] {
+    let lens = |m: &RadialMap| {
+        let l = match m.lens() {
+            Lens::Equidistant => 0.0,
+            Lens::Equisolid => 1.0,
+            Lens::Stereographic => 2.0,
+            Lens::Orthographic => 3.0,
+        };
+        [l, m.lens_constant(), m.theta_max().cos(), 0.0]
+    };
+    let v = match p {
+        Projection::Mercator(m) => {
+            let y = m.ordinate_limit();
+            [y, y.tanh(), 0.0, 0.0]
+        }
+        Projection::Angular(a) => lens(a.radial()),
+        Projection::Fisheye(f) => lens(f.radial()),
+        Projection::Cylinder(c) => {
+            let rule = match c.rule() {
+                CylinderRule::Central => 0.0,
+                CylinderRule::EqualArea => 1.0,
+                CylinderRule::Equidistant => 2.0,
+            };
+            [
+                rule,
+                2.0 / c.hfov_deg().to_radians(),
+                1.0 / c.height_scale(),
+                0.0,
+            ]
+        }
+        Projection::View(v) => {
+            let (x, y) = v.plane_extent();
+            [v.distance(), 1.0 / x, 1.0 / y, v.cos_half_hfov()]
+        }
+        _ => [0.0; 4],
+    };
+    v.map(|x| x as f32)
 }

@@ -139,12 +139,7 @@ mod tests {
     #[test]
     fn the_padded_read_is_the_cores_seamless_read() {
         // Texels that name themselves: a tap taken from the wrong texel shows.
-        for kind in [
-            ProjectionKind::LatLong,
-            ProjectionKind::Cube,
-            ProjectionKind::Sphere,
-            ProjectionKind::Paraboloid,
-        ] {
+        for kind in ProjectionKind::ALL {
             let map = indexed(kind, 8);
             let bytes = encode(&map, Precision::Float);
             let n = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;

@@ -30,15 +30,40 @@ export async function glsl(name) {
   return sources.get(name);
 }
 
-/** The projections the shaders know, by the server's name for them. */
-export const KINDS = ['latlong', 'cube', 'sphere', 'paraboloid'];
-const DISKS = new Set(['sphere', 'paraboloid']);
+/**
+ * The GLSL files of each projection's envUv, in order, by the server's name for it
+ * (state.rs `gpu_kind`): math.glsl first, then the shared machines (cube faces, the disks'
+ * radius and lenses), then the projection's own file, one home per formula.
+ */
+const SOURCES = {
+  latlong: ['latlong'],
+  cube: ['cubeface', 'cube'],
+  sphere: ['radial', 'lens', 'sphere'],
+  paraboloid: ['radial', 'lens', 'paraboloid'],
+  'continuous-cube': ['cubeface', 'continuous_cube'],
+  eac: ['cubeface', 'eac'],
+  mercator: ['mercator'],
+  angular: ['radial', 'lens', 'fisheye'],
+  fisheye: ['radial', 'lens', 'fisheye'],
+  octahedral: ['octahedral'],
+  'equal-area-octahedral': ['equal_area_octahedral'],
+  cylindrical: ['cylinder'],
+  'cylindrical-equal-area': ['cylinder'],
+  'half-equirect': ['cylinder'],
+  hammer: ['hammer'],
+  sinusoidal: ['sinusoidal'],
+  perspective: ['view'],
+  pannini: ['view'],
+};
 
-/** The GLSL of projection `kind`'s envUv (with the disk maps' shared machine). */
+/** The projections the shaders know, by the server's name for them. */
+export const KINDS = Object.keys(SOURCES);
+
+/** The GLSL of projection `kind`'s envUv (with math.glsl and the machines it uses). */
 export async function projectionSource(kind) {
   if (!KINDS.includes(kind)) throw new Error(`the viewport does not draw ${kind} maps`);
-  const own = await glsl(`${kind}.glsl`);
-  return DISKS.has(kind) ? (await glsl('radial.glsl')) + '\n' + own : own;
+  const parts = await Promise.all(['math', ...SOURCES[kind]].map((f) => glsl(`${f}.glsl`)));
+  return parts.join('\n');
 }
 
 /** An environment payload (texture.rs): its JSON header and texels. */
@@ -93,11 +118,12 @@ export function parseMesh(buffer) {
   };
 }
 
-/** A grid payload (grid.rs): count, the frame, and nine floats a direction. */
+/** A grid payload (grid.rs): count, the frame, the parameters, and nine floats a direction. */
 export function parseGrid(buffer) {
   const count = new DataView(buffer).getUint32(0, true);
   const frame = Array.from(new Float32Array(buffer, 4, 9));
-  return { count, frame, values: new Float32Array(buffer, 40, 9 * count) };
+  const params = Array.from(new Float32Array(buffer, 40, 4));
+  return { count, frame, params, values: new Float32Array(buffer, 56, 9 * count) };
 }
 
 /** The viewport's vertex attributes, in the order of `triangleVertices`' floats. */
@@ -131,7 +157,7 @@ export function triangleVertices(mesh) {
   return out;
 }
 
-const HEADER = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2DArray;\n';
+export const HEADER = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2DArray;\n';
 
 function compile(gl, type, source) {
   const s = gl.createShader(type);
@@ -194,10 +220,11 @@ export async function viewportProgram(gl, { kind, layers, mode, background }) {
 }
 
 /**
- * Runs projection `kind`'s envUv (frame `frame`: 9 numbers, column-major, for disk maps) on
- * `dirs` (3 floats each) in a float render target; returns (u, v, layer) per direction.
+ * Runs projection `kind`'s envUv (frame `frame`: 9 numbers, column-major; `params`: its
+ * uParams, 4 numbers) on `dirs` (3 floats each) in a float render target; returns
+ * (u, v, layer) per direction.
  */
-export async function envUvOnGpu(gl, kind, frame, dirs) {
+export async function envUvOnGpu(gl, kind, frame, params, dirs) {
   if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('no EXT_color_buffer_float');
   const count = dirs.length / 3;
   const width = Math.min(count, 1024);
@@ -231,6 +258,7 @@ export async function envUvOnGpu(gl, kind, frame, dirs) {
   gl.bindTexture(gl.TEXTURE_2D, src);
   gl.uniform1i(gl.getUniformLocation(p, 'uDirs'), 0);
   if (frame) gl.uniformMatrix3fv(gl.getUniformLocation(p, 'uFrame'), false, new Float32Array(frame));
+  if (params) gl.uniform4fv(gl.getUniformLocation(p, 'uParams'), new Float32Array(params));
   gl.viewport(0, 0, width, height);
   gl.drawArrays(gl.TRIANGLES, 0, 3);
   const out = new Float32Array(width * height * 4);
@@ -246,10 +274,10 @@ export async function envUvOnGpu(gl, kind, frame, dirs) {
  */
 export async function checkProjection(gl, { kind, spec, n = 64, tolerance = 1e-4 }) {
   const buf = await (await api(`/api/grid?projection=${encodeURIComponent(spec)}&n=${n}`)).arrayBuffer();
-  const { count, frame, values } = parseGrid(buf);
+  const { count, frame, params, values } = parseGrid(buf);
   const dirs = new Float32Array(3 * count);
   for (let i = 0; i < count; i++) dirs.set(values.subarray(9 * i, 9 * i + 3), 3 * i);
-  const got = await envUvOnGpu(gl, kind, frame, dirs);
+  const got = await envUvOnGpu(gl, kind, frame, params, dirs);
   let worst = 0;
   let worstAt = null;
   let seams = 0;

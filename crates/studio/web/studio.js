@@ -145,11 +145,17 @@ function camera() {
   return { eye, view: lookAt(eye, t, c.up) };
 }
 
-async function draw() {
+/**
+ * Draws the scene; `pass` (the simulator's, sim.js) may draw it into `framebuffer` with
+ * `program(background)` instead of the viewport's, clear to `clear`, leave the background
+ * out (`background: false`) and draw each mesh itself (`drawMesh(mesh)`).
+ */
+async function draw(pass = {}) {
   const s = view.state.scene;
   const c = s.camera;
+  gl.bindFramebuffer(gl.FRAMEBUFFER, pass.framebuffer ?? null);
   gl.viewport(0, 0, canvas.width, canvas.height);
-  gl.clearColor(0, 0, 0, 0);
+  gl.clearColor(...(pass.clear ?? [0, 0, 0, 0]));
   gl.clearDepth(1);
   gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
   if (!view.env) return;
@@ -175,6 +181,7 @@ async function draw() {
     gl.uniform3fv(u('uForward'), forward);
     gl.uniform1i(u('uAttachEye'), env.attach === 'eye' ? 1 : 0);
     if (h.frame) gl.uniformMatrix3fv(u('uFrame'), false, new Float32Array(h.frame));
+    if (h.params) gl.uniform4fv(u('uParams'), new Float32Array(h.params));
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, view.env.texture);
     gl.uniform1i(u('uEnv'), 0);
@@ -187,27 +194,38 @@ async function draw() {
     gl.uniform2f(u('uViewportSize'), canvas.width, canvas.height);
     return u;
   };
-  if (s.background) {
+  const programOf = pass.program ?? program;
+  if (s.background && pass.background !== false) {
     gl.disable(gl.DEPTH_TEST);
-    setCommon(await program(true));
+    setCommon(await programOf(true));
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
   gl.enable(gl.DEPTH_TEST);
   gl.depthFunc(gl.LESS);
-  const u = setCommon(await program(false));
+  const u = setCommon(await programOf(false));
   for (const m of view.meshes) {
     gl.uniform3fv(u('uTint'), m.material.tint);
     gl.bindVertexArray(m.vao);
-    gl.drawArrays(gl.TRIANGLES, 0, m.vertices);
+    if (pass.drawMesh) pass.drawMesh(m);
+    else gl.drawArrays(gl.TRIANGLES, 0, m.vertices);
   }
   gl.bindVertexArray(null);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
 }
+
+/** Called after each redraw of the viewport (the simulator's update). */
+const afterDraw = [];
 
 let drawing = null;
 /** Draws (one draw at a time; a request while drawing draws again after it). */
 function redraw() {
-  drawing = (drawing || Promise.resolve()).then(draw).catch(report);
+  drawing = (drawing || Promise.resolve())
+    .then(async () => {
+      await draw();
+      for (const f of afterDraw) await f();
+    })
+    .catch(report);
   return drawing;
 }
 
@@ -310,4 +328,9 @@ const ready = (async () => {
 })();
 ready.catch(report);
 
-window.studio = { ready, redraw, pixels, view, gl, G };
+const handle = { ready, redraw, pixels, view, gl, G, draw, camera, afterDraw, canvas, embed, program };
+// The simulator panel and the view state in the URL (sim.js); `ready` waits for both.
+const sim = await import(`./sim.js?token=${encodeURIComponent(token)}`);
+handle.sim = sim.attach(handle);
+handle.ready = ready.then(() => handle.sim.ready);
+window.studio = handle;

@@ -117,7 +117,7 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                 let out = resample(&src, proj, size, &opts);
                 let secs = t.elapsed().as_secs_f64();
                 let name = kind.name();
-                let layout = save::default_layout(proj.layer_count());
+                let layout = mirrorball_core::Layout::default_for(proj.kind());
                 let save_opts = |w: WriteOptions| SaveOptions {
                     layout: Some(layout),
                     write: w,

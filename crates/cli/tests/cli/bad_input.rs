@@ -234,3 +234,38 @@ fn an_unwritable_face_is_named_and_leaves_no_temporary_files() {
     let left = files(dir.path());
     assert!(left.iter().all(|n| !n.contains(".tmp")), "{left:?}");
 }
+
+/// A dual fisheye's bad lens: the key and the problem, exit status 2 (the request), nothing
+/// written.
+#[test]
+fn dual_fisheye_bad_lenses() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = asset("city.exr");
+    let s = s.to_str().unwrap();
+    let out = dir.path().join("a.exr");
+    let o = out.to_str().unwrap();
+    for (spec, says) in [
+        ("dfisheye:fov=400", &["fov=400", "over 360"][..]),
+        ("dfisheye:back-fov=0", &["back lens", "fov=0"]),
+        ("dfisheye:fov=nan", &["'nan' is not a number"]),
+        (
+            "dfisheye:front=1.5,0.5,-0.5",
+            &["front lens", "radius -0.5"],
+        ),
+        ("dfisheye:front=4,0.5,0.5", &["front lens", "outside"]),
+        (
+            "dfisheye:fov=220:k=0,-0.3",
+            &["k=0,-0.3", "stops increasing"],
+        ),
+    ] {
+        for args in [
+            ["convert", s, o, "--to", spec, "--size", "64"],
+            ["convert", s, o, "--from", spec, "--to", "latlong"],
+        ] {
+            let e = fails(&args, says);
+            let code = run(&args).status.code();
+            assert_eq!(code, Some(2), "{spec}: {e}");
+        }
+    }
+    assert!(files(dir.path()).is_empty());
+}

@@ -16,3 +16,4 @@ mod roundtrip;
 mod safety;
 mod util;
 mod v360;
+mod zoneplate;

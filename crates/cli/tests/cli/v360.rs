@@ -10,7 +10,10 @@
 //!   found by decoding its output, up to half a pixel off at the edges): the picture handed
 //!   to ffmpeg is coded at those positions (the same mirrorball projection evaluated at
 //!   `uv = (i/(w − 1), j/(h − 1))`), the one handed to mirrorball at the texel centres, so
-//!   that each tool is given the panorama it believes it reads.
+//!   that each tool is given the panorama it believes it reads. Its `dfisheye` input is
+//!   read another way (`xyz_to_dfisheye`: pixel `i` of a half `ew` wide at `2i/ew − 1`, its
+//!   top-left corner), so a dual fisheye is coded at `uv = (i/w, j/h)`;
+//! - a dual fisheye's texels outside both circles are coded with the nearest rim's direction.
 //!
 //! Skipped, loudly, where no `ffmpeg` is on the PATH (CI installs it).
 use crate::util::ok;
@@ -20,7 +23,7 @@ use mirrorball_core::{Projection, WorldProjection};
 use std::path::Path;
 use std::process::Command;
 
-fn have_ffmpeg() -> bool {
+pub(crate) fn have_ffmpeg() -> bool {
     let found = Command::new("ffmpeg").arg("-version").output().is_ok();
     if !found {
         eprintln!(
@@ -45,7 +48,8 @@ fn ffmpeg(args: &[&str]) -> Vec<u8> {
     o.stdout
 }
 
-fn code(d: DVec3) -> [u16; 3] {
+/// The 16-bit code of direction `d`: `½ + 0.49·d` of full scale.
+pub(crate) fn code(d: DVec3) -> [u16; 3] {
     d.to_array()
         .map(|c| ((0.5 + 0.49 * c) * 65535.0).round() as u16)
 }
@@ -61,13 +65,17 @@ fn decode(c: [f64; 3]) -> Option<DVec3> {
 /// texel centre, or (`align`) where FFmpeg 5.1 reads it.
 fn write_coded(path: &Path, p: &Projection, w: u32, h: u32, align: bool) {
     let mut raw = Vec::with_capacity((w * h * 6) as usize);
+    let dfisheye = matches!(p, Projection::DualFisheye(_));
     for y in 0..h {
         for x in 0..w {
-            let uv = if align {
+            let uv = if align && dfisheye {
+                DVec2::new(x as f64 / w as f64, y as f64 / h as f64)
+            } else if align {
                 DVec2::new(x as f64 / (w - 1) as f64, y as f64 / (h - 1) as f64)
             } else {
                 DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64)
             };
+            let uv = p.nearest_covered(0, uv);
             let d = p.uv_to_dir(0, uv).expect("a direction at every texel");
             for c in code(d) {
                 raw.extend_from_slice(&c.to_le_bytes());
@@ -260,6 +268,24 @@ fn projections_land_where_v360_puts_them() {
             96,
         ),
         e("e:fisheye:h_fov=180:v_fov=180", "fisheye:fov=180", 96),
+        e("e:dfisheye:h_fov=180:v_fov=180", "dfisheye", 128),
+        e("e:dfisheye:h_fov=200:v_fov=200", "dfisheye:fov=200", 128),
+        Case {
+            from: "dfisheye",
+            in_size: (256, 128),
+            v360: "dfisheye:e:ih_fov=180:iv_fov=180",
+            to: "latlong",
+            size: 128,
+        },
+        // Where both lenses see, mirrorball blends them (v360 takes the nearer axis's):
+        // both are codes of about the same direction.
+        Case {
+            from: "dfisheye:fov=200",
+            in_size: (256, 128),
+            v360: "dfisheye:e:ih_fov=200:iv_fov=200",
+            to: "latlong",
+            size: 128,
+        },
         // A photo put back: black (nothing) outside its frustum in both.
         Case {
             from: "perspective:hfov=100:vfov=70",
@@ -271,5 +297,143 @@ fn projections_land_where_v360_puts_them() {
     ];
     for case in &cases {
         compare(dir.path(), case);
+    }
+}
+
+/// One comparison of a packed cube output: `v360=e:OUT` against `mirrorball convert --to TO
+/// --layout LAYOUT --size N` from the same lat-long.
+struct Packed {
+    v360: &'static str,
+    to: &'static str,
+    layout: &'static str,
+    size: u32,
+}
+
+fn compare_packed(dir: &Path, case: &Packed) {
+    let src = ProjectionSpec::parse("latlong")
+        .unwrap()
+        .build(Some((256, 128)))
+        .unwrap();
+    let layout: mirrorball_core::Layout = case.layout.parse().unwrap();
+    let (w, h) = layout.extent(6, case.size, case.size);
+    let (for_mb, for_ff) = (dir.join("in_mb.png"), dir.join("in_ff.png"));
+    write_coded(&for_mb, &src, 256, 128, false);
+    write_coded(&for_ff, &src, 256, 128, true);
+    let filter = format!("v360=e:{}:interp=line:w={w}:h={h}", case.v360);
+    let ff = ffmpeg(&[
+        "-i",
+        for_ff.to_str().unwrap(),
+        "-vf",
+        &filter,
+        "-f",
+        "rawvideo",
+        "-pix_fmt",
+        "rgb48le",
+        "-",
+    ]);
+    assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
+    let out = dir.join("out_mb.png");
+    let size = case.size.to_string();
+    ok(&[
+        "convert",
+        for_mb.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--from",
+        "latlong",
+        "--to",
+        case.to,
+        "--layout",
+        case.layout,
+        "--size",
+        &size,
+        "--precision",
+        "16",
+        "-q",
+    ]);
+    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
+    let img = &mb.layers[0];
+    assert_eq!((img.width(), img.height()), (w, h), "{}", case.layout);
+    let ffd = |x: u32, y: u32| {
+        let k = ((y * w + x) * 6) as usize;
+        decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
+    };
+    let (mut compared, mut worst) = (0, 0.0f64);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let (Some(df), Some(dm)) = (
+                ffd(x, y),
+                decode(
+                    [0, 1, 2]
+                        .map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64)),
+                ),
+            ) else {
+                panic!("{}: texel ({x}, {y}) is black", case.layout);
+            };
+            // One pixel: ffmpeg's own neighbours, leaving out those across a seam between
+            // cells (more than twice as far as the nearest).
+            let near: Vec<f64> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .filter_map(|(dx, dy)| ffd((x as i64 + dx) as u32, (y as i64 + dy) as u32))
+                .map(|n| df.angle_between(n))
+                .collect();
+            let min = near.iter().cloned().fold(f64::INFINITY, f64::min);
+            let tol = near
+                .iter()
+                .cloned()
+                .filter(|&a| a <= 2.0 * min)
+                .fold(0.0, f64::max);
+            let e = df.angle_between(dm);
+            worst = worst.max(e / tol);
+            compared += 1;
+            assert!(
+                e <= tol,
+                "{} {} vs v360=e:{}: texel ({x}, {y}) differs by {:.3}° (a pixel is {:.3}°): \
+                 ffmpeg {df}, mirrorball {dm}",
+                case.to,
+                case.layout,
+                case.v360,
+                e.to_degrees(),
+                tol.to_degrees()
+            );
+        }
+    }
+    eprintln!(
+        "{:>40} {:<40} ↔ v360=e:{:<50} {compared} texels, worst {worst:.3} of a pixel",
+        case.to, case.layout, case.v360
+    );
+}
+
+#[test]
+fn cube_layouts_land_where_v360_puts_them() {
+    if !have_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let p = |v360, to, layout, size| Packed {
+        v360,
+        to,
+        layout,
+        size,
+    };
+    let cases = [
+        p("eac", "eac", "eac", 48),
+        p("c3x2", "cube", "c3x2", 48),
+        p("c6x1", "cube", "c6x1", 32),
+        p("c1x6", "cube", "c1x6", 32),
+        p(
+            "c3x2:out_forder=fbudlr:out_frot=123012",
+            "cube",
+            "c3x2:forder=fbudlr:frot=123012",
+            40,
+        ),
+        p(
+            "c6x1:out_forder=udfblr:out_frot=321032",
+            "cube",
+            "c6x1:forder=udfblr:frot=321032",
+            32,
+        ),
+    ];
+    for case in &cases {
+        compare_packed(dir.path(), case);
     }
 }

@@ -182,6 +182,11 @@ impl RadialMap {
     pub fn lens(&self) -> Lens {
         self.lens
     }
+    /// The lens constant `k = f(θ_max)` (θ_max, sin(θ_max/2), tan(θ_max/2) or sin θ_max):
+    /// `ρ = f(θ)/k`.
+    pub fn lens_constant(&self) -> f64 {
+        self.k
+    }
     /// Half the field of view, radians.
     pub fn theta_max(&self) -> f64 {
         self.theta_max
@@ -273,36 +278,14 @@ impl RadialMap {
     /// Disk coordinates `(a, b)` of unit direction `d`, or `None` beyond θ_max.
     #[inline]
     pub fn dir_to_ab(&self, d: DVec3) -> Option<DVec2> {
-        let l = self.frame.to_local(d);
-        let s = (l.x * l.x + l.y * l.y).sqrt();
-        let theta = s.atan2(l.z);
-        if theta > self.theta_max * (1.0 + 1e-12) {
-            return None;
-        }
-        let rho = self.rho_of_theta(theta);
-        if s > 0.0 {
-            Some(DVec2::new(l.x, l.y) * (rho / s))
-        } else {
-            Some(DVec2::new(rho, 0.0))
-        }
+        dir_to_ab_of(&self.frame, self.theta_max, d, |t| self.rho_of_theta(t))
     }
 
     /// The direction at disk coordinates `(a, b)`; with `extend`, also past the rim as far as
     /// the lens formula goes (θ ≤ π).
     #[inline]
     pub fn ab_to_dir(&self, ab: DVec2, extend: bool) -> Option<DVec3> {
-        let rho = ab.length();
-        if rho > 1.0 + 1e-12 && !extend {
-            return None;
-        }
-        let theta = self.theta_of_rho(rho).min(PI);
-        let (st, ct) = theta.sin_cos();
-        let f = &self.frame;
-        if rho == 0.0 {
-            return Some(f.forward);
-        }
-        let k = st / rho;
-        Some((f.forward * ct + f.right * (ab.x * k) + f.up * (ab.y * k)).normalize())
+        ab_to_dir_of(&self.frame, ab, extend, |r| self.theta_of_rho(r))
     }
 
     #[inline]
@@ -331,44 +314,99 @@ impl RadialMap {
         total.abs()
     }
 
-    /// `∫ H(ρ) dψ` along the segment `p0 → p1`.
-    fn edge_integral(&self, p0: DVec2, p1: DVec2) -> f64 {
-        let e = p1 - p0;
-        let c = p0.perp_dot(e);
-        if c == 0.0 {
-            return 0.0; // radial segment: ψ is constant
-        }
-        // Split at the rim: |p0 + t e|² = 1.
-        let (qa, qb, qc) = (
-            e.length_squared(),
-            2.0 * p0.dot(e),
-            p0.length_squared() - 1.0,
-        );
-        let mut cuts = [0.0, 1.0, 1.0, 1.0];
-        let mut n = 1;
-        let disc = qb * qb - 4.0 * qa * qc;
-        if disc > 0.0 {
-            let sq = disc.sqrt();
-            for t in [(-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)] {
-                if t > 0.0 && t < 1.0 {
-                    cuts[n] = t;
-                    n += 1;
-                }
-            }
-        }
-        cuts[n] = 1.0;
-        let mut s = 0.0;
-        for i in 0..n {
-            let (t0, t1) = (cuts[i], cuts[i + 1]);
-            if t1 > t0 {
-                s += gauss_legendre(t0, t1, |t| {
-                    let p = p0 + e * t;
-                    self.h_over_rho2(p.length_squared())
-                });
-            }
-        }
-        s * c
+    /// `∫ H(ρ) dψ` along the segment `p0 → p1`: summed around a polygon of the `(a, b)`
+    /// plane, its solid angle inside the disk (signed by its orientation).
+    pub(super) fn edge_integral(&self, p0: DVec2, p1: DVec2) -> f64 {
+        edge_integral_of(p0, p1, |r2| self.h_over_rho2(r2))
     }
+}
+
+/// The disk coordinates `(a, b)` of unit direction `d` for a lens looking along `frame` whose
+/// radius at angle θ from its axis is `rho_of_theta(θ)`, or `None` beyond `theta_max`: the
+/// radius in the direction of `d`'s azimuth. [`RadialMap`] and the dual fisheye's lenses
+/// share it.
+#[inline]
+pub(super) fn dir_to_ab_of(
+    frame: &Frame,
+    theta_max: f64,
+    d: DVec3,
+    rho_of_theta: impl Fn(f64) -> f64,
+) -> Option<DVec2> {
+    let l = frame.to_local(d);
+    let s = (l.x * l.x + l.y * l.y).sqrt();
+    let theta = s.atan2(l.z);
+    if theta > theta_max * (1.0 + 1e-12) {
+        return None;
+    }
+    let rho = rho_of_theta(theta);
+    if s > 0.0 {
+        Some(DVec2::new(l.x, l.y) * (rho / s))
+    } else {
+        Some(DVec2::new(rho, 0.0))
+    }
+}
+
+/// The inverse of [`dir_to_ab_of`], with `theta_of_rho` the lens's inverse; past the unit
+/// rim only with `extend` (θ clamped to π).
+#[inline]
+pub(super) fn ab_to_dir_of(
+    frame: &Frame,
+    ab: DVec2,
+    extend: bool,
+    theta_of_rho: impl Fn(f64) -> f64,
+) -> Option<DVec3> {
+    let rho = ab.length();
+    if rho > 1.0 + 1e-12 && !extend {
+        return None;
+    }
+    let theta = theta_of_rho(rho).min(PI);
+    let (st, ct) = theta.sin_cos();
+    let f = frame;
+    if rho == 0.0 {
+        return Some(f.forward);
+    }
+    let k = st / rho;
+    Some((f.forward * ct + f.right * (ab.x * k) + f.up * (ab.y * k)).normalize())
+}
+
+/// `∫ H(ρ) dψ` along the segment `p0 → p1` of the `(a, b)` plane (the module's Green's
+/// theorem), for a lens whose `H(ρ)/ρ²` is `h_over_rho2(ρ²)`, saturating at the rim.
+pub(super) fn edge_integral_of(p0: DVec2, p1: DVec2, h_over_rho2: impl Fn(f64) -> f64) -> f64 {
+    let e = p1 - p0;
+    let c = p0.perp_dot(e);
+    if c == 0.0 {
+        return 0.0; // radial segment: ψ is constant
+    }
+    // Split at the rim: |p0 + t e|² = 1.
+    let (qa, qb, qc) = (
+        e.length_squared(),
+        2.0 * p0.dot(e),
+        p0.length_squared() - 1.0,
+    );
+    let mut cuts = [0.0, 1.0, 1.0, 1.0];
+    let mut n = 1;
+    let disc = qb * qb - 4.0 * qa * qc;
+    if disc > 0.0 {
+        let sq = disc.sqrt();
+        for t in [(-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)] {
+            if t > 0.0 && t < 1.0 {
+                cuts[n] = t;
+                n += 1;
+            }
+        }
+    }
+    cuts[n] = 1.0;
+    let mut s = 0.0;
+    for i in 0..n {
+        let (t0, t1) = (cuts[i], cuts[i + 1]);
+        if t1 > t0 {
+            s += gauss_legendre(t0, t1, |t| {
+                let p = p0 + e * t;
+                h_over_rho2(p.length_squared())
+            });
+        }
+    }
+    s * c
 }
 
 macro_rules! radial_impl {

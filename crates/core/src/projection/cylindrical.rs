@@ -95,6 +95,11 @@ impl Cylinder {
     pub fn rule(&self) -> CylinderRule {
         self.rule
     }
+    /// `g(V/2)` (tan, sin or the identity of half the vertical field of view): the
+    /// picture height `b = g(φ)/g(V/2)`.
+    pub fn height_scale(&self) -> f64 {
+        self.k
+    }
     /// Horizontal field of view, degrees.
     pub fn hfov_deg(&self) -> f64 {
         self.hfov.to_degrees()

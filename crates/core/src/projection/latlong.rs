@@ -200,6 +200,10 @@ impl Mercator {
         }
     }
 
+    /// The ordinate limit `Y_max = atanh(sin φ_max)`: `v = ½(1 − atanh(sin φ)/Y_max)`.
+    pub fn ordinate_limit(&self) -> f64 {
+        self.y_max
+    }
     /// The latitude limit in degrees.
     pub fn max_latitude_deg(&self) -> f64 {
         self.max_lat.to_degrees()

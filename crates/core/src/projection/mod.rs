@@ -16,6 +16,8 @@ mod continuous_cube;
 mod cube;
 mod cylindrical;
 pub mod derivative;
+mod dual_fisheye;
+mod eac;
 pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
@@ -28,13 +30,15 @@ pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap,
 pub use continuous_cube::ContinuousCube;
 pub use cube::{CubeFace, CubeMap, FaceLanes};
 pub use cylindrical::{Cylinder, CylinderRule};
+pub use dual_fisheye::{DualFisheye, FisheyeLens, LensModel};
+pub use eac::Eac;
 pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
 pub use perspective::View;
 pub use pseudo::{Hammer, Sinusoidal};
 pub use spec::{parse_dir, ProjectionSpec};
 
-use crate::{Choice, UnknownName};
+use crate::{Choice, Image, UnknownName};
 use glam::{DVec2, DVec3};
 use std::fmt;
 use std::str::FromStr;
@@ -236,6 +240,14 @@ pub trait WorldProjection {
             y.clamp(0, h as i64 - 1) as u32,
         )
     }
+
+    /// For reading `layers` (this projection's) as the source of a conversion: where two
+    /// parts of the map see the same directions (a dual fisheye's overlap), the layers with
+    /// those parts blended, which every lookup then reads; `None` (the default: nothing seen
+    /// twice) reads them as they are. Called once per source map, before its lookups.
+    fn blend_overlap(&self, _layers: &[Image]) -> Option<Vec<Image>> {
+        None
+    }
 }
 
 /// The names of the projections, as the command line spells them.
@@ -275,11 +287,15 @@ pub enum ProjectionKind {
     Perspective,
     /// Pannini view.
     Pannini,
+    /// Equi-angular cube map (YouTube's EAC, v360's `eac`).
+    Eac,
+    /// Dual fisheye: two lenses back to back in one 2:1 picture.
+    DualFisheye,
 }
 
 impl ProjectionKind {
     /// Every kind, in the order the documentation lists them.
-    pub const ALL: [ProjectionKind; 17] = [
+    pub const ALL: [ProjectionKind; 19] = [
         ProjectionKind::LatLong,
         ProjectionKind::Cube,
         ProjectionKind::Sphere,
@@ -297,6 +313,8 @@ impl ProjectionKind {
         ProjectionKind::Sinusoidal,
         ProjectionKind::Perspective,
         ProjectionKind::Pannini,
+        ProjectionKind::Eac,
+        ProjectionKind::DualFisheye,
     ];
 
     /// The canonical command-line name (the canonical name of [`Choice`]).
@@ -330,6 +348,8 @@ impl ProjectionKind {
             ProjectionKind::Pannini => {
                 Projection::View(View::pannini(1.0, 120.0, 90.0, 0.0, 0.0, 0.0).expect("valid"))
             }
+            ProjectionKind::Eac => Projection::Eac(Eac),
+            ProjectionKind::DualFisheye => Projection::DualFisheye(DualFisheye::default()),
         }
     }
 }
@@ -420,6 +440,19 @@ impl Choice for ProjectionKind {
             &["perspective", "rectilinear", "flat", "gnomonic"],
         ),
         (ProjectionKind::Pannini, &["pannini", "panini"]),
+        (
+            ProjectionKind::Eac,
+            &[
+                "eac",
+                "equi-angular-cube",
+                "equiangular-cube",
+                "equi-angular-cubemap",
+            ],
+        ),
+        (
+            ProjectionKind::DualFisheye,
+            &["dual-fisheye", "dfisheye", "dualfisheye", "dual_fisheye"],
+        ),
     ];
 }
 
@@ -464,6 +497,9 @@ impl FromStr for ProjectionKind {
 
 /// Any world projection, with its parameters. Implements [`WorldProjection`] by delegating
 /// to the named type inside.
+// The dual fisheye (two lenses, each with its frame) is the largest variant, a few hundred
+// bytes: `Projection` stays `Copy` and is passed by reference in the loops.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
     /// See [`LatLong`].
@@ -495,6 +531,10 @@ pub enum Projection {
     Sinusoidal(Sinusoidal),
     /// See [`View`]: perspective or Pannini.
     View(View),
+    /// See [`Eac`].
+    Eac(Eac),
+    /// See [`DualFisheye`].
+    DualFisheye(DualFisheye),
 }
 
 macro_rules! delegate {
@@ -514,6 +554,8 @@ macro_rules! delegate {
             Projection::Hammer($p) => $e,
             Projection::Sinusoidal($p) => $e,
             Projection::View($p) => $e,
+            Projection::Eac($p) => $e,
+            Projection::DualFisheye($p) => $e,
         }
     };
 }
@@ -541,6 +583,8 @@ impl Projection {
             Projection::Sinusoidal(_) => ProjectionKind::Sinusoidal,
             Projection::View(v) if v.is_pannini() => ProjectionKind::Pannini,
             Projection::View(_) => ProjectionKind::Perspective,
+            Projection::Eac(_) => ProjectionKind::Eac,
+            Projection::DualFisheye(_) => ProjectionKind::DualFisheye,
         }
     }
 
@@ -606,6 +650,9 @@ impl WorldProjection for Projection {
     fn wrap_texel(&self, layer: usize, x: i64, y: i64, w: u32, h: u32) -> (usize, u32, u32) {
         delegate!(self, p => p.wrap_texel(layer, x, y, w, h))
     }
+    fn blend_overlap(&self, layers: &[Image]) -> Option<Vec<Image>> {
+        delegate!(self, p => p.blend_overlap(layers))
+    }
 }
 
 macro_rules! impl_from {
@@ -629,7 +676,9 @@ impl_from!(
     Cylinder(Cylinder),
     Hammer(Hammer),
     Sinusoidal(Sinusoidal),
-    View(View)
+    View(View),
+    Eac(Eac),
+    DualFisheye(DualFisheye)
 );
 
 /// The `[lo, hi]` range in `uv` of texel index `i` of `n`.

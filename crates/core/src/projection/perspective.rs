@@ -112,6 +112,19 @@ impl View {
             * DMat3::from_rotation_z(-roll.to_radians())
     }
 
+    /// Where the view looks: its right, up and forward axes.
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+    /// The picture plane's half extents `(X_max, Y_max)`: `a = X/X_max`, `b = Y/Y_max`.
+    pub fn plane_extent(&self) -> (f64, f64) {
+        (self.x_max, self.y_max)
+    }
+    /// `cos(hfov/2)`: a direction whose view-frame `z < √(x² + z²)·cos(hfov/2)` is not
+    /// covered.
+    pub fn cos_half_hfov(&self) -> f64 {
+        self.cos_half_h
+    }
     /// Whether this is a Pannini view (otherwise rectilinear).
     pub fn is_pannini(&self) -> bool {
         self.pannini

@@ -9,16 +9,26 @@
 //! equirectangular and the views), `d=NUM` (Pannini's distance), `yaw=DEG`, `pitch=DEG` and
 //! `roll=DEG` (where a view looks: yaw to the right, pitch up, as [`View::frame_of`] says).
 //!
+//! The dual fisheye (see [`DualFisheye`]) takes `fov`, `lens` and `look`/`up` (the front
+//! lens's axis) for both lenses, `k=K1,K2,K3,K4` (OpenCV's fisheye coefficients, 1 to 4 of
+//! them: the polynomial model for both lenses), `front=CX,CY,R[,ROLL]` and
+//! `back=CX,CY,R[,ROLL]` (each image circle's centre and radius in units of the picture's
+//! height, its roll in degrees counter-clockwise), and per lens `front-fov`, `front-lens`,
+//! `front-k`, `back-fov`, `back-lens`, `back-k`, which override the shared keys:
+//! `dual-fisheye:fov=200:lens=equisolid`,
+//! `dfisheye:fov=204:k=0.02,-0.004:front=1.49,0.51,0.47,1.5:back=0.5,0.5,0.52`.
+//!
 //! [`Projection::spec`] gives every parameter of a built projection, and its text (the
 //! `Display` of [`ProjectionSpec`] or [`Projection`]) is canonical: the name, then the keys
 //! that apply in the order `fov`, `lens`, `max-lat`, `hfov`, `vfov`, `d`, `yaw`, `pitch`,
-//! `roll`, `look`, `up` (a view's zero angles left out), numbers rounded to 1e-9 (of a
+//! `roll`, the dual fisheye's (`k`, then per lens `fov`, `lens`, `k`, then `front`, `back`),
+//! `look`, `up` (a view's zero angles left out), numbers rounded to 1e-9 (of a
 //! degree, or of a unit vector's component). [`ProjectionSpec::parse`] reads it back to the
 //! same projection, to that rounding.
 
 use super::{
-    AngularMap, Cylinder, CylinderRule, DualParaboloid, Fisheye, Frame, Lens, Mercator, Projection,
-    ProjectionKind, SphereMap, UnknownProjection, View,
+    AngularMap, Cylinder, CylinderRule, DualFisheye, DualParaboloid, Fisheye, FisheyeLens, Frame,
+    Lens, LensModel, Mercator, Projection, ProjectionKind, SphereMap, UnknownProjection, View,
 };
 use crate::Choice;
 use glam::DVec3;
@@ -50,6 +60,61 @@ pub struct ProjectionSpec {
     distance: Option<f64>,
     /// Yaw, pitch, roll.
     aim: [Option<f64>; 3],
+    /// The dual fisheye's polynomial for both lenses.
+    k: Option<[f64; 4]>,
+    /// The dual fisheye's lenses (front, back).
+    lenses: [LensSpec; 2],
+}
+
+/// One dual fisheye lens's keys: `front=`/`back=` and its own `fov`, `lens`, `k`.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct LensSpec {
+    /// Centre x, centre y, radius, roll.
+    place: Option<[f64; 4]>,
+    fov: Option<f64>,
+    lens: Option<Lens>,
+    k: Option<[f64; 4]>,
+}
+
+/// `K1[,K2[,K3[,K4]]]`: OpenCV's fisheye coefficients, those left out zero.
+fn parse_k(key: &str, v: &str) -> Result<[f64; 4], String> {
+    let parts: Vec<Option<f64>> = v
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect();
+    if parts.is_empty() || parts.len() > 4 || parts.iter().any(Option::is_none) {
+        return Err(format!(
+            "{key}={v}: give 1 to 4 numbers k1,k2,k3,k4 (OpenCV's fisheye coefficients)"
+        ));
+    }
+    let mut k = [0.0; 4];
+    for (o, p) in k.iter_mut().zip(parts) {
+        *o = p.unwrap_or(0.0);
+    }
+    Ok(k)
+}
+
+/// `CX,CY,R[,ROLL]`: an image circle in units of the picture's height, its roll in degrees.
+fn parse_place(key: &str, v: &str) -> Result<[f64; 4], String> {
+    let parts: Vec<Option<f64>> = v
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect();
+    if !(3..=4).contains(&parts.len()) || parts.iter().any(Option::is_none) {
+        return Err(format!(
+            "{key}={v}: give cx,cy,r[,roll] (the image circle's centre and radius in picture \
+             heights, its roll in degrees)"
+        ));
+    }
+    let mut out = [0.0; 4];
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = p.unwrap_or(0.0);
+    }
+    Ok(out)
+}
+
+fn parse_lens(v: &str) -> Result<Lens, String> {
+    Lens::parse_name(v).map_err(|e| format!("unknown lens '{v}' (known: {})", e.list()))
 }
 
 /// Parses a direction: `+x`, `-y`, `z`, or three numbers `x,y,z`.
@@ -104,11 +169,19 @@ impl ProjectionSpec {
                 "look" | "dir" | "view" => spec.look = Some(parse_dir(v)?),
                 "up" => spec.up = Some(parse_dir(v)?),
                 "fov" => spec.fov = Some(num(v)?),
-                "lens" => {
-                    spec.lens = Some(
-                        Lens::parse_name(v)
-                            .map_err(|e| format!("unknown lens '{v}' (known: {})", e.list()))?,
-                    )
+                "lens" => spec.lens = Some(parse_lens(v)?),
+                "k" => spec.k = Some(parse_k("k", v)?),
+                key @ ("front" | "back") => {
+                    spec.lenses[(key == "back") as usize].place = Some(parse_place(key, v)?)
+                }
+                key @ ("front-fov" | "back-fov") => {
+                    spec.lenses[key.starts_with("back") as usize].fov = Some(num(v)?)
+                }
+                key @ ("front-lens" | "back-lens") => {
+                    spec.lenses[key.starts_with("back") as usize].lens = Some(parse_lens(v)?)
+                }
+                key @ ("front-k" | "back-k") => {
+                    spec.lenses[key.starts_with("back") as usize].k = Some(parse_k(key, v)?)
                 }
                 "max-lat" | "maxlat" | "lat" => spec.max_lat = Some(num(v)?),
                 "hfov" | "h-fov" | "h_fov" => spec.hfov = Some(num(v)?),
@@ -120,7 +193,8 @@ impl ProjectionSpec {
                 other => {
                     return Err(format!(
                         "unknown option '{other}' in '{s}' (known: look, up, fov, lens, \
-                         max-lat, hfov, vfov, d, yaw, pitch, roll)"
+                         max-lat, hfov, vfov, d, yaw, pitch, roll, k, front, back, front-fov, \
+                         front-lens, front-k, back-fov, back-lens, back-k)"
                     ))
                 }
             }
@@ -135,12 +209,18 @@ impl ProjectionSpec {
         use ProjectionKind as K;
         if spec.look.is_some() || spec.up.is_some() {
             applies(
-                matches!(kind, K::Sphere | K::Angular | K::Fisheye | K::Paraboloid),
+                matches!(
+                    kind,
+                    K::Sphere | K::Angular | K::Fisheye | K::Paraboloid | K::DualFisheye
+                ),
                 "look/up",
             )?;
         }
         if spec.fov.is_some() || spec.lens.is_some() {
-            applies(kind == K::Fisheye, "fov/lens")?;
+            applies(matches!(kind, K::Fisheye | K::DualFisheye), "fov/lens")?;
+        }
+        if spec.k.is_some() || spec.lenses != <[LensSpec; 2]>::default() {
+            applies(kind == K::DualFisheye, "k/front/back")?;
         }
         if spec.max_lat.is_some() {
             applies(kind == K::Mercator, "max-lat")?;
@@ -178,6 +258,8 @@ impl ProjectionSpec {
             vfov: None,
             distance: None,
             aim: [None; 3],
+            k: None,
+            lenses: Default::default(),
         }
     }
 
@@ -266,6 +348,37 @@ impl ProjectionSpec {
                     )
                 })?)
             }
+            ProjectionKind::DualFisheye => {
+                let defaults = [FisheyeLens::FRONT, FisheyeLens::BACK];
+                let mut lenses = defaults;
+                for (i, (l, ls)) in lenses.iter_mut().zip(&self.lenses).enumerate() {
+                    let name = ["front", "back"][i];
+                    if let Some([cx, cy, r, roll]) = ls.place {
+                        (l.centre, l.radius, l.roll_deg) = (glam::DVec2::new(cx, cy), r, roll);
+                    }
+                    l.fov_deg = ls.fov.or(self.fov).unwrap_or(l.fov_deg);
+                    if ls.lens.is_some() && ls.k.is_some() {
+                        return Err(format!(
+                            "dual-fisheye: {name}-lens and {name}-k both given: a lens has one model"
+                        ));
+                    }
+                    l.model = match (ls.k, ls.lens, self.k, self.lens) {
+                        (Some(k), ..) => LensModel::Polynomial(k),
+                        (None, Some(lens), ..) => LensModel::Standard(lens),
+                        (None, None, Some(_), Some(_)) => {
+                            return Err("dual-fisheye: lens and k both given: a lens has one \
+                                        model (per lens: front-lens, back-k, ...)"
+                                .into())
+                        }
+                        (None, None, Some(k), None) => LensModel::Polynomial(k),
+                        (None, None, None, Some(lens)) => LensModel::Standard(lens),
+                        (None, None, None, None) => l.model,
+                    };
+                }
+                DualFisheye::new(frame, lenses[0], lenses[1])
+                    .map_err(|e| format!("dual-fisheye: {e}"))?
+                    .into()
+            }
             k => k.default_projection(),
         })
     }
@@ -285,6 +398,31 @@ impl Projection {
                 Some(*p.radial().frame())
             }
             Projection::Paraboloid(p) => Some(*p.frame()),
+            Projection::DualFisheye(p) => {
+                let [f, b] = *p.lenses();
+                if f.fov_deg == b.fov_deg {
+                    s.fov = Some(f.fov_deg);
+                } else {
+                    s.lenses[0].fov = Some(f.fov_deg);
+                    s.lenses[1].fov = Some(b.fov_deg);
+                }
+                let set = |m: LensModel, lens: &mut Option<Lens>, k: &mut Option<[f64; 4]>| match m
+                {
+                    LensModel::Standard(l) => *lens = Some(l),
+                    LensModel::Polynomial(c) => *k = Some(c),
+                };
+                if f.model == b.model {
+                    set(f.model, &mut s.lens, &mut s.k);
+                } else {
+                    for (ls, l) in s.lenses.iter_mut().zip([f, b]) {
+                        set(l.model, &mut ls.lens, &mut ls.k);
+                    }
+                }
+                for (ls, l) in s.lenses.iter_mut().zip([f, b]) {
+                    ls.place = Some([l.centre.x, l.centre.y, l.radius, l.roll_deg]);
+                }
+                Some(*p.rig())
+            }
             Projection::Mercator(p) => {
                 s.max_lat = Some(p.max_latitude_deg());
                 None
@@ -362,6 +500,31 @@ impl fmt::Display for ProjectionSpec {
         for (key, a) in ["yaw", "pitch", "roll"].iter().zip(self.aim) {
             if let Some(v) = a {
                 write!(f, ":{key}={}", Num(v))?;
+            }
+        }
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|x| Num(*x).to_string())
+                .collect::<Vec<_>>()
+                .join(",")
+        };
+        if let Some(k) = self.k {
+            write!(f, ":k={}", list(&k))?;
+        }
+        for (name, ls) in ["front", "back"].iter().zip(&self.lenses) {
+            if let Some(v) = ls.fov {
+                write!(f, ":{name}-fov={}", Num(v))?;
+            }
+            if let Some(l) = ls.lens {
+                write!(f, ":{name}-lens={}", l.name())?;
+            }
+            if let Some(k) = ls.k {
+                write!(f, ":{name}-k={}", list(&k))?;
+            }
+        }
+        for (name, ls) in ["front", "back"].iter().zip(&self.lenses) {
+            if let Some(p) = ls.place {
+                write!(f, ":{name}={}", list(&p))?;
             }
         }
         if let Some(d) = self.look {
@@ -510,6 +673,57 @@ mod tests {
                 .count(),
             1
         );
+    }
+
+    #[test]
+    fn dual_fisheye_text() {
+        let p = ProjectionSpec::parse("dfisheye:fov=200:lens=equisolid")
+            .unwrap()
+            .build(None)
+            .unwrap();
+        let Projection::DualFisheye(d) = p else {
+            panic!("{p:?}")
+        };
+        assert_eq!(d.lenses()[1].fov_deg, 200.0);
+        assert_eq!(d.lenses()[0].model, LensModel::Standard(Lens::Equisolid));
+        let text = "dual-fisheye:fov=204:k=0.02,-0.004:back-fov=198:back-k=0.01:\
+                    front=1.49,0.51,0.47,1.5:back=0.5,0.5,0.52:look=0.2,-0.1,-1";
+        let p = ProjectionSpec::parse(text).unwrap().build(None).unwrap();
+        let Projection::DualFisheye(d) = p else {
+            panic!("{p:?}")
+        };
+        let [f, b] = *d.lenses();
+        assert_eq!(f.model, LensModel::Polynomial([0.02, -0.004, 0.0, 0.0]));
+        assert_eq!(b.model, LensModel::Polynomial([0.01, 0.0, 0.0, 0.0]));
+        assert_eq!((f.fov_deg, b.fov_deg), (204.0, 198.0));
+        assert_eq!((f.roll_deg, b.radius), (1.5, 0.52));
+        let back = ProjectionSpec::parse(&p.to_string())
+            .unwrap()
+            .build(None)
+            .unwrap();
+        assert!(max_dir_diff(&p, &back) < 1e-8, "{p}");
+        assert_eq!(back.to_string(), p.to_string());
+        // Bad input: the key and the problem.
+        for (bad, says) in [
+            ("dfisheye:fov=400", "fov=400 is over 360"),
+            ("dfisheye:front-fov=-5", "front lens: fov=-5"),
+            ("dfisheye:fov=nan", "'nan' is not a number"),
+            ("dfisheye:front=1.5,0.5,0", "radius 0 must be over 0"),
+            ("dfisheye:back=5,0.5,0.5", "outside the 2×1 picture"),
+            ("dfisheye:back=1.2,0.5,0.5", "overlap in the picture"),
+            ("dfisheye:fov=200:k=0,-0.2", "stops increasing"),
+            ("dfisheye:k=1,2,3,4,5", "1 to 4 numbers"),
+            ("dfisheye:front=1,2", "cx,cy,r[,roll]"),
+            ("dfisheye:lens=equisolid:k=0.1", "lens and k both given"),
+            (
+                "dfisheye:fov=200:lens=orthographic",
+                "orthographic lens covers at most 180",
+            ),
+            ("fisheye:k=0.1", "does not apply"),
+        ] {
+            let e = ProjectionSpec::parse(bad).unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
     }
 
     fn frame_up_angular() -> AngularMap {

@@ -398,12 +398,11 @@ fn convert_frames(
             let layout = plan
                 .save
                 .layout
-                .unwrap_or_else(|| save::default_layout(dst.layer_count()));
-            let (gc, gr) = layout.grid(dst.layer_count());
+                .unwrap_or_else(|| Layout::default_for(dst.kind()));
             let (pw, ph) = if layout == Layout::Separate {
                 (w, h)
             } else {
-                (w * gc, h * gr)
+                layout.extent(dst.layer_count(), w, h)
             };
             if !a.quiet {
                 eprintln!(
