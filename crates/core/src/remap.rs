@@ -19,11 +19,12 @@
 
 use crate::envmap::{bilinear_blend, lerp4, seam_taps};
 use crate::projection::{Projection, WorldProjection};
-use crate::resample::{Job, PointScratch, Pyramid, RowScratch};
+use crate::resample::{Job, PointScratch, Pyramid, PyramidPlan, RowScratch};
 use crate::{EnvMap, Image, ResampleOptions};
 use mirrorball_simd::{prefetch, F32x4};
 use rayon::prelude::*;
 use std::fmt;
+use std::sync::Mutex;
 
 /// The source texel index's bits; the layer sits above them.
 const INDEX_BITS: u32 = 29;
@@ -143,6 +144,10 @@ pub struct Remap {
     taps: Vec<Vec<Tap>>,
     /// Per output layer, where each row's groups and taps start (`h + 1` pairs).
     row_starts: Vec<Vec<(u32, u32)>>,
+    /// The source's mip levels' block weights, as deep as the taps read.
+    pyramid: PyramidPlan,
+    /// The last applied source's mip levels, kept to be filled again by the next.
+    spare: Mutex<Vec<Vec<Image>>>,
 }
 
 impl fmt::Debug for Remap {
@@ -214,6 +219,8 @@ impl Remap {
             taps.push(k);
             row_starts.push(starts);
         }
+        let depth = groups.iter().flatten().map(|g| g.level as usize).max();
+        let pyramid = PyramidPlan::new(&job.sproj, (sw, sh), src_layers, depth.unwrap_or(0));
         Remap {
             job,
             src_extent: (sw, sh),
@@ -222,6 +229,8 @@ impl Remap {
             groups,
             taps,
             row_starts,
+            pyramid,
+            spare: Mutex::new(Vec::new()),
         }
     }
 
@@ -250,6 +259,7 @@ impl Remap {
             + g * std::mem::size_of::<Group>()
             + self.tap_count() * std::mem::size_of::<Tap>()
             + o * 8
+            + self.pyramid.memory_bytes()
     }
 
     fn check_source(&self, src: &EnvMap) -> Result<(), RemapError> {
@@ -362,20 +372,15 @@ impl Remap {
 pub struct RemapRows<'a> {
     remap: &'a Remap,
     pyr: Pyramid<'a>,
-    planes: [&'a [f32]; MAX_LAYERS],
     c: usize,
 }
 
 impl<'a> RemapRows<'a> {
     fn new(remap: &'a Remap, src: &'a EnvMap) -> RemapRows<'a> {
-        let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
-        for (p, l) in planes.iter_mut().zip(src.layers()) {
-            *p = l.data();
-        }
+        let spare = std::mem::take(&mut *remap.spare.lock().unwrap_or_else(|e| e.into_inner()));
         RemapRows {
             remap,
-            pyr: Pyramid::new(src, remap.job.levels - 1),
-            planes,
+            pyr: Pyramid::planned(src, &remap.pyramid, spare),
             c: src.channels(),
         }
     }
@@ -392,14 +397,27 @@ impl<'a> RemapRows<'a> {
     pub fn row_into(&self, layer: usize, y: usize, row: &mut [f32]) {
         assert!(layer < self.remap.texels.len() && y < self.remap.job.h as usize);
         assert_eq!(row.len(), self.row_len());
+        // The base as the pyramid holds it (a dual fisheye's overlap blended).
+        let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
+        for (p, l) in planes.iter_mut().zip(self.pyr.level(0)) {
+            *p = l.data();
+        }
         match self.c {
             3 => self
                 .remap
-                .fill_row::<3>(&self.pyr, &self.planes, layer, y, row),
+                .fill_row::<3>(&self.pyr, &planes, layer, y, row),
             _ => self
                 .remap
-                .fill_row::<4>(&self.pyr, &self.planes, layer, y, row),
+                .fill_row::<4>(&self.pyr, &planes, layer, y, row),
         }
+    }
+}
+
+impl Drop for RemapRows<'_> {
+    /// Gives the mip levels back to the plan, for the next source to fill.
+    fn drop(&mut self) {
+        let levels = self.pyr.take_levels();
+        *self.remap.spare.lock().unwrap_or_else(|e| e.into_inner()) = levels;
     }
 }
 

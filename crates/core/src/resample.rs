@@ -169,24 +169,54 @@ pub(crate) struct Pyramid<'a> {
 
 impl<'a> Pyramid<'a> {
     pub(crate) fn new(src: &'a EnvMap, depth: usize) -> Pyramid<'a> {
+        let plan = PyramidPlan::new(
+            src.projection(),
+            (src.width(), src.height()),
+            src.layers().len(),
+            depth,
+        );
+        Pyramid::planned(src, &plan, Vec::new())
+    }
+
+    /// The pyramid of `src` with `plan`'s block weights (made for `src`'s projection and
+    /// size), filling the images of `spare` (an earlier pyramid's levels, from
+    /// [`Pyramid::take_levels`]) where their shapes fit, so that a frame loop allocates
+    /// nothing.
+    pub(crate) fn planned(
+        src: &'a EnvMap,
+        plan: &PyramidPlan,
+        mut spare: Vec<Vec<Image>>,
+    ) -> Pyramid<'a> {
         let base = match src.projection().blend_overlap(src.layers()) {
             Some(blended) => std::borrow::Cow::Owned(blended),
             None => std::borrow::Cow::Borrowed(src.layers()),
         };
-        let mut levels: Vec<Vec<Image>> = Vec::new();
-        for _ in 0..depth {
+        spare.truncate(plan.levels.len());
+        let mut levels: Vec<Vec<Image>> = Vec::with_capacity(plan.levels.len());
+        let mut spare = spare.into_iter();
+        for weights in &plan.levels {
             let prev = levels.last().map(|l| l.as_slice()).unwrap_or(&base);
-            if prev[0].width() == 1 && prev[0].height() == 1 {
-                break;
+            let mut next = spare.next().unwrap_or_default();
+            next.truncate(prev.len());
+            for (layer, (img, w)) in prev.iter().zip(weights).enumerate() {
+                let (nw, nh) = half_extent(img.width(), img.height());
+                let fits = next.get(layer).is_some_and(|o: &Image| {
+                    (o.width(), o.height(), o.channels()) == (nw, nh, img.channels())
+                });
+                if !fits {
+                    next.truncate(layer);
+                    next.push(Image::new(nw, nh, img.channels()));
+                }
+                downsample_into(img, w, &mut next[layer]);
             }
-            let next = prev
-                .iter()
-                .enumerate()
-                .map(|(layer, img)| downsample(src.projection(), layer, img))
-                .collect();
             levels.push(next);
         }
         Pyramid { base, levels }
+    }
+
+    /// The levels below the base, taken out for [`Pyramid::planned`] to fill again.
+    pub(crate) fn take_levels(&mut self) -> Vec<Vec<Image>> {
+        std::mem::take(&mut self.levels)
     }
 
     #[inline]
@@ -199,15 +229,56 @@ impl<'a> Pyramid<'a> {
     }
 }
 
-/// Halves `img` (layer `layer` of `proj`), each 2×2 block averaged with the source texels'
-/// solid angles (density at their centres) as weights.
-fn downsample(proj: &Projection, layer: usize, img: &Image) -> Image {
-    let (w, h) = (img.width(), img.height());
-    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-    let c = img.channels();
-    let mut out = Image::new(nw, nh, c);
-    out.data_mut()
-        .par_chunks_mut(nw as usize * c)
+/// A level's size: each side halved, at least 1.
+fn half_extent(w: u32, h: u32) -> (u32, u32) {
+    ((w / 2).max(1), (h / 2).max(1))
+}
+
+/// What [`Pyramid`] needs of the projection, worked out once for a source's projection and
+/// size: for each level below the base and each layer, every 2×2 block's four weights (the
+/// source texels' densities at their centres, normalised to sum to 1; a block past an odd
+/// edge repeats its last row or column). A conversion applied frame after frame
+/// ([`crate::Remap`]) keeps one, so that no frame works out a direction.
+pub(crate) struct PyramidPlan {
+    /// Per level (the first is half the base), per layer, one entry per texel of that level.
+    levels: Vec<Vec<Vec<[f32; 4]>>>,
+}
+
+impl PyramidPlan {
+    /// The plan of `depth` levels (fewer where halving reaches 1×1) of `layers` layers of
+    /// `(w, h)` texels in `proj`.
+    pub(crate) fn new(proj: &Projection, (w, h): (u32, u32), layers: usize, depth: usize) -> Self {
+        let mut levels = Vec::new();
+        let (mut w, mut h) = (w.max(1), h.max(1));
+        for _ in 0..depth {
+            if w == 1 && h == 1 {
+                break;
+            }
+            levels.push(
+                (0..layers)
+                    .map(|layer| block_weights(proj, layer, w, h))
+                    .collect(),
+            );
+            (w, h) = half_extent(w, h);
+        }
+        PyramidPlan { levels }
+    }
+
+    /// Bytes the plan occupies.
+    pub(crate) fn memory_bytes(&self) -> usize {
+        self.levels.iter().flatten().map(|l| l.len() * 16).sum()
+    }
+}
+
+/// The four weights of each 2×2 block of a `w`×`h` layer `layer` of `proj` (the texels
+/// `(2x, 2y)`, `(2x + 1, 2y)`, `(2x, 2y + 1)`, `(2x + 1, 2y + 1)`, clamped to the layer),
+/// each texel's density at its centre (its solid angle per unit `uv`, the texels being
+/// equal in `uv`) over the block's sum; a texel nothing sees weighs 10⁻¹² so that a block
+/// wholly outside the map still averages.
+fn block_weights(proj: &Projection, layer: usize, w: u32, h: u32) -> Vec<[f32; 4]> {
+    let (nw, nh) = half_extent(w, h);
+    let mut out = vec![[0.0f32; 4]; nw as usize * nh as usize];
+    out.par_chunks_mut(nw as usize)
         .enumerate()
         .for_each_init(
             || (vec![None; w as usize], vec![None; w as usize]),
@@ -215,27 +286,41 @@ fn downsample(proj: &Projection, layer: usize, img: &Image) -> Image {
                 let ys = [(2 * y as u32).min(h - 1), (2 * y as u32 + 1).min(h - 1)];
                 proj.row_dirs(layer, ys[0], w, h, d0);
                 proj.row_dirs(layer, ys[1], w, h, d1);
-                for x in 0..nw as usize {
-                    let xs = [(2 * x as u32).min(w - 1), (2 * x as u32 + 1).min(w - 1)];
-                    let mut acc = [0.0f64; 4];
-                    let mut wsum = 0.0;
-                    for (k, &sy) in ys.iter().enumerate() {
-                        let dens = if k == 0 { &*d0 } else { &*d1 };
-                        for &sx in &xs {
-                            let wt = dens[sx as usize].map_or(0.0, |(_, dn)| dn).max(1e-12);
-                            for (a, v) in acc.iter_mut().zip(img.get(sx, sy)) {
-                                *a += wt * *v as f64;
-                            }
-                            wsum += wt;
-                        }
-                    }
-                    for i in 0..c {
-                        row[x * c + i] = (acc[i] / wsum) as f32;
-                    }
+                for (x, wt) in row.iter_mut().enumerate() {
+                    let xs = [(2 * x).min(w as usize - 1), (2 * x + 1).min(w as usize - 1)];
+                    let dens = |d: &[Option<(DVec3, f64)>], sx: usize| {
+                        d[sx].map_or(0.0, |(_, dn)| dn).max(1e-12)
+                    };
+                    let q = [dens(d0, xs[0]), dens(d0, xs[1]), dens(d1, xs[0]), dens(d1, xs[1])];
+                    let sum: f64 = q.iter().sum();
+                    *wt = q.map(|v| (v / sum) as f32);
                 }
             },
         );
     out
+}
+
+/// Halves `img` into `out` (its size from [`half_extent`]), each 2×2 block averaged with
+/// `weights` ([`block_weights`] of `img`'s layer and size).
+fn downsample_into(img: &Image, weights: &[[f32; 4]], out: &mut Image) {
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let nw = out.width() as usize;
+    let c = img.channels();
+    let data = img.data();
+    out.data_mut()
+        .par_chunks_mut(nw * c)
+        .zip(weights.par_chunks(nw))
+        .enumerate()
+        .for_each(|(y, (row, wts))| {
+            let r0 = &data[(2 * y).min(h - 1) * w * c..][..w * c];
+            let r1 = &data[(2 * y + 1).min(h - 1) * w * c..][..w * c];
+            for (x, (o, q)) in row.chunks_exact_mut(c).zip(wts).enumerate() {
+                let (a, b) = ((2 * x).min(w - 1) * c, (2 * x + 1).min(w - 1) * c);
+                for i in 0..c {
+                    o[i] = q[0] * r0[a + i] + q[1] * r0[b + i] + q[2] * r1[a + i] + q[3] * r1[b + i];
+                }
+            }
+        });
 }
 
 /// Converts `src` into projection `dst` at edge `size` (see

@@ -44,13 +44,14 @@ pub struct Packing {
     /// leaves them.
     gaps: bool,
     /// Every run lies along a layer row, so rows made one at a time can be encoded.
-    #[cfg_attr(not(test), allow(dead_code))] // read by encode_rows, not yet in the pipeline
     along_rows: bool,
 }
 
 impl Packing {
     /// The packing of `dst`'s `w`×`h` layers by `layout` (a single layer, or `Separate`,
-    /// is the layer itself); `None` if the layout does not fit `dst`.
+    /// is the layer itself); `None` if the layout does not fit `dst`, or if it places
+    /// texels that are not copies of one layer texel (EAC's border, looked up in each
+    /// border texel's direction): such frames are packed with `Layout::pack`.
     pub fn new(layout: Layout, dst: Projection, (w, h): (u32, u32)) -> Option<Packing> {
         let n = dst.layer_count();
         if n == 1 || layout == Layout::Separate {
@@ -86,6 +87,15 @@ impl Packing {
                 if t[0] == 0.0 {
                     gaps = true;
                     continue;
+                }
+                // A texel `pack` made by looking up a direction (EAC's border) holds a blend
+                // of positions, not one: such a layout is packed frame by frame instead.
+                if t.iter().any(|v| v.fract() != 0.0)
+                    || t[0] as usize > n
+                    || t[1] >= w as f32
+                    || t[2] >= h as f32
+                {
+                    return None;
                 }
                 let (layer, x, y) = (t[0] as u32 - 1, t[1] as u32, t[2] as u32);
                 if let Some(run) = runs[first..].last_mut() {
@@ -161,7 +171,6 @@ impl Packing {
 
     /// Whether [`Packing::encode_rows`] can encode this packing (every run lies along a
     /// layer row: strips, crosses, a single layer).
-    #[cfg_attr(not(test), allow(dead_code))] // not yet in the pipeline
     pub fn along_rows(&self) -> bool {
         self.along_rows
     }
@@ -186,7 +195,6 @@ impl Packing {
     /// Encodes the frame whose rows `rows` makes (a `Remap` of the packing's layers) into
     /// `out`, each row made and encoded by one thread while it is in its cache. Only for a
     /// packing [`along_rows`](Packing::along_rows).
-    #[cfg_attr(not(test), allow(dead_code))] // not yet in the pipeline
     pub fn encode_rows(&self, fmt: PixFmt, rows: &RemapRows, out: &mut Vec<u8>) {
         assert!(
             self.along_rows,
@@ -358,5 +366,8 @@ mod tests {
             (8, 4)
         );
         assert!(Packing::new(Layout::Separate, cube, (8, 8)).is_none());
+        // EAC's border texels are looked up, not copied: no packing, `pack` per frame.
+        let eac = ProjectionKind::Eac.default_projection();
+        assert!(Packing::new(Layout::default_for(ProjectionKind::Eac), eac, (16, 16)).is_none());
     }
 }

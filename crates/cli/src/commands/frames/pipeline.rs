@@ -1,13 +1,17 @@
 //! The frame loop: one thread reads (and decodes) frame k+1 while another converts frame k
-//! with the planned `Remap` and a third writes (and encodes) frame k−1. The stages are
-//! joined by channels that hold one frame each, and buffers go back to the stage that fills
-//! them, so at most three source maps and three output maps exist whatever the number of
-//! frames (their memory is [`FRAMES_IN_FLIGHT`] of each), and a long run allocates nothing
-//! after its first frames. Each stage's heavy loops are parallel (rayon), so the two cores
-//! share whichever stages have work.
+//! with the planned `Remap` and a third writes frame k−1. The stages are joined by channels
+//! that hold one frame each, and buffers go back to the stage that fills them, so at most
+//! three source maps and three outputs exist whatever the number of frames (their memory is
+//! [`FRAMES_IN_FLIGHT`] of each), and a long run allocates nothing after its first frames.
+//! Each stage's heavy loops are parallel (rayon), so the two cores share whichever stages
+//! have work.
+//!
+//! An output is whatever the converter makes for the writer: a map (encoded by the writer
+//! into files), or a raw frame's bytes already encoded (the converter encodes each row as
+//! the `Remap` makes it, so the frame never exists as floats).
 
 use crate::error::CliError;
-use mirrorball_core::{EnvMap, Remap};
+use mirrorball_core::EnvMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender};
 
@@ -28,29 +32,31 @@ pub struct Meta {
 /// `None` at the end.
 pub type Next<'a> =
     dyn FnMut(Option<EnvMap>) -> Option<Result<(Meta, EnvMap), CliError>> + Send + 'a;
+/// Converts a source frame into an output of the writer's kind, reusing its memory.
+pub type Convert<'a, O> = dyn Fn(&Meta, &EnvMap, &mut O) -> Result<(), CliError> + Sync + 'a;
 /// Writes a converted frame.
-pub type Put<'a> = dyn FnMut(&Meta, &EnvMap) -> Result<(), CliError> + Send + 'a;
+pub type Put<'a, O> = dyn FnMut(&Meta, &O) -> Result<(), CliError> + Send + 'a;
 
 /// Runs the loop until `next` ends or a stage fails; `done` counts the frames written.
 /// The first error of the reader, the converter or the writer (in that order: a failing
 /// stage makes the others stop without one) is returned after every frame before it was
 /// written.
-pub fn run(
+pub fn run<O: Send>(
     next: &mut Next<'_>,
-    remap: &Remap,
-    fresh_output: &(dyn Fn() -> EnvMap + Sync),
-    put: &mut Put<'_>,
+    convert: &Convert<'_, O>,
+    fresh_output: &(dyn Fn() -> O + Sync),
+    put: &mut Put<'_, O>,
     done: &AtomicU64,
 ) -> Result<(), CliError> {
     let (src_tx, src_rx) = sync_channel::<(Meta, EnvMap)>(1);
-    let (out_tx, out_rx) = sync_channel::<(Meta, EnvMap)>(1);
+    let (out_tx, out_rx) = sync_channel::<(Meta, O)>(1);
     let (src_back_tx, src_back_rx) = channel::<EnvMap>();
-    let (out_back_tx, out_back_rx) = channel::<EnvMap>();
+    let (out_back_tx, out_back_rx) = channel::<O>();
     std::thread::scope(|s| {
         let reader = s.spawn(move || read_stage(next, src_tx, src_back_rx));
         let writer = s.spawn(move || write_stage(put, out_rx, out_back_tx, done));
         let converted = convert_stage(
-            remap,
+            convert,
             fresh_output,
             src_rx,
             out_tx,
@@ -82,13 +88,13 @@ fn read_stage(
     }
 }
 
-fn convert_stage(
-    remap: &Remap,
-    fresh_output: &(dyn Fn() -> EnvMap + Sync),
+fn convert_stage<O>(
+    convert: &Convert<'_, O>,
+    fresh_output: &(dyn Fn() -> O + Sync),
     rx: Receiver<(Meta, EnvMap)>,
-    tx: std::sync::mpsc::SyncSender<(Meta, EnvMap)>,
+    tx: std::sync::mpsc::SyncSender<(Meta, O)>,
     src_back: Sender<EnvMap>,
-    out_back: Receiver<EnvMap>,
+    out_back: Receiver<O>,
 ) -> Result<(), CliError> {
     let mut made = 0;
     for (meta, src) in rx {
@@ -103,12 +109,7 @@ fn convert_stage(
                 Err(_) => return Ok(()), // the writer stopped
             },
         };
-        remap.apply_into(&src, &mut out).map_err(|e| {
-            CliError::input(format!(
-                "{}: {e} (every frame must have the first's projection and size)",
-                meta.input
-            ))
-        })?;
+        convert(&meta, &src, &mut out)?;
         let _ = src_back.send(src);
         if tx.send((meta, out)).is_err() {
             return Ok(());
@@ -117,10 +118,10 @@ fn convert_stage(
     Ok(())
 }
 
-fn write_stage(
-    put: &mut Put<'_>,
-    rx: Receiver<(Meta, EnvMap)>,
-    back: Sender<EnvMap>,
+fn write_stage<O>(
+    put: &mut Put<'_, O>,
+    rx: Receiver<(Meta, O)>,
+    back: Sender<O>,
     done: &AtomicU64,
 ) -> Result<(), CliError> {
     for (meta, out) in rx {

@@ -392,7 +392,6 @@ fn convert_frames(
             + remap.memory_bytes() as u64,
         "a smaller --size",
     )?;
-    let t_plan = t0.elapsed();
     let packed = match &output {
         Output::Pipe(fmt) => {
             let layout = plan
@@ -411,16 +410,26 @@ fn convert_frames(
                     times(dst.layer_count())
                 );
             }
-            // Where every packed texel comes from, once: frames are encoded from the layers.
-            let packing = Packing::new(layout, dst, (w, h)).ok_or_else(|| {
-                CliError::request(format!("--layout {layout} does not fit {}", dst.name()))
-            })?;
-            debug_assert_eq!(packing.extent(), (pw, ph));
-            Some((packing, *fmt))
+            // Where every packed texel comes from, once: frames are encoded straight from
+            // the layers, or from each row as the Remap makes it; a layout whose texels are
+            // not all copies (EAC's border) is packed frame by frame.
+            let packing = Packing::new(layout, dst, (w, h));
+            if let Some(p) = &packing {
+                debug_assert_eq!(p.extent(), (pw, ph));
+            } else if (layout == Layout::Separate || !layout.fits(dst.layer_count()))
+                && dst.layer_count() > 1
+            {
+                return Err(CliError::request(format!(
+                    "--layout {layout} does not fit {}",
+                    dst.name()
+                )));
+            }
+            Some((layout, packing, *fmt))
         }
         _ => None,
     };
 
+    let t_plan = t0.elapsed();
     let fresh = || {
         let layers = (0..dst.layer_count())
             .map(|_| Image::new(w, h, c))
@@ -430,41 +439,86 @@ fn convert_frames(
     let mut first = Some((meta0, src0));
     let mut next = |spare: Option<EnvMap>| first.take().map(Ok).or_else(|| reader.next(spare));
     let stdout = std::io::stdout();
-    let mut bytes = Vec::new();
-    let mut put = |m: &Meta, env: &EnvMap| -> Result<(), CliError> {
-        let t = Instant::now();
-        let out: String = match (&output, &packed) {
-            (Output::Pipe(_), Some((packing, fmt))) => {
-                packing.encode_layers(*fmt, env.layers(), &mut bytes);
-                pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
-                "-".into()
-            }
-            (Output::Files(p), _) => save_frame(env, &p.path(m.number), plan)?,
-            (Output::File(s), _) => save_frame(env, Path::new(s), plan)?,
-            _ => unreachable!("a pipe has its format"),
-        };
+    let logged = |m: &Meta, out: String, t: Instant| {
         log.line(
             json!({"frame": m.number, "input": m.input, "output": out}),
             Status::Done,
             t.elapsed(),
             None,
         );
-        Ok(())
+    };
+    let misfit = |m: &Meta, e: mirrorball_core::RemapError| {
+        CliError::input(format!(
+            "{}: {e} (every frame must have the first's projection and size)",
+            m.input
+        ))
     };
     let t1 = Instant::now();
     let done = with_progress("frames", total, a.quiet, |counter| {
         let done = AtomicU64::new(0);
-        let r = pipeline::run(
-            &mut next,
-            &remap,
-            &fresh,
-            &mut |m, e| {
-                put(m, e)?;
-                counter.fetch_add(1, Ordering::Relaxed);
-                Ok(())
-            },
-            &done,
-        );
+        let r = match &packed {
+            // Rows made and encoded together: no float copy of the output frame.
+            Some((_, Some(packing), fmt)) if packing.along_rows() => pipeline::run(
+                &mut next,
+                &|m: &Meta, src: &EnvMap, bytes: &mut Vec<u8>| {
+                    let rows = remap.rows(src).map_err(|e| misfit(m, e))?;
+                    packing.encode_rows(*fmt, &rows, bytes);
+                    Ok(())
+                },
+                &Vec::new,
+                &mut |m: &Meta, bytes: &Vec<u8>| {
+                    let t = Instant::now();
+                    pipe::write_frame(&mut stdout.lock(), bytes, m.number)?;
+                    logged(m, "-".into(), t);
+                    counter.fetch_add(1, Ordering::Relaxed);
+                    Ok(())
+                },
+                &done,
+            ),
+            _ => {
+                let mut bytes = Vec::new();
+                pipeline::run(
+                    &mut next,
+                    &|m: &Meta, src: &EnvMap, out: &mut EnvMap| {
+                        remap.apply_into(src, out).map_err(|e| misfit(m, e))
+                    },
+                    &fresh,
+                    &mut |m: &Meta, env: &EnvMap| {
+                        let t = Instant::now();
+                        let out: String = match (&output, &packed) {
+                            (Output::Pipe(_), Some((_, Some(packing), fmt))) => {
+                                packing.encode_layers(*fmt, env.layers(), &mut bytes);
+                                pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
+                                "-".into()
+                            }
+                            (Output::Pipe(_), Some((layout, None, fmt))) => {
+                                let pic = layout.pack(env).ok_or_else(|| {
+                                    CliError::request(format!(
+                                        "--layout {layout} does not fit {}",
+                                        dst.name()
+                                    ))
+                                })?;
+                                let (pw, ph) = (pic.width(), pic.height());
+                                Packing::single(pw, ph).encode_layers(
+                                    *fmt,
+                                    std::slice::from_ref(&pic),
+                                    &mut bytes,
+                                );
+                                pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
+                                "-".into()
+                            }
+                            (Output::Files(p), _) => save_frame(env, &p.path(m.number), plan)?,
+                            (Output::File(s), _) => save_frame(env, Path::new(s), plan)?,
+                            _ => unreachable!("a pipe has its format"),
+                        };
+                        logged(m, out, t);
+                        counter.fetch_add(1, Ordering::Relaxed);
+                        Ok(())
+                    },
+                    &done,
+                )
+            }
+        };
         (r, done.load(Ordering::Relaxed))
     });
     let (result, n) = done;
