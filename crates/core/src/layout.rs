@@ -182,7 +182,7 @@ impl CubeCells {
     /// The face coordinates `(s, t)` shown at cell coordinates `(c, d)` of cell `i`, as
     /// doubled integers (`2x + 1 − n` for texel `x` of `n`) or as reals: a signed
     /// permutation (see the type's documentation).
-    fn to_face<T: Copy + std::ops::Neg<Output = T>>(&self, i: usize, c: T, d: T) -> (T, T) {
+    fn face_coords<T: Copy + std::ops::Neg<Output = T>>(&self, i: usize, c: T, d: T) -> (T, T) {
         let (c, d) = match self.turns[i] & 3 {
             0 => (c, d),
             1 => (d, -c),
@@ -204,7 +204,7 @@ impl CubeCells {
             for y in 0..n {
                 for x in 0..n {
                     let (c, d) = (2 * x as i64 + 1 - n2, 2 * y as i64 + 1 - n2);
-                    let (s, t) = self.to_face(i, c, d);
+                    let (s, t) = self.face_coords(i, c, d);
                     f(
                         i,
                         ox + x,
@@ -230,7 +230,7 @@ impl CubeCells {
         let fy = (py as f64 + 0.5 - 2.0 - (row * (n + 4)) as f64) / nf;
         let (c, d) = (2.0 * (fx - col as f64) - 1.0, 2.0 * fy - 1.0);
         let i = (row * cols + col) as usize;
-        let (s, t) = self.to_face(i, c, d);
+        let (s, t) = self.face_coords(i, c, d);
         let warp = |a: f64| {
             if a.abs() > 1.0 {
                 a

@@ -114,7 +114,7 @@ fn the_environment_comes_padded_in_its_own_and_other_projections() {
         "projection=cube&size=0",
         "projection=nonsense",
         "precision=double",
-        "projection=octahedral",
+        "projection=dual-fisheye",
     ] {
         let a = own(&r, "GET", &format!("/api/environment?{bad}"), b"");
         assert!(
@@ -164,7 +164,7 @@ fn the_grid_holds_the_cores_answers() {
     assert_eq!(a.status, 200);
     let count = u32::from_le_bytes(a.body[..4].try_into().unwrap()) as usize;
     assert_eq!(count, 6 * 81);
-    assert_eq!(a.body.len(), 40 + 36 * count);
+    assert_eq!(a.body.len(), 56 + 36 * count);
     assert_eq!(
         own(&r, "GET", "/api/grid?projection=cube&n=100000", b"").status,
         400
