@@ -36,6 +36,8 @@ pub struct Source {
     /// The right eye, when a stereo pair was read with both eyes ([`load_eyes`]); of the
     /// same projection and size as [`Source::env`], the left.
     pub right: Option<EnvMap>,
+    /// How the picture held its eyes (`2d`: one).
+    pub stereo: Stereo,
     /// NaN, infinite and negative values in the file(s) as read
     /// (`mirrorball_io::Loaded::invalid`): none spares [`Source::prepare`] its pass over the
     /// whole map.
@@ -96,29 +98,30 @@ pub fn load(
     layout: Option<Layout>,
     limits: &Limits,
 ) -> Result<Source, CliError> {
-    load_eyes(input, from, layout, (Stereo::Mono, 1), limits)
+    load_eyes(input, from, layout, (None, Stereo::Mono), limits)
 }
 
-/// [`load`] for a picture arranged as `stereo.0` (a stereo pair, or `2d`), reading its first
-/// `stereo.1` eyes: the left into [`Source::env`], the right into [`Source::right`]. Each
-/// eye is interpreted as `from` and `layout` say (or as the file records or its shape
-/// says), the same way. A pair is one picture: a cube container or `{face}` files are
-/// refused, and so is a picture that does not halve evenly.
+/// [`load`] for a picture that may be a stereo pair: arranged as `stereo.0` says, else as
+/// the file records, else one eye (`2d`). The eyes a conversion to `stereo.1` needs are read
+/// (`Stereo::eyes_read`): the left into [`Source::env`], the right into
+/// [`Source::right`]. Each eye is interpreted as `from` and `layout` say (or as the file
+/// records or its shape says), the same way. A pair is one picture: a cube container or
+/// `{face}` files are refused, and so is a picture that does not halve evenly.
 pub fn load_eyes(
     input: &str,
     from: Option<&ProjSpec>,
     layout: Option<Layout>,
-    (stereo, eyes): (Stereo, usize),
+    (asked, output): (Option<Stereo>, Stereo),
     limits: &Limits,
 ) -> Result<Source, CliError> {
-    let one_picture = |what: &str| {
+    let one_picture = |stereo: Stereo, what: &str| {
         CliError::request(format!(
             "{input}: --in-stereo {stereo} splits one picture into eyes, but {what}"
         ))
     };
     if input.contains(FACE) {
-        if stereo != Stereo::Mono {
-            return Err(one_picture(&format!("{FACE} names one file per layer")));
+        if let Some(s) = asked.filter(|s| *s != Stereo::Mono) {
+            return Err(one_picture(s, &format!("{FACE} names one file per layer")));
         }
         return load_layers(input, from, limits);
     }
@@ -154,8 +157,11 @@ pub fn load_eyes(
         }
         _ => String::new(),
     };
+    let stereo = asked
+        .or(recorded.as_ref().map(|r| r.stereo))
+        .unwrap_or_default();
     if layers.len() == 6 && stereo != Stereo::Mono {
-        return Err(one_picture("the file holds six cube faces"));
+        return Err(one_picture(stereo, "the file holds six cube faces"));
     }
     if layers.len() == 6 {
         // A cube container: KTX2 or DDS.
@@ -186,6 +192,7 @@ pub fn load_eyes(
             description,
             decided,
             right: None,
+            stereo: Stereo::Mono,
             invalid,
         });
     }
@@ -209,6 +216,7 @@ pub fn load_eyes(
                 description,
                 decided: "the file is tagged envmap=latlong: OpenEXR's lat-long (+Z at the centre), turned half a turn into mirrorball's (--from latlong reads the picture as mirrorball's)".to_string(),
                 right: None,
+        stereo: Stereo::Mono,
                 invalid,
             });
         }
@@ -222,6 +230,7 @@ pub fn load_eyes(
                 description,
                 decided: "the file is tagged envmap=cube: OpenEXR's vertical strip of faces, read into OpenGL's faces (--from cube --layout vstrip reads the picture as mirrorball's strip)".to_string(),
                 right: None,
+        stereo: Stereo::Mono,
                 invalid,
             });
         }
@@ -230,7 +239,7 @@ pub fn load_eyes(
     let (env, right, decided) = interpret_eyes(
         input,
         image,
-        (stereo, eyes),
+        (stereo, stereo.eyes_read(output)),
         from,
         layout,
         recorded,
@@ -242,6 +251,7 @@ pub fn load_eyes(
         description,
         decided,
         right,
+        stereo,
         invalid,
     })
 }
@@ -521,6 +531,7 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
         description: format!("{} files", names.len()),
         decided,
         right: None,
+        stereo: Stereo::Mono,
         invalid,
     })
 }

@@ -168,11 +168,16 @@ pub fn pack_eyes(eyes: &[EnvMap], stereo: Stereo, layout: Layout) -> Result<Imag
         .map(|e| layout.pack(e))
         .collect::<Option<Vec<Image>>>()
         .ok_or_else(|| {
-            CliError::request(format!("layout {layout} does not fit a map of {n} layer(s)"))
+            CliError::request(format!(
+                "layout {layout} does not fit a map of {n} layer(s)"
+            ))
         })?;
-    stereo
-        .join(pictures)
-        .ok_or_else(|| CliError::request(format!("a {stereo} picture needs {} eye(s) of one size", stereo.eyes())))
+    stereo.join(pictures).ok_or_else(|| {
+        CliError::request(format!(
+            "a {stereo} picture needs {} eye(s) of one size",
+            stereo.eyes()
+        ))
+    })
 }
 
 /// Writes `eyes` (one map per eye of `stereo`; one map for `2d`) to `out`; returns the
@@ -201,6 +206,7 @@ pub fn save_eyes(
         write.declared = Some(MapInfo {
             projection: *env.projection(),
             layout: None,
+            stereo: Default::default(),
         });
         mirrorball_io::write_cube(path, &levels, &write)?;
         return Ok(vec![path.to_path_buf()]);
@@ -222,6 +228,7 @@ pub fn save_eyes(
     write.declared = Some(MapInfo {
         projection: *env.projection(),
         layout: Some(layout),
+        stereo,
     });
     let img = pack_eyes(eyes, stereo, layout).map_err(|e| e.context(out))?;
     mirrorball_io::write_image(path, &img, &write)?;
@@ -238,6 +245,7 @@ pub fn per_layer_write(
         declared: Some(MapInfo {
             projection,
             layout: Some(Layout::Separate),
+            stereo: Default::default(),
         }),
         ..*write
     }

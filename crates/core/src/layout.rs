@@ -737,7 +737,9 @@ impl Stereo {
         Ok((0..eyes.min(2))
             .map(|e| {
                 let (x, y) = self.origin(e, w, h);
-                picture.crop(x, y, w, h).expect("an eye lies inside the picture")
+                picture
+                    .crop(x, y, w, h)
+                    .expect("an eye lies inside the picture")
             })
             .collect())
     }
@@ -951,7 +953,10 @@ mod tests {
         assert_eq!(Stereo::TopBottom.join(tb).unwrap(), pic);
         // The left eye alone; a 2d picture is its one eye.
         assert_eq!(Stereo::SideBySide.split(pic.clone(), 1).unwrap().len(), 1);
-        assert_eq!(Stereo::Mono.split(pic.clone(), 2).unwrap(), vec![pic.clone()]);
+        assert_eq!(
+            Stereo::Mono.split(pic.clone(), 2).unwrap(),
+            vec![pic.clone()]
+        );
         assert!(Stereo::SideBySide.join(vec![pic.clone()]).is_none());
         // Odd halves are refused by name.
         let e = Stereo::TopBottom.split(Image::new(4, 5, 3), 2).unwrap_err();

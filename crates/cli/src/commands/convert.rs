@@ -27,8 +27,9 @@ pub(crate) struct Plan {
     /// `--for`'s engine axes, for a cube output: applied exactly after resampling
     /// (`EnvMap::transformed`); other outputs take it in `resample.rotation`.
     pub(crate) orient: AxisMap,
-    /// `--in-stereo`: how the input picture holds its eyes.
-    pub(crate) in_stereo: Stereo,
+    /// `--in-stereo`: how the input picture holds its eyes (`None`: as the file records,
+    /// else one eye).
+    pub(crate) in_stereo: Option<Stereo>,
     /// `--stereo`: how the output picture holds its eyes.
     pub(crate) stereo: Stereo,
 }
@@ -118,10 +119,9 @@ impl Plan {
             given
                 .map(|m| crate::choice::parse_flag::<Stereo>(flag, m))
                 .transpose()
-                .map(Option::unwrap_or_default)
         };
         let in_stereo = stereo_flag("--in-stereo", a.in_stereo.as_deref())?;
-        let stereo = stereo_flag("--stereo", a.stereo.as_deref())?;
+        let stereo = stereo_flag("--stereo", a.stereo.as_deref())?.unwrap_or_default();
         save::check_stereo(&a.output, layers, stereo, &save)?;
         let mut files = Files::new();
         files.input_arg("the input", &a.input);
@@ -151,9 +151,10 @@ impl Plan {
         })
     }
 
-    /// Whether either side is a stereo pair.
+    /// Whether either side is said to be a stereo pair (a pair a file records, read with
+    /// neither flag, gives its left eye: a `2d` output).
     pub(crate) fn is_stereo(&self) -> bool {
-        self.in_stereo != Stereo::Mono || self.stereo != Stereo::Mono
+        self.in_stereo.is_some_and(|s| s != Stereo::Mono) || self.stereo != Stereo::Mono
     }
 }
 
@@ -310,20 +311,21 @@ fn convert_layers(
 fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
     let t0 = Instant::now();
     let limits = mirrorball_io::Limits::default();
-    let reads = plan.in_stereo.eyes_read(plan.stereo);
     let mut src = load::load_eyes(
         &a.input,
         plan.input.from.as_ref(),
         plan.input.layout,
-        (plan.in_stereo, reads),
+        (plan.in_stereo, plan.stereo),
         &limits,
     )?;
+    let in_stereo = src.stereo;
     for line in src.prepare(&a.input, plan.input.keep_invalid) {
         if !a.quiet {
             eprintln!("{line}");
         }
     }
     let eyes: Vec<EnvMap> = std::iter::once(src.env).chain(src.right).collect();
+    let t_read = t0.elapsed();
     let dst = plan.to.build(None).map_err(|e| bad("--to", e))?;
     let left = &eyes[0];
     let size = plan
@@ -358,28 +360,33 @@ fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
         "a smaller --size",
     )?;
     let t1 = Instant::now();
-    let out = with_spinner("converting", a.quiet, || -> Result<Vec<EnvMap>, CliError> {
-        let mut out: Vec<EnvMap> = Vec::with_capacity(out_eyes);
-        for e in 0..out_eyes {
-            let from = plan.in_stereo.source_eye(e);
-            // A 2d input gives both eyes one picture: converted once.
-            if e > 0 && plan.in_stereo.source_eye(e - 1) == from {
-                out.push(out[e - 1].clone());
-                continue;
+    let out = with_spinner(
+        "converting",
+        a.quiet,
+        || -> Result<Vec<EnvMap>, CliError> {
+            let mut out: Vec<EnvMap> = Vec::with_capacity(out_eyes);
+            for e in 0..out_eyes {
+                let from = in_stereo.source_eye(e);
+                // A 2d input gives both eyes one picture: converted once.
+                if e > 0 && in_stereo.source_eye(e - 1) == from {
+                    out.push(out[e - 1].clone());
+                    continue;
+                }
+                let made = remap
+                    .apply(&eyes[from])
+                    .map_err(|err| CliError::input(format!("{}: {err}", a.input)))?;
+                out.push(match plan.orient.is_identity() {
+                    true => made,
+                    false => made
+                        .transformed(&plan.orient)
+                        .expect("only cube outputs are oriented here"),
+                });
             }
-            let made = remap
-                .apply(&eyes[from])
-                .map_err(|err| CliError::input(format!("{}: {err}", a.input)))?;
-            out.push(match plan.orient.is_identity() {
-                true => made,
-                false => made
-                    .transformed(&plan.orient)
-                    .expect("only cube outputs are oriented here"),
-            });
-        }
-        Ok(out)
-    })?;
+            Ok(out)
+        },
+    )?;
     let t_conv = t1.elapsed();
+    let eyes_read = eyes.len();
     drop(eyes);
     let files = with_spinner("writing", a.quiet, || {
         save::save_eyes(&out, plan.stereo, &a.output, &plan.save)
@@ -396,8 +403,8 @@ fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
                 String::new()
             },
             plan.stereo,
-            reads,
-            (t1 - t0).as_secs_f64(),
+            eyes_read,
+            t_read.as_secs_f64(),
             t_conv.as_secs_f64(),
             (t1.elapsed() - t_conv).as_secs_f64()
         );

@@ -40,6 +40,7 @@ fn every_flat_container_with_text_gives_back_what_it_recorded() {
             MapInfo {
                 projection: fisheye,
                 layout: None,
+                stereo: Default::default(),
             },
             (16, 16),
         ),
@@ -47,6 +48,7 @@ fn every_flat_container_with_text_gives_back_what_it_recorded() {
             MapInfo {
                 projection: paraboloid,
                 layout: Some(Layout::VerticalStrip),
+                stereo: Default::default(),
             },
             (8, 16),
         ),
@@ -90,6 +92,7 @@ fn a_ktx2_cube_records_its_projection() {
     let info = MapInfo {
         projection: ProjectionKind::Cube.default_projection(),
         layout: None,
+        stereo: Default::default(),
     };
     write_cube(&path, &[faces], &declared(info)).unwrap();
     let loaded = read(&path, &Default::default()).unwrap();
@@ -142,6 +145,7 @@ fn an_exr_with_projection_and_layout_is_the_same_bytes_every_time() {
     let info = MapInfo {
         projection: ProjectionKind::Cube.default_projection(),
         layout: Some(Layout::HorizontalCross),
+        stereo: Default::default(),
     };
     let img = picture(8, 6);
     let first = dir.path().join("c0.exr");
