@@ -13,7 +13,8 @@
 //! packed into one picture, the [`Layout`], where the container has a place for text:
 //! OpenEXR string attributes, KTX2 key/value data, PNG `tEXt` chunks, a JPEG comment
 //! segment and Radiance header lines, each under the keys [`PROJECTION_KEY`] and
-//! [`LAYOUT_KEY`]. DDS files record nothing: DDS has no place for text.
+//! [`LAYOUT_KEY`]; a stereo pair records its arrangement in the layout text ([`MapInfo`]).
+//! DDS files record nothing: DDS has no place for text.
 //! Reading gives them back as [`Loaded::recorded`]. OpenEXR's own `envmap` attribute is
 //! reported as [`Loaded::declared`]; its pictures follow OpenEXR's conventions, which
 //! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
