@@ -266,11 +266,7 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
         dst.name(),
         w,
         h,
-        if dst.layer_count() > 1 {
-            format!(" x{}", dst.layer_count())
-        } else {
-            String::new()
-        },
+        times(dst.layer_count()),
     ));
     Ok(())
 }
@@ -397,11 +393,7 @@ fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
             "wrote {}: {} {w}x{h}{} per eye, {} ({} eye(s) read; read {:.2}s, convert {:.2}s, write {:.2}s)",
             names.join(", "),
             dst.name(),
-            if dst.layer_count() > 1 {
-                format!(" x{}", dst.layer_count())
-            } else {
-                String::new()
-            },
+            times(dst.layer_count()),
             plan.stereo,
             eyes_read,
             t_read.as_secs_f64(),
@@ -410,4 +402,13 @@ fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// " x6" after a layer's size, for maps of several layers.
+pub(crate) fn times(layers: usize) -> String {
+    if layers > 1 {
+        format!(" x{layers}")
+    } else {
+        String::new()
+    }
 }

@@ -48,6 +48,21 @@ fn ffmpeg(args: &[&str]) -> Vec<u8> {
     o.stdout
 }
 
+/// What ffmpeg makes of the picture at `input` with `filter`: raw `rgb48le`.
+fn v360_raw(input: &Path, filter: &str) -> Vec<u8> {
+    ffmpeg(&[
+        "-i",
+        input.to_str().unwrap(),
+        "-vf",
+        filter,
+        "-f",
+        "rawvideo",
+        "-pix_fmt",
+        "rgb48le",
+        "-",
+    ])
+}
+
 /// The 16-bit code of direction `d`: `½ + 0.49·d` of full scale.
 pub(crate) fn code(d: DVec3) -> [u16; 3] {
     d.to_array()
@@ -157,17 +172,7 @@ fn compare(dir: &Path, case: &Case) {
     write_coded(&for_ff, &src, iw, ih, true);
 
     let filter = format!("v360={}:interp=line:w={w}:h={h}", case.v360);
-    let ff = ffmpeg(&[
-        "-i",
-        for_ff.to_str().unwrap(),
-        "-vf",
-        &filter,
-        "-f",
-        "rawvideo",
-        "-pix_fmt",
-        "rgb48le",
-        "-",
-    ]);
+    let ff = v360_raw(&for_ff, &filter);
     assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
     let out = dir.join("out_mb.png");
     let size = case.size.to_string();
@@ -313,6 +318,22 @@ fn projections_land_where_v360_puts_them() {
     }
 }
 
+/// One pixel's angle at `(x, y)` of ffmpeg's output (`ffd` decodes a pixel, `df` the one
+/// at `(x, y)`): the farthest of its neighbours, leaving out those across a seam between
+/// cells or eyes (more than twice as far as the nearest).
+fn ffmpeg_pixel(ffd: &impl Fn(u32, u32) -> Option<DVec3>, x: u32, y: u32, df: DVec3) -> f64 {
+    let near: Vec<f64> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+        .iter()
+        .filter_map(|(dx, dy)| ffd((x as i64 + dx) as u32, (y as i64 + dy) as u32))
+        .map(|n| df.angle_between(n))
+        .collect();
+    let min = near.iter().cloned().fold(f64::INFINITY, f64::min);
+    near.iter()
+        .cloned()
+        .filter(|&a| a <= 2.0 * min)
+        .fold(0.0, f64::max)
+}
+
 /// One comparison of a packed cube output: `v360=e:OUT` against `mirrorball convert --to TO
 /// --layout LAYOUT --size N` from the same lat-long.
 struct Packed {
@@ -333,17 +354,7 @@ fn compare_packed(dir: &Path, case: &Packed) {
     write_coded(&for_mb, &src, 256, 128, false);
     write_coded(&for_ff, &src, 256, 128, true);
     let filter = format!("v360=e:{}:interp=line:w={w}:h={h}", case.v360);
-    let ff = ffmpeg(&[
-        "-i",
-        for_ff.to_str().unwrap(),
-        "-vf",
-        &filter,
-        "-f",
-        "rawvideo",
-        "-pix_fmt",
-        "rgb48le",
-        "-",
-    ]);
+    let ff = v360_raw(&for_ff, &filter);
     assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
     let out = dir.join("out_mb.png");
     let size = case.size.to_string();
@@ -382,19 +393,7 @@ fn compare_packed(dir: &Path, case: &Packed) {
             ) else {
                 panic!("{}: texel ({x}, {y}) is black", case.layout);
             };
-            // One pixel: ffmpeg's own neighbours, leaving out those across a seam between
-            // cells (more than twice as far as the nearest).
-            let near: Vec<f64> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
-                .iter()
-                .filter_map(|(dx, dy)| ffd((x as i64 + dx) as u32, (y as i64 + dy) as u32))
-                .map(|n| df.angle_between(n))
-                .collect();
-            let min = near.iter().cloned().fold(f64::INFINITY, f64::min);
-            let tol = near
-                .iter()
-                .cloned()
-                .filter(|&a| a <= 2.0 * min)
-                .fold(0.0, f64::max);
+            let tol = ffmpeg_pixel(&ffd, x, y, df);
             let e = df.angle_between(dm);
             worst = worst.max(e / tol);
             compared += 1;
@@ -516,17 +515,7 @@ fn compare_pair(dir: &Path, case: &Pair) {
         "v360=e:{}:in_stereo={}:out_stereo={}:interp=line:w={w}:h={h}",
         case.v360, case.in_stereo, case.out_stereo
     );
-    let ff = ffmpeg(&[
-        "-i",
-        for_ff.to_str().unwrap(),
-        "-vf",
-        &filter,
-        "-f",
-        "rawvideo",
-        "-pix_fmt",
-        "rgb48le",
-        "-",
-    ]);
+    let ff = v360_raw(&for_ff, &filter);
     assert_eq!(ff.len(), (fw * fh * 6) as usize, "{filter}: output size");
     let out = dir.join("pair_out.png");
     let size = case.size.to_string();
@@ -575,19 +564,7 @@ fn compare_pair(dir: &Path, case: &Pair) {
                 let (Some(df), Some(dm)) = (ffd(x, y), decode(m)) else {
                     panic!("{filter}: texel ({x}, {y}) is black");
                 };
-                // One pixel: ffmpeg's own neighbours in this eye, leaving out those across
-                // a seam between cells (more than twice as far as the nearest).
-                let near: Vec<f64> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
-                    .iter()
-                    .filter_map(|(dx, dy)| ffd((x as i64 + dx) as u32, (y as i64 + dy) as u32))
-                    .map(|n| df.angle_between(n))
-                    .collect();
-                let min = near.iter().cloned().fold(f64::INFINITY, f64::min);
-                let tol = near
-                    .iter()
-                    .cloned()
-                    .filter(|&a| a <= 2.0 * min)
-                    .fold(0.0, f64::max);
+                let tol = ffmpeg_pixel(&ffd, x, y, df);
                 let err = df.angle_between(dm);
                 worst = worst.max(err / tol);
                 compared += 1;

@@ -12,7 +12,7 @@ use super::pattern::{Frame, Pattern, Printf};
 use super::pipe::{self, PixFmt};
 use super::pipeline::{self, Eyes, Meta, FRAMES_IN_FLIGHT};
 use super::shard::Shard;
-use crate::commands::convert::Plan;
+use crate::commands::convert::{times, Plan};
 use crate::error::CliError;
 use crate::progress::with_progress;
 use crate::spec::bad;
@@ -532,15 +532,6 @@ fn convert_frames(
         );
     }
     result
-}
-
-/// " x6" after a layer's size, for maps of several layers.
-fn times(layers: usize) -> String {
-    if layers > 1 {
-        format!(" x{layers}")
-    } else {
-        String::new()
-    }
 }
 
 /// Writes one frame's file(s) through io's atomic writes; the name for the log.
