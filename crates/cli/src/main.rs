@@ -130,7 +130,7 @@ pub struct ConvertArgs {
     layout: Option<String>,
     /// The input picture as a stereo pair, as FFmpeg v360's in_stereo: 2d (one eye), sbs
     /// (left eye | right eye), tb (left eye above the right). Each eye is read as --from and
-    /// --in-layout say.
+    /// --in-layout say. Default: as the file records (a pair mirrorball wrote), else 2d.
     #[arg(long = "in-stereo", value_name = "MODE", value_parser = names::<mirrorball_core::Stereo>())]
     in_stereo: Option<String>,
     /// The output as a stereo pair, as v360's out_stereo: 2d (of a pair, the left eye), sbs
