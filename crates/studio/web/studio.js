@@ -380,6 +380,45 @@ document.getElementById('projection').addEventListener('change', async (e) => {
   redraw();
 });
 
+/** Hands `blob` to the browser as a download called `name`. */
+function download(blob, name) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  document.body.appendChild(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 60000);
+}
+
+/**
+ * Downloads what the server writes (`/api/export`): the map as the viewport shows it (its
+ * projection and size) or the GGX chain it is lit by, in the chosen container.
+ */
+async function exportFile(what) {
+  const format = document.getElementById('export-format').value;
+  let q = `what=${what}&format=${format}`;
+  if (what === 'map') {
+    q += `&projection=${encodeURIComponent(view.projection)}`;
+    if (view.size) q += `&size=${view.size}`;
+  }
+  try {
+    const r = await G.api(`/api/export?${q}`);
+    const name = /filename="([^"]+)"/.exec(r.headers.get('content-disposition') || '')?.[1] || `export.${format}`;
+    download(await r.blob(), name);
+    report();
+  } catch (e) {
+    report(e);
+  }
+}
+
+document.getElementById('export-map').addEventListener('click', () => exportFile('map'));
+document.getElementById('export-chain').addEventListener('click', () => exportFile('chain'));
+document.getElementById('screenshot').addEventListener('click', async () => {
+  await drawing;
+  canvas.toBlob((b) => download(b, 'mirrorball-viewport.png'), 'image/png');
+});
+
 function startOrbit() {
   if (view.orbit) return;
   const c = view.state.scene.camera;

@@ -3,11 +3,14 @@
 //! environments, so that the page shows the CLI's messages; the URL (with its token) is the
 //! first line of standard output.
 
+use super::prefilter::outputs;
 use crate::error::CliError;
 use crate::load;
+use crate::save::{self, SaveOptions};
 use crate::RenderArgs;
 use clap::{Args, Parser};
-use mirrorball_studio::{Host, Opened, SceneView, Studio};
+use mirrorball_io::WriteOptions;
+use mirrorball_studio::{Export, Host, Opened, SceneView, Studio};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -159,5 +162,40 @@ impl Host for CliHost {
 
     fn default_scene(&self) -> SceneView {
         scene_view(None).expect("render's defaults make a scene")
+    }
+
+    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String> {
+        // Written as `convert` and `prefilter` write their outputs, into a folder of its own,
+        // then read back for the page and the folder removed.
+        let dir = std::env::temp_dir().join(format!(
+            "mirrorball-studio-export-{}-{}",
+            std::process::id(),
+            mirrorball_studio::guard::new_token()?
+        ));
+        std::fs::create_dir(&dir).map_err(|e| format!("cannot write the export: {e}"))?;
+        let path = dir.join(format!("export.{format}"));
+        let shown = path.display().to_string();
+        let written = match what {
+            Export::Map(map) => save::save(
+                map,
+                &shown,
+                &SaveOptions {
+                    layout: None,
+                    write: WriteOptions::default(),
+                    mips: false,
+                },
+            )
+            .map(|_| ()),
+            Export::Chain(chain) => {
+                outputs::write_cube_chain(&path, chain, &WriteOptions::default())
+            }
+        };
+        let result = written
+            .map_err(|e| e.to_string().replace(&shown, &format!("export.{format}")))
+            .and_then(|()| {
+                std::fs::read(&path).map_err(|e| format!("cannot read the export back: {e}"))
+            });
+        let _ = std::fs::remove_dir_all(&dir);
+        result
     }
 }
