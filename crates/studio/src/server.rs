@@ -389,7 +389,10 @@ struct ExportQuery {
 /// A file to download: the map (converted as the page shows it) or the last prefiltered
 /// chain, in the container asked for, written by the host on a blocking thread.
 async fn export(Shared(app): Shared<AppState>, Query(q): Query<ExportQuery>) -> Response {
-    let format = q.format.unwrap_or_else(|| "exr".into()).to_ascii_lowercase();
+    let format = q
+        .format
+        .unwrap_or_else(|| "exr".into())
+        .to_ascii_lowercase();
     if !EXPORT_FORMATS.contains(&format.as_str()) {
         return bad(
             StatusCode::BAD_REQUEST,
@@ -412,7 +415,13 @@ async fn export(Shared(app): Shared<AppState>, Query(q): Query<ExportQuery>) -> 
             let projection = q.projection.unwrap_or_else(|| "native".into());
             let shown: String = projection
                 .chars()
-                .map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' })
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
                 .collect();
             let name = format!("environment-{shown}.{format}");
             let host = app.host.clone();
@@ -435,9 +444,9 @@ async fn export(Shared(app): Shared<AppState>, Query(q): Query<ExportQuery>) -> 
                 );
             }
             let lit = app.lit.lock().expect("lit").clone();
-            let Some((_, (l, _))) = lit.filter(|(k, _)| {
-                k.starts_with(&format!("{:p} ", Arc::as_ptr(&map)))
-            }) else {
+            let Some((_, (l, _))) =
+                lit.filter(|(k, _)| k.starts_with(&format!("{:p} ", Arc::as_ptr(&map))))
+            else {
                 return bad(
                     StatusCode::NOT_FOUND,
                     "no prefiltered chain of this environment yet: choose the prefiltered GGX material first",

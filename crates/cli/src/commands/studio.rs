@@ -106,6 +106,19 @@ fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
     })
 }
 
+/// A new folder of this process's own under the system's temporary folder, named for
+/// `purpose` and a fresh token (so that no other process can have made it): the caller
+/// removes it.
+fn private_dir(purpose: &str) -> Result<PathBuf, String> {
+    let dir = std::env::temp_dir().join(format!(
+        "mirrorball-studio-{purpose}-{}-{}",
+        std::process::id(),
+        mirrorball_studio::guard::new_token()?
+    ));
+    std::fs::create_dir(&dir).map_err(|e| e.to_string())?;
+    Ok(dir)
+}
+
 /// Reads files as the CLI's commands do.
 struct CliHost;
 
@@ -146,12 +159,8 @@ impl Host for CliHost {
                  the files a scene names are read only when named there"
             ));
         }
-        let dir = std::env::temp_dir().join(format!(
-            "mirrorball-studio-{}-{}",
-            std::process::id(),
-            mirrorball_studio::guard::new_token()?
-        ));
-        std::fs::create_dir(&dir).map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
+        let dir =
+            private_dir("upload").map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
         let path = dir.join(format!("upload.{ext}"));
         let result = std::fs::write(&path, bytes)
             .map_err(|e| format!("{name}: cannot store the upload: {e}"))
@@ -167,12 +176,7 @@ impl Host for CliHost {
     fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String> {
         // Written as `convert` and `prefilter` write their outputs, into a folder of its own,
         // then read back for the page and the folder removed.
-        let dir = std::env::temp_dir().join(format!(
-            "mirrorball-studio-export-{}-{}",
-            std::process::id(),
-            mirrorball_studio::guard::new_token()?
-        ));
-        std::fs::create_dir(&dir).map_err(|e| format!("cannot write the export: {e}"))?;
+        let dir = private_dir("export").map_err(|e| format!("cannot write the export: {e}"))?;
         let path = dir.join(format!("export.{format}"));
         let shown = path.display().to_string();
         let written = match what {

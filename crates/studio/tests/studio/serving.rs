@@ -197,10 +197,22 @@ fn exports_are_the_hosts_files_and_bad_requests_say_what_is_wrong() {
     assert_eq!(a.status, 200, "{}", a.text());
     assert_eq!(&a.body[1..7], b"KTX 20");
     for (target, status, says) in [
-        ("/api/export?what=map&format=bmp", 400, "'bmp' is not one of"),
-        ("/api/export?what=scene&format=exr", 400, "'scene' is not map or chain"),
+        (
+            "/api/export?what=map&format=bmp",
+            400,
+            "'bmp' is not one of",
+        ),
+        (
+            "/api/export?what=scene&format=exr",
+            400,
+            "'scene' is not map or chain",
+        ),
         ("/api/export?what=chain&format=exr", 400, "ktx2 or dds"),
-        ("/api/export?what=chain&format=ktx2", 404, "no prefiltered chain"),
+        (
+            "/api/export?what=chain&format=ktx2",
+            404,
+            "no prefiltered chain",
+        ),
         (
             "/api/export?what=map&format=exr&projection=nonsense",
             400,
