@@ -3,7 +3,7 @@
 // and the screenshot, which is the viewport's pixels.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { readFileSync } from 'node:fs';
+import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { browser, run, tempDir, readPng, studio, openStudio, ROOT } from './lib.mjs';
 
@@ -77,6 +77,92 @@ test('the map, the GGX chain and the screenshot download from the page, and mirr
     throw new Error(`${e.stack}\n${logs.join('\n')}`);
   } finally {
     await page.close();
+    s.stop();
+  }
+});
+
+test('the scene exported from an orbited embed view renders with mirrorball render as the page draws it', async () => {
+  const scene = path.join(work.dir, 'sphere.json');
+  writeFileSync(
+    scene,
+    JSON.stringify({
+      meshes: [{ mesh: 'sphere', tessellation: 12 }],
+      camera: { eye: [0, 0.4, 3.2], target: [0, 0, 0], fov: 40, width: 160, height: 120 },
+      // Relative to the scene file: the export names it absolutely.
+      environment: { file: path.relative(work.dir, VENICE), projection: 'latlong', attach: 'world', filter: 'ewa' },
+      material: { kind: 'mirror' },
+      supersample: 2,
+      background: true,
+    }),
+  );
+  const s = await studio([scene]);
+  try {
+    const { page, logs } = await openStudio(chromium, `${s.url}&view=viewport&mode=2&yaw=0.6&pitch=0.35&distance=2.8`);
+    const got = await page.evaluate(() => {
+      const p = window.studio.pixels();
+      return { width: p.width, height: p.height, data: Array.from(p.data), file: window.studio.sceneFile() };
+    });
+    await page.close();
+    assert.deepEqual(logs.filter((l) => /error/i.test(l)), []);
+    assert.equal(got.file.indexing, 'vertex');
+    assert.equal(got.file.supersample, 1);
+    assert.ok(path.isAbsolute(got.file.environment.file));
+    const exported = path.join(work.dir, 'exported.json');
+    writeFileSync(exported, JSON.stringify(got.file));
+    const out = path.join(work.dir, 'exported.png');
+    run(['render', exported, '-o', out, '--quiet']);
+    const cover = path.join(work.dir, 'cover.png');
+    run(['render', exported, '-o', cover, '--quiet', '--no-background']);
+    const cpu = readPng(readFileSync(out));
+    const alpha = readPng(readFileSync(cover));
+    assert.equal(cpu.width, got.width);
+    assert.equal(cpu.height, got.height);
+    // As studio.test.mjs compares the embed view with render: covered pixels whose eight
+    // neighbours are covered too (the rim's coverage is the rasterisers' business), and the
+    // background.
+    const { width: w, height: h } = cpu;
+    const covered = (x, y) => alpha.data[4 * (y * w + x) + 3] > 0;
+    let n = 0;
+    let within = 0;
+    let bg = 0;
+    let bgWithin = 0;
+    for (let y = 1; y < h - 1; y++) {
+      for (let x = 1; x < w - 1; x++) {
+        const i = y * w + x;
+        const d = Math.max(...[0, 1, 2].map((c) => Math.abs(got.data[4 * i + c] - cpu.data[4 * i + c])));
+        let inner = true;
+        for (let dy = -1; dy <= 1; dy++) for (let dx = -1; dx <= 1; dx++) inner &&= covered(x + dx, y + dy);
+        if (inner) {
+          n++;
+          if (d <= 2) within++;
+        } else if (!covered(x, y)) {
+          bg++;
+          if (d <= 2) bgWithin++;
+        }
+      }
+    }
+    console.log(`exported scene: ${((100 * within) / n).toFixed(2)}% of ${n} covered pixels within 2/255, background ${((100 * bgWithin) / bg).toFixed(2)}%`);
+    assert.ok(n > 1000, `${n} covered pixels`);
+    assert.ok(within / n >= 0.99);
+    assert.ok(bgWithin / bg >= 0.99);
+    // An environment opened on its own has no scene file to export.
+    const other = await studio([VENICE]);
+    try {
+      const { page: p2 } = await openStudio(chromium, other.url);
+      const message = await p2.evaluate(() => {
+        try {
+          window.studio.sceneFile();
+          return null;
+        } catch (e) {
+          return e.message;
+        }
+      });
+      await p2.close();
+      assert.match(message ?? '', /no scene file/);
+    } finally {
+      other.stop();
+    }
+  } finally {
     s.stop();
   }
 });

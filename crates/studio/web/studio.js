@@ -412,6 +412,42 @@ async function exportFile(what) {
   }
 }
 
+/**
+ * The scene as a scene file (docs/render-scene.md) that `mirrorball render FILE --ss 1`
+ * draws as the viewport does: the file the scene was read from (the server made its paths
+ * absolute) with the camera now (orbited or not), the mode, one sample a pixel and the
+ * bilinear filter the viewport reads with. Refused, with the reason, where a scene file
+ * cannot say what the viewport shows.
+ */
+function sceneFile() {
+  const s = view.state.scene;
+  if (!s.source) {
+    throw new Error('the scene came from no scene file, or its environment was replaced: only a scene opened from a file exports (its meshes and environment are named by path)');
+  }
+  if (view.projection !== 'native') {
+    throw new Error(`the viewport shows the environment converted to ${view.projection}, which a scene file cannot say (render's --env-as): choose "as loaded" to export the scene`);
+  }
+  if (materialNow() !== 'mirror') {
+    throw new Error('the prefiltered materials have no scene-file form: choose the mirror to export the scene');
+  }
+  const out = JSON.parse(JSON.stringify(s.source));
+  const c = s.camera;
+  const cam = camera();
+  out.camera = Object.assign({}, out.camera, { eye: cam.eye, target: c.target, up: c.up, width: c.width, height: c.height });
+  out.indexing = ['texgen', 'vertex', 'pixel'][view.mode - 1];
+  out.supersample = 1;
+  if (out.environment) out.environment.filter = 'bilinear';
+  return out;
+}
+
+document.getElementById('export-scene').addEventListener('click', () => {
+  try {
+    download(new Blob([JSON.stringify(sceneFile(), null, 2)], { type: 'application/json' }), 'mirrorball-scene.json');
+    report();
+  } catch (e) {
+    report(e);
+  }
+});
 document.getElementById('export-map').addEventListener('click', () => exportFile('map'));
 document.getElementById('export-chain').addEventListener('click', () => exportFile('chain'));
 document.getElementById('screenshot').addEventListener('click', async () => {
@@ -466,7 +502,7 @@ const ready = (async () => {
 })();
 ready.catch(report);
 
-const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting };
+const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting, sceneFile };
 // The simulator panel and the view state in the URL (sim.js); `ready` waits for both.
 const sim = await import(`./sim.js?token=${encodeURIComponent(token)}`);
 handle.sim = sim.attach(handle);

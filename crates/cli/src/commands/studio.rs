@@ -103,6 +103,7 @@ fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
         settings,
         exposure,
         tone,
+        source: scene.map(super::render::schema::portable).transpose()?,
     })
 }
 

@@ -58,6 +58,7 @@ impl Host for TestHost {
             settings: Settings::default(),
             exposure: 0.0,
             tone: Tone::Clamp,
+            source: None,
         }
     }
     fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String> {
