@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, run, tempDir, readPng, studio, openStudio, ROOT } from './lib.mjs';
+import { browser, run, tempDir, readPng, studio, openStudio, againstRender, ROOT } from './lib.mjs';
 
 let chromium;
 let work;
@@ -117,30 +117,8 @@ test('the scene exported from an orbited embed view renders with mirrorball rend
     const alpha = readPng(readFileSync(cover));
     assert.equal(cpu.width, got.width);
     assert.equal(cpu.height, got.height);
-    // As studio.test.mjs compares the embed view with render: covered pixels whose eight
-    // neighbours are covered too (the rim's coverage is the rasterisers' business), and the
-    // background.
-    const { width: w, height: h } = cpu;
-    const covered = (x, y) => alpha.data[4 * (y * w + x) + 3] > 0;
-    let n = 0;
-    let within = 0;
-    let bg = 0;
-    let bgWithin = 0;
-    for (let y = 1; y < h - 1; y++) {
-      for (let x = 1; x < w - 1; x++) {
-        const i = y * w + x;
-        const d = Math.max(...[0, 1, 2].map((c) => Math.abs(got.data[4 * i + c] - cpu.data[4 * i + c])));
-        let inner = true;
-        for (let dy = -1; dy <= 1; dy++) for (let dx = -1; dx <= 1; dx++) inner &&= covered(x + dx, y + dy);
-        if (inner) {
-          n++;
-          if (d <= 2) within++;
-        } else if (!covered(x, y)) {
-          bg++;
-          if (d <= 2) bgWithin++;
-        }
-      }
-    }
+    // As studio.test.mjs compares the embed view with render.
+    const { n, within, bg, bgWithin } = againstRender(got.data, cpu, alpha);
     console.log(`exported scene: ${((100 * within) / n).toFixed(2)}% of ${n} covered pixels within 2/255, background ${((100 * bgWithin) / bg).toFixed(2)}%`);
     assert.ok(n > 1000, `${n} covered pixels`);
     assert.ok(within / n >= 0.99);
