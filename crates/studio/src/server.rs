@@ -10,11 +10,12 @@
 //! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
 //! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
 //! | `GET /api/lighting/progress` | `{"done", "total", "busy"}`: rows of the prefilter running |
+//! | `GET /api/export?what=map\|chain&format=EXT&projection=…&size=N` | a file to download, written by the [`Host`]: the map (as loaded, or converted as `/api/environment` converts it) or the last prefiltered chain |
 //! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit) |
 
 use crate::guard::Guard;
 use crate::state::{gpu_kind, State};
-use crate::{geometry, grid, lighting, texture, web, Host};
+use crate::{geometry, grid, lighting, texture, web, Export, Host, EXPORT_FORMATS};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State as Shared};
@@ -91,8 +92,9 @@ struct App {
     options: Studio,
     /// The last conversion asked for, by its query.
     converted: Mutex<Option<(String, Arc<EnvMap>)>>,
-    /// The last prefiltered lighting, by its request, and the running one's progress.
-    lit: Mutex<Option<(String, Arc<Vec<u8>>)>>,
+    /// The last prefiltered lighting (and its payload), by its request, and the running
+    /// one's progress.
+    lit: Mutex<Option<(String, Lit)>>,
     lit_progress: Progress,
 }
 
@@ -103,6 +105,9 @@ struct Progress {
     total: AtomicU64,
     busy: AtomicBool,
 }
+
+/// A prefiltered chain and its payload for the page.
+type Lit = (Arc<lighting::Lighting>, Arc<Vec<u8>>);
 
 type AppState = Arc<App>;
 
@@ -171,6 +176,7 @@ fn serve(
             .route("/api/grid", get(grid_of))
             .route("/api/lighting", get(lighting_of))
             .route("/api/lighting/progress", get(lighting_progress))
+            .route("/api/export", get(export))
             .route(
                 "/api/upload",
                 post(upload).layer(DefaultBodyLimit::max(limit)),
@@ -331,7 +337,7 @@ async fn lighting_of(Shared(app): Shared<AppState>, Query(q): Query<LightingQuer
         }
     };
     let key = format!("{:p} {size} {}", Arc::as_ptr(&map), mapping.name());
-    if let Some((k, b)) = app.lit.lock().expect("lit").as_ref() {
+    if let Some((k, (_, b))) = app.lit.lock().expect("lit").as_ref() {
         if *k == key {
             return binary(b.to_vec());
         }
@@ -347,14 +353,15 @@ async fn lighting_of(Shared(app): Shared<AppState>, Query(q): Query<LightingQuer
     p.total.store(lighting::rows(size), Ordering::SeqCst);
     let done = p.done.clone();
     let work = tokio::task::spawn_blocking(move || {
-        lighting::encode(&lighting::prefilter(&map, size, mapping, done))
+        let l = lighting::prefilter(&map, size, mapping, done);
+        let b = lighting::encode(&l);
+        (Arc::new(l), Arc::new(b))
     })
     .await;
     p.busy.store(false, Ordering::SeqCst);
     match work {
-        Ok(b) => {
-            let b = Arc::new(b);
-            *app.lit.lock().expect("lit") = Some((key, b.clone()));
+        Ok((l, b)) => {
+            *app.lit.lock().expect("lit") = Some((key, (l, b.clone())));
             binary(b.to_vec())
         }
         Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
@@ -369,6 +376,109 @@ async fn lighting_progress(Shared(app): Shared<AppState>) -> Response {
         "busy": p.busy.load(Ordering::SeqCst),
     }))
     .into_response()
+}
+
+#[derive(Deserialize)]
+struct ExportQuery {
+    what: Option<String>,
+    format: Option<String>,
+    projection: Option<String>,
+    size: Option<u32>,
+}
+
+/// A file to download: the map (converted as the page shows it) or the last prefiltered
+/// chain, in the container asked for, written by the host on a blocking thread.
+async fn export(Shared(app): Shared<AppState>, Query(q): Query<ExportQuery>) -> Response {
+    let format = q
+        .format
+        .unwrap_or_else(|| "exr".into())
+        .to_ascii_lowercase();
+    if !EXPORT_FORMATS.contains(&format.as_str()) {
+        return bad(
+            StatusCode::BAD_REQUEST,
+            format!(
+                "format '{format}' is not one of {}",
+                EXPORT_FORMATS.join(", ")
+            ),
+        );
+    }
+    let what = q.what.unwrap_or_else(|| "map".into());
+    let map = {
+        let s = app.state.lock().expect("state");
+        match &s.view.scene.environment {
+            Some(e) => e.map.clone(),
+            None => return bad(StatusCode::NOT_FOUND, "no environment is loaded"),
+        }
+    };
+    let (name, work) = match what.as_str() {
+        "map" => {
+            let projection = q.projection.unwrap_or_else(|| "native".into());
+            let shown: String = projection
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            let name = format!("environment-{shown}.{format}");
+            let host = app.host.clone();
+            let work = tokio::task::spawn_blocking(move || {
+                let map = if projection == "native" {
+                    map
+                } else {
+                    convert(&app, &map, &projection, q.size)?
+                };
+                host.export(Export::Map(&map), &format)
+                    .map_err(|e| (StatusCode::UNPROCESSABLE_ENTITY, e))
+            });
+            (name, work)
+        }
+        "chain" => {
+            if !matches!(format.as_str(), "ktx2" | "dds") {
+                return bad(
+                    StatusCode::BAD_REQUEST,
+                    format!("format '{format}': a chain is one file only as ktx2 or dds (`mirrorball prefilter` writes the others one file a level)"),
+                );
+            }
+            let lit = app.lit.lock().expect("lit").clone();
+            let Some((_, (l, _))) =
+                lit.filter(|(k, _)| k.starts_with(&format!("{:p} ", Arc::as_ptr(&map))))
+            else {
+                return bad(
+                    StatusCode::NOT_FOUND,
+                    "no prefiltered chain of this environment yet: choose the prefiltered GGX material first",
+                );
+            };
+            let name = format!("ggx-{}-{}.{format}", l.size, l.mapping.name());
+            let host = app.host.clone();
+            let work = tokio::task::spawn_blocking(move || {
+                host.export(Export::Chain(&l.chain), &format)
+                    .map_err(|e| (StatusCode::UNPROCESSABLE_ENTITY, e))
+            });
+            (name, work)
+        }
+        w => {
+            return bad(
+                StatusCode::BAD_REQUEST,
+                format!("what '{w}' is not map or chain"),
+            )
+        }
+    };
+    match work.await {
+        Ok(Ok(bytes)) => {
+            let disposition = format!("attachment; filename=\"{name}\"");
+            let mut r = binary(bytes);
+            if let Ok(v) = HeaderValue::from_str(&disposition) {
+                r.headers_mut().insert(header::CONTENT_DISPOSITION, v);
+            }
+            r
+        }
+        Ok(Err((s, m))) => bad(s, m),
+        Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+    }
 }
 
 async fn mesh(Shared(app): Shared<AppState>, UrlPath(i): UrlPath<usize>) -> Response {

@@ -20,6 +20,10 @@ pub struct SceneView {
     pub settings: Settings,
     pub exposure: f32,
     pub tone: Tone,
+    /// The scene file as JSON whose paths are absolute (`docs/render-scene.md`), which the
+    /// page exports with its own camera and mode; `None` when the scene came from no file
+    /// or its environment was replaced (the file would name the wrong one).
+    pub source: Option<Value>,
 }
 
 /// What a file held.
@@ -72,6 +76,7 @@ impl State {
                     },
                 };
                 self.view.scene.environment = Some(env);
+                self.view.source = None;
                 self.view.name = format!("{} with {name}", self.view.name);
             }
         }
@@ -161,6 +166,7 @@ fn describe_scene(v: &SceneView) -> Value {
         "indexing": v.settings.indexing.name(),
         "mode": v.settings.indexing.number(),
         "background": v.scene.background,
+        "source": v.source,
         "exposure": v.exposure,
         "tone": v.tone.name(),
         "objects": objects,

@@ -40,6 +40,7 @@ const FILES: &[(&str, &str, &str)] = files![
     "glsl/sinusoidal.glsl": "glsl",
     "glsl/view.glsl": "glsl",
     "glsl/bilinear.glsl": "glsl",
+    "glsl/lighting.glsl": "glsl",
     "glsl/display.glsl": "glsl",
     "glsl/interpolate.glsl": "glsl",
     "glsl/texgen.glsl": "glsl",

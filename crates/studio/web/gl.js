@@ -197,11 +197,19 @@ export function texgenOf(kind, layers) {
   return layers === 1 ? 2 : 1;
 }
 
-/** The viewport's program for `kind`, indexing `mode` (1–3), objects or the background. */
-export async function viewportProgram(gl, { kind, layers, mode, background }) {
+/** The materials the viewport draws objects with (viewport.frag `MATERIAL`). */
+export const MATERIALS = { mirror: 0, ggx: 1, lambert: 2 };
+
+/**
+ * The viewport's program for `kind`, indexing `mode` (1–3), objects or the background, the
+ * objects in `material` (a name of `MATERIALS`; the prefiltered ones add lighting.glsl).
+ */
+export async function viewportProgram(gl, { kind, layers, mode, background, material = 'mirror' }) {
+  const m = MATERIALS[material];
+  if (m === undefined) throw new Error(`material '${material}' is not ${Object.keys(MATERIALS).join(', ')}`);
   const defines =
     `#define MODE ${mode}\n#define TEXGEN ${texgenOf(kind, layers)}\n` +
-    `#define BACKGROUND ${background ? 1 : 0}\n`;
+    `#define BACKGROUND ${background ? 1 : 0}\n#define MATERIAL ${background ? 0 : m}\n`;
   const proj = await projectionSource(kind);
   const vs = HEADER + defines + proj + '\n' + (await glsl('texgen.glsl')) + '\n' + (await glsl('viewport.vert'));
   const fs =
@@ -211,6 +219,7 @@ export async function viewportProgram(gl, { kind, layers, mode, background }) {
     '\n' +
     (await glsl('bilinear.glsl')) +
     '\n' +
+    (m && !background ? (await glsl('lighting.glsl')) + '\n' : '') +
     (await glsl('display.glsl')) +
     '\n' +
     (await glsl('interpolate.glsl')) +

@@ -164,10 +164,73 @@ fn the_grid_holds_the_cores_answers() {
     assert_eq!(a.status, 200);
     let count = u32::from_le_bytes(a.body[..4].try_into().unwrap()) as usize;
     assert_eq!(count, 6 * 81);
+    // Count, the frame (9 floats), the parameters (4), then nine floats a direction.
     assert_eq!(a.body.len(), 56 + 36 * count);
     assert_eq!(
         own(&r, "GET", "/api/grid?projection=cube&n=100000", b"").status,
         400
     );
+    r.stop();
+}
+
+#[test]
+fn exports_are_the_hosts_files_and_bad_requests_say_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = start(&[latlong_exr(dir.path())]);
+    // The map as loaded: an EXR the io crate reads back with the loaded texels.
+    let a = own(&r, "GET", "/api/export?what=map&format=exr", b"");
+    assert_eq!(a.status, 200, "{}", a.text());
+    assert_eq!(
+        a.header("content-disposition"),
+        Some("attachment; filename=\"environment-native.exr\"")
+    );
+    let file = dir.path().join("back.exr");
+    std::fs::write(&file, &a.body).unwrap();
+    let back = mirrorball_io::read(&file, &mirrorball_io::Limits::default()).unwrap();
+    assert_eq!((back.layers[0].width(), back.layers[0].height()), (16, 8));
+    // Converted as the page asks: a cube into KTX2.
+    let a = own(
+        &r,
+        "GET",
+        "/api/export?what=map&format=ktx2&projection=cube&size=8",
+        b"",
+    );
+    assert_eq!(a.status, 200, "{}", a.text());
+    assert_eq!(&a.body[1..7], b"KTX 20");
+    for (target, status, says) in [
+        (
+            "/api/export?what=map&format=bmp",
+            400,
+            "'bmp' is not one of",
+        ),
+        (
+            "/api/export?what=scene&format=exr",
+            400,
+            "'scene' is not map or chain",
+        ),
+        ("/api/export?what=chain&format=exr", 400, "ktx2 or dds"),
+        (
+            "/api/export?what=chain&format=ktx2",
+            404,
+            "no prefiltered chain",
+        ),
+        (
+            "/api/export?what=map&format=exr&projection=nonsense",
+            400,
+            "projection",
+        ),
+    ] {
+        let a = own(&r, "GET", target, b"");
+        assert_eq!(a.status, status, "{target}: {}", a.text());
+        let m = json(&a)["error"].as_str().unwrap().to_string();
+        assert!(m.contains(says), "{target}: {m}");
+    }
+    // Once the page is lit, its chain: every level in one KTX2.
+    let a = own(&r, "GET", "/api/lighting?size=8", b"");
+    assert_eq!(a.status, 200, "{}", a.text());
+    let a = own(&r, "GET", "/api/export?what=chain&format=ktx2", b"");
+    assert_eq!(a.status, 200, "{}", a.text());
+    let levels = u32::from_le_bytes(a.body[40..44].try_into().unwrap());
+    assert_eq!(levels, 4);
     r.stop();
 }

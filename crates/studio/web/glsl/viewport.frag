@@ -2,7 +2,14 @@
 // display.glsl and interpolate.glsl): the mode's reflected direction, as mirrorball-render's render/shade.rs
 // (`Prepared::shade`, `env_color`) and render/texgen.rs (`texgen_read`), read through the
 // projection's envUv, shown as display.glsl says. The background is the camera's rays
-// (render/background.rs, camera.rs `Rays::ray`).
+// (render/background.rs, camera.rs `Rays::ray`). MATERIAL (gl.js; 0 when not defined, as
+// the simulator's passes compile it) picks the objects' material: 0 the mirror, indexed by
+// the mode; 1 the prefiltered GGX chain in the per-pixel reflected direction, 2 the Lambert
+// SH9 at the per-pixel normal (lighting.glsl, included before this file for 1 and 2): the
+// prefiltered materials are shaded per pixel whatever the mode.
+#ifndef MATERIAL
+#define MATERIAL 0
+#endif
 flat in vec4 vClip0;
 flat in vec4 vClip1;
 flat in vec4 vClip2;
@@ -54,7 +61,13 @@ void main() {
     vec3 vNrm = b.x * vN0 + b.y * vN1 + b.z * vN2;
     vec3 vR = b.x * vC0 + b.y * vC1 + b.z * vC2;
     vec3 c;
-#if MODE == 3
+#if MATERIAL == 1
+    vec3 n = normalizeOrZero(vNrm);
+    vec3 v = uPersp ? normalizeOrZero(vPos - uEye) : uForward;
+    c = chainRead(attach(v - 2.0 * dot(n, v) * n));
+#elif MATERIAL == 2
+    c = irradiance(attach(normalizeOrZero(vNrm)));
+#elif MODE == 3
     vec3 n = normalizeOrZero(vNrm);
     vec3 v = uPersp ? normalizeOrZero(vPos - uEye) : uForward;
     c = lookup(attach(v - 2.0 * dot(n, v) * n));

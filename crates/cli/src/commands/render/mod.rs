@@ -9,7 +9,7 @@
 mod material;
 mod output;
 mod plan;
-mod schema;
+pub(crate) mod schema;
 
 use crate::budget;
 use crate::error::CliError;
