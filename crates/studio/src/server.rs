@@ -5,7 +5,7 @@
 //! | `GET /` | the page (`?view=viewport`: the viewport alone, at the camera's size) |
 //! | `GET /web/NAME` | the page's scripts and shaders, embedded in the binary |
 //! | `GET /api/state` | what is loaded, as JSON ([`State::describe`]) |
-//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float` | the environment's texels ([`texture`]) |
+//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float&mips=0\|1` | the environment's texels, with its mip chain for `mips=1` ([`texture`]) |
 //! | `GET /api/mesh/I` | object `I` in world space ([`geometry`]) |
 //! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
 //! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
@@ -232,6 +232,7 @@ struct EnvQuery {
     projection: Option<String>,
     size: Option<u32>,
     precision: Option<String>,
+    mips: Option<String>,
 }
 
 async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -> Response {
@@ -243,6 +244,11 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
     {
         Ok(p) => p,
         Err(e) => return bad(StatusCode::BAD_REQUEST, format!("precision: {e}")),
+    };
+    let mips = match q.mips.as_deref().unwrap_or("0") {
+        "0" => false,
+        "1" => true,
+        m => return bad(StatusCode::BAD_REQUEST, format!("mips: '{m}' is not 0 or 1")),
     };
     let map = {
         let s = app.state.lock().expect("state");
@@ -271,7 +277,11 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
                 ),
             ));
         }
-        Ok(texture::encode(&map, precision))
+        Ok(if mips {
+            texture::encode_mips(&map, precision)
+        } else {
+            texture::encode(&map, precision)
+        })
     });
     match work.await {
         Ok(Ok(b)) => binary(b),

@@ -129,8 +129,15 @@ fn describe_scene(v: &SceneView) -> Value {
             })
         })
         .collect();
-    if v.settings.indexing == Indexing::Cone {
-        notes.push("mode 4 (cones) is drawn as mode 3 by the viewport".into());
+    let cone = v.settings.indexing == Indexing::Cone;
+    if cone {
+        let asked = v.scene.environment.as_ref().map(|e| e.filter);
+        if asked != Some(mirrorball_render::Filter::Trilinear) {
+            notes.push(
+                "mode 4: the viewport filters the cone trilinearly (the scene's renderer: EWA)"
+                    .into(),
+            );
+        }
     }
     if v.settings.supersample != 1 {
         notes.push(format!(
@@ -139,7 +146,7 @@ fn describe_scene(v: &SceneView) -> Value {
         ));
     }
     let environment = v.scene.environment.as_ref().map(|e| {
-        if e.filter != mirrorball_render::Filter::Bilinear {
+        if !cone && e.filter != mirrorball_render::Filter::Bilinear {
             notes.push(format!(
                 "the viewport reads the environment bilinearly (the scene asks for {})",
                 e.filter.name()

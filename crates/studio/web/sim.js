@@ -231,7 +231,7 @@ export function attach(studio) {
       const proj = await G.projectionSource(kind);
       const vs = G.HEADER + defines + proj + '\n' + (await G.glsl('texgen.glsl')) + '\n' + (await G.glsl('viewport.vert'));
       const fs = [G.HEADER + defines + proj];
-      for (const f of ['bilinear.glsl', 'display.glsl', 'interpolate.glsl', 'sim-record.glsl', 'viewport.frag']) fs.push(await G.glsl(f));
+      for (const f of ['bilinear.glsl', 'display.glsl', 'interpolate.glsl', 'sim-record.glsl', 'cone.glsl', 'viewport.frag']) fs.push(await G.glsl(f));
       sim.programs.set(key, G.link(gl, vs, fs.join('\n')));
     }
     return sim.programs.get(key);
@@ -608,6 +608,7 @@ export function attach(studio) {
     const p = new URLSearchParams(location.search);
     p.set('mode', String(view.mode));
     p.set('projection', view.projection);
+    p.set('paraboloid', view.paraboloid);
     if (view.size) p.set('size', String(view.size));
     if (view.orbit) {
       p.set('yaw', String(view.orbit.yaw));

@@ -1,7 +1,8 @@
 // The studio page: the viewport (WebGL2) over what the server has loaded, its controls, file
 // picker and drop target, orbit and zoom. `?view=viewport`: the viewport alone, at the scene
 // camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode and the
-// projection the environment is converted to. `window.studio` is the page's handle for
+// projection the environment is converted to; `paraboloid=hardware` draws a dual paraboloid
+// as the hardware did (two textures, the alpha choosing: paraboloid_hw.glsl). `window.studio` is the page's handle for
 // tests and later views (simulator, overlays) to plug into.
 
 const params = new URLSearchParams(location.search);
@@ -29,7 +30,8 @@ const view = {
   mode: null,
   projection: params.get('projection') || 'native',
   size: params.get('size') ? Number(params.get('size')) : null,
-  env: null, // { header, texture }
+  paraboloid: params.get('paraboloid') === 'hardware' ? 'hardware' : 'exact',
+  env: null, // { header, texture, halves (a dual paraboloid's two 2D textures) }
   meshes: [], // { vao, count }
   programs: new Map(),
   // The orbit: null until the person moves the camera (then the view matrix is made here).
@@ -64,9 +66,10 @@ async function loadState() {
   view.state = await (await G.api('/api/state')).json();
   const s = view.state.scene;
   document.getElementById('scene-name').textContent = s.name;
-  if (view.mode === null) view.mode = Number(params.get('mode') || Math.min(s.mode, 3));
+  if (view.mode === null) view.mode = Number(params.get('mode') || s.mode);
   document.getElementById('mode').value = String(view.mode);
   document.getElementById('projection').value = view.projection;
+  document.getElementById('paraboloid').value = view.paraboloid;
   canvas.width = s.camera.width;
   canvas.height = s.camera.height;
   canvas.style.width = `${s.camera.width}px`;
@@ -97,21 +100,25 @@ async function loadMeshes() {
 }
 
 async function loadEnvironment() {
-  if (view.env) gl.deleteTexture(view.env.texture);
+  if (view.env) for (const t of [view.env.texture, ...(view.env.halves || [])]) gl.deleteTexture(t);
   view.env = null;
   if (!view.state.scene.environment) return;
-  let q = `projection=${encodeURIComponent(view.projection)}&precision=float`;
+  // Mode 4 reads the mip chain (texture.rs `encode_mips`).
+  const mips = view.mode === 4;
+  let q = `projection=${encodeURIComponent(view.projection)}&precision=float&mips=${mips ? 1 : 0}`;
   if (view.size) q += `&size=${view.size}`;
   const parsed = G.parseTexture(await (await G.api(`/api/environment?${q}`)).arrayBuffer());
-  view.env = { header: parsed.header, texture: G.environmentTexture(gl, parsed) };
+  const halves = parsed.header.projection === 'paraboloid' ? G.paraboloidTextures(gl, parsed) : null;
+  view.env = { header: parsed.header, texture: G.environmentTexture(gl, parsed), halves };
 }
 
 async function program(background) {
   const h = view.env.header;
   const kind = h.projection;
-  const key = `${kind} ${h.layers} ${view.mode} ${background}`;
+  const paraboloid = view.paraboloid;
+  const key = `${kind} ${h.layers} ${view.mode} ${background} ${paraboloid}`;
   if (!view.programs.has(key)) {
-    view.programs.set(key, await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background }));
+    view.programs.set(key, await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background, paraboloid }));
   }
   return view.programs.get(key);
 }
@@ -186,6 +193,18 @@ async function draw(pass = {}) {
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, view.env.texture);
     gl.uniform1i(u('uEnv'), 0);
     gl.uniform2i(u('uEnvSize'), h.width, h.height);
+    gl.uniform1i(u('uLevelCount'), h.levels.length);
+    gl.uniform4iv(u('uLevels'), new Int32Array(h.levels.flat()));
+    if (view.env.halves) {
+      view.env.halves.forEach((t, i) => {
+        gl.activeTexture(gl.TEXTURE1 + i);
+        gl.bindTexture(gl.TEXTURE_2D, t);
+      });
+      gl.uniform1i(u('uFront'), 1);
+      gl.uniform1i(u('uBack'), 2);
+      gl.uniformMatrix4fv(u('uParaMatrix'), false, G.paraboloidTextureMatrices(h.frame));
+      gl.activeTexture(gl.TEXTURE0);
+    }
     gl.uniform1f(u('uIntensity'), env.intensity);
     gl.uniform1f(u('uExposureScale'), Math.pow(2, s.exposure));
     gl.uniform1i(u('uTone'), tone);
@@ -267,8 +286,19 @@ document.addEventListener('drop', (e) => {
   document.body.id = '';
   if (e.dataTransfer.files[0]) upload(e.dataTransfer.files[0]);
 });
-document.getElementById('mode').addEventListener('change', (e) => {
+document.getElementById('mode').addEventListener('change', async (e) => {
   view.mode = Number(e.target.value);
+  if (view.mode === 4 && view.env && view.env.header.levels.length === 1 && view.env.header.width * view.env.header.height > 1) {
+    try {
+      await loadEnvironment();
+    } catch (err) {
+      report(err);
+    }
+  }
+  redraw();
+});
+document.getElementById('paraboloid').addEventListener('change', (e) => {
+  view.paraboloid = e.target.value;
   redraw();
 });
 document.getElementById('projection').addEventListener('change', async (e) => {

@@ -1,0 +1,151 @@
+// The fragment stage's camera and Greene's pixel cone (mode 4), as mirrorball-render's
+// render/cone.rs and lookup.rs do them, and the cone's level of detail as the filter crate's
+// `Sampler` takes it for trilinear filtering (sampler.rs `footprint_ellipse`, `semi_axes`).
+// Comes after bilinear.glsl and interpolate.glsl (uViewportSize), before viewport.frag.
+//
+// The cone: the camera rays through the pixel's four corners, reflected off the hit
+// triangle's plane extended to them, the normal interpolated there with the triangle's
+// barycentric coordinates extrapolated (`corner_reflections`); their spread as ray
+// differentials dd/dx = ((c1 - c0) + (c2 - c3))/2, dd/dy = ((c3 - c0) + (c2 - c1))/2, corners
+// in the order (-,-) (+,-) (+,+) (-,+) (`footprint`). In the tangent frame at the looked-up
+// direction d (t1 = normalize(y x d), t2 = d x t1) they are the ellipse's conjugate
+// semi-diameters p, q; the projection's Jacobian J = d(u, v)/d(t1, t2) carries them to
+// texels of level 0, and lod = log2 of the ellipse's major semi-axis there (0 below one
+// texel), as OpenGL takes the longer derivative. The CPU takes J as the inverse of
+// d(dir)/d(u, v) by differences of uv_to_dir; here J comes straight from envUv by central
+// differences along t1 and t2 (one-sided where a step leaves the layer or wraps).
+uniform mat4 uView;
+uniform vec3 uEye;
+uniform bool uPersp;
+uniform vec3 uForward;
+uniform bool uAttachEye;
+// The camera's rays: right and up scaled by the lens (tan(fov/2)·aspect, tan(fov/2), or the
+// orthographic half extents): mirrorball-render's camera.rs `Rays`.
+uniform vec3 uRayRight;
+uniform vec3 uRayUp;
+
+vec3 normalizeOrZero(vec3 v) {
+    float l = length(v);
+    return l > 0.0 ? v / l : vec3(0.0);
+}
+
+// World direction r to the environment's direction (`Prepared::attach32`).
+vec3 attach(vec3 r) {
+    return normalizeOrZero(uAttachEye ? mat3(uView) * r : r);
+}
+
+// The camera ray through window position `w` (pixels, y up): its origin and unit direction
+// (camera.rs `Rays::ray`).
+void cameraRay(vec2 w, out vec3 o, out vec3 d) {
+    vec2 ndc = 2.0 * w / uViewportSize - 1.0;
+    if (uPersp) {
+        o = uEye;
+        d = normalizeOrZero(uForward + uRayRight * ndc.x + uRayUp * ndc.y);
+    } else {
+        o = uEye + uRayRight * ndc.x + uRayUp * ndc.y;
+        d = uForward;
+    }
+}
+
+// The offsets of the pixel's corners, in the footprint's order.
+const vec2 MB_CORNERS[4] = vec2[4](vec2(-0.5, -0.5), vec2(0.5, -0.5), vec2(0.5, 0.5), vec2(-0.5, 0.5));
+
+// Barycentric coordinates of p in the plane of abc (render/cone.rs `barycentric`).
+vec3 barycentric(vec3 a, vec3 b, vec3 c, vec3 p) {
+    vec3 v0 = b - a;
+    vec3 v1 = c - a;
+    vec3 v2 = p - a;
+    float d00 = dot(v0, v0);
+    float d01 = dot(v0, v1);
+    float d11 = dot(v1, v1);
+    float d20 = dot(v2, v0);
+    float d21 = dot(v2, v1);
+    float den = d00 * d11 - d01 * d01;
+    if (abs(den) < 1e-30) {
+        return vec3(1.0, 0.0, 0.0);
+    }
+    float v = (d11 * d20 - d01 * d21) / den;
+    float w = (d00 * d21 - d01 * d20) / den;
+    return vec3(1.0 - v - w, v, w);
+}
+
+// The reflected ray at pixel corner k of the triangle (a, b, c) with normals (na, nb, nc);
+// `n` is the normal at the pixel's centre, for a corner ray along the plane.
+vec3 cornerReflection(int k, vec3 a, vec3 b, vec3 c, vec3 na, vec3 nb, vec3 nc, vec3 n) {
+    vec3 o;
+    vec3 d;
+    cameraRay(gl_FragCoord.xy + MB_CORNERS[k], o, d);
+    vec3 planeN = cross(b - a, c - a);
+    float denom = dot(planeN, d);
+    if (abs(denom) >= 1e-12) {
+        vec3 p = o + d * (dot(planeN, a - o) / denom);
+        vec3 w = barycentric(a, b, c, p);
+        n = normalizeOrZero(na * w.x + nb * w.y + nc * w.z);
+    }
+    return d - 2.0 * dot(n, d) * n;
+}
+
+// d(u, v)/d(angle) at unit d along unit tangent t, by envUv; false where no step stays in the
+// layer without wrapping.
+const float MB_STEP = 1.0 / 512.0;
+bool uvAlong(vec3 d, vec3 t, vec3 at, out vec2 j) {
+    vec3 plus = envUv(normalize(d + MB_STEP * t));
+    vec3 minus = envUv(normalize(d - MB_STEP * t));
+    bool p = plus.z == at.z && all(lessThan(abs(plus.xy - at.xy), vec2(0.25)));
+    bool m = minus.z == at.z && all(lessThan(abs(minus.xy - at.xy), vec2(0.25)));
+    // normalize(d + h t) is atan(h) from d.
+    float h = mbAtanPos(MB_STEP);
+    if (p && m) {
+        j = (plus.xy - minus.xy) / (2.0 * h);
+    } else if (p) {
+        j = (plus.xy - at.xy) / h;
+    } else if (m) {
+        j = (at.xy - minus.xy) / h;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+// The major semi-axis of the ellipse with conjugate semi-diameters a, b (sampler.rs
+// `semi_axes`: the square root of the larger eigenvalue of [a b][a b]^T).
+float majorSemiAxis(vec2 a, vec2 b) {
+    float s00 = a.x * a.x + b.x * b.x;
+    float s01 = a.x * a.y + b.x * b.y;
+    float s11 = a.y * a.y + b.y * b.y;
+    float disc = sqrt((s00 - s11) * (s00 - s11) + 4.0 * s01 * s01);
+    return sqrt(max(0.5 * (s00 + s11 + disc), 0.0));
+}
+
+// The trilinear level of detail of the footprint of corner directions c (attached, unit)
+// about unit d, whose envUv is `at`: 0 for a point (a degenerate corner) or where the
+// projection's Jacobian is not found.
+float coneLod(vec3 d, vec3 c[4], vec3 at) {
+    for (int k = 0; k < 4; k++) {
+        if (!(dot(c[k], c[k]) >= 0.5) || any(isnan(c[k])) || any(isinf(c[k]))) {
+            return 0.0;
+        }
+    }
+    vec3 dx = 0.5 * ((c[1] - c[0]) + (c[2] - c[3]));
+    vec3 dy = 0.5 * ((c[3] - c[0]) + (c[2] - c[1]));
+    vec3 t1 = vec3(d.z, 0.0, -d.x);
+    t1 = dot(t1, t1) > 1e-20 ? normalize(t1) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(d, t1);
+    vec2 p = vec2(dot(t1, dx), dot(t2, dx));
+    vec2 q = vec2(dot(t1, dy), dot(t2, dy));
+    vec2 j1;
+    vec2 j2;
+    if (at.z < 0.0 || !uvAlong(d, t1, at, j1) || !uvAlong(d, t2, at, j2)) {
+        return 0.0;
+    }
+    vec2 texels = vec2(uEnvSize);
+    float major = majorSemiAxis((j1 * p.x + j2 * p.y) * texels, (j1 * q.x + j2 * q.y) * texels);
+    return major > 1.0 ? log2(major) : 0.0;
+}
+
+// The environment filtered over the cone of corner directions c about d (render/cone.rs
+// `cone_read` with the trilinear sampler).
+vec3 coneRead(vec3 d, vec3 c[4]) {
+    vec3 at = envUv(d);
+    return envTrilinear(at, coneLod(d, c, at));
+}
