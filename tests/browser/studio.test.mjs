@@ -328,3 +328,45 @@ for (const object of Object.keys(SCENES)) {
     }
   });
 }
+
+// The hardware's dual paraboloid divides the vector the mode interpolates as it is. Where
+// that vector is a unit vector everywhere (mode 3; mode 2 on a flat quad seen by an
+// orthographic camera, whose per-vertex reflections are all the same) the two textures and
+// the alpha give the exact read, mirrorball render's; where it is shorter inside the
+// triangles (modes 1-2 under perspective) the picture departs from it, as the hardware's did.
+test('the hardware dual paraboloid: the exact read where the interpolated vector is unit, not where it is shorter', async () => {
+  const cases = [
+    ['sphere', [1, 2, 3]],
+    ['door', [1, 2, 3]],
+    ['door-ortho', [2]],
+  ];
+  SCENES['door-ortho'] = {
+    ...SCENES.door,
+    camera: { eye: [0, 0, 2.2], target: [0, 0, 0], ortho_half_height: 0.8, width: 128, height: 128 },
+  };
+  const rows = [];
+  try {
+    for (const [object, modes] of cases) {
+      const scene = sceneFile(object);
+      const s = await studio([scene]);
+      try {
+        for (const mode of modes) {
+          const name = `${object}-paraboloid-${mode}-hardware`;
+          const r = await compare(s, scene, { name, mode, proj: 'paraboloid', size: 96, query: '&paraboloid=hardware' });
+          rows.push({ object, mode, ...r });
+        }
+      } finally {
+        s.stop();
+      }
+    }
+  } finally {
+    delete SCENES['door-ortho'];
+  }
+  for (const r of rows) {
+    assert.ok(r.covered > 200, `${r.name}: only ${r.covered} covered pixels`);
+    assert.ok(r.background >= 0.99, `${r.name}: background ${(100 * r.background).toFixed(2)}%`);
+    const unit = r.mode === 3 || r.object === 'door-ortho';
+    if (unit) assert.ok(r.share >= 0.99, `${r.name}: ${(100 * r.share).toFixed(2)}% within 2/255 ${r.logs}`);
+    else assert.ok(r.share < 0.9 && r.mean > 2, `${r.name}: the interpolated vector's shortening does not show (${(100 * r.share).toFixed(2)}% within 2/255)`);
+  }
+});
