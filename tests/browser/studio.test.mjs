@@ -306,7 +306,7 @@ for (const object of Object.keys(SCENES)) {
 }
 
 for (const object of Object.keys(SCENES)) {
-  test(`mode 4 draws the ${object}'s cones as mirrorball render --mode 4 filters them (trilinear; EWA measured)`, async () => {
+  test(`mode 4 draws the ${object}'s cones as mirrorball render --mode 4 filters them (trilinear; EWA approximated)`, async () => {
     const rows = [];
     for (const filter of ['trilinear', 'ewa']) {
       const scene = sceneFile(object, filter);
@@ -324,6 +324,17 @@ for (const object of Object.keys(SCENES)) {
       if (r.filter === 'trilinear') {
         assert.ok(r.share >= 0.99, `${r.name}: ${(100 * r.share).toFixed(2)}% within 2/255 ${r.logs}`);
         assert.ok(r.background >= 0.99, `${r.name}: background ${(100 * r.background).toFixed(2)}%`);
+      } else {
+        // Against the CPU's EWA the viewport's anisotropic taps (cone.glsl
+        // `coneReadAnisotropic`) are an approximation: measured 87-97% of covered pixels
+        // within 2/255, mean 0.8-1.5/255, background 84-94% (under magnification EWA's
+        // reconstruction is a Gaussian a texel wide, the taps' bilinear a tent). The
+        // trilinear read (the level of the major axis) measured 62-96% and a mean up to
+        // 4.9/255 against the same EWA pictures, bilinear without a cone 75-94% and 2.5/255:
+        // these bounds hold the taps to closer than either.
+        assert.ok(r.share >= 0.85, `${r.name}: ${(100 * r.share).toFixed(2)}% within 2/255 of EWA`);
+        assert.ok(r.mean < 2, `${r.name}: mean difference ${r.mean.toFixed(3)}/255 from EWA`);
+        assert.ok(r.background >= 0.8, `${r.name}: background ${(100 * r.background).toFixed(2)}%`);
       }
     }
   });

@@ -154,6 +154,7 @@ fn describe_scene(v: &SceneView) -> Value {
         }
         let mut d = describe_map(&e.map);
         d["attach"] = json!(e.attach.name());
+        d["filter"] = json!(e.filter.name());
         d["intensity"] = json!(e.intensity);
         d
     });

@@ -265,14 +265,25 @@ export function paraboloidHardware(kind, mode, paraboloid) {
 }
 
 /**
- * The viewport's program for `kind`, indexing `mode` (1–4), objects or the background;
- * `paraboloid: 'hardware'` draws a dual paraboloid from its two textures.
+ * Mode 4's read (cone.glsl) for the environment's `filter` (state.rs): the trilinear one for
+ * a trilinear environment, as `mirrorball render` filters it; anisotropic taps for the rest,
+ * which the CPU filters by EWA.
  */
-export async function viewportProgram(gl, { kind, layers, mode, background, paraboloid }) {
+export function coneRead(filter) {
+  return filter === 'trilinear' ? 'coneRead' : 'coneReadAnisotropic';
+}
+
+/**
+ * The viewport's program for `kind`, indexing `mode` (1–4), objects or the background;
+ * `paraboloid: 'hardware'` draws a dual paraboloid from its two textures; `filter` is the
+ * environment's (mode 4: `coneRead`).
+ */
+export async function viewportProgram(gl, { kind, layers, mode, background, paraboloid, filter }) {
   const hw = paraboloidHardware(kind, mode, paraboloid);
   const defines =
     `#define MODE ${mode}\n#define TEXGEN ${texgenOf(kind, layers)}\n` +
     `#define BACKGROUND ${background ? 1 : 0}\n` +
+    `#define CONE_READ ${coneRead(filter)}\n` +
     (hw ? '#define PARA_HW 1\n' : '');
   const proj = await projectionSource(kind);
   const vs = HEADER + defines + proj + '\n' + (await glsl('texgen.glsl')) + '\n' + (await glsl('viewport.vert'));

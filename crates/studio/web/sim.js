@@ -225,12 +225,13 @@ export function attach(studio) {
   }
 
   async function recordProgram(mode, kind, layers) {
-    const key = `record ${kind} ${layers} ${mode}`;
+    const key = `record ${kind} ${layers} ${mode} ${view.state.scene.environment.filter}`;
     if (!sim.programs.has(key)) {
+      const cone = `#define CONE_READ ${G.coneRead(view.state.scene.environment.filter)}\n`;
       const defines = `#define MODE ${mode}\n#define TEXGEN ${G.texgenOf(kind, layers)}\n#define BACKGROUND 0\n`;
       const proj = await G.projectionSource(kind);
       const vs = G.HEADER + defines + proj + '\n' + (await G.glsl('texgen.glsl')) + '\n' + (await G.glsl('viewport.vert'));
-      const fs = [G.HEADER + defines + proj];
+      const fs = [G.HEADER + defines + cone + proj];
       for (const f of ['bilinear.glsl', 'display.glsl', 'interpolate.glsl', 'sim-record.glsl', 'cone.glsl', 'viewport.frag']) fs.push(await G.glsl(f));
       sim.programs.set(key, G.link(gl, vs, fs.join('\n')));
     }

@@ -116,9 +116,10 @@ async function program(background) {
   const h = view.env.header;
   const kind = h.projection;
   const paraboloid = view.paraboloid;
-  const key = `${kind} ${h.layers} ${view.mode} ${background} ${paraboloid}`;
+  const filter = view.state.scene.environment.filter;
+  const key = `${kind} ${h.layers} ${view.mode} ${background} ${paraboloid} ${filter}`;
   if (!view.programs.has(key)) {
-    view.programs.set(key, await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background, paraboloid }));
+    view.programs.set(key, await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background, paraboloid, filter }));
   }
   return view.programs.get(key);
 }

@@ -14,6 +14,12 @@
 // texel), as OpenGL takes the longer derivative. The CPU takes J as the inverse of
 // d(dir)/d(u, v) by differences of uv_to_dir; here J comes straight from envUv by central
 // differences along t1 and t2 (one-sided where a step leaves the layer or wraps).
+// CONE_CENTRE(uvl) is told the (u, v, layer) of each cone's centre (the simulator's record
+// pass, sim-record.glsl, defines it).
+#ifndef CONE_CENTRE
+#define CONE_CENTRE(uvl)
+#endif
+
 uniform mat4 uView;
 uniform vec3 uEye;
 uniform bool uPersp;
@@ -117,35 +123,121 @@ float majorSemiAxis(vec2 a, vec2 b) {
     return sqrt(max(0.5 * (s00 + s11 + disc), 0.0));
 }
 
-// The trilinear level of detail of the footprint of corner directions c (attached, unit)
-// about unit d, whose envUv is `at`: 0 for a point (a degenerate corner) or where the
+// The footprint of corner directions c (attached, unit) about unit d, whose envUv is `at`:
+// its conjugate semi-diameters in the tangent frame (t1, t2) at d (radians, p and q) and in
+// level-0 texels (a and b). False for a point (a degenerate corner) or where the
 // projection's Jacobian is not found.
-float coneLod(vec3 d, vec3 c[4], vec3 at) {
+bool coneFootprint(vec3 d, vec3 c[4], vec3 at, out vec3 t1, out vec3 t2, out vec2 p, out vec2 q, out vec2 a, out vec2 b) {
     for (int k = 0; k < 4; k++) {
         if (!(dot(c[k], c[k]) >= 0.5) || any(isnan(c[k])) || any(isinf(c[k]))) {
-            return 0.0;
+            return false;
         }
     }
     vec3 dx = 0.5 * ((c[1] - c[0]) + (c[2] - c[3]));
     vec3 dy = 0.5 * ((c[3] - c[0]) + (c[2] - c[1]));
-    vec3 t1 = vec3(d.z, 0.0, -d.x);
+    t1 = vec3(d.z, 0.0, -d.x);
     t1 = dot(t1, t1) > 1e-20 ? normalize(t1) : vec3(1.0, 0.0, 0.0);
-    vec3 t2 = cross(d, t1);
-    vec2 p = vec2(dot(t1, dx), dot(t2, dx));
-    vec2 q = vec2(dot(t1, dy), dot(t2, dy));
+    t2 = cross(d, t1);
+    p = vec2(dot(t1, dx), dot(t2, dx));
+    q = vec2(dot(t1, dy), dot(t2, dy));
     vec2 j1;
     vec2 j2;
     if (at.z < 0.0 || !uvAlong(d, t1, at, j1) || !uvAlong(d, t2, at, j2)) {
-        return 0.0;
+        return false;
     }
     vec2 texels = vec2(uEnvSize);
-    float major = majorSemiAxis((j1 * p.x + j2 * p.y) * texels, (j1 * q.x + j2 * q.y) * texels);
-    return major > 1.0 ? log2(major) : 0.0;
+    a = (j1 * p.x + j2 * p.y) * texels;
+    b = (j1 * q.x + j2 * q.y) * texels;
+    return true;
 }
 
-// The environment filtered over the cone of corner directions c about d (render/cone.rs
-// `cone_read` with the trilinear sampler).
+// The environment filtered over the cone of corner directions c about d with the trilinear
+// sampler (render/cone.rs `cone_read`, sampler.rs `Sampler::sample`): lod = log2 of the
+// major semi-axis in level-0 texels, 0 below one texel or for a point.
 vec3 coneRead(vec3 d, vec3 c[4]) {
     vec3 at = envUv(d);
-    return envTrilinear(at, coneLod(d, c, at));
+    CONE_CENTRE(at);
+    vec3 t1;
+    vec3 t2;
+    vec2 p;
+    vec2 q;
+    vec2 a;
+    vec2 b;
+    float lod = 0.0;
+    if (coneFootprint(d, c, at, t1, t2, p, q, a, b)) {
+        float major = majorSemiAxis(a, b);
+        lod = major > 1.0 ? log2(major) : 0.0;
+    }
+    return envTrilinear(at, lod);
+}
+
+// The semi-axes (major, minor) of the ellipse with conjugate semi-diameters a, b, and in
+// `axis` the unit direction of the major one (sampler.rs `semi_axes`,
+// `principal_directions`).
+vec2 semiAxes(vec2 a, vec2 b, out vec2 axis) {
+    float s00 = a.x * a.x + b.x * b.x;
+    float s01 = a.x * a.y + b.x * b.y;
+    float s11 = a.y * a.y + b.y * b.y;
+    float disc = sqrt((s00 - s11) * (s00 - s11) + 4.0 * s01 * s01);
+    float th = 0.5 * mbAtan2(2.0 * s01, s00 - s11);
+    axis = vec2(cos(th), sin(th));
+    return vec2(sqrt(max(0.5 * (s00 + s11 + disc), 0.0)), sqrt(max(0.5 * (s00 + s11 - disc), 0.0)));
+}
+
+// The most taps along the major axis, and the largest ratio of the axes before the minor one
+// is widened (the CPU's `Sampler::max_anisotropy`).
+#define MB_MAX_TAPS 32
+const float MB_MAX_ANISOTROPY = 16.0;
+
+// The environment filtered over the cone as anisotropic hardware filters a footprint, in the
+// place of the CPU's EWA (sampler.rs `Sampler::ewa`: a Gaussian exp(-2r^2) - exp(-2) on the
+// sphere, r = 1 on the ellipse): taps along the ellipse's major axis on the sphere (the
+// directions normalize(d + tan(x R) e), R the major semi-axis in radians, e its tangent
+// direction, x at the centres of n equal steps across (-1, 1)), weighted by the same
+// Gaussian of x, each a trilinear read at lod = log2 of the minor semi-axis in level-0
+// texels (the minor axis widened to 1/16 of the major as the CPU widens it), so that a tap
+// blurs across the minor axis about as the Gaussian does there (a bilinear tent over box-
+// filtered texels of size s has variance s^2/4, the Gaussian's is minor^2/4); n = 2
+// major/minor taps (at most 32) keep them a texel of that level apart. Taps the projection
+// does not cover are left out, as EWA leaves out texels of no solid angle. An approximation
+// of EWA, not EWA: the taps lie on one line, and the level is one for the whole footprint.
+vec3 coneReadAnisotropic(vec3 d, vec3 c[4]) {
+    vec3 at = envUv(d);
+    CONE_CENTRE(at);
+    vec3 t1;
+    vec3 t2;
+    vec2 p;
+    vec2 q;
+    vec2 a;
+    vec2 b;
+    if (!coneFootprint(d, c, at, t1, t2, p, q, a, b)) {
+        return envTrilinear(at, 0.0);
+    }
+    vec2 unused;
+    vec2 texels = semiAxes(a, b, unused);
+    float minor = max(texels.y, texels.x / MB_MAX_ANISOTROPY);
+    float lod = minor > 1.0 ? log2(minor) : 0.0;
+    int n = int(clamp(ceil(2.0 * texels.x / max(minor, 1.0)), 1.0, float(MB_MAX_TAPS)));
+    if (n == 1) {
+        return envTrilinear(at, lod);
+    }
+    vec2 e;
+    float radius = min(semiAxes(p, q, e).x, 1.5);
+    vec3 axis = t1 * e.x + t2 * e.y;
+    vec3 sum = vec3(0.0);
+    float wsum = 0.0;
+    for (int i = 0; i < MB_MAX_TAPS; i++) {
+        if (i >= n) {
+            break;
+        }
+        float x = (2.0 * float(i) + 1.0) / float(n) - 1.0;
+        vec3 uvl = envUv(normalize(d + axis * tan(radius * x)));
+        if (uvl.z < 0.0) {
+            continue;
+        }
+        float w = exp(-2.0 * x * x) - 0.1353352832366127;
+        sum += w * envTrilinear(uvl, lod);
+        wsum += w;
+    }
+    return wsum > 0.0 ? sum / wsum : vec3(0.0);
 }

@@ -4,7 +4,8 @@
 // (`texgen_read`) and render/cone.rs (mode 4: the pixel's cone, filtered trilinearly), read
 // through the projection's envUv, shown as display.glsl says. The background is the camera's
 // rays (render/background.rs, camera.rs `Rays::ray`), in mode 4 filtered over the cone of
-// the pixel's corner rays as the CPU filters it. With PARA_HW defined (a dual paraboloid
+// the pixel's corner rays as the CPU filters it. CONE_READ (gl.js) is cone.glsl's coneRead
+// (trilinear, the CPU's trilinear) or coneReadAnisotropic (in the place of its EWA). With PARA_HW defined (a dual paraboloid
 // drawn as the hardware did, modes 1-3) paraboloid_hw.glsl comes after cone.glsl and reads
 // instead of envRead.
 flat in vec4 vClip0;
@@ -44,7 +45,7 @@ void main() {
         cameraRay(gl_FragCoord.xy + MB_CORNERS[k], o, corners[k]);
         corners[k] = attach(corners[k]);
     }
-    outColor = vec4(display(coneRead(attach(dir), corners)), 1.0);
+    outColor = vec4(display(CONE_READ(attach(dir), corners)), 1.0);
 #else
     outColor = vec4(display(lookup(attach(dir))), 1.0);
 #endif
@@ -61,7 +62,7 @@ void main() {
     for (int k = 0; k < 4; k++) {
         corners[k] = attach(cornerReflection(k, vP0, vP1, vP2, vN0, vN1, vN2, n));
     }
-    c = coneRead(attach(v - 2.0 * dot(n, v) * n), corners);
+    c = CONE_READ(attach(v - 2.0 * dot(n, v) * n), corners);
 #elif MODE == 3
     vec3 n = normalizeOrZero(vNrm);
     vec3 v = uPersp ? normalizeOrZero(vPos - uEye) : uForward;
