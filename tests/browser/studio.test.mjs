@@ -381,3 +381,38 @@ test('the hardware dual paraboloid: the exact read where the interpolated vector
     else assert.ok(r.share < 0.9 && r.mean > 2, `${r.name}: the interpolated vector's shortening does not show (${(100 * r.share).toFixed(2)}% within 2/255)`);
   }
 });
+
+test("the tessellation slider re-tessellates a built-in as mirrorball render tessellates it", async () => {
+  const scene = sceneFile('sphere');
+  const fine = path.join(work.dir, 'sphere-48.json');
+  const body = JSON.parse(readFileSync(scene, 'utf8'));
+  body.meshes[0].tessellation = 48;
+  writeFileSync(fine, JSON.stringify(body));
+  const s = await studio([scene]);
+  try {
+    // The 12-segment scene asked for 48 segments draws the 48-segment scene's picture (mode 2:
+    // per-vertex reflection, where the tessellation shows).
+    const r48 = await compare(s, fine, { name: 'sphere-latlong-2-tessellation-48', mode: 2, proj: 'latlong', size: 256, query: '&tessellation=48' });
+    assert.ok(r48.share >= 0.99, `${(100 * r48.share).toFixed(2)}% within 2/255`);
+    const r12 = await compare(s, fine, { name: 'sphere-latlong-2-tessellation-12', mode: 2, proj: 'latlong', size: 256 });
+    assert.ok(r12.share < 0.9, `the scene's 12 segments draw as 48 do (${(100 * r12.share).toFixed(2)}%)`);
+    // The slider on the page: moved, it fetches the meshes again.
+    const { page } = await open(s.url);
+    try {
+      await page.waitForFunction(() => !document.getElementById('tessellation-label').hidden);
+      assert.equal(await page.inputValue('#tessellation'), '12');
+      await page.fill('#tessellation', '48');
+      await page.dispatchEvent('#tessellation', 'change');
+      await page.waitForFunction(() => window.studio.view.meshes[0]?.vertices === 48 * 24 * 6 - 2 * 48 * 3);
+    } finally {
+      await page.close();
+    }
+    // Out of range, or a mesh file: refused with a message.
+    const api = (q) => fetch(s.url.replace('/?', `/api/mesh/0?${q}&`));
+    const r = await api('tessellation=0');
+    assert.equal(r.status, 400);
+    assert.match((await r.json()).error, /^tessellation: 0 is outside 1\.\.=\d+ for the sphere/);
+  } finally {
+    s.stop();
+  }
+});

@@ -4,7 +4,7 @@ use mirrorball_core::glam::{DVec3, Mat3};
 use mirrorball_core::{Choice, CylinderRule, EnvMap, Frame, Lens, Projection, RadialMap};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{
-    Attach, Camera, CameraLens, Environment, Indexing, Material, Scene, Settings,
+    Attach, Builtin, Camera, CameraLens, Environment, Indexing, Material, Scene, Settings,
 };
 use serde_json::{json, Value};
 use std::sync::Arc;
@@ -20,6 +20,9 @@ pub struct SceneView {
     pub settings: Settings,
     pub exposure: f32,
     pub tone: Tone,
+    /// Per object, the built-in mesh and tessellation it was made from (`None`: a mesh
+    /// file), so that the page may ask for it tessellated otherwise (`/api/mesh/I?tessellation=N`).
+    pub builtins: Vec<Option<(Builtin, u32)>>,
 }
 
 /// What a file held.
@@ -39,6 +42,9 @@ pub struct State {
     /// Bumped on every change, so that the page knows to fetch again.
     pub generation: u64,
 }
+
+/// The most triangles the page may ask a built-in to be tessellated into.
+pub const MAX_TRIANGLES: u64 = 1 << 21;
 
 /// The most messages kept for the page.
 const MAX_ERRORS: usize = 20;
@@ -121,11 +127,15 @@ fn describe_scene(v: &SceneView) -> Value {
                     json!({"kind": "mirror", "tint": [1.0, 1.0, 1.0]})
                 }
             };
+            let builtin = v.builtins.get(i).copied().flatten();
             json!({
                 "mesh": i,
                 "vertices": o.mesh.positions.len(),
                 "triangles": o.mesh.triangles.len(),
                 "material": material,
+                "builtin": builtin.map(|(b, _)| b.name()),
+                "tessellation": builtin.map(|(_, l)| l),
+                "maxTessellation": builtin.map(|(b, _)| b.max_tessellation(MAX_TRIANGLES)),
             })
         })
         .collect();

@@ -610,6 +610,7 @@ export function attach(studio) {
     p.set('mode', String(view.mode));
     p.set('projection', view.projection);
     p.set('paraboloid', view.paraboloid);
+    if (view.tessellation) p.set('tessellation', String(view.tessellation));
     if (view.size) p.set('size', String(view.size));
     if (view.orbit) {
       p.set('yaw', String(view.orbit.yaw));

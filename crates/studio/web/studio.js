@@ -2,7 +2,8 @@
 // picker and drop target, orbit and zoom. `?view=viewport`: the viewport alone, at the scene
 // camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode and the
 // projection the environment is converted to; `paraboloid=hardware` draws a dual paraboloid
-// as the hardware did (two textures, the alpha choosing: paraboloid_hw.glsl). `window.studio` is the page's handle for
+// as the hardware did (two textures, the alpha choosing: paraboloid_hw.glsl);
+// `tessellation=N` re-tessellates the built-in objects (the slider). `window.studio` is the page's handle for
 // tests and later views (simulator, overlays) to plug into.
 
 const params = new URLSearchParams(location.search);
@@ -31,6 +32,8 @@ const view = {
   projection: params.get('projection') || 'native',
   size: params.get('size') ? Number(params.get('size')) : null,
   paraboloid: params.get('paraboloid') === 'hardware' ? 'hardware' : 'exact',
+  // The built-in objects' tessellation (null: the scene's).
+  tessellation: params.get('tessellation') ? Number(params.get('tessellation')) : null,
   env: null, // { header, texture, halves (a dual paraboloid's two 2D textures) }
   meshes: [], // { vao, count }
   programs: new Map(),
@@ -74,16 +77,30 @@ async function loadState() {
   canvas.height = s.camera.height;
   canvas.style.width = `${s.camera.width}px`;
   canvas.style.height = `${s.camera.height}px`;
+  showTessellation();
   await loadMeshes();
   await loadEnvironment();
   report();
+}
+
+/** The slider, for scenes with built-in objects: up to the least of their largest levels. */
+function showTessellation() {
+  const builtins = view.state.scene.objects.filter((o) => o.builtin);
+  const label = document.getElementById('tessellation-label');
+  label.hidden = builtins.length === 0;
+  if (label.hidden) return;
+  const input = document.getElementById('tessellation');
+  input.max = String(Math.min(256, ...builtins.map((o) => o.maxTessellation)));
+  input.value = String(view.tessellation ?? builtins[0].tessellation);
+  document.getElementById('tessellation-value').textContent = input.value;
 }
 
 async function loadMeshes() {
   for (const m of view.meshes) gl.deleteVertexArray(m.vao);
   view.meshes = [];
   for (const o of view.state.scene.objects) {
-    const mesh = G.parseMesh(await (await G.api(`/api/mesh/${o.mesh}`)).arrayBuffer());
+    const q = o.builtin && view.tessellation ? `?tessellation=${view.tessellation}` : '';
+    const mesh = G.parseMesh(await (await G.api(`/api/mesh/${o.mesh}${q}`)).arrayBuffer());
     const vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
     const b = gl.createBuffer();
@@ -295,6 +312,19 @@ document.getElementById('mode').addEventListener('change', async (e) => {
     } catch (err) {
       report(err);
     }
+  }
+  redraw();
+});
+document.getElementById('tessellation').addEventListener('input', (e) => {
+  document.getElementById('tessellation-value').textContent = e.target.value;
+});
+document.getElementById('tessellation').addEventListener('change', async (e) => {
+  view.tessellation = Number(e.target.value);
+  try {
+    await loadMeshes();
+    report();
+  } catch (err) {
+    report(err);
   }
   redraw();
 });

@@ -58,6 +58,7 @@ impl Host for TestHost {
             settings: Settings::default(),
             exposure: 0.0,
             tone: Tone::Clamp,
+            builtins: vec![Some((Builtin::Sphere, 16))],
         }
     }
 }
