@@ -343,7 +343,7 @@ export function attach(studio) {
         dirs[i + 2] = v[2] * x + v[6] * y + v[10] * z;
       }
     }
-    const uv = dirs.length ? await G.envUvOnGpu(gl, h.projection, h.frame, dirs) : new Float32Array(0);
+    const uv = dirs.length ? await G.envUvOnGpu(gl, h.projection, h.frame, h.params, dirs) : new Float32Array(0);
     for (let e = 0; e < dirs.length / 3 / (steps + 1); e++) {
       let line = [];
       let last = null;

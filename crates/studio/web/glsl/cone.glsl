@@ -113,62 +113,49 @@ bool uvAlong(vec3 d, vec3 t, vec3 at, out vec2 j) {
     return true;
 }
 
-// The major semi-axis of the ellipse with conjugate semi-diameters a, b (sampler.rs
-// `semi_axes`: the square root of the larger eigenvalue of [a b][a b]^T).
-float majorSemiAxis(vec2 a, vec2 b) {
-    float s00 = a.x * a.x + b.x * b.x;
-    float s01 = a.x * a.y + b.x * b.y;
-    float s11 = a.y * a.y + b.y * b.y;
-    float disc = sqrt((s00 - s11) * (s00 - s11) + 4.0 * s01 * s01);
-    return sqrt(max(0.5 * (s00 + s11 + disc), 0.0));
-}
-
-// The footprint of corner directions c (attached, unit) about unit d, whose envUv is `at`:
-// its conjugate semi-diameters in the tangent frame (t1, t2) at d (radians, p and q) and in
-// level-0 texels (a and b). False for a point (a degenerate corner) or where the
+// The footprint of a cone: the envUv of its centre direction d, the tangent frame (t1, t2)
+// at d, and the ellipse's conjugate semi-diameters there (radians, p and q) and in level-0
+// texels (a and b); `ok` is false for a point (a degenerate corner) or where the
 // projection's Jacobian is not found.
-bool coneFootprint(vec3 d, vec3 c[4], vec3 at, out vec3 t1, out vec3 t2, out vec2 p, out vec2 q, out vec2 a, out vec2 b) {
-    for (int k = 0; k < 4; k++) {
-        if (!(dot(c[k], c[k]) >= 0.5) || any(isnan(c[k])) || any(isinf(c[k]))) {
-            return false;
-        }
-    }
-    vec3 dx = 0.5 * ((c[1] - c[0]) + (c[2] - c[3]));
-    vec3 dy = 0.5 * ((c[3] - c[0]) + (c[2] - c[1]));
-    t1 = vec3(d.z, 0.0, -d.x);
-    t1 = dot(t1, t1) > 1e-20 ? normalize(t1) : vec3(1.0, 0.0, 0.0);
-    t2 = cross(d, t1);
-    p = vec2(dot(t1, dx), dot(t2, dx));
-    q = vec2(dot(t1, dy), dot(t2, dy));
-    vec2 j1;
-    vec2 j2;
-    if (at.z < 0.0 || !uvAlong(d, t1, at, j1) || !uvAlong(d, t2, at, j2)) {
-        return false;
-    }
-    vec2 texels = vec2(uEnvSize);
-    a = (j1 * p.x + j2 * p.y) * texels;
-    b = (j1 * q.x + j2 * q.y) * texels;
-    return true;
-}
-
-// The environment filtered over the cone of corner directions c about d with the trilinear
-// sampler (render/cone.rs `cone_read`, sampler.rs `Sampler::sample`): lod = log2 of the
-// major semi-axis in level-0 texels, 0 below one texel or for a point.
-vec3 coneRead(vec3 d, vec3 c[4]) {
-    vec3 at = envUv(d);
-    CONE_CENTRE(at);
+struct Footprint {
+    bool ok;
+    vec3 at;
     vec3 t1;
     vec3 t2;
     vec2 p;
     vec2 q;
     vec2 a;
     vec2 b;
-    float lod = 0.0;
-    if (coneFootprint(d, c, at, t1, t2, p, q, a, b)) {
-        float major = majorSemiAxis(a, b);
-        lod = major > 1.0 ? log2(major) : 0.0;
+};
+
+// The footprint of corner directions c (attached, unit) about unit d.
+Footprint coneFootprint(vec3 d, vec3 c[4]) {
+    Footprint f;
+    f.ok = false;
+    f.at = envUv(d);
+    CONE_CENTRE(f.at);
+    for (int k = 0; k < 4; k++) {
+        if (!(dot(c[k], c[k]) >= 0.5) || any(isnan(c[k])) || any(isinf(c[k]))) {
+            return f;
+        }
     }
-    return envTrilinear(at, lod);
+    vec3 dx = 0.5 * ((c[1] - c[0]) + (c[2] - c[3]));
+    vec3 dy = 0.5 * ((c[3] - c[0]) + (c[2] - c[1]));
+    f.t1 = vec3(d.z, 0.0, -d.x);
+    f.t1 = dot(f.t1, f.t1) > 1e-20 ? normalize(f.t1) : vec3(1.0, 0.0, 0.0);
+    f.t2 = cross(d, f.t1);
+    f.p = vec2(dot(f.t1, dx), dot(f.t2, dx));
+    f.q = vec2(dot(f.t1, dy), dot(f.t2, dy));
+    vec2 j1;
+    vec2 j2;
+    if (f.at.z < 0.0 || !uvAlong(d, f.t1, f.at, j1) || !uvAlong(d, f.t2, f.at, j2)) {
+        return f;
+    }
+    vec2 texels = vec2(uEnvSize);
+    f.a = (j1 * f.p.x + j2 * f.p.y) * texels;
+    f.b = (j1 * f.q.x + j2 * f.q.y) * texels;
+    f.ok = true;
+    return f;
 }
 
 // The semi-axes (major, minor) of the ellipse with conjugate semi-diameters a, b, and in
@@ -182,6 +169,20 @@ vec2 semiAxes(vec2 a, vec2 b, out vec2 axis) {
     float th = 0.5 * mbAtan2(2.0 * s01, s00 - s11);
     axis = vec2(cos(th), sin(th));
     return vec2(sqrt(max(0.5 * (s00 + s11 + disc), 0.0)), sqrt(max(0.5 * (s00 + s11 - disc), 0.0)));
+}
+
+// The environment filtered over the cone of corner directions c about d with the trilinear
+// sampler (render/cone.rs `cone_read`, sampler.rs `Sampler::sample`): lod = log2 of the
+// major semi-axis in level-0 texels, 0 below one texel or for a point.
+vec3 coneRead(vec3 d, vec3 c[4]) {
+    Footprint f = coneFootprint(d, c);
+    float lod = 0.0;
+    if (f.ok) {
+        vec2 axis;
+        float major = semiAxes(f.a, f.b, axis).x;
+        lod = major > 1.0 ? log2(major) : 0.0;
+    }
+    return envTrilinear(f.at, lod);
 }
 
 // The most taps along the major axis, and the largest ratio of the axes before the minor one
@@ -202,28 +203,21 @@ const float MB_MAX_ANISOTROPY = 16.0;
 // does not cover are left out, as EWA leaves out texels of no solid angle. An approximation
 // of EWA, not EWA: the taps lie on one line, and the level is one for the whole footprint.
 vec3 coneReadAnisotropic(vec3 d, vec3 c[4]) {
-    vec3 at = envUv(d);
-    CONE_CENTRE(at);
-    vec3 t1;
-    vec3 t2;
-    vec2 p;
-    vec2 q;
-    vec2 a;
-    vec2 b;
-    if (!coneFootprint(d, c, at, t1, t2, p, q, a, b)) {
-        return envTrilinear(at, 0.0);
+    Footprint f = coneFootprint(d, c);
+    if (!f.ok) {
+        return envTrilinear(f.at, 0.0);
     }
     vec2 unused;
-    vec2 texels = semiAxes(a, b, unused);
+    vec2 texels = semiAxes(f.a, f.b, unused);
     float minor = max(texels.y, texels.x / MB_MAX_ANISOTROPY);
     float lod = minor > 1.0 ? log2(minor) : 0.0;
     int n = int(clamp(ceil(2.0 * texels.x / max(minor, 1.0)), 1.0, float(MB_MAX_TAPS)));
     if (n == 1) {
-        return envTrilinear(at, lod);
+        return envTrilinear(f.at, lod);
     }
     vec2 e;
-    float radius = min(semiAxes(p, q, e).x, 1.5);
-    vec3 axis = t1 * e.x + t2 * e.y;
+    float radius = min(semiAxes(f.p, f.q, e).x, 1.5);
+    vec3 axis = f.t1 * e.x + f.t2 * e.y;
     vec3 sum = vec3(0.0);
     float wsum = 0.0;
     for (int i = 0; i < MB_MAX_TAPS; i++) {
