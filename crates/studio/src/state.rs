@@ -144,7 +144,7 @@ fn describe_scene(v: &SceneView) -> Value {
         let asked = v.scene.environment.as_ref().map(|e| e.filter);
         if asked != Some(mirrorball_render::Filter::Trilinear) {
             notes.push(
-                "mode 4: the viewport filters the cone trilinearly (the scene's renderer: EWA)"
+                "mode 4: the viewport approximates the renderer's EWA by anisotropic taps (a trilinear environment it draws exactly)"
                     .into(),
             );
         }

@@ -110,11 +110,31 @@ fn the_environment_comes_padded_in_its_own_and_other_projections() {
         (Some("cube"), Some(6))
     );
     assert_eq!(a.body.len(), 8 + n + 6 * 10 * 10 * 8);
+    // With the mip chain: 8², 4², 2², 1² faces, each padded, in one atlas a face.
+    let a = own(
+        &r,
+        "GET",
+        "/api/environment?projection=cube&size=8&precision=half&mips=1",
+        b"",
+    );
+    assert_eq!(a.status, 200, "{}", a.text());
+    let n = u32::from_le_bytes(a.body[4..8].try_into().unwrap()) as usize;
+    let h: serde_json::Value = serde_json::from_slice(&a.body[8..8 + n]).unwrap();
+    assert_eq!(
+        h["levels"],
+        serde_json::json!([[0, 0, 8, 8], [10, 0, 4, 4], [10, 6, 2, 2], [10, 10, 1, 1]])
+    );
+    let (w, ht) = (
+        h["texelWidth"].as_u64().unwrap(),
+        h["texelHeight"].as_u64().unwrap(),
+    );
+    assert_eq!((w, ht), (16, 13));
+    assert_eq!(a.body.len(), 8 + n + 6 * (w * ht) as usize * 8);
     for bad in [
         "projection=cube&size=0",
         "projection=nonsense",
         "precision=double",
-        "projection=octahedral",
+        "mips=2",
     ] {
         let a = own(&r, "GET", &format!("/api/environment?{bad}"), b"");
         assert!(
@@ -154,6 +174,19 @@ fn meshes_come_in_world_space() {
         );
     }
     assert_eq!(own(&r, "GET", "/api/mesh/1", b"").status, 404);
+    // The built-in sphere tessellated otherwise: the render crate's mesh at that level.
+    let a = own(&r, "GET", "/api/mesh/0?tessellation=32", b"");
+    assert_eq!(a.status, 200, "{}", a.text());
+    let want = mirrorball_render::Builtin::Sphere.mesh(32);
+    let counts = [0, 4].map(|o| u32::from_le_bytes(a.body[o..o + 4].try_into().unwrap()));
+    assert_eq!(
+        counts,
+        [want.positions.len() as u32, want.triangles.len() as u32]
+    );
+    for bad in ["tessellation=0", "tessellation=100000", "tessellation=x"] {
+        let a = own(&r, "GET", &format!("/api/mesh/0?{bad}"), b"");
+        assert_eq!(a.status, 400, "{bad}: {}", a.text());
+    }
     r.stop();
 }
 
@@ -164,7 +197,8 @@ fn the_grid_holds_the_cores_answers() {
     assert_eq!(a.status, 200);
     let count = u32::from_le_bytes(a.body[..4].try_into().unwrap()) as usize;
     assert_eq!(count, 6 * 81);
-    assert_eq!(a.body.len(), 40 + 36 * count);
+    // The count, the frame (9 floats), the parameters (4), then 9 floats a direction.
+    assert_eq!(a.body.len(), 56 + 36 * count);
     assert_eq!(
         own(&r, "GET", "/api/grid?projection=cube&n=100000", b"").status,
         400
