@@ -1,10 +1,10 @@
 // The studio page: the viewport (WebGL2) over what the server has loaded, its controls, file
 // picker and drop target, orbit and zoom. `?view=viewport`: the viewport alone, at the scene
-// camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode and the
-// projection the environment is converted to; `paraboloid=hardware` draws a dual paraboloid
-// as the hardware did (two textures, the alpha choosing: paraboloid_hw.glsl);
-// `tessellation=N` re-tessellates the built-in objects (the slider). `window.studio` is the page's handle for
-// tests and later views (simulator, overlays) to plug into.
+// camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode (1-4) and
+// the projection the environment is converted to; `paraboloid=hardware` draws a dual
+// paraboloid as the hardware did (two textures, the alpha choosing: paraboloid_hw.glsl);
+// `tessellation=N` re-tessellates the built-in objects (the slider). `window.studio` is the
+// page's handle for tests and later views (simulator, overlays) to plug into.
 
 const params = new URLSearchParams(location.search);
 const token = params.get('token') || '';

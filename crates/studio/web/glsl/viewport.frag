@@ -1,13 +1,13 @@
 // The viewport's fragment stage (prepended as viewport.vert, then bilinear.glsl,
 // display.glsl, interpolate.glsl and cone.glsl): the mode's reflected direction, as
 // mirrorball-render's render/shade.rs (`Prepared::shade`, `env_color`), render/texgen.rs
-// (`texgen_read`) and render/cone.rs (mode 4: the pixel's cone, filtered trilinearly), read
-// through the projection's envUv, shown as display.glsl says. The background is the camera's
-// rays (render/background.rs, camera.rs `Rays::ray`), in mode 4 filtered over the cone of
-// the pixel's corner rays as the CPU filters it. CONE_READ (gl.js) is cone.glsl's coneRead
-// (trilinear, the CPU's trilinear) or coneReadAnisotropic (in the place of its EWA). With PARA_HW defined (a dual paraboloid
-// drawn as the hardware did, modes 1-3) paraboloid_hw.glsl comes after cone.glsl and reads
-// instead of envRead.
+// (`texgen_read`) and render/cone.rs (mode 4: the pixel's cone), read through the
+// projection's envUv, shown as display.glsl says. The background is the camera's rays
+// (render/background.rs, camera.rs `Rays::ray`), in mode 4 filtered over the cone of the
+// pixel's corner rays as the CPU filters it. CONE_READ (gl.js `coneRead`) is cone.glsl's
+// coneRead (the CPU's trilinear) or coneReadAnisotropic (in the place of its EWA). With
+// PARA_HW defined (a dual paraboloid drawn as the hardware did, modes 1-3),
+// paraboloid_hw.glsl comes after cone.glsl and its paraRead reads instead of envRead.
 flat in vec4 vClip0;
 flat in vec4 vClip1;
 flat in vec4 vClip2;
