@@ -5,8 +5,8 @@
 //! | `GET /` | the page (`?view=viewport`: the viewport alone, at the camera's size) |
 //! | `GET /web/NAME` | the page's scripts and shaders, embedded in the binary |
 //! | `GET /api/state` | what is loaded, as JSON ([`State::describe`]) |
-//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float` | the environment's texels ([`texture`]) |
-//! | `GET /api/mesh/I` | object `I` in world space ([`geometry`]) |
+//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float&mips=0\|1` | the environment's texels, with its mip chain for `mips=1` ([`texture`]) |
+//! | `GET /api/mesh/I?tessellation=N` | object `I` in world space ([`geometry`]); a built-in tessellated `N` (`state::MAX_TRIANGLES` at most) |
 //! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
 //! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
 //! | `GET /api/lighting/progress` | `{"done", "total", "busy"}`: rows of the prefilter running |
@@ -238,6 +238,7 @@ struct EnvQuery {
     projection: Option<String>,
     size: Option<u32>,
     precision: Option<String>,
+    mips: Option<String>,
 }
 
 async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -> Response {
@@ -249,6 +250,16 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
     {
         Ok(p) => p,
         Err(e) => return bad(StatusCode::BAD_REQUEST, format!("precision: {e}")),
+    };
+    let mips = match q.mips.as_deref().unwrap_or("0") {
+        "0" => false,
+        "1" => true,
+        m => {
+            return bad(
+                StatusCode::BAD_REQUEST,
+                format!("mips: '{m}' is not 0 or 1"),
+            )
+        }
     };
     let map = {
         let s = app.state.lock().expect("state");
@@ -277,7 +288,11 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
                 ),
             ));
         }
-        Ok(texture::encode(&map, precision))
+        Ok(if mips {
+            texture::encode_mips(&map, precision)
+        } else {
+            texture::encode(&map, precision)
+        })
     });
     match work.await {
         Ok(Ok(b)) => binary(b),
@@ -481,10 +496,46 @@ async fn export(Shared(app): Shared<AppState>, Query(q): Query<ExportQuery>) -> 
     }
 }
 
-async fn mesh(Shared(app): Shared<AppState>, UrlPath(i): UrlPath<usize>) -> Response {
-    let object = {
+#[derive(Deserialize)]
+struct MeshQuery {
+    tessellation: Option<u32>,
+}
+
+async fn mesh(
+    Shared(app): Shared<AppState>,
+    UrlPath(i): UrlPath<usize>,
+    Query(q): Query<MeshQuery>,
+) -> Response {
+    let (object, builtin) = {
         let s = app.state.lock().expect("state");
-        s.view.scene.objects.get(i).cloned()
+        (
+            s.view.scene.objects.get(i).cloned(),
+            s.view.builtins.get(i).copied().flatten(),
+        )
+    };
+    let object = match (object, q.tessellation) {
+        (Some(mut o), Some(level)) => {
+            let Some((b, _)) = builtin else {
+                return bad(
+                    StatusCode::BAD_REQUEST,
+                    format!("tessellation: object {i} is a mesh file, not a built-in"),
+                );
+            };
+            let max = b.max_tessellation(crate::state::MAX_TRIANGLES);
+            if !(1..=max).contains(&level) {
+                return bad(
+                    StatusCode::BAD_REQUEST,
+                    format!(
+                        "tessellation: {level} is outside 1..={max} for the {} (at most {} triangles)",
+                        b.name(),
+                        crate::state::MAX_TRIANGLES
+                    ),
+                );
+            }
+            o.mesh = Arc::new(b.mesh(level));
+            Some(o)
+        }
+        (o, _) => o,
     };
     match object {
         Some(o) => match tokio::task::spawn_blocking(move || geometry::encode(&o)).await {

@@ -43,6 +43,8 @@ const FILES: &[(&str, &str, &str)] = files![
     "glsl/lighting.glsl": "glsl",
     "glsl/display.glsl": "glsl",
     "glsl/interpolate.glsl": "glsl",
+    "glsl/cone.glsl": "glsl",
+    "glsl/paraboloid_hw.glsl": "glsl",
     "glsl/texgen.glsl": "glsl",
     "glsl/viewport.vert": "glsl",
     "glsl/viewport.frag": "glsl",

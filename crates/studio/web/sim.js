@@ -225,13 +225,14 @@ export function attach(studio) {
   }
 
   async function recordProgram(mode, kind, layers) {
-    const key = `record ${kind} ${layers} ${mode}`;
+    const key = `record ${kind} ${layers} ${mode} ${view.state.scene.environment.filter}`;
     if (!sim.programs.has(key)) {
+      const cone = `#define CONE_READ ${G.coneRead(view.state.scene.environment.filter)}\n`;
       const defines = `#define MODE ${mode}\n#define TEXGEN ${G.texgenOf(kind, layers)}\n#define BACKGROUND 0\n`;
       const proj = await G.projectionSource(kind);
       const vs = G.HEADER + defines + proj + '\n' + (await G.glsl('texgen.glsl')) + '\n' + (await G.glsl('viewport.vert'));
-      const fs = [G.HEADER + defines + proj];
-      for (const f of ['bilinear.glsl', 'display.glsl', 'interpolate.glsl', 'sim-record.glsl', 'viewport.frag']) fs.push(await G.glsl(f));
+      const fs = [G.HEADER + defines + cone + proj];
+      for (const f of ['bilinear.glsl', 'display.glsl', 'interpolate.glsl', 'sim-record.glsl', 'cone.glsl', 'viewport.frag']) fs.push(await G.glsl(f));
       sim.programs.set(key, G.link(gl, vs, fs.join('\n')));
     }
     return sim.programs.get(key);
@@ -637,6 +638,8 @@ export function attach(studio) {
     p.set('material', view.material);
     p.set('roughness', String(view.roughness));
     p.set('lightsize', String(view.lightSize));
+    p.set('paraboloid', view.paraboloid);
+    if (view.tessellation) p.set('tessellation', String(view.tessellation));
     if (view.size) p.set('size', String(view.size));
     if (view.orbit) {
       p.set('yaw', String(view.orbit.yaw));

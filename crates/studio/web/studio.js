@@ -1,10 +1,12 @@
 // The studio page: the viewport (WebGL2) over what the server has loaded, its controls, file
 // picker and drop target, orbit and zoom. `?view=viewport`: the viewport alone, at the scene
-// camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode and the
-// projection the environment is converted to; `material` (mirror, ggx, lambert) and
+// camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode (1-4) and
+// the projection the environment is converted to; `material` (mirror, ggx, lambert) and
 // `roughness` the objects' material, the prefiltered ones lit by the server's chain (level 0
-// `lightsize`² a face) and SH9 (panels.js, lighting.glsl). `window.studio` is the page's handle for tests and later views
-// (simulator, overlays) to plug into.
+// `lightsize`² a face) and SH9 (panels.js, lighting.glsl); `paraboloid=hardware` draws a
+// dual paraboloid as the hardware did (two textures, the alpha choosing: paraboloid_hw.glsl);
+// `tessellation=N` re-tessellates the built-in objects (the slider). `window.studio` is the
+// page's handle for tests and later views (simulator, overlays) to plug into.
 
 const params = new URLSearchParams(location.search);
 const token = params.get('token') || '';
@@ -32,7 +34,10 @@ const view = {
   mode: null,
   projection: params.get('projection') || 'native',
   size: params.get('size') ? Number(params.get('size')) : null,
-  env: null, // { header, texture }
+  paraboloid: params.get('paraboloid') === 'hardware' ? 'hardware' : 'exact',
+  // The built-in objects' tessellation (null: the scene's).
+  tessellation: params.get('tessellation') ? Number(params.get('tessellation')) : null,
+  env: null, // { header, texture, halves (a dual paraboloid's two 2D textures) }
   material: G.MATERIALS[params.get('material')] !== undefined ? params.get('material') : 'mirror',
   roughness: params.get('roughness') !== null && Number.isFinite(Number(params.get('roughness'))) ? Number(params.get('roughness')) : 0.5,
   // The prefiltered lighting of the loaded environment: { header, texture, sh }, or null
@@ -77,15 +82,17 @@ async function loadState() {
   view.state = await (await G.api('/api/state')).json();
   const s = view.state.scene;
   document.getElementById('scene-name').textContent = s.name;
-  if (view.mode === null) view.mode = Number(params.get('mode') || Math.min(s.mode, 3));
+  if (view.mode === null) view.mode = Number(params.get('mode') || s.mode);
   document.getElementById('mode').value = String(view.mode);
   document.getElementById('projection').value = view.projection;
   document.getElementById('material').value = view.material;
   document.getElementById('roughness').value = String(view.roughness);
+  document.getElementById('paraboloid').value = view.paraboloid;
   canvas.width = s.camera.width;
   canvas.height = s.camera.height;
   canvas.style.width = `${s.camera.width}px`;
   canvas.style.height = `${s.camera.height}px`;
+  showTessellation();
   await loadMeshes();
   await loadEnvironment();
   report();
@@ -152,11 +159,24 @@ function dropLighting() {
   view.generation++;
 }
 
+/** The slider, for scenes with built-in objects: up to the least of their largest levels. */
+function showTessellation() {
+  const builtins = view.state.scene.objects.filter((o) => o.builtin);
+  const label = document.getElementById('tessellation-label');
+  label.hidden = builtins.length === 0;
+  if (label.hidden) return;
+  const input = document.getElementById('tessellation');
+  input.max = String(Math.min(256, ...builtins.map((o) => o.maxTessellation)));
+  input.value = String(view.tessellation ?? builtins[0].tessellation);
+  document.getElementById('tessellation-value').textContent = input.value;
+}
+
 async function loadMeshes() {
   for (const m of view.meshes) gl.deleteVertexArray(m.vao);
   view.meshes = [];
   for (const o of view.state.scene.objects) {
-    const mesh = G.parseMesh(await (await G.api(`/api/mesh/${o.mesh}`)).arrayBuffer());
+    const q = o.builtin && view.tessellation ? `?tessellation=${view.tessellation}` : '';
+    const mesh = G.parseMesh(await (await G.api(`/api/mesh/${o.mesh}${q}`)).arrayBuffer());
     const vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
     const b = gl.createBuffer();
@@ -173,22 +193,30 @@ async function loadMeshes() {
 }
 
 async function loadEnvironment() {
-  if (view.env) gl.deleteTexture(view.env.texture);
+  if (view.env) for (const t of [view.env.texture, ...(view.env.halves || [])]) gl.deleteTexture(t);
   view.env = null;
   if (!view.state.scene.environment) return;
-  let q = `projection=${encodeURIComponent(view.projection)}&precision=float`;
+  // Mode 4 reads the mip chain (texture.rs `encode_mips`).
+  const mips = view.mode === 4;
+  let q = `projection=${encodeURIComponent(view.projection)}&precision=float&mips=${mips ? 1 : 0}`;
   if (view.size) q += `&size=${view.size}`;
   const parsed = G.parseTexture(await (await G.api(`/api/environment?${q}`)).arrayBuffer());
-  view.env = { header: parsed.header, texture: G.environmentTexture(gl, parsed) };
+  const halves = parsed.header.projection === 'paraboloid' ? G.paraboloidTextures(gl, parsed) : null;
+  view.env = { header: parsed.header, texture: G.environmentTexture(gl, parsed), halves };
 }
 
 async function program(background) {
   const h = view.env.header;
   const kind = h.projection;
   const material = background ? 'mirror' : materialNow();
-  const key = `${kind} ${h.layers} ${view.mode} ${background} ${material}`;
+  const paraboloid = view.paraboloid;
+  const filter = view.state.scene.environment.filter;
+  const key = `${kind} ${h.layers} ${view.mode} ${background} ${material} ${paraboloid} ${filter}`;
   if (!view.programs.has(key)) {
-    view.programs.set(key, await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background, material }));
+    view.programs.set(
+      key,
+      await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background, material, paraboloid, filter }),
+    );
   }
   return view.programs.get(key);
 }
@@ -263,6 +291,18 @@ async function draw(pass = {}) {
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, view.env.texture);
     gl.uniform1i(u('uEnv'), 0);
     gl.uniform2i(u('uEnvSize'), h.width, h.height);
+    gl.uniform1i(u('uLevelCount'), h.levels.length);
+    gl.uniform4iv(u('uLevels'), new Int32Array(h.levels.flat()));
+    if (view.env.halves) {
+      view.env.halves.forEach((t, i) => {
+        gl.activeTexture(gl.TEXTURE1 + i);
+        gl.bindTexture(gl.TEXTURE_2D, t);
+      });
+      gl.uniform1i(u('uFront'), 1);
+      gl.uniform1i(u('uBack'), 2);
+      gl.uniformMatrix4fv(u('uParaMatrix'), false, G.paraboloidTextureMatrices(h.frame));
+      gl.activeTexture(gl.TEXTURE0);
+    }
     gl.uniform1f(u('uIntensity'), env.intensity);
     gl.uniform1f(u('uExposureScale'), Math.pow(2, s.exposure));
     gl.uniform1i(u('uTone'), tone);
@@ -354,8 +394,32 @@ document.addEventListener('drop', (e) => {
   document.body.id = '';
   if (e.dataTransfer.files[0]) upload(e.dataTransfer.files[0]);
 });
-document.getElementById('mode').addEventListener('change', (e) => {
+document.getElementById('mode').addEventListener('change', async (e) => {
   view.mode = Number(e.target.value);
+  if (view.mode === 4 && view.env && view.env.header.levels.length === 1 && view.env.header.width * view.env.header.height > 1) {
+    try {
+      await loadEnvironment();
+    } catch (err) {
+      report(err);
+    }
+  }
+  redraw();
+});
+document.getElementById('tessellation').addEventListener('input', (e) => {
+  document.getElementById('tessellation-value').textContent = e.target.value;
+});
+document.getElementById('tessellation').addEventListener('change', async (e) => {
+  view.tessellation = Number(e.target.value);
+  try {
+    await loadMeshes();
+    report();
+  } catch (err) {
+    report(err);
+  }
+  redraw();
+});
+document.getElementById('paraboloid').addEventListener('change', (e) => {
+  view.paraboloid = e.target.value;
   redraw();
 });
 document.getElementById('material').addEventListener('change', (e) => {

@@ -89,7 +89,8 @@ fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
         .map_err(|e| CliError::request(e.to_string()))?
         .args;
     args.given = vec!["ss".into()];
-    let (mut scene_data, camera, settings, exposure, tone) = super::render::studio_scene(&args)?;
+    let (mut scene_data, camera, settings, exposure, tone, builtins) =
+        super::render::studio_scene(&args)?;
     if scene.is_none() {
         scene_data.background = true;
         for o in &mut scene_data.objects {
@@ -104,6 +105,7 @@ fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
         exposure,
         tone,
         source: scene.map(super::render::schema::portable).transpose()?,
+        builtins,
     })
 }
 

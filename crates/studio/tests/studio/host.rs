@@ -59,6 +59,7 @@ impl Host for TestHost {
             exposure: 0.0,
             tone: Tone::Clamp,
             source: None,
+            builtins: vec![Some((Builtin::Sphere, 16))],
         }
     }
     fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String> {
