@@ -246,3 +246,33 @@ export async function openStudio(chromium, url) {
   await page.evaluate(() => window.studio.ready);
   return { page, logs };
 }
+
+/// A studio viewport's RGBA8 pixels `gpu` against `mirrorball render`'s picture `full` of
+/// the same scene, `cover` the same rendered with `--no-background` (its alpha: the
+/// objects' coverage): over the covered pixels whose eight neighbours are covered too (the
+/// silhouette's coverage is each rasteriser's own business) and over the background, how
+/// many there are and how many are within 2/255 in every channel.
+export function againstRender(gpu, full, cover) {
+  const { width: w, height: h } = full;
+  const covered = (x, y) => cover.data[4 * (y * w + x) + 3] > 0;
+  let n = 0;
+  let within = 0;
+  let bg = 0;
+  let bgWithin = 0;
+  for (let y = 1; y < h - 1; y++) {
+    for (let x = 1; x < w - 1; x++) {
+      const i = y * w + x;
+      const d = Math.max(...[0, 1, 2].map((c) => Math.abs(gpu[4 * i + c] - full.data[4 * i + c])));
+      let inner = true;
+      for (let dy = -1; dy <= 1; dy++) for (let dx = -1; dx <= 1; dx++) inner &&= covered(x + dx, y + dy);
+      if (inner) {
+        n++;
+        if (d <= 2) within++;
+      } else if (!covered(x, y)) {
+        bg++;
+        if (d <= 2) bgWithin++;
+      }
+    }
+  }
+  return { n, within, bg, bgWithin };
+}

@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, studio, run, tempDir, readPng, ROOT } from './lib.mjs';
+import { browser, studio, run, tempDir, readPng, againstRender, ROOT } from './lib.mjs';
 
 
 let chromium;
@@ -115,28 +115,8 @@ test('the embed view draws the mirror sphere as mirrorball render does in every 
       };
       const full = png([]);
       const cover = png(['--no-background']);
-      const { width: w, height: h } = full;
-      assert.equal(gpu.length, 4 * w * h);
-      const covered = (x, y) => cover.data[4 * (y * w + x) + 3] > 0;
-      let n = 0;
-      let within = 0;
-      let bg = 0;
-      let bgWithin = 0;
-      for (let y = 1; y < h - 1; y++) {
-        for (let x = 1; x < w - 1; x++) {
-          const i = y * w + x;
-          const d = Math.max(...[0, 1, 2].map((c) => Math.abs(gpu[4 * i + c] - full.data[4 * i + c])));
-          let inner = true;
-          for (let dy = -1; dy <= 1; dy++) for (let dx = -1; dx <= 1; dx++) inner &&= covered(x + dx, y + dy);
-          if (inner) {
-            n++;
-            if (d <= 2) within++;
-          } else if (!covered(x, y)) {
-            bg++;
-            if (d <= 2) bgWithin++;
-          }
-        }
-      }
+      assert.equal(gpu.length, 4 * full.width * full.height);
+      const { n, within, bg, bgWithin } = againstRender(gpu, full, cover);
       console.log(`${proj}: ${((100 * within) / n).toFixed(2)}% of ${n} covered pixels within 2/255, background ${((100 * bgWithin) / bg).toFixed(2)}%`);
       if (n < 200 || within / n < 0.99 || bgWithin / bg < 0.99) bad.push(`${proj}: ${within}/${n} covered, ${bgWithin}/${bg} background`);
     }

@@ -86,7 +86,7 @@ test("sim.js's uvToDir inverts the core's direction→uv on a dense grid", async
       const b = Uint8Array.from(buf).buffer;
       const count = new DataView(b).getUint32(0, true);
       const frame = Array.from(new Float32Array(b, 4, 9));
-      const values = new Float32Array(b, 40, 9 * count);
+      const values = new Float32Array(b, 56, 9 * count);
       let worst = 0;
       let checked = 0;
       for (let i = 0; i < count; i++) {

@@ -619,6 +619,7 @@ pub(crate) fn cube_write(opts: &BakeOptions, metadata: Vec<(String, String)>) ->
         declared: Some(mirrorball_io::MapInfo {
             projection: ProjectionKind::Cube.default_projection(),
             layout: None,
+            stereo: Default::default(),
         }),
         metadata,
     }

@@ -6,7 +6,8 @@
 use crate::error::CliError;
 use crate::spec::ProjSpec;
 use mirrorball_core::{
-    guess, CubeMap, EnvMap, Image, LatLong, Layout, Projection, ProjectionKind, WorldProjection,
+    guess, CubeMap, EnvMap, Image, LatLong, Layout, Projection, ProjectionKind, Stereo,
+    WorldProjection,
 };
 use mirrorball_io::{openexr, Format, Limits, Loaded};
 use rayon::prelude::*;
@@ -32,6 +33,11 @@ pub struct Source {
     pub description: String,
     /// How projection and layout were decided (said to the user).
     pub decided: String,
+    /// The right eye, when a stereo pair was read with both eyes ([`load_eyes`]); of the
+    /// same projection and size as [`Source::env`], the left.
+    pub right: Option<EnvMap>,
+    /// How the picture held its eyes (`2d`: one).
+    pub stereo: Stereo,
     /// NaN, infinite and negative values in the file(s) as read
     /// (`mirrorball_io::Loaded::invalid`): none spares [`Source::prepare`] its pass over the
     /// whole map.
@@ -57,7 +63,7 @@ impl Source {
             self.decided
         )];
         if !keep_invalid && self.invalid != 0 {
-            let fixed = self.env.sanitize();
+            let fixed = self.env.sanitize() + self.right.as_mut().map_or(0, EnvMap::sanitize);
             if fixed > 0 {
                 lines.push(format!(
                     "warning: {input}: {fixed} NaN, infinite or negative values set to 0 (--keep-invalid keeps them)"
@@ -92,7 +98,31 @@ pub fn load(
     layout: Option<Layout>,
     limits: &Limits,
 ) -> Result<Source, CliError> {
+    load_eyes(input, from, layout, (None, Stereo::Mono), limits)
+}
+
+/// [`load`] for a picture that may be a stereo pair: arranged as `stereo.0` says, else as
+/// the file records, else one eye (`2d`). The eyes a conversion to `stereo.1` needs are read
+/// (`Stereo::eyes_read`): the left into [`Source::env`], the right into
+/// [`Source::right`]. Each eye is interpreted as `from` and `layout` say (or as the file
+/// records or its shape says), the same way. A pair is one picture: a cube container or
+/// `{face}` files are refused, and so is a picture that does not halve evenly.
+pub fn load_eyes(
+    input: &str,
+    from: Option<&ProjSpec>,
+    layout: Option<Layout>,
+    (asked, output): (Option<Stereo>, Stereo),
+    limits: &Limits,
+) -> Result<Source, CliError> {
+    let one_picture = |stereo: Stereo, what: &str| {
+        CliError::request(format!(
+            "{input}: --in-stereo {stereo} splits one picture into eyes, but {what}"
+        ))
+    };
     if input.contains(FACE) {
+        if let Some(s) = asked.filter(|s| *s != Stereo::Mono) {
+            return Err(one_picture(s, &format!("{FACE} names one file per layer")));
+        }
         return load_layers(input, from, limits);
     }
     let path = Path::new(input);
@@ -127,6 +157,12 @@ pub fn load(
         }
         _ => String::new(),
     };
+    let stereo = asked
+        .or(recorded.as_ref().map(|r| r.stereo))
+        .unwrap_or_default();
+    if layers.len() == 6 && stereo != Stereo::Mono {
+        return Err(one_picture(stereo, "the file holds six cube faces"));
+    }
     if layers.len() == 6 {
         // A cube container: KTX2 or DDS.
         let (spec, proj) = match (&recorded, from) {
@@ -155,6 +191,8 @@ pub fn load(
             env,
             description,
             decided,
+            right: None,
+            stereo: Stereo::Mono,
             invalid,
         });
     }
@@ -164,7 +202,11 @@ pub fn load(
         .ok_or_else(|| CliError::input(format!("{input}: no image")))?;
     // OpenEXR's `envmap` tag, when it alone says the projection: its pictures follow
     // OpenEXR's conventions (ImfEnvmap), turned into mirrorball's here.
-    let tagged = from.is_none() && layout.is_none() && recorded.is_none() && format == Format::Exr;
+    let tagged = stereo == Stereo::Mono
+        && from.is_none()
+        && layout.is_none()
+        && recorded.is_none()
+        && format == Format::Exr;
     match declared.filter(|_| tagged) {
         Some(ProjectionKind::LatLong) => {
             let env = EnvMap::new(LatLong.into(), vec![openexr::latlong_to_mirrorball(&image)])
@@ -173,6 +215,8 @@ pub fn load(
                 env,
                 description,
                 decided: "the file is tagged envmap=latlong: OpenEXR's lat-long (+Z at the centre), turned half a turn into mirrorball's (--from latlong reads the picture as mirrorball's)".to_string(),
+                right: None,
+        stereo: Stereo::Mono,
                 invalid,
             });
         }
@@ -185,14 +229,17 @@ pub fn load(
                 env,
                 description,
                 decided: "the file is tagged envmap=cube: OpenEXR's vertical strip of faces, read into OpenGL's faces (--from cube --layout vstrip reads the picture as mirrorball's strip)".to_string(),
+                right: None,
+        stereo: Stereo::Mono,
                 invalid,
             });
         }
         _ => {}
     }
-    let (env, decided) = interpret(
+    let (env, right, decided) = interpret_eyes(
         input,
         image,
+        (stereo, stereo.eyes_read(output)),
         from,
         layout,
         recorded,
@@ -203,8 +250,63 @@ pub fn load(
         env,
         description,
         decided,
+        right,
+        stereo,
         invalid,
     })
+}
+
+/// [`interpret`] for a picture arranged as `stereo.0`: split into its first `stereo.1` eyes
+/// (a size that does not halve is the request's error, naming `input`), each eye
+/// interpreted alike. Returns the left eye, the right when read, and the decision's words.
+#[allow(clippy::too_many_arguments)]
+pub fn interpret_eyes(
+    input: &str,
+    image: Image,
+    (stereo, eyes): (Stereo, usize),
+    from: Option<&ProjSpec>,
+    layout: Option<Layout>,
+    recorded: Option<mirrorball_io::MapInfo>,
+    declared: Option<ProjectionKind>,
+    records_other: impl Fn(&Projection) -> String,
+) -> Result<(EnvMap, Option<EnvMap>, String), CliError> {
+    let (w, h) = (image.width(), image.height());
+    let mut pictures = stereo
+        .split(image, eyes)
+        .map_err(|e| CliError::request(format!("{input}: --in-stereo {stereo}: {e}")))?
+        .into_iter();
+    let left = pictures.next().expect("a picture has an eye");
+    let (env, decided) = interpret(
+        input,
+        left,
+        from,
+        layout,
+        recorded,
+        declared,
+        &records_other,
+    )?;
+    let right = pictures
+        .next()
+        .map(|eye| interpret(input, eye, from, layout, recorded, declared, &records_other))
+        .transpose()?
+        .map(|r| r.0);
+    let decided = match stereo {
+        Stereo::Mono => decided,
+        _ => {
+            let (ew, eh) = stereo.extent(1, 1);
+            format!(
+                "a {stereo} stereo pair, eyes {}x{} of {w}x{h}{}; each eye {decided}",
+                w / ew,
+                h / eh,
+                if right.is_none() {
+                    " (the left eye read)"
+                } else {
+                    ""
+                }
+            )
+        }
+    };
+    Ok((env, right, decided))
 }
 
 /// The map in one picture read from `input` (a file, or a raw frame from a pipe): its
@@ -428,6 +530,8 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
         env,
         description: format!("{} files", names.len()),
         decided,
+        right: None,
+        stereo: Stereo::Mono,
         invalid,
     })
 }

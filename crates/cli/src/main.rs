@@ -120,14 +120,25 @@ pub struct ConvertArgs {
     )]
     to: String,
     /// Face edge (cubes), width (lat-long, Mercator, cylinders, Hammer, sinusoidal, views) or
-    /// diameter (disk maps), in texels.
-    /// Default: about the source's resolution.
+    /// diameter (disk maps), in texels; one eye's, for a stereo pair (--stereo).
+    /// Default: about the source's resolution (its one eye's).
     #[arg(long)]
     size: Option<u32>,
     /// Layout of the output's layers: hcross, vcross, hstrip, vstrip, separate, or v360's
     /// c3x2, c6x1, c1x6 (with `:forder=rludfb:frot=000000`) and eac (EAC's default).
     #[arg(long, value_name = "LAYOUT")]
     layout: Option<String>,
+    /// The input picture as a stereo pair, as FFmpeg v360's in_stereo: 2d (one eye), sbs
+    /// (left eye | right eye), tb (left eye above the right). Each eye is read as --from and
+    /// --in-layout say. Default: as the file records (a pair mirrorball wrote), else 2d.
+    #[arg(long = "in-stereo", value_name = "MODE", value_parser = names::<mirrorball_core::Stereo>())]
+    in_stereo: Option<String>,
+    /// The output as a stereo pair, as v360's out_stereo: 2d (of a pair, the left eye), sbs
+    /// or tb (of a 2d input, its one eye twice). --size and --layout are one eye's: the
+    /// picture is twice as wide (sbs) or as tall (tb). One picture per frame (.exr .hdr .png
+    /// .jpg, or a raw pipe).
+    #[arg(long, value_name = "MODE", value_parser = names::<mirrorball_core::Stereo>())]
+    stereo: Option<String>,
     #[command(flatten)]
     input_args: InputArgs,
     /// Turn the environment about +Y (degrees; positive turns it to the left).

@@ -3,7 +3,7 @@
 
 use crate::error::CliError;
 use crate::load::{layer_names, FACE};
-use mirrorball_core::{EnvMap, Image, Layout, ProjectionKind, WorldProjection};
+use mirrorball_core::{EnvMap, Image, Layout, ProjectionKind, Stereo, WorldProjection};
 use mirrorball_filter::MipChain;
 use mirrorball_io::{Format, MapInfo, OutputSet, WriteOptions};
 use std::path::{Path, PathBuf};
@@ -131,8 +131,67 @@ pub fn per_part_path(out: &str, placeholder: &str, part: &str) -> PathBuf {
 
 /// Writes `env` to `out`; returns the files written.
 pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>, CliError> {
+    save_eyes(std::slice::from_ref(env), Stereo::Mono, out, opts)
+}
+
+/// Refuses an output that cannot hold a stereo pair before any work starts: a pair
+/// (`stereo` not `2d`) is one picture, so neither a KTX2/DDS cube nor one file a layer.
+pub fn check_stereo(
+    out: &str,
+    layers: usize,
+    stereo: Stereo,
+    opts: &SaveOptions,
+) -> Result<(), CliError> {
+    if stereo == Stereo::Mono {
+        return Ok(());
+    }
+    let format = Format::from_path(Path::new(out));
+    if format.is_some_and(Format::is_cube_container) {
+        return Err(CliError::request(format!(
+            "{out}: --stereo {stereo} packs both eyes into one picture, which a KTX2 or DDS cube cannot hold; write .exr .hdr .png or .jpg"
+        )));
+    }
+    if layer_files(out, layers, opts).is_some() {
+        return Err(CliError::request(format!(
+            "{out}: --stereo {stereo} packs both eyes into one picture, not one file a layer; give a packed --layout (hcross, c3x2, hstrip, …) and no {FACE}"
+        )));
+    }
+    Ok(())
+}
+
+/// The picture of `eyes` (one per eye of `stereo`, each of one projection and size): each
+/// eye packed in `layout`, the eyes joined as `stereo` arranges them.
+pub fn pack_eyes(eyes: &[EnvMap], stereo: Stereo, layout: Layout) -> Result<Image, CliError> {
+    let n = eyes[0].layers().len();
+    let pictures = eyes
+        .iter()
+        .map(|e| layout.pack(e))
+        .collect::<Option<Vec<Image>>>()
+        .ok_or_else(|| {
+            CliError::request(format!(
+                "layout {layout} does not fit a map of {n} layer(s)"
+            ))
+        })?;
+    stereo.join(pictures).ok_or_else(|| {
+        CliError::request(format!(
+            "a {stereo} picture needs {} eye(s) of one size",
+            stereo.eyes()
+        ))
+    })
+}
+
+/// Writes `eyes` (one map per eye of `stereo`; one map for `2d`) to `out`; returns the
+/// files written. The file records one eye's projection and layout.
+pub fn save_eyes(
+    eyes: &[EnvMap],
+    stereo: Stereo,
+    out: &str,
+    opts: &SaveOptions,
+) -> Result<Vec<PathBuf>, CliError> {
+    let env = &eyes[0];
     let path = Path::new(out);
     let format = check(out, env.projection().kind(), opts.layout)?;
+    check_stereo(out, env.layers().len(), stereo, opts)?;
     if format.is_cube_container() {
         let levels: Vec<Vec<Image>> = if opts.mips {
             MipChain::resampled(env)
@@ -147,6 +206,7 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
         write.declared = Some(MapInfo {
             projection: *env.projection(),
             layout: None,
+            stereo: Default::default(),
         });
         mirrorball_io::write_cube(path, &levels, &write)?;
         return Ok(vec![path.to_path_buf()]);
@@ -168,12 +228,9 @@ pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>,
     write.declared = Some(MapInfo {
         projection: *env.projection(),
         layout: Some(layout),
+        stereo,
     });
-    let img = layout.pack(env).ok_or_else(|| {
-        CliError::request(format!(
-            "{out}: layout {layout} does not fit a map of {n} layer(s)"
-        ))
-    })?;
+    let img = pack_eyes(eyes, stereo, layout).map_err(|e| e.context(out))?;
     mirrorball_io::write_image(path, &img, &write)?;
     Ok(vec![path.to_path_buf()])
 }
@@ -188,6 +245,7 @@ pub fn per_layer_write(
         declared: Some(MapInfo {
             projection,
             layout: Some(Layout::Separate),
+            stereo: Default::default(),
         }),
         ..*write
     }

@@ -182,7 +182,7 @@ impl CubeCells {
     /// The face coordinates `(s, t)` shown at cell coordinates `(c, d)` of cell `i`, as
     /// doubled integers (`2x + 1 − n` for texel `x` of `n`) or as reals: a signed
     /// permutation (see the type's documentation).
-    fn to_face<T: Copy + std::ops::Neg<Output = T>>(&self, i: usize, c: T, d: T) -> (T, T) {
+    fn face_coords<T: Copy + std::ops::Neg<Output = T>>(&self, i: usize, c: T, d: T) -> (T, T) {
         let (c, d) = match self.turns[i] & 3 {
             0 => (c, d),
             1 => (d, -c),
@@ -204,7 +204,7 @@ impl CubeCells {
             for y in 0..n {
                 for x in 0..n {
                     let (c, d) = (2 * x as i64 + 1 - n2, 2 * y as i64 + 1 - n2);
-                    let (s, t) = self.to_face(i, c, d);
+                    let (s, t) = self.face_coords(i, c, d);
                     f(
                         i,
                         ox + x,
@@ -230,7 +230,7 @@ impl CubeCells {
         let fy = (py as f64 + 0.5 - 2.0 - (row * (n + 4)) as f64) / nf;
         let (c, d) = (2.0 * (fx - col as f64) - 1.0, 2.0 * fy - 1.0);
         let i = (row * cols + col) as usize;
-        let (s, t) = self.to_face(i, c, d);
+        let (s, t) = self.face_coords(i, c, d);
         let warp = |a: f64| {
             if a.abs() > 1.0 {
                 a
@@ -648,6 +648,141 @@ fn unpack_cells(
     EnvMap::new(projection, faces).map_err(|e| e.to_string())
 }
 
+/// How one picture holds a stereo pair: FFmpeg `v360`'s `in_stereo`/`out_stereo`
+/// (`libavfilter/vf_v360.c`, `config_output` and the remap slices).
+///
+/// `2d` is one picture, one eye; `sbs` the left eye in the left half and the right eye in
+/// the right half; `tb` the left eye on top, the right below. Each eye is a whole picture of
+/// the projection in its layout, so a pair is split before the layout unpacks an eye and
+/// joined after it packs one; no padding between the eyes. v360 halves an odd width or
+/// height by integer division and leaves the last column or row unread; [`Stereo::split`]
+/// refuses it instead.
+///
+/// Converting from one arrangement to another, output eye `e` is made from input eye
+/// [`Stereo::source_eye`] of the input: the left eye of a pair for a `2d` output (v360 converts only its
+/// first eye then), the one eye of a `2d` input for both eyes of a pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Stereo {
+    /// One eye (`2d`).
+    #[default]
+    Mono,
+    /// Left | right (`sbs`).
+    SideBySide,
+    /// Left above right (`tb`).
+    TopBottom,
+}
+
+impl Choice for Stereo {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (Stereo::Mono, &["2d", "mono"]),
+        (Stereo::SideBySide, &["sbs", "side-by-side"]),
+        (Stereo::TopBottom, &["tb", "top-bottom", "over-under"]),
+    ];
+}
+crate::choice_traits!(Stereo);
+
+impl Stereo {
+    /// How many eyes the picture holds: 1 or 2.
+    pub fn eyes(self) -> usize {
+        match self {
+            Stereo::Mono => 1,
+            _ => 2,
+        }
+    }
+
+    /// The picture of eyes of `w`×`h` texels.
+    pub fn extent(self, w: u32, h: u32) -> (u32, u32) {
+        match self {
+            Stereo::Mono => (w, h),
+            Stereo::SideBySide => (2 * w, h),
+            Stereo::TopBottom => (w, 2 * h),
+        }
+    }
+
+    /// The size of each eye of a `w`×`h` picture; an error when the width (`sbs`) or the
+    /// height (`tb`) does not halve evenly.
+    pub fn eye_extent(self, w: u32, h: u32) -> Result<(u32, u32), String> {
+        let (n, what) = match self {
+            Stereo::Mono => return Ok((w, h)),
+            Stereo::SideBySide => (w, "width"),
+            Stereo::TopBottom => (h, "height"),
+        };
+        if n % 2 != 0 || n == 0 {
+            return Err(format!(
+                "a {self} stereo pair needs an even {what}, one half per eye; {w}x{h} has {what} {n}"
+            ));
+        }
+        Ok(match self {
+            Stereo::SideBySide => (w / 2, h),
+            _ => (w, h / 2),
+        })
+    }
+
+    /// The top-left texel of eye `e` for eyes of `w`×`h`.
+    fn origin(self, e: usize, w: u32, h: u32) -> (u32, u32) {
+        match self {
+            Stereo::SideBySide => (e as u32 * w, 0),
+            Stereo::TopBottom => (0, e as u32 * h),
+            Stereo::Mono => (0, 0),
+        }
+    }
+
+    /// The first `eyes` eyes of `picture` (left first), at most [`Stereo::eyes`]: a `2d`
+    /// picture is its one eye, kept as it is.
+    pub fn split(self, picture: Image, eyes: usize) -> Result<Vec<Image>, String> {
+        if self == Stereo::Mono {
+            return Ok(vec![picture]);
+        }
+        let (w, h) = self.eye_extent(picture.width(), picture.height())?;
+        Ok((0..eyes.min(2))
+            .map(|e| {
+                let (x, y) = self.origin(e, w, h);
+                picture
+                    .crop(x, y, w, h)
+                    .expect("an eye lies inside the picture")
+            })
+            .collect())
+    }
+
+    /// The picture holding `eyes` (left first, each of one size): the one eye for `2d`.
+    /// `None` when the count is not [`Stereo::eyes`] or the sizes differ.
+    pub fn join(self, mut eyes: Vec<Image>) -> Option<Image> {
+        if eyes.len() != self.eyes() {
+            return None;
+        }
+        if self == Stereo::Mono {
+            return eyes.pop();
+        }
+        let (w, h, c) = (eyes[0].width(), eyes[0].height(), eyes[0].channels());
+        if eyes
+            .iter()
+            .any(|e| (e.width(), e.height(), e.channels()) != (w, h, c))
+        {
+            return None;
+        }
+        let (pw, ph) = self.extent(w, h);
+        let mut out = Image::new(pw, ph, c);
+        for (e, eye) in eyes.iter().enumerate() {
+            let (x, y) = self.origin(e, w, h);
+            out.paste(eye, x, y);
+        }
+        Some(out)
+    }
+
+    /// The eye of a picture arranged as `self` (the input) that output eye `e` is made
+    /// from: the same eye, or for a `2d` input its one eye. A `2d` output's one eye is eye
+    /// 0, the left.
+    pub fn source_eye(self, e: usize) -> usize {
+        e.min(self.eyes() - 1)
+    }
+
+    /// How many eyes of a picture arranged as `self` a conversion to `output` reads: the
+    /// left eye alone for a `2d` output.
+    pub fn eyes_read(self, output: Stereo) -> usize {
+        self.eyes().min(output.eyes())
+    }
+}
+
 /// A guess at projection and layout from a picture's size (and a declared projection, such
 /// as OpenEXR's `envmap` attribute), with the reason, for [`guess`].
 #[derive(Clone, Debug, PartialEq)]
@@ -797,5 +932,41 @@ mod tests {
             Layout::Cells(CubeCells::v360(CellGrid::C3x2))
         );
         assert_eq!("eac".parse::<Layout>().unwrap().to_string(), "eac");
+    }
+
+    #[test]
+    fn stereo_split_and_join_are_inverse_and_put_the_left_eye_first() {
+        let mut pic = Image::new(6, 4, 3);
+        for y in 0..4 {
+            for x in 0..6 {
+                pic.set(x, y, &[x as f32, y as f32, 0.0]);
+            }
+        }
+        let sbs = Stereo::SideBySide.split(pic.clone(), 2).unwrap();
+        assert_eq!((sbs[0].width(), sbs[0].height()), (3, 4));
+        assert_eq!(sbs[0].get(0, 0), &[0.0, 0.0, 0.0]);
+        assert_eq!(sbs[1].get(0, 0), &[3.0, 0.0, 0.0]);
+        assert_eq!(Stereo::SideBySide.join(sbs).unwrap(), pic);
+        let tb = Stereo::TopBottom.split(pic.clone(), 2).unwrap();
+        assert_eq!((tb[1].width(), tb[1].height()), (6, 2));
+        assert_eq!(tb[1].get(5, 0), &[5.0, 2.0, 0.0]);
+        assert_eq!(Stereo::TopBottom.join(tb).unwrap(), pic);
+        // The left eye alone; a 2d picture is its one eye.
+        assert_eq!(Stereo::SideBySide.split(pic.clone(), 1).unwrap().len(), 1);
+        assert_eq!(
+            Stereo::Mono.split(pic.clone(), 2).unwrap(),
+            vec![pic.clone()]
+        );
+        assert!(Stereo::SideBySide.join(vec![pic.clone()]).is_none());
+        // Odd halves are refused by name.
+        let e = Stereo::TopBottom.split(Image::new(4, 5, 3), 2).unwrap_err();
+        assert!(e.contains("even height") && e.contains("4x5"), "{e}");
+        assert!(Stereo::SideBySide.eye_extent(7, 4).is_err());
+        // v360's eye rule.
+        assert_eq!(Stereo::SideBySide.eyes_read(Stereo::Mono), 1);
+        assert_eq!(Stereo::Mono.source_eye(1), 0);
+        assert_eq!(Stereo::TopBottom.source_eye(1), 1);
+        assert_eq!("SBS".parse::<Stereo>().unwrap(), Stereo::SideBySide);
+        assert_eq!(Stereo::Mono.to_string(), "2d");
     }
 }

@@ -37,7 +37,7 @@ pub use envmap::{
 };
 pub use fault::Fault;
 pub use image::Image;
-pub use layout::{guess, CellGrid, CubeCells, Guess, Layout};
+pub use layout::{guess, CellGrid, CubeCells, Guess, Layout, Stereo};
 pub use projection::{
     AngularMap, ContinuousCube, CubeFace, CubeMap, Cylinder, CylinderRule, DirRun, DualParaboloid,
     Eac, EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,

@@ -13,7 +13,8 @@
 //! packed into one picture, the [`Layout`], where the container has a place for text:
 //! OpenEXR string attributes, KTX2 key/value data, PNG `tEXt` chunks, a JPEG comment
 //! segment and Radiance header lines, each under the keys [`PROJECTION_KEY`] and
-//! [`LAYOUT_KEY`]. DDS files record nothing: DDS has no place for text.
+//! [`LAYOUT_KEY`]; a stereo pair records its arrangement in the layout text ([`MapInfo`]).
+//! DDS files record nothing: DDS has no place for text.
 //! Reading gives them back as [`Loaded::recorded`]. OpenEXR's own `envmap` attribute is
 //! reported as [`Loaded::declared`]; its pictures follow OpenEXR's conventions, which
 //! [`openexr`] converts to mirrorball's. mirrorball does not write `envmap`.
@@ -56,7 +57,7 @@ use atomic::Staged;
 use exr_io::WriteBuffers;
 
 use mirrorball_core::projection::ProjectionSpec;
-use mirrorball_core::{Image, Layout, Projection, ProjectionKind, WorldProjection};
+use mirrorball_core::{Image, Layout, Projection, ProjectionKind, Stereo, WorldProjection};
 use std::path::Path;
 
 /// The key under which files record their projection (see [`MapInfo`]).
@@ -65,14 +66,22 @@ pub const PROJECTION_KEY: &str = "mirrorball:projection";
 pub const LAYOUT_KEY: &str = "mirrorball:layout";
 
 /// What mirrorball records about the map in a file it writes: the projection with every
-/// parameter, and the layout of a multi-layer map packed into one picture.
+/// parameter, the layout of a multi-layer map packed into one picture, and whether the
+/// picture is a stereo pair.
+///
+/// A stereo pair is recorded in the layout text, before the eye's layout and a `/`:
+/// `sbs/c3x2`, `tb/separate` (the layout of each eye; see [`Stereo`]). One text keeps
+/// OpenEXR headers the same from run to run (see `exr_io`), and a reader that knows no
+/// stereo refuses the layout rather than misreading the picture.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MapInfo {
     /// The projection, recorded as its canonical text (`fisheye:fov=190:lens=equisolid:look=0,1,0`).
     pub projection: Projection,
     /// How the layers are packed into the picture (recorded only for maps of several
-    /// layers).
+    /// layers, or for each eye of a stereo pair).
     pub layout: Option<Layout>,
+    /// How the picture holds its eyes: [`Stereo::Mono`] for one.
+    pub stereo: Stereo,
 }
 
 impl MapInfo {
@@ -80,14 +89,21 @@ impl MapInfo {
     pub fn texts(&self) -> (String, Option<String>) {
         let layout = self
             .layout
-            .filter(|_| self.projection.layer_count() > 1)
+            .filter(|_| self.projection.layer_count() > 1 || self.stereo != Stereo::Mono)
             .map(|l| l.name().to_string());
+        let layout = match self.stereo {
+            Stereo::Mono => layout,
+            s => Some(format!(
+                "{s}/{}",
+                layout.as_deref().unwrap_or(Layout::Separate.name())
+            )),
+        };
         (self.projection.to_string(), layout)
     }
 
-    /// Reads the recorded texts back for a `w`×`h` picture (whose shape fixes a Mercator
-    /// map's latitude limit when the text has none). The error says what was recorded and
-    /// why it cannot be read.
+    /// Reads the recorded texts back for a `w`×`h` picture (whose shape, an eye's for a
+    /// stereo pair, fixes a Mercator map's latitude limit when the text has none). The
+    /// error says what was recorded and why it cannot be read.
     pub fn from_texts(
         projection: &str,
         layout: Option<&str>,
@@ -97,16 +113,35 @@ impl MapInfo {
         let unreadable = |key: &str, text: &str, e: String| {
             format!("records {key} = '{text}', which cannot be read ({e})")
         };
+        let text = layout.unwrap_or_default();
+        let (stereo, layout) = match layout.and_then(|l| l.split_once('/')) {
+            Some((s, l)) => {
+                let stereo = s
+                    .trim()
+                    .parse::<Stereo>()
+                    .map_err(|e| unreadable(LAYOUT_KEY, text, e.to_string()))?;
+                (stereo, Some(l))
+            }
+            None => (Stereo::Mono, layout),
+        };
+        let (w, h) = stereo
+            .eye_extent(w, h)
+            .map_err(|e| unreadable(LAYOUT_KEY, text, e))?;
         let projection = ProjectionSpec::parse(projection)
             .and_then(|s| s.build(Some((w, h))))
             .map_err(|e| unreadable(PROJECTION_KEY, projection, e))?;
         let layout = layout
             .map(|l| {
-                l.parse::<Layout>()
+                l.trim()
+                    .parse::<Layout>()
                     .map_err(|e| unreadable(LAYOUT_KEY, l, e))
             })
             .transpose()?;
-        Ok(MapInfo { projection, layout })
+        Ok(MapInfo {
+            projection,
+            layout,
+            stereo,
+        })
     }
 }
 

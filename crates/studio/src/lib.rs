@@ -31,7 +31,20 @@ mod web;
 pub use server::{open_browser, Running, Studio};
 pub use state::{Opened, SceneView};
 
+use mirrorball_core::EnvMap;
 use std::path::Path;
+
+/// What the page asks to download ([`Host::export`]).
+pub enum Export<'a> {
+    /// A map in its projection: the page's current conversion, or the map as loaded.
+    Map(&'a EnvMap),
+    /// The prefiltered GGX cube chain the page is lit by, level 0 first.
+    Chain(&'a [EnvMap]),
+}
+
+/// The containers [`Host::export`] is asked for, by extension: one file each (a chain only
+/// in the cube containers, the last two).
+pub const EXPORT_FORMATS: [&str; 6] = ["exr", "hdr", "png", "jpg", "ktx2", "dds"];
 
 /// Reads what the studio shows: the files named on the command line and the uploads. Its
 /// errors are the messages a person reads (on the command line, or on the page).
@@ -42,4 +55,7 @@ pub trait Host: Send + Sync + 'static {
     fn upload(&self, name: &str, bytes: &[u8]) -> Result<Opened, String>;
     /// The scene shown before any scene is opened (an environment alone is shown on it).
     fn default_scene(&self) -> SceneView;
+    /// `what` written as a file of container `format` (one of [`EXPORT_FORMATS`]), as the
+    /// embedding program writes its own outputs: the file's bytes, or why it cannot be.
+    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String>;
 }

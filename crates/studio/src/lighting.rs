@@ -5,13 +5,19 @@
 //! of `E/π` (`mirrorball_filter::sh::project`, then `Sh9::lambert`, no window: the CLI's
 //! default `--sh-window none`).
 //!
-//! The page reads level `mapping.level(roughness, levels)` (the inverse of the mapping, the
-//! rule `prefilter` writes into its SH JSON as `roughness_to_level`) with `textureLod`,
-//! trilinear between the two levels around it, and adds `dc·Σ cᵢ Yᵢ(n)`.
+//! The page's roughness slider moves in steps of `1/`[`ROUGHNESS_STEPS`]; for each step the
+//! header carries the level `mapping.level(roughness, levels)` (the inverse of the mapping,
+//! the rule `prefilter` writes into its SH JSON as `roughness_to_level`: the page computes
+//! no level itself), which the page reads with `textureLod`, trilinear between the two
+//! levels around it. The Lambert material is `Σ cᵢ Kᵢ mᵢ(n)`: the coefficients, the basis's
+//! constants `Kᵢ` ([`sh::CONSTANTS`]) and its monomials `mᵢ` (`web/glsl/lighting.glsl`,
+//! [`sh::basis`]'s order).
 //!
 //! The payload, little-endian: `b"MBLT"`, `u32` length of a JSON header, the header (padded
 //! with spaces to a multiple of 4: `size`, `levels`, `mapping`, `roughness` per level,
-//! `roughnessToLevel`, `sh9` as nine `[r, g, b]`, `basis`, `irradiance`), then each level's
+//! `roughnessToLevel`, `levelOf` (the level of roughness `i/ROUGHNESS_STEPS`, `i` = 0 …
+//! `ROUGHNESS_STEPS`), `sh9` as nine `[r, g, b]`, `shConstants`, `basis`, `irradiance`),
+//! then each level's
 //! six faces in OpenGL's order (+X −X +Y −Y +Z −Z), row 0 (`t = 0`) first, RGBA as IEEE half
 //! floats: what `texImage2D(TEXTURE_CUBE_MAP_POSITIVE_X + f, m, RGBA16F, …, HALF_FLOAT)`
 //! takes as it is.
@@ -26,6 +32,9 @@ use std::sync::Arc;
 
 /// The smallest and largest level-0 face edge the page may ask for.
 pub const SIZES: std::ops::RangeInclusive<u32> = 8..=512;
+
+/// The page's roughness slider has this many steps from 0 to 1.
+pub const ROUGHNESS_STEPS: u32 = 100;
 
 /// A prefiltered chain and the irradiance's SH9.
 pub struct Lighting {
@@ -101,6 +110,13 @@ pub fn prefilter(
     }
 }
 
+/// The level the page reads at each step of its roughness slider: `mapping.level(i/STEPS)`.
+pub fn level_table(mapping: &RoughnessMapping, levels: usize) -> Vec<f64> {
+    (0..=ROUGHNESS_STEPS)
+        .map(|i| mapping.level(f64::from(i) / f64::from(ROUGHNESS_STEPS), levels))
+        .collect()
+}
+
 /// The payload described in the module's docs.
 pub fn encode(l: &Lighting) -> Vec<u8> {
     let header = json!({
@@ -109,7 +125,9 @@ pub fn encode(l: &Lighting) -> Vec<u8> {
         "mapping": l.mapping.name(),
         "roughness": l.roughness,
         "roughnessToLevel": l.mapping.level_formula(),
+        "levelOf": level_table(&l.mapping, l.chain.len()),
         "sh9": l.irradiance.coeffs.to_vec(),
+        "shConstants": sh::CONSTANTS,
         "basis": sh::BASIS_TEXT,
         "irradiance": sh::IRRADIANCE_TEXT,
     });
@@ -179,6 +197,11 @@ mod tests {
         let hl = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
         let h: serde_json::Value = serde_json::from_slice(&bytes[8..8 + hl]).unwrap();
         assert_eq!(h["levels"], 5);
+        let table = h["levelOf"].as_array().unwrap();
+        assert_eq!(table.len(), ROUGHNESS_STEPS as usize + 1);
+        assert_eq!(table[50], 2.0);
+        assert_eq!(table[100], 4.0);
+        assert_eq!(h["shConstants"].as_array().unwrap().len(), 9);
         let texels: usize = (0..5).map(|m| 6 * (16usize >> m).pow(2)).sum();
         assert_eq!(bytes.len(), 8 + hl + 8 * texels);
         // Level 0 (a mirror) at +Y's face centre is the sky's top: 2.

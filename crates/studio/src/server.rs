@@ -5,16 +5,17 @@
 //! | `GET /` | the page (`?view=viewport`: the viewport alone, at the camera's size) |
 //! | `GET /web/NAME` | the page's scripts and shaders, embedded in the binary |
 //! | `GET /api/state` | what is loaded, as JSON ([`State::describe`]) |
-//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float` | the environment's texels ([`texture`]) |
-//! | `GET /api/mesh/I` | object `I` in world space ([`geometry`]) |
+//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float&mips=0\|1` | the environment's texels, with its mip chain for `mips=1` ([`texture`]) |
+//! | `GET /api/mesh/I?tessellation=N` | object `I` in world space ([`geometry`]); a built-in tessellated `N` (`state::MAX_TRIANGLES` at most) |
 //! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
 //! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
 //! | `GET /api/lighting/progress` | `{"done", "total", "busy"}`: rows of the prefilter running |
+//! | `GET /api/export?what=map\|chain&format=EXT&projection=…&size=N` | a file to download, written by the [`Host`]: the map (as loaded, or converted as `/api/environment` converts it) or the last prefiltered chain |
 //! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit) |
 
 use crate::guard::Guard;
 use crate::state::{gpu_kind, State};
-use crate::{geometry, grid, lighting, texture, web, Host};
+use crate::{geometry, grid, lighting, texture, web, Export, Host, EXPORT_FORMATS};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State as Shared};
@@ -91,8 +92,9 @@ struct App {
     options: Studio,
     /// The last conversion asked for, by its query.
     converted: Mutex<Option<(String, Arc<EnvMap>)>>,
-    /// The last prefiltered lighting, by its request, and the running one's progress.
-    lit: Mutex<Option<(String, Arc<Vec<u8>>)>>,
+    /// The last prefiltered lighting (and its payload), by its request, and the running
+    /// one's progress.
+    lit: Mutex<Option<(String, Lit)>>,
     lit_progress: Progress,
 }
 
@@ -103,6 +105,9 @@ struct Progress {
     total: AtomicU64,
     busy: AtomicBool,
 }
+
+/// A prefiltered chain and its payload for the page.
+type Lit = (Arc<lighting::Lighting>, Arc<Vec<u8>>);
 
 type AppState = Arc<App>;
 
@@ -171,6 +176,7 @@ fn serve(
             .route("/api/grid", get(grid_of))
             .route("/api/lighting", get(lighting_of))
             .route("/api/lighting/progress", get(lighting_progress))
+            .route("/api/export", get(export))
             .route(
                 "/api/upload",
                 post(upload).layer(DefaultBodyLimit::max(limit)),
@@ -232,6 +238,7 @@ struct EnvQuery {
     projection: Option<String>,
     size: Option<u32>,
     precision: Option<String>,
+    mips: Option<String>,
 }
 
 async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -> Response {
@@ -243,6 +250,16 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
     {
         Ok(p) => p,
         Err(e) => return bad(StatusCode::BAD_REQUEST, format!("precision: {e}")),
+    };
+    let mips = match q.mips.as_deref().unwrap_or("0") {
+        "0" => false,
+        "1" => true,
+        m => {
+            return bad(
+                StatusCode::BAD_REQUEST,
+                format!("mips: '{m}' is not 0 or 1"),
+            )
+        }
     };
     let map = {
         let s = app.state.lock().expect("state");
@@ -271,7 +288,11 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
                 ),
             ));
         }
-        Ok(texture::encode(&map, precision))
+        Ok(if mips {
+            texture::encode_mips(&map, precision)
+        } else {
+            texture::encode(&map, precision)
+        })
     });
     match work.await {
         Ok(Ok(b)) => binary(b),
@@ -331,7 +352,7 @@ async fn lighting_of(Shared(app): Shared<AppState>, Query(q): Query<LightingQuer
         }
     };
     let key = format!("{:p} {size} {}", Arc::as_ptr(&map), mapping.name());
-    if let Some((k, b)) = app.lit.lock().expect("lit").as_ref() {
+    if let Some((k, (_, b))) = app.lit.lock().expect("lit").as_ref() {
         if *k == key {
             return binary(b.to_vec());
         }
@@ -347,14 +368,15 @@ async fn lighting_of(Shared(app): Shared<AppState>, Query(q): Query<LightingQuer
     p.total.store(lighting::rows(size), Ordering::SeqCst);
     let done = p.done.clone();
     let work = tokio::task::spawn_blocking(move || {
-        lighting::encode(&lighting::prefilter(&map, size, mapping, done))
+        let l = lighting::prefilter(&map, size, mapping, done);
+        let b = lighting::encode(&l);
+        (Arc::new(l), Arc::new(b))
     })
     .await;
     p.busy.store(false, Ordering::SeqCst);
     match work {
-        Ok(b) => {
-            let b = Arc::new(b);
-            *app.lit.lock().expect("lit") = Some((key, b.clone()));
+        Ok((l, b)) => {
+            *app.lit.lock().expect("lit") = Some((key, (l, b.clone())));
             binary(b.to_vec())
         }
         Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
@@ -371,10 +393,149 @@ async fn lighting_progress(Shared(app): Shared<AppState>) -> Response {
     .into_response()
 }
 
-async fn mesh(Shared(app): Shared<AppState>, UrlPath(i): UrlPath<usize>) -> Response {
-    let object = {
+#[derive(Deserialize)]
+struct ExportQuery {
+    what: Option<String>,
+    format: Option<String>,
+    projection: Option<String>,
+    size: Option<u32>,
+}
+
+/// A file to download: the map (converted as the page shows it) or the last prefiltered
+/// chain, in the container asked for, written by the host on a blocking thread.
+async fn export(Shared(app): Shared<AppState>, Query(q): Query<ExportQuery>) -> Response {
+    let format = q
+        .format
+        .unwrap_or_else(|| "exr".into())
+        .to_ascii_lowercase();
+    if !EXPORT_FORMATS.contains(&format.as_str()) {
+        return bad(
+            StatusCode::BAD_REQUEST,
+            format!(
+                "format '{format}' is not one of {}",
+                EXPORT_FORMATS.join(", ")
+            ),
+        );
+    }
+    let what = q.what.unwrap_or_else(|| "map".into());
+    let map = {
         let s = app.state.lock().expect("state");
-        s.view.scene.objects.get(i).cloned()
+        match &s.view.scene.environment {
+            Some(e) => e.map.clone(),
+            None => return bad(StatusCode::NOT_FOUND, "no environment is loaded"),
+        }
+    };
+    let (name, work) = match what.as_str() {
+        "map" => {
+            let projection = q.projection.unwrap_or_else(|| "native".into());
+            let shown: String = projection
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            let name = format!("environment-{shown}.{format}");
+            let host = app.host.clone();
+            let work = tokio::task::spawn_blocking(move || {
+                let map = if projection == "native" {
+                    map
+                } else {
+                    convert(&app, &map, &projection, q.size)?
+                };
+                host.export(Export::Map(&map), &format)
+                    .map_err(|e| (StatusCode::UNPROCESSABLE_ENTITY, e))
+            });
+            (name, work)
+        }
+        "chain" => {
+            if !matches!(format.as_str(), "ktx2" | "dds") {
+                return bad(
+                    StatusCode::BAD_REQUEST,
+                    format!("format '{format}': a chain is one file only as ktx2 or dds (`mirrorball prefilter` writes the others one file a level)"),
+                );
+            }
+            let lit = app.lit.lock().expect("lit").clone();
+            let Some((_, (l, _))) =
+                lit.filter(|(k, _)| k.starts_with(&format!("{:p} ", Arc::as_ptr(&map))))
+            else {
+                return bad(
+                    StatusCode::NOT_FOUND,
+                    "no prefiltered chain of this environment yet: choose the prefiltered GGX material first",
+                );
+            };
+            let name = format!("ggx-{}-{}.{format}", l.size, l.mapping.name());
+            let host = app.host.clone();
+            let work = tokio::task::spawn_blocking(move || {
+                host.export(Export::Chain(&l.chain), &format)
+                    .map_err(|e| (StatusCode::UNPROCESSABLE_ENTITY, e))
+            });
+            (name, work)
+        }
+        w => {
+            return bad(
+                StatusCode::BAD_REQUEST,
+                format!("what '{w}' is not map or chain"),
+            )
+        }
+    };
+    match work.await {
+        Ok(Ok(bytes)) => {
+            let disposition = format!("attachment; filename=\"{name}\"");
+            let mut r = binary(bytes);
+            if let Ok(v) = HeaderValue::from_str(&disposition) {
+                r.headers_mut().insert(header::CONTENT_DISPOSITION, v);
+            }
+            r
+        }
+        Ok(Err((s, m))) => bad(s, m),
+        Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+    }
+}
+
+#[derive(Deserialize)]
+struct MeshQuery {
+    tessellation: Option<u32>,
+}
+
+async fn mesh(
+    Shared(app): Shared<AppState>,
+    UrlPath(i): UrlPath<usize>,
+    Query(q): Query<MeshQuery>,
+) -> Response {
+    let (object, builtin) = {
+        let s = app.state.lock().expect("state");
+        (
+            s.view.scene.objects.get(i).cloned(),
+            s.view.builtins.get(i).copied().flatten(),
+        )
+    };
+    let object = match (object, q.tessellation) {
+        (Some(mut o), Some(level)) => {
+            let Some((b, _)) = builtin else {
+                return bad(
+                    StatusCode::BAD_REQUEST,
+                    format!("tessellation: object {i} is a mesh file, not a built-in"),
+                );
+            };
+            let max = b.max_tessellation(crate::state::MAX_TRIANGLES);
+            if !(1..=max).contains(&level) {
+                return bad(
+                    StatusCode::BAD_REQUEST,
+                    format!(
+                        "tessellation: {level} is outside 1..={max} for the {} (at most {} triangles)",
+                        b.name(),
+                        crate::state::MAX_TRIANGLES
+                    ),
+                );
+            }
+            o.mesh = Arc::new(b.mesh(level));
+            Some(o)
+        }
+        (o, _) => o,
     };
     match object {
         Some(o) => match tokio::task::spawn_blocking(move || geometry::encode(&o)).await {

@@ -4,7 +4,7 @@ use mirrorball_core::glam::{DVec3, Mat3};
 use mirrorball_core::{Choice, CylinderRule, EnvMap, Frame, Lens, Projection, RadialMap};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{
-    Attach, Camera, CameraLens, Environment, Indexing, Material, Scene, Settings,
+    Attach, Builtin, Camera, CameraLens, Environment, Indexing, Material, Scene, Settings,
 };
 use serde_json::{json, Value};
 use std::sync::Arc;
@@ -20,6 +20,13 @@ pub struct SceneView {
     pub settings: Settings,
     pub exposure: f32,
     pub tone: Tone,
+    /// The scene file as JSON whose paths are absolute (`docs/render-scene.md`), which the
+    /// page exports with its own camera and mode; `None` when the scene came from no file
+    /// or its environment was replaced (the file would name the wrong one).
+    pub source: Option<Value>,
+    /// Per object, the built-in mesh and tessellation it was made from (`None`: a mesh
+    /// file), so that the page may ask for it tessellated otherwise (`/api/mesh/I?tessellation=N`).
+    pub builtins: Vec<Option<(Builtin, u32)>>,
 }
 
 /// What a file held.
@@ -39,6 +46,9 @@ pub struct State {
     /// Bumped on every change, so that the page knows to fetch again.
     pub generation: u64,
 }
+
+/// The most triangles the page may ask a built-in to be tessellated into.
+pub const MAX_TRIANGLES: u64 = 1 << 21;
 
 /// The most messages kept for the page.
 const MAX_ERRORS: usize = 20;
@@ -72,6 +82,7 @@ impl State {
                     },
                 };
                 self.view.scene.environment = Some(env);
+                self.view.source = None;
                 self.view.name = format!("{} with {name}", self.view.name);
             }
         }
@@ -121,16 +132,27 @@ fn describe_scene(v: &SceneView) -> Value {
                     json!({"kind": "mirror", "tint": [1.0, 1.0, 1.0]})
                 }
             };
+            let builtin = v.builtins.get(i).copied().flatten();
             json!({
                 "mesh": i,
                 "vertices": o.mesh.positions.len(),
                 "triangles": o.mesh.triangles.len(),
                 "material": material,
+                "builtin": builtin.map(|(b, _)| b.name()),
+                "tessellation": builtin.map(|(_, l)| l),
+                "maxTessellation": builtin.map(|(b, _)| b.max_tessellation(MAX_TRIANGLES)),
             })
         })
         .collect();
-    if v.settings.indexing == Indexing::Cone {
-        notes.push("mode 4 (cones) is drawn as mode 3 by the viewport".into());
+    let cone = v.settings.indexing == Indexing::Cone;
+    if cone {
+        let asked = v.scene.environment.as_ref().map(|e| e.filter);
+        if asked != Some(mirrorball_render::Filter::Trilinear) {
+            notes.push(
+                "mode 4: the viewport approximates the renderer's EWA by anisotropic taps (a trilinear environment it draws exactly)"
+                    .into(),
+            );
+        }
     }
     if v.settings.supersample != 1 {
         notes.push(format!(
@@ -139,7 +161,7 @@ fn describe_scene(v: &SceneView) -> Value {
         ));
     }
     let environment = v.scene.environment.as_ref().map(|e| {
-        if e.filter != mirrorball_render::Filter::Bilinear {
+        if !cone && e.filter != mirrorball_render::Filter::Bilinear {
             notes.push(format!(
                 "the viewport reads the environment bilinearly (the scene asks for {})",
                 e.filter.name()
@@ -147,6 +169,7 @@ fn describe_scene(v: &SceneView) -> Value {
         }
         let mut d = describe_map(&e.map);
         d["attach"] = json!(e.attach.name());
+        d["filter"] = json!(e.filter.name());
         d["intensity"] = json!(e.intensity);
         d
     });
@@ -161,6 +184,7 @@ fn describe_scene(v: &SceneView) -> Value {
         "indexing": v.settings.indexing.name(),
         "mode": v.settings.indexing.number(),
         "background": v.scene.background,
+        "source": v.source,
         "exposure": v.exposure,
         "tone": v.tone.name(),
         "objects": objects,

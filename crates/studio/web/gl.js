@@ -106,6 +106,65 @@ export function environmentTexture(gl, { header, data }) {
   return t;
 }
 
+/**
+ * A dual paraboloid's two halves as the hardware held them (paraboloid_hw.glsl): two RGBA32F
+ * 2D textures, level 0's padded layers of the payload, each texel's alpha 1 where its centre
+ * lies in the unit disk (a = 2u - 1, b = 1 - 2v, a² + b² ≤ 1) and 0 outside (the padding
+ * included); the colours are the payload's (outside the disk, the rim's).
+ */
+export function paraboloidTextures(gl, { header, data }) {
+  const [x0, y0, w, h] = header.levels[0];
+  const [pw, ph] = [w + 2, h + 2];
+  const aw = header.texelWidth;
+  const ah = header.texelHeight;
+  return [0, 1].map((layer) => {
+    const texels = new Float32Array(pw * ph * 4);
+    for (let py = 0; py < ph; py++) {
+      for (let px = 0; px < pw; px++) {
+        const at = 4 * ((layer * ah + y0 + py) * aw + x0 + px);
+        const o = 4 * (py * pw + px);
+        for (let k = 0; k < 3; k++) texels[o + k] = data[at + k];
+        const a = (2 * (px - 0.5)) / w - 1;
+        const b = 1 - (2 * (py - 0.5)) / h;
+        texels[o + 3] = a * a + b * b <= 1 ? 1 : 0;
+      }
+    }
+    const t = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, t);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, pw, ph, 0, gl.RGBA, gl.FLOAT, texels);
+    for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+    for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) gl.texParameteri(gl.TEXTURE_2D, p, gl.CLAMP_TO_EDGE);
+    return t;
+  });
+}
+
+/**
+ * The two halves' texture matrices (paraboloid_hw.glsl), column-major, from the map's frame
+ * `frame` (9 numbers, columns right, up, forward of the front half): with l = (right·r,
+ * up·r, forward·r), the front's (s, t, 0, q) = ((q + l.x)/2, (q − l.y)/2, 0, 1 + l.z) and the
+ * back's, in its frame (−l.x, l.y, −l.z), ((q − l.x)/2, (q − l.y)/2, 0, 1 − l.z).
+ */
+export function paraboloidTextureMatrices(frame) {
+  const right = frame.slice(0, 3);
+  const up = frame.slice(3, 6);
+  const fwd = frame.slice(6, 9);
+  const half = (sx, sz) => {
+    // Rows: s, t, 0, q, each a linear form of r plus a constant.
+    const q = [sz * fwd[0], sz * fwd[1], sz * fwd[2], 1];
+    const s = [0, 1, 2].map((k) => 0.5 * (q[k] + sx * right[k])).concat(0.5);
+    const t = [0, 1, 2].map((k) => 0.5 * (q[k] - up[k])).concat(0.5);
+    const rows = [s, t, [0, 0, 0, 0], q];
+    const m = new Float32Array(16);
+    for (let c = 0; c < 4; c++) for (let r = 0; r < 4; r++) m[4 * c + r] = rows[r][c];
+    return m;
+  };
+  const out = new Float32Array(32);
+  out.set(half(1, 1), 0);
+  out.set(half(-1, -1), 16);
+  return out;
+}
+
 /** A mesh payload (geometry.rs). */
 export function parseMesh(buffer) {
   const v = new DataView(buffer);
@@ -197,11 +256,41 @@ export function texgenOf(kind, layers) {
   return layers === 1 ? 2 : 1;
 }
 
-/** The viewport's program for `kind`, indexing `mode` (1–3), objects or the background. */
-export async function viewportProgram(gl, { kind, layers, mode, background }) {
+/** The materials the viewport draws objects with (viewport.frag `MATERIAL`). */
+export const MATERIALS = { mirror: 0, ggx: 1, lambert: 2 };
+
+/**
+ * Whether a map of `kind` under `mode` is drawn as the hardware drew a dual paraboloid
+ * (`paraboloid: 'hardware'`: two textures, the alpha choosing; paraboloid_hw.glsl).
+ */
+export function paraboloidHardware(kind, mode, paraboloid) {
+  return kind === 'paraboloid' && paraboloid === 'hardware' && mode <= 3;
+}
+
+/**
+ * Mode 4's read (cone.glsl) for the environment's `filter` (state.rs): the trilinear one for
+ * a trilinear environment, as `mirrorball render` filters it; anisotropic taps for the rest,
+ * which the CPU filters by EWA.
+ */
+export function coneRead(filter) {
+  return filter === 'trilinear' ? 'coneRead' : 'coneReadAnisotropic';
+}
+
+/**
+ * The viewport's program for `kind`, indexing `mode` (1–4), objects or the background, the
+ * objects in `material` (a name of `MATERIALS`; the prefiltered ones add lighting.glsl);
+ * `paraboloid: 'hardware'` draws a dual paraboloid from its two textures; `filter` is the
+ * environment's (mode 4: `coneRead`).
+ */
+export async function viewportProgram(gl, { kind, layers, mode, background, material = 'mirror', paraboloid, filter }) {
+  const m = MATERIALS[material];
+  if (m === undefined) throw new Error(`material '${material}' is not ${Object.keys(MATERIALS).join(', ')}`);
+  const hw = paraboloidHardware(kind, mode, paraboloid);
   const defines =
     `#define MODE ${mode}\n#define TEXGEN ${texgenOf(kind, layers)}\n` +
-    `#define BACKGROUND ${background ? 1 : 0}\n`;
+    `#define BACKGROUND ${background ? 1 : 0}\n#define MATERIAL ${background ? 0 : m}\n` +
+    `#define CONE_READ ${coneRead(filter)}\n` +
+    (hw ? '#define PARA_HW 1\n' : '');
   const proj = await projectionSource(kind);
   const vs = HEADER + defines + proj + '\n' + (await glsl('texgen.glsl')) + '\n' + (await glsl('viewport.vert'));
   const fs =
@@ -211,10 +300,14 @@ export async function viewportProgram(gl, { kind, layers, mode, background }) {
     '\n' +
     (await glsl('bilinear.glsl')) +
     '\n' +
+    (m && !background ? (await glsl('lighting.glsl')) + '\n' : '') +
     (await glsl('display.glsl')) +
     '\n' +
     (await glsl('interpolate.glsl')) +
     '\n' +
+    (await glsl('cone.glsl')) +
+    '\n' +
+    (hw ? (await glsl('paraboloid_hw.glsl')) + '\n' : '') +
     (await glsl('viewport.frag'));
   return link(gl, vs, fs);
 }

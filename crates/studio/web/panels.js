@@ -1,13 +1,8 @@
 // The server's panels: prefiltered lighting (`/api/lighting`, lighting.rs). The chain is a
-// cube with mip levels, read with textureLod at level `mapping.level(roughness)` (the rule
-// the header's `roughnessToLevel` states, prefilter's); the diffuse term is the SH9 of E/π
-// (sh.rs `basis`: the constants below are its K0, K1, K2, K20, K22).
-
-const LEVEL = {
-  linear: (r, n) => r * (n - 1),
-  ue4: (r, n) => n - 2 + 1.2 * Math.log2(Math.max(r, 1e-3)),
-  filament: (r, n) => (n - 1) * r * (2 - r),
-};
+// cube with mip levels, read with textureLod at the level the header's `levelOf` table gives
+// for the slider's roughness (the filter crate's `RoughnessMapping::level`, computed on the
+// server: the page has no copy of the rule); the diffuse term is the SH9 of E/π, its
+// coefficients times the basis's constants (`shConstants`, sh.rs `CONSTANTS`).
 
 /** Parses the `MBLT` payload: `{ header, levels: [Uint16Array per level (6 faces)] }`. */
 export function parseLighting(buf) {
@@ -44,11 +39,23 @@ export function lightingTexture(gl, { header, levels }) {
   return t;
 }
 
-/** The level the page reads for `roughness` (prefilter's `roughness_to_level`). */
+/** The slider's step: the header's `levelOf` has one entry a step from roughness 0 to 1. */
+export function roughnessStep(header) {
+  return 1 / (header.levelOf.length - 1);
+}
+
+/** The level the page reads for `roughness` (rounded to the slider's step): `levelOf`'s entry. */
 export function levelOf(header, roughness) {
-  const rule = LEVEL[header.mapping];
-  const r = Math.min(1, Math.max(0, roughness));
-  return Math.min(header.levels - 1, Math.max(0, rule(r, header.levels)));
+  const steps = header.levelOf.length - 1;
+  const r = Math.min(1, Math.max(0, Number.isFinite(roughness) ? roughness : 0));
+  return header.levelOf[Math.round(r * steps)];
+}
+
+/** lighting.glsl's `uSh`: each coefficient times its basis constant, 27 floats. */
+export function shUniform(header) {
+  const out = new Float32Array(27);
+  header.sh9.forEach((c, i) => out.set(c.map((x) => x * header.shConstants[i]), 3 * i));
+  return out;
 }
 
 /**

@@ -225,13 +225,14 @@ export function attach(studio) {
   }
 
   async function recordProgram(mode, kind, layers) {
-    const key = `record ${kind} ${layers} ${mode}`;
+    const key = `record ${kind} ${layers} ${mode} ${view.state.scene.environment.filter}`;
     if (!sim.programs.has(key)) {
+      const cone = `#define CONE_READ ${G.coneRead(view.state.scene.environment.filter)}\n`;
       const defines = `#define MODE ${mode}\n#define TEXGEN ${G.texgenOf(kind, layers)}\n#define BACKGROUND 0\n`;
       const proj = await G.projectionSource(kind);
       const vs = G.HEADER + defines + proj + '\n' + (await G.glsl('texgen.glsl')) + '\n' + (await G.glsl('viewport.vert'));
-      const fs = [G.HEADER + defines + proj];
-      for (const f of ['bilinear.glsl', 'display.glsl', 'interpolate.glsl', 'sim-record.glsl', 'viewport.frag']) fs.push(await G.glsl(f));
+      const fs = [G.HEADER + defines + cone + proj];
+      for (const f of ['bilinear.glsl', 'display.glsl', 'interpolate.glsl', 'sim-record.glsl', 'cone.glsl', 'viewport.frag']) fs.push(await G.glsl(f));
       sim.programs.set(key, G.link(gl, vs, fs.join('\n')));
     }
     return sim.programs.get(key);
@@ -342,7 +343,7 @@ export function attach(studio) {
         dirs[i + 2] = v[2] * x + v[6] * y + v[10] * z;
       }
     }
-    const uv = dirs.length ? await G.envUvOnGpu(gl, h.projection, h.frame, dirs) : new Float32Array(0);
+    const uv = dirs.length ? await G.envUvOnGpu(gl, h.projection, h.frame, h.params, dirs) : new Float32Array(0);
     for (let e = 0; e < dirs.length / 3 / (steps + 1); e++) {
       let line = [];
       let last = null;
@@ -441,12 +442,38 @@ export function attach(studio) {
       background: false,
       program: () => recordProgram(mode, h.projection, h.layers),
     });
-    const raw = readFloats(target, 0, 0, 0, target.w, target.h);
+    return topFirst(readFloats(target, 0, 0, 0, target.w, target.h), target.w, target.h);
+  }
+
+  /** Four floats a pixel read bottom row first, turned top row first. */
+  function topFirst(raw, w, h) {
     const out = new Float32Array(raw.length);
-    const row = 4 * target.w;
-    for (let y = 0; y < target.h; y++) out.set(raw.subarray((target.h - 1 - y) * row, (target.h - y) * row), y * row);
+    const row = 4 * w;
+    for (let y = 0; y < h; y++) out.set(raw.subarray((h - 1 - y) * row, (h - y) * row), y * row);
     return out;
   }
+
+  /**
+   * Each viewport pixel's world position and unit normal as the viewport interpolates them
+   * (the surface pass), top row first, four floats a pixel (alpha 1 where an object is):
+   * `{ width, height, position, normal }`.
+   */
+  sim.surface = async () => {
+    const t = targets();
+    const h = view.env.header;
+    await studio.draw({
+      framebuffer: t.surface.fb,
+      clear: [0, 0, 0, 0],
+      background: false,
+      program: () => surfaceProgram(h.projection, h.layers),
+    });
+    return {
+      width: t.w,
+      height: t.h,
+      position: topFirst(readFloats(t.surface, 0, 0, 0, t.w, t.h), t.w, t.h),
+      normal: topFirst(readFloats(t.surface, 1, 0, 0, t.w, t.h), t.w, t.h),
+    };
+  };
 
   /** The map picture of the loaded environment (one pixel a texel), made once per environment. */
   async function mapPicture() {
@@ -608,6 +635,11 @@ export function attach(studio) {
     const p = new URLSearchParams(location.search);
     p.set('mode', String(view.mode));
     p.set('projection', view.projection);
+    p.set('material', view.material);
+    p.set('roughness', String(view.roughness));
+    p.set('lightsize', String(view.lightSize));
+    p.set('paraboloid', view.paraboloid);
+    if (view.tessellation) p.set('tessellation', String(view.tessellation));
     if (view.size) p.set('size', String(view.size));
     if (view.orbit) {
       p.set('yaw', String(view.orbit.yaw));

@@ -1,12 +1,17 @@
 // The studio page: the viewport (WebGL2) over what the server has loaded, its controls, file
 // picker and drop target, orbit and zoom. `?view=viewport`: the viewport alone, at the scene
-// camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode and the
-// projection the environment is converted to. `window.studio` is the page's handle for
-// tests and later views (simulator, overlays) to plug into.
+// camera's size. `mode`, `projection`, `size` in the URL choose the indexing mode (1-4) and
+// the projection the environment is converted to; `material` (mirror, ggx, lambert) and
+// `roughness` the objects' material, the prefiltered ones lit by the server's chain (level 0
+// `lightsize`² a face) and SH9 (panels.js, lighting.glsl); `paraboloid=hardware` draws a
+// dual paraboloid as the hardware did (two textures, the alpha choosing: paraboloid_hw.glsl);
+// `tessellation=N` re-tessellates the built-in objects (the slider). `window.studio` is the
+// page's handle for tests and later views (simulator, overlays) to plug into.
 
 const params = new URLSearchParams(location.search);
 const token = params.get('token') || '';
 const G = await import(`./gl.js?token=${encodeURIComponent(token)}`);
+const P = await import(`./panels.js?token=${encodeURIComponent(token)}`);
 
 const embed = params.get('view') === 'viewport';
 if (embed) {
@@ -29,7 +34,20 @@ const view = {
   mode: null,
   projection: params.get('projection') || 'native',
   size: params.get('size') ? Number(params.get('size')) : null,
-  env: null, // { header, texture }
+  paraboloid: params.get('paraboloid') === 'hardware' ? 'hardware' : 'exact',
+  // The built-in objects' tessellation (null: the scene's).
+  tessellation: params.get('tessellation') ? Number(params.get('tessellation')) : null,
+  env: null, // { header, texture, halves (a dual paraboloid's two 2D textures) }
+  material: G.MATERIALS[params.get('material')] !== undefined ? params.get('material') : 'mirror',
+  roughness: params.get('roughness') !== null && Number.isFinite(Number(params.get('roughness'))) ? Number(params.get('roughness')) : 0.5,
+  // The prefiltered lighting of the loaded environment: { header, texture, sh }, or null
+  // until the server has made it (the objects are drawn as mirrors meanwhile).
+  lighting: null,
+  lightingPending: null,
+  // The chain's level-0 face edge (`lightsize`: a power of two, 8 to 512; the server says
+  // what it refuses).
+  lightSize: Number(params.get('lightsize') || 128),
+  lightingGeneration: -1,
   meshes: [], // { vao, count }
   programs: new Map(),
   // The orbit: null until the person moves the camera (then the view matrix is made here).
@@ -64,23 +82,101 @@ async function loadState() {
   view.state = await (await G.api('/api/state')).json();
   const s = view.state.scene;
   document.getElementById('scene-name').textContent = s.name;
-  if (view.mode === null) view.mode = Number(params.get('mode') || Math.min(s.mode, 3));
+  if (view.mode === null) view.mode = Number(params.get('mode') || s.mode);
   document.getElementById('mode').value = String(view.mode);
   document.getElementById('projection').value = view.projection;
+  document.getElementById('material').value = view.material;
+  document.getElementById('roughness').value = String(view.roughness);
+  document.getElementById('paraboloid').value = view.paraboloid;
   canvas.width = s.camera.width;
   canvas.height = s.camera.height;
   canvas.style.width = `${s.camera.width}px`;
   canvas.style.height = `${s.camera.height}px`;
+  showTessellation();
   await loadMeshes();
   await loadEnvironment();
   report();
+}
+
+/** What the lighting panel says: the material's level, or the server's progress. */
+function lightingNote(text) {
+  document.getElementById('roughness-value').textContent = view.roughness.toFixed(2);
+  document.getElementById('lighting-status').textContent = text;
+}
+
+/**
+ * Asks the server for the loaded environment's prefiltered lighting when a prefiltered
+ * material is chosen and it is not here yet, showing the server's progress; resolves when
+ * it is here (the page keeps drawing meanwhile: the objects as mirrors).
+ */
+function ensureLighting() {
+  if (view.material === 'mirror' || view.lighting || !view.state?.scene.environment) {
+    lightingNote(view.lighting ? levelNote() : '');
+    return Promise.resolve();
+  }
+  if (!view.lightingPending) {
+    const generation = view.generation;
+    view.lightingGeneration = generation;
+    view.lightingPending = P.fetchLighting(G.api, { size: view.lightSize }, (done, total) => {
+      if (total) lightingNote(`prefiltering on the server: ${Math.round((100 * done) / total)}%`);
+    })
+      .then((l) => {
+        if (generation !== view.generation) return;
+        view.lighting = { header: l.header, texture: P.lightingTexture(gl, l), sh: P.shUniform(l.header) };
+        const slider = document.getElementById('roughness');
+        slider.step = String(P.roughnessStep(l.header));
+        lightingNote(levelNote());
+      })
+      .catch((e) => {
+        lightingNote('');
+        report(e);
+      })
+      .finally(() => (view.lightingPending = null));
+    lightingNote('prefiltering on the server…');
+  }
+  // A request for the environment before an upload is followed by one for the new one.
+  const asked = view.lightingGeneration;
+  return view.lightingPending.then(() => (asked === view.generation ? redraw() : ensureLighting()));
+}
+
+/** The chain's level the material reads, for the panel. */
+function levelNote() {
+  if (!view.lighting || view.material === 'mirror') return '';
+  const h = view.lighting.header;
+  if (view.material === 'lambert') return 'E/π from SH9';
+  return `level ${P.levelOf(h, view.roughness).toFixed(2)} of ${h.levels} (${h.mapping}: ${h.roughnessToLevel})`;
+}
+
+/** The material the objects are drawn with now: a prefiltered one once its lighting is here. */
+function materialNow() {
+  return view.lighting ? view.material : 'mirror';
+}
+
+/** Forgets the lighting (a new environment was loaded). */
+function dropLighting() {
+  if (view.lighting) gl.deleteTexture(view.lighting.texture);
+  view.lighting = null;
+  view.generation++;
+}
+
+/** The slider, for scenes with built-in objects: up to the least of their largest levels. */
+function showTessellation() {
+  const builtins = view.state.scene.objects.filter((o) => o.builtin);
+  const label = document.getElementById('tessellation-label');
+  label.hidden = builtins.length === 0;
+  if (label.hidden) return;
+  const input = document.getElementById('tessellation');
+  input.max = String(Math.min(256, ...builtins.map((o) => o.maxTessellation)));
+  input.value = String(view.tessellation ?? builtins[0].tessellation);
+  document.getElementById('tessellation-value').textContent = input.value;
 }
 
 async function loadMeshes() {
   for (const m of view.meshes) gl.deleteVertexArray(m.vao);
   view.meshes = [];
   for (const o of view.state.scene.objects) {
-    const mesh = G.parseMesh(await (await G.api(`/api/mesh/${o.mesh}`)).arrayBuffer());
+    const q = o.builtin && view.tessellation ? `?tessellation=${view.tessellation}` : '';
+    const mesh = G.parseMesh(await (await G.api(`/api/mesh/${o.mesh}${q}`)).arrayBuffer());
     const vao = gl.createVertexArray();
     gl.bindVertexArray(vao);
     const b = gl.createBuffer();
@@ -97,21 +193,30 @@ async function loadMeshes() {
 }
 
 async function loadEnvironment() {
-  if (view.env) gl.deleteTexture(view.env.texture);
+  if (view.env) for (const t of [view.env.texture, ...(view.env.halves || [])]) gl.deleteTexture(t);
   view.env = null;
   if (!view.state.scene.environment) return;
-  let q = `projection=${encodeURIComponent(view.projection)}&precision=float`;
+  // Mode 4 reads the mip chain (texture.rs `encode_mips`).
+  const mips = view.mode === 4;
+  let q = `projection=${encodeURIComponent(view.projection)}&precision=float&mips=${mips ? 1 : 0}`;
   if (view.size) q += `&size=${view.size}`;
   const parsed = G.parseTexture(await (await G.api(`/api/environment?${q}`)).arrayBuffer());
-  view.env = { header: parsed.header, texture: G.environmentTexture(gl, parsed) };
+  const halves = parsed.header.projection === 'paraboloid' ? G.paraboloidTextures(gl, parsed) : null;
+  view.env = { header: parsed.header, texture: G.environmentTexture(gl, parsed), halves };
 }
 
 async function program(background) {
   const h = view.env.header;
   const kind = h.projection;
-  const key = `${kind} ${h.layers} ${view.mode} ${background}`;
+  const material = background ? 'mirror' : materialNow();
+  const paraboloid = view.paraboloid;
+  const filter = view.state.scene.environment.filter;
+  const key = `${kind} ${h.layers} ${view.mode} ${background} ${material} ${paraboloid} ${filter}`;
   if (!view.programs.has(key)) {
-    view.programs.set(key, await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background }));
+    view.programs.set(
+      key,
+      await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background, material, paraboloid, filter }),
+    );
   }
   return view.programs.get(key);
 }
@@ -186,12 +291,32 @@ async function draw(pass = {}) {
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, view.env.texture);
     gl.uniform1i(u('uEnv'), 0);
     gl.uniform2i(u('uEnvSize'), h.width, h.height);
+    gl.uniform1i(u('uLevelCount'), h.levels.length);
+    gl.uniform4iv(u('uLevels'), new Int32Array(h.levels.flat()));
+    if (view.env.halves) {
+      view.env.halves.forEach((t, i) => {
+        gl.activeTexture(gl.TEXTURE1 + i);
+        gl.bindTexture(gl.TEXTURE_2D, t);
+      });
+      gl.uniform1i(u('uFront'), 1);
+      gl.uniform1i(u('uBack'), 2);
+      gl.uniformMatrix4fv(u('uParaMatrix'), false, G.paraboloidTextureMatrices(h.frame));
+      gl.activeTexture(gl.TEXTURE0);
+    }
     gl.uniform1f(u('uIntensity'), env.intensity);
     gl.uniform1f(u('uExposureScale'), Math.pow(2, s.exposure));
     gl.uniform1i(u('uTone'), tone);
     gl.uniform3fv(u('uRayRight'), right.map((x) => x * ty * aspect));
     gl.uniform3fv(u('uRayUp'), up.map((x) => x * ty));
     gl.uniform2f(u('uViewportSize'), canvas.width, canvas.height);
+    if (view.lighting) {
+      gl.activeTexture(gl.TEXTURE1);
+      gl.bindTexture(gl.TEXTURE_CUBE_MAP, view.lighting.texture);
+      gl.uniform1i(u('uChain'), 1);
+      gl.uniform1f(u('uLevel'), P.levelOf(view.lighting.header, view.roughness));
+      gl.uniform3fv(u('uSh'), view.lighting.sh);
+      gl.activeTexture(gl.TEXTURE0);
+    }
     return u;
   };
   const programOf = pass.program ?? program;
@@ -244,8 +369,10 @@ async function upload(file) {
   try {
     await G.api(`/api/upload?name=${encodeURIComponent(file.name)}`, { method: 'POST', body: file });
     view.programs.clear();
+    dropLighting();
     await loadState();
     await redraw();
+    await ensureLighting();
   } catch (e) {
     view.state = await (await G.api('/api/state')).json();
     report(e);
@@ -267,8 +394,43 @@ document.addEventListener('drop', (e) => {
   document.body.id = '';
   if (e.dataTransfer.files[0]) upload(e.dataTransfer.files[0]);
 });
-document.getElementById('mode').addEventListener('change', (e) => {
+document.getElementById('mode').addEventListener('change', async (e) => {
   view.mode = Number(e.target.value);
+  if (view.mode === 4 && view.env && view.env.header.levels.length === 1 && view.env.header.width * view.env.header.height > 1) {
+    try {
+      await loadEnvironment();
+    } catch (err) {
+      report(err);
+    }
+  }
+  redraw();
+});
+document.getElementById('tessellation').addEventListener('input', (e) => {
+  document.getElementById('tessellation-value').textContent = e.target.value;
+});
+document.getElementById('tessellation').addEventListener('change', async (e) => {
+  view.tessellation = Number(e.target.value);
+  try {
+    await loadMeshes();
+    report();
+  } catch (err) {
+    report(err);
+  }
+  redraw();
+});
+document.getElementById('paraboloid').addEventListener('change', (e) => {
+  view.paraboloid = e.target.value;
+  redraw();
+});
+document.getElementById('material').addEventListener('change', (e) => {
+  view.material = e.target.value;
+  lightingNote(levelNote());
+  redraw();
+  ensureLighting();
+});
+document.getElementById('roughness').addEventListener('input', (e) => {
+  view.roughness = Number(e.target.value);
+  lightingNote(levelNote());
   redraw();
 });
 document.getElementById('projection').addEventListener('change', async (e) => {
@@ -280,6 +442,81 @@ document.getElementById('projection').addEventListener('change', async (e) => {
     report(err);
   }
   redraw();
+});
+
+/** Hands `blob` to the browser as a download called `name`. */
+function download(blob, name) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  document.body.appendChild(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 60000);
+}
+
+/**
+ * Downloads what the server writes (`/api/export`): the map as the viewport shows it (its
+ * projection and size) or the GGX chain it is lit by, in the chosen container.
+ */
+async function exportFile(what) {
+  const format = document.getElementById('export-format').value;
+  let q = `what=${what}&format=${format}`;
+  if (what === 'map') {
+    q += `&projection=${encodeURIComponent(view.projection)}`;
+    if (view.size) q += `&size=${view.size}`;
+  }
+  try {
+    const r = await G.api(`/api/export?${q}`);
+    const name = /filename="([^"]+)"/.exec(r.headers.get('content-disposition') || '')?.[1] || `export.${format}`;
+    download(await r.blob(), name);
+    report();
+  } catch (e) {
+    report(e);
+  }
+}
+
+/**
+ * The scene as a scene file (docs/render-scene.md) that `mirrorball render FILE --ss 1`
+ * draws as the viewport does: the file the scene was read from (the server made its paths
+ * absolute) with the camera now (orbited or not), the mode, one sample a pixel and the
+ * bilinear filter the viewport reads with. Refused, with the reason, where a scene file
+ * cannot say what the viewport shows.
+ */
+function sceneFile() {
+  const s = view.state.scene;
+  if (!s.source) {
+    throw new Error('the scene came from no scene file, or its environment was replaced: only a scene opened from a file exports (its meshes and environment are named by path)');
+  }
+  if (view.projection !== 'native') {
+    throw new Error(`the viewport shows the environment converted to ${view.projection}, which a scene file cannot say (render's --env-as): choose "as loaded" to export the scene`);
+  }
+  if (materialNow() !== 'mirror') {
+    throw new Error('the prefiltered materials have no scene-file form: choose the mirror to export the scene');
+  }
+  const out = JSON.parse(JSON.stringify(s.source));
+  const c = s.camera;
+  const cam = camera();
+  out.camera = Object.assign({}, out.camera, { eye: cam.eye, target: c.target, up: c.up, width: c.width, height: c.height });
+  out.indexing = ['texgen', 'vertex', 'pixel'][view.mode - 1];
+  out.supersample = 1;
+  if (out.environment) out.environment.filter = 'bilinear';
+  return out;
+}
+
+document.getElementById('export-scene').addEventListener('click', () => {
+  try {
+    download(new Blob([JSON.stringify(sceneFile(), null, 2)], { type: 'application/json' }), 'mirrorball-scene.json');
+    report();
+  } catch (e) {
+    report(e);
+  }
+});
+document.getElementById('export-map').addEventListener('click', () => exportFile('map'));
+document.getElementById('export-chain').addEventListener('click', () => exportFile('chain'));
+document.getElementById('screenshot').addEventListener('click', async () => {
+  await drawing;
+  canvas.toBlob((b) => download(b, 'mirrorball-viewport.png'), 'image/png');
 });
 
 function startOrbit() {
@@ -325,10 +562,11 @@ const ready = (async () => {
   if (!gl) throw new Error('this browser has no WebGL2');
   await loadState();
   await redraw();
+  await ensureLighting();
 })();
 ready.catch(report);
 
-const handle = { ready, redraw, pixels, view, gl, G, draw, camera, afterDraw, canvas, embed, program };
+const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting, sceneFile };
 // The simulator panel and the view state in the URL (sim.js); `ready` waits for both.
 const sim = await import(`./sim.js?token=${encodeURIComponent(token)}`);
 handle.sim = sim.attach(handle);

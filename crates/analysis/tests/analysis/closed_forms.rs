@@ -48,7 +48,10 @@ fn crossovers_of_the_other_disk_maps() {
 fn used_area_fractions() {
     for k in K::ALL {
         let want = match k {
-            K::Sphere | K::Paraboloid | K::Angular | K::Fisheye | K::Hammer => PI / 4.0,
+            // The dual fisheye: a disk inscribed in each half.
+            K::Sphere | K::Paraboloid | K::Angular | K::Fisheye | K::Hammer | K::DualFisheye => {
+                PI / 4.0
+            }
             // |u − ½| ≤ ½ sin πv.
             K::Sinusoidal => 2.0 / PI,
             _ => 1.0,

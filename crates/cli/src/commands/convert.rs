@@ -9,8 +9,8 @@ use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
 use mirrorball_core::{
-    resample, Axis, AxisMap, Layout, Projection, ProjectionKind, ResampleOptions, Resampler,
-    Rotation, WorldProjection,
+    resample, Axis, AxisMap, EnvMap, Layout, Projection, ProjectionKind, Remap, ResampleOptions,
+    Resampler, Rotation, Stereo, WorldProjection,
 };
 use mirrorball_io::{ExrCompression, Format, OutputSet, Precision, WriteOptions};
 use std::path::PathBuf;
@@ -27,6 +27,11 @@ pub(crate) struct Plan {
     /// `--for`'s engine axes, for a cube output: applied exactly after resampling
     /// (`EnvMap::transformed`); other outputs take it in `resample.rotation`.
     pub(crate) orient: AxisMap,
+    /// `--in-stereo`: how the input picture holds its eyes (`None`: as the file records,
+    /// else one eye).
+    pub(crate) in_stereo: Option<Stereo>,
+    /// `--stereo`: how the output picture holds its eyes.
+    pub(crate) stereo: Stereo,
 }
 
 pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
@@ -110,6 +115,14 @@ impl Plan {
             mips: a.mips,
         };
         let layers = to.build(None).map_err(|e| bad("--to", e))?.layer_count();
+        let stereo_flag = |flag: &str, given: Option<&str>| {
+            given
+                .map(|m| crate::choice::parse_flag::<Stereo>(flag, m))
+                .transpose()
+        };
+        let in_stereo = stereo_flag("--in-stereo", a.in_stereo.as_deref())?;
+        let stereo = stereo_flag("--stereo", a.stereo.as_deref())?.unwrap_or_default();
+        save::check_stereo(&a.output, layers, stereo, &save)?;
         let mut files = Files::new();
         files.input_arg("the input", &a.input);
         match save::layer_files(&a.output, layers, &save) {
@@ -133,7 +146,15 @@ impl Plan {
                 progress: None,
             },
             orient,
+            in_stereo,
+            stereo,
         })
+    }
+
+    /// Whether either side is said to be a stereo pair (a pair a file records, read with
+    /// neither flag, gives its left eye: a `2d` output).
+    pub(crate) fn is_stereo(&self) -> bool {
+        self.in_stereo.is_some_and(|s| s != Stereo::Mono) || self.stereo != Stereo::Mono
     }
 }
 
@@ -143,6 +164,9 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
         return done;
     }
     let mut plan = Plan::new(&a)?;
+    if plan.is_stereo() {
+        return convert_pair(&a, &plan);
+    }
     let t0 = Instant::now();
     let limits = mirrorball_io::Limits::default();
     let mut src = load::load(
@@ -242,11 +266,7 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
         dst.name(),
         w,
         h,
-        if dst.layer_count() > 1 {
-            format!(" x{}", dst.layer_count())
-        } else {
-            String::new()
-        },
+        times(dst.layer_count()),
     ));
     Ok(())
 }
@@ -278,4 +298,117 @@ fn convert_layers(
     drop(src);
     set.finish()?;
     Ok(())
+}
+
+/// `convert` of one file with a stereo pair on either side (`--in-stereo`, `--stereo`): the
+/// eyes it needs read (`Stereo::eyes_read`), one `Remap` planned from the left eye's shape
+/// and applied to each, each output eye made from its `Stereo::source_eye`, the eyes packed
+/// and joined into one picture.
+fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
+    let t0 = Instant::now();
+    let limits = mirrorball_io::Limits::default();
+    let mut src = load::load_eyes(
+        &a.input,
+        plan.input.from.as_ref(),
+        plan.input.layout,
+        (plan.in_stereo, plan.stereo),
+        &limits,
+    )?;
+    let in_stereo = src.stereo;
+    for line in src.prepare(&a.input, plan.input.keep_invalid) {
+        if !a.quiet {
+            eprintln!("{line}");
+        }
+    }
+    let eyes: Vec<EnvMap> = std::iter::once(src.env).chain(src.right).collect();
+    let t_read = t0.elapsed();
+    let dst = plan.to.build(None).map_err(|e| bad("--to", e))?;
+    let left = &eyes[0];
+    let size = plan
+        .size
+        .unwrap_or_else(|| save::default_size(left, dst.kind()));
+    let (w, h) = dst.layer_extent(size);
+    let c = left.channels() as u64;
+    let texels = |w: u32, h: u32, n: usize| w as u64 * h as u64 * n as u64;
+    let out_eyes = plan.stereo.eyes();
+    let remap = Remap::with_extent(
+        *left.projection(),
+        (left.width(), left.height()),
+        left.layers().len(),
+        dst,
+        (w, h),
+        &plan.resample,
+    );
+    budget::check(
+        &format!(
+            "{} {w}x{h}x{}, {} eye(s)",
+            dst.name(),
+            dst.layer_count(),
+            out_eyes
+        ),
+        budget::f32_texels(
+            texels(left.width(), left.height(), left.layers().len()) * eyes.len() as u64,
+            c,
+        ),
+        // Each output eye, and the joined picture.
+        2 * budget::f32_texels(texels(w, h, dst.layer_count()) * out_eyes as u64, c)
+            + remap.memory_bytes() as u64,
+        "a smaller --size",
+    )?;
+    let t1 = Instant::now();
+    let out = with_spinner(
+        "converting",
+        a.quiet,
+        || -> Result<Vec<EnvMap>, CliError> {
+            let mut out: Vec<EnvMap> = Vec::with_capacity(out_eyes);
+            for e in 0..out_eyes {
+                let from = in_stereo.source_eye(e);
+                // A 2d input gives both eyes one picture: converted once.
+                if e > 0 && in_stereo.source_eye(e - 1) == from {
+                    out.push(out[e - 1].clone());
+                    continue;
+                }
+                let made = remap
+                    .apply(&eyes[from])
+                    .map_err(|err| CliError::input(format!("{}: {err}", a.input)))?;
+                out.push(match plan.orient.is_identity() {
+                    true => made,
+                    false => made
+                        .transformed(&plan.orient)
+                        .expect("only cube outputs are oriented here"),
+                });
+            }
+            Ok(out)
+        },
+    )?;
+    let t_conv = t1.elapsed();
+    let eyes_read = eyes.len();
+    drop(eyes);
+    let files = with_spinner("writing", a.quiet, || {
+        save::save_eyes(&out, plan.stereo, &a.output, &plan.save)
+    })?;
+    if !a.quiet {
+        let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+        eprintln!(
+            "wrote {}: {} {w}x{h}{} per eye, {} ({} eye(s) read; read {:.2}s, convert {:.2}s, write {:.2}s)",
+            names.join(", "),
+            dst.name(),
+            times(dst.layer_count()),
+            plan.stereo,
+            eyes_read,
+            t_read.as_secs_f64(),
+            t_conv.as_secs_f64(),
+            (t1.elapsed() - t_conv).as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+/// " x6" after a layer's size, for maps of several layers.
+pub(crate) fn times(layers: usize) -> String {
+    if layers > 1 {
+        format!(" x{layers}")
+    } else {
+        String::new()
+    }
 }

@@ -3,11 +3,14 @@
 //! environments, so that the page shows the CLI's messages; the URL (with its token) is the
 //! first line of standard output.
 
+use super::prefilter::outputs;
 use crate::error::CliError;
 use crate::load;
+use crate::save::{self, SaveOptions};
 use crate::RenderArgs;
 use clap::{Args, Parser};
-use mirrorball_studio::{Host, Opened, SceneView, Studio};
+use mirrorball_io::WriteOptions;
+use mirrorball_studio::{Export, Host, Opened, SceneView, Studio};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -86,7 +89,8 @@ fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
         .map_err(|e| CliError::request(e.to_string()))?
         .args;
     args.given = vec!["ss".into()];
-    let (mut scene_data, camera, settings, exposure, tone) = super::render::studio_scene(&args)?;
+    let (mut scene_data, camera, settings, exposure, tone, builtins) =
+        super::render::studio_scene(&args)?;
     if scene.is_none() {
         scene_data.background = true;
         for o in &mut scene_data.objects {
@@ -100,7 +104,22 @@ fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
         settings,
         exposure,
         tone,
+        source: scene.map(super::render::schema::portable).transpose()?,
+        builtins,
     })
+}
+
+/// A new folder of this process's own under the system's temporary folder, named for
+/// `purpose` and a fresh token (so that no other process can have made it): the caller
+/// removes it.
+fn private_dir(purpose: &str) -> Result<PathBuf, String> {
+    let dir = std::env::temp_dir().join(format!(
+        "mirrorball-studio-{purpose}-{}-{}",
+        std::process::id(),
+        mirrorball_studio::guard::new_token()?
+    ));
+    std::fs::create_dir(&dir).map_err(|e| e.to_string())?;
+    Ok(dir)
 }
 
 /// Reads files as the CLI's commands do.
@@ -143,12 +162,8 @@ impl Host for CliHost {
                  the files a scene names are read only when named there"
             ));
         }
-        let dir = std::env::temp_dir().join(format!(
-            "mirrorball-studio-{}-{}",
-            std::process::id(),
-            mirrorball_studio::guard::new_token()?
-        ));
-        std::fs::create_dir(&dir).map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
+        let dir =
+            private_dir("upload").map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
         let path = dir.join(format!("upload.{ext}"));
         let result = std::fs::write(&path, bytes)
             .map_err(|e| format!("{name}: cannot store the upload: {e}"))
@@ -159,5 +174,35 @@ impl Host for CliHost {
 
     fn default_scene(&self) -> SceneView {
         scene_view(None).expect("render's defaults make a scene")
+    }
+
+    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String> {
+        // Written as `convert` and `prefilter` write their outputs, into a folder of its own,
+        // then read back for the page and the folder removed.
+        let dir = private_dir("export").map_err(|e| format!("cannot write the export: {e}"))?;
+        let path = dir.join(format!("export.{format}"));
+        let shown = path.display().to_string();
+        let written = match what {
+            Export::Map(map) => save::save(
+                map,
+                &shown,
+                &SaveOptions {
+                    layout: None,
+                    write: WriteOptions::default(),
+                    mips: false,
+                },
+            )
+            .map(|_| ()),
+            Export::Chain(chain) => {
+                outputs::write_cube_chain(&path, chain, &WriteOptions::default())
+            }
+        };
+        let result = written
+            .map_err(|e| e.to_string().replace(&shown, &format!("export.{format}")))
+            .and_then(|()| {
+                std::fs::read(&path).map_err(|e| format!("cannot read the export back: {e}"))
+            });
+        let _ = std::fs::remove_dir_all(&dir);
+        result
     }
 }

@@ -269,3 +269,106 @@ fn dual_fisheye_bad_lenses() {
     }
     assert!(files(dir.path()).is_empty());
 }
+
+/// Stereo requests that cannot be met: refused by name with exit status 2, nothing written.
+#[test]
+fn bad_stereo_requests_name_the_file_and_the_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let odd = dir.path().join("odd.exr");
+    mirrorball_io::write_image(&odd, &Image::new(65, 32, 3), &Default::default()).unwrap();
+    let odd = odd.to_str().unwrap();
+    let tall = dir.path().join("tall.exr");
+    mirrorball_io::write_image(&tall, &Image::new(64, 33, 3), &Default::default()).unwrap();
+    let tall = tall.to_str().unwrap();
+    let out = dir.path().join("out.exr");
+    let o = out.to_str().unwrap();
+    let ktx = dir.path().join("out.ktx2");
+    let faces = dir.path().join("f_{face}.exr");
+    for (args, says) in [
+        (
+            vec![
+                "convert",
+                odd,
+                o,
+                "--from",
+                "latlong",
+                "--in-stereo",
+                "sbs",
+                "--to",
+                "latlong",
+            ],
+            vec!["odd.exr", "even width", "65x32"],
+        ),
+        (
+            vec![
+                "convert",
+                tall,
+                o,
+                "--from",
+                "latlong",
+                "--in-stereo",
+                "tb",
+                "--to",
+                "latlong",
+            ],
+            vec!["tall.exr", "even height", "64x33"],
+        ),
+        (
+            vec![
+                "convert",
+                "-",
+                o,
+                "--in-size",
+                "64x33",
+                "--pix-fmt",
+                "rgb24",
+                "--in-stereo",
+                "tb",
+                "--to",
+                "latlong",
+            ],
+            vec!["--in-size 64x33", "even height"],
+        ),
+        (
+            vec!["convert", odd, o, "--in-stereo", "3d", "--to", "latlong"],
+            vec!["--in-stereo", "unknown '3d'", "2d, sbs, tb"],
+        ),
+        (
+            vec!["convert", odd, o, "--stereo", "left", "--to", "latlong"],
+            vec!["--stereo", "unknown 'left'"],
+        ),
+        (
+            vec![
+                "convert",
+                odd,
+                ktx.to_str().unwrap(),
+                "--from",
+                "latlong",
+                "--stereo",
+                "sbs",
+                "--to",
+                "cube",
+            ],
+            vec!["out.ktx2", "one picture"],
+        ),
+        (
+            vec![
+                "convert",
+                odd,
+                faces.to_str().unwrap(),
+                "--from",
+                "latlong",
+                "--stereo",
+                "tb",
+                "--to",
+                "cube",
+            ],
+            vec!["f_{face}.exr", "one picture"],
+        ),
+    ] {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        fails(&args, &says);
+    }
+    assert!(!out.exists() && !ktx.exists());
+}

@@ -332,44 +332,145 @@ fn ffmpeg_to_mirrorball_to_ffmpeg_is_the_frames_converted_as_pngs() {
         assert!(st.success());
         for k in 0..3 {
             let one = pngs.join(format!("cube_{k}.png"));
-            ok(&[
-                "convert",
-                pngs.join(format!("{}.png", k + 1)).to_str().unwrap(),
-                one.to_str().unwrap(),
-                "--to",
-                "cube",
-                "--size",
-                "32",
-                "--layout",
-                "hstrip",
-                "--precision",
-                if bytes == 2 { "16" } else { "8" },
-                "-q",
-            ]);
+            to_strip(&pngs.join(format!("{}.png", k + 1)), &one, bytes);
             let img = image_codes(&one, bytes);
-            let ours = &got[k * frame..(k + 1) * frame];
-            let codes: Vec<i64> = if bytes == 2 {
-                ours.chunks_exact(2)
-                    .map(|c| u16::from_le_bytes([c[0], c[1]]) as i64)
-                    .collect()
-            } else {
-                ours.iter().map(|&c| c as i64).collect()
-            };
-            assert_eq!(codes.len(), img.len());
+            let codes = raw_codes(&got[k * frame..(k + 1) * frame], bytes);
             // The pipe's fast sRGB encoder gives the nearest code or its neighbour; 16-bit
             // codes also carry Remap's 1e-5 against resample.
             let tol = if bytes == 2 { 3 } else { 1 };
-            let worst = codes
-                .iter()
-                .zip(&img)
-                .map(|(a, b)| (a - b).abs())
-                .max()
-                .unwrap();
+            let worst = worst_difference(&codes, &img);
             assert!(worst <= tol, "{fmt} frame {k}: off by {worst} codes");
             let spread = codes.iter().max().unwrap() - codes.iter().min().unwrap();
             assert!(spread > 100, "the frame has content");
         }
     }
+}
+
+/// A stereo pair through pipes: ffmpeg's side-by-side frames (two different test sources,
+/// so a swapped eye shows) converted to a top-bottom pair of cube strips are, eye by eye,
+/// each eye cut out by ffmpeg and converted alone as a PNG.
+#[test]
+fn a_stereo_pair_through_pipes_is_each_eye_converted_alone() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let graph = "testsrc2=size=256x128:rate=5[l];testsrc=size=256x128:rate=5[r];[l][r]hstack";
+    let raw = dir.join("pair.raw");
+    let m = pipe_through(
+        &[
+            "-hide_banner",
+            "-filter_complex",
+            graph,
+            "-frames:v",
+            "2",
+            "-pix_fmt",
+            "rgb48le",
+            "-f",
+            "rawvideo",
+            "-",
+        ],
+        &[
+            "convert",
+            "-",
+            "-",
+            "--in-size",
+            "512x128",
+            "--pix-fmt",
+            "rgb48le",
+            "--in-stereo",
+            "sbs",
+            "--from",
+            "latlong",
+            "--to",
+            "cube",
+            "--size",
+            "32",
+            "--layout",
+            "hstrip",
+            "--stereo",
+            "tb",
+        ],
+        &[
+            "-hide_banner",
+            "-y",
+            "-f",
+            "rawvideo",
+            "-pix_fmt",
+            "rgb48le",
+            "-s",
+            "192x64",
+            "-i",
+            "-",
+            "-f",
+            "rawvideo",
+            "-pix_fmt",
+            "rgb48le",
+            raw.to_str().unwrap(),
+        ],
+    );
+    assert!(m.status.success(), "{}", stderr(&m));
+    assert!(stderr(&m).contains("writing 192x64"), "{}", stderr(&m));
+    let got = std::fs::read(&raw).unwrap();
+    let frame = 192 * 64 * 3 * 2;
+    assert_eq!(got.len(), 2 * frame, "two whole frames");
+    for (eye, crop) in [(0, "crop=256:128:0:0"), (1, "crop=256:128:256:0")] {
+        let pngs = dir.join(format!("eye{eye}"));
+        std::fs::create_dir_all(&pngs).unwrap();
+        let st = Command::new(FFMPEG)
+            .args(["-hide_banner", "-loglevel", "error", "-filter_complex"])
+            .arg(format!("{graph},{crop}"))
+            .args(["-frames:v", "2", "-pix_fmt", "rgb48be"])
+            .arg(pngs.join("%d.png"))
+            .status()
+            .unwrap();
+        assert!(st.success());
+        for k in 0..2 {
+            let one = pngs.join(format!("cube_{k}.png"));
+            to_strip(&pngs.join(format!("{}.png", k + 1)), &one, 2);
+            let img = image_codes(&one, 2);
+            // This eye's half of the frame: the top for the left eye.
+            let half = &got[k * frame + eye * frame / 2..k * frame + (eye + 1) * frame / 2];
+            let worst = worst_difference(&raw_codes(half, 2), &img);
+            assert!(worst <= 3, "eye {eye} of frame {k}: off by {worst} codes");
+        }
+    }
+    // The two eyes differ, so a swap would have shown.
+    assert_ne!(&got[..frame / 2], &got[frame / 2..frame]);
+}
+
+/// Converts the PNG `png` alone to a horizontal strip of 32² cube faces at `out`, in PNG
+/// samples of `bytes` bytes: what the pipe tests compare their frames with.
+fn to_strip(png: &Path, out: &Path, bytes: usize) {
+    ok(&[
+        "convert",
+        png.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--to",
+        "cube",
+        "--size",
+        "32",
+        "--layout",
+        "hstrip",
+        "--precision",
+        if bytes == 2 { "16" } else { "8" },
+        "-q",
+    ]);
+}
+
+/// The codes of raw little-endian samples of `bytes` bytes each.
+fn raw_codes(raw: &[u8], bytes: usize) -> Vec<i64> {
+    if bytes == 2 {
+        raw.chunks_exact(2)
+            .map(|c| u16::from_le_bytes([c[0], c[1]]) as i64)
+            .collect()
+    } else {
+        raw.iter().map(|&c| c as i64).collect()
+    }
+}
+
+/// The largest difference between two pictures' codes, of one length.
+fn worst_difference(a: &[i64], b: &[i64]) -> i64 {
+    assert_eq!(a.len(), b.len());
+    a.iter().zip(b).map(|(a, b)| (a - b).abs()).max().unwrap()
 }
 
 /// The codes of an RGB PNG of `bytes` bytes a sample, from the linear values io reads

@@ -341,3 +341,52 @@ fn sets_of_one_file_a_layer_read_back_by_their_record() {
         );
     }
 }
+
+/// A stereo pair mirrorball writes records its arrangement with the eye's layout
+/// (`sbs/c3x2`): read back with no flag, `info` reports the left eye and says it is a pair,
+/// and a conversion to a pair keeps both eyes where they were.
+#[test]
+fn a_stereo_pair_reads_back_by_its_record() {
+    let d = tempfile::tempdir().unwrap();
+    let pair = d.path().join("pair.exr");
+    let again = d.path().join("again.exr");
+    let (p, a) = (pair.to_str().unwrap(), again.to_str().unwrap());
+    let city = asset("city.exr");
+    ok(&[
+        "convert",
+        city.to_str().unwrap(),
+        p,
+        "--to",
+        "cube",
+        "--size",
+        "16",
+        "--layout",
+        "c3x2",
+        "--stereo",
+        "sbs",
+        "--yaw",
+        "30",
+        "-q",
+    ]);
+    let info = ok(&["info", p]);
+    assert!(
+        info.contains("sbs stereo pair") && info.contains("16x16 x 6"),
+        "{info}"
+    );
+    ok(&[
+        "convert", p, a, "--to", "cube", "--size", "16", "--layout", "c3x2", "--stereo", "sbs",
+        "-q",
+    ]);
+    let (x, y) = (
+        mirrorball_io::read(&pair, &Default::default()).unwrap(),
+        mirrorball_io::read(&again, &Default::default()).unwrap(),
+    );
+    assert_eq!((y.layers[0].width(), y.layers[0].height()), (96, 32));
+    let worst = x.layers[0]
+        .data()
+        .iter()
+        .zip(y.layers[0].data())
+        .map(|(a, b)| (a - b).abs() / (1.0 + a.abs()))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 2e-3, "cube to the same cube moved texels: {worst}");
+}

@@ -48,6 +48,21 @@ fn ffmpeg(args: &[&str]) -> Vec<u8> {
     o.stdout
 }
 
+/// What ffmpeg makes of the picture at `input` with `filter`: raw `rgb48le`.
+fn v360_raw(input: &Path, filter: &str) -> Vec<u8> {
+    ffmpeg(&[
+        "-i",
+        input.to_str().unwrap(),
+        "-vf",
+        filter,
+        "-f",
+        "rawvideo",
+        "-pix_fmt",
+        "rgb48le",
+        "-",
+    ])
+}
+
 /// The 16-bit code of direction `d`: `½ + 0.49·d` of full scale.
 pub(crate) fn code(d: DVec3) -> [u16; 3] {
     d.to_array()
@@ -64,8 +79,14 @@ fn decode(c: [f64; 3]) -> Option<DVec3> {
 /// A `w`×`h` 16-bit PNG of projection `p`, each pixel the code of its direction: at the
 /// texel centre, or (`align`) where FFmpeg 5.1 reads it.
 fn write_coded(path: &Path, p: &Projection, w: u32, h: u32, align: bool) {
-    let mut raw = Vec::with_capacity((w * h * 6) as usize);
+    write_rgb48(path, w, h, &coded(p, w, h, align, 1.0));
+}
+
+/// The codes of a `w`×`h` picture of projection `p` (see [`write_coded`]), each the code of
+/// `sign` times its direction, row by row.
+fn coded(p: &Projection, w: u32, h: u32, align: bool, sign: f64) -> Vec<[u16; 3]> {
     let dfisheye = matches!(p, Projection::DualFisheye(_));
+    let mut codes = Vec::with_capacity((w * h) as usize);
     for y in 0..h {
         for x in 0..w {
             let uv = if align && dfisheye {
@@ -77,11 +98,18 @@ fn write_coded(path: &Path, p: &Projection, w: u32, h: u32, align: bool) {
             };
             let uv = p.nearest_covered(0, uv);
             let d = p.uv_to_dir(0, uv).expect("a direction at every texel");
-            for c in code(d) {
-                raw.extend_from_slice(&c.to_le_bytes());
-            }
+            codes.push(code(sign * d));
         }
     }
+    codes
+}
+
+/// Writes `w`×`h` codes as a 16-bit PNG, through ffmpeg.
+fn write_rgb48(path: &Path, w: u32, h: u32, codes: &[[u16; 3]]) {
+    let raw: Vec<u8> = codes
+        .iter()
+        .flat_map(|c| c.iter().flat_map(|v| v.to_le_bytes()))
+        .collect();
     let rawp = path.with_extension("raw");
     std::fs::write(&rawp, raw).unwrap();
     let size = format!("{w}x{h}");
@@ -144,17 +172,7 @@ fn compare(dir: &Path, case: &Case) {
     write_coded(&for_ff, &src, iw, ih, true);
 
     let filter = format!("v360={}:interp=line:w={w}:h={h}", case.v360);
-    let ff = ffmpeg(&[
-        "-i",
-        for_ff.to_str().unwrap(),
-        "-vf",
-        &filter,
-        "-f",
-        "rawvideo",
-        "-pix_fmt",
-        "rgb48le",
-        "-",
-    ]);
+    let ff = v360_raw(&for_ff, &filter);
     assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
     let out = dir.join("out_mb.png");
     let size = case.size.to_string();
@@ -300,6 +318,22 @@ fn projections_land_where_v360_puts_them() {
     }
 }
 
+/// One pixel's angle at `(x, y)` of ffmpeg's output (`ffd` decodes a pixel, `df` the one
+/// at `(x, y)`): the farthest of its neighbours, leaving out those across a seam between
+/// cells or eyes (more than twice as far as the nearest).
+fn ffmpeg_pixel(ffd: &impl Fn(u32, u32) -> Option<DVec3>, x: u32, y: u32, df: DVec3) -> f64 {
+    let near: Vec<f64> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+        .iter()
+        .filter_map(|(dx, dy)| ffd((x as i64 + dx) as u32, (y as i64 + dy) as u32))
+        .map(|n| df.angle_between(n))
+        .collect();
+    let min = near.iter().cloned().fold(f64::INFINITY, f64::min);
+    near.iter()
+        .cloned()
+        .filter(|&a| a <= 2.0 * min)
+        .fold(0.0, f64::max)
+}
+
 /// One comparison of a packed cube output: `v360=e:OUT` against `mirrorball convert --to TO
 /// --layout LAYOUT --size N` from the same lat-long.
 struct Packed {
@@ -320,17 +354,7 @@ fn compare_packed(dir: &Path, case: &Packed) {
     write_coded(&for_mb, &src, 256, 128, false);
     write_coded(&for_ff, &src, 256, 128, true);
     let filter = format!("v360=e:{}:interp=line:w={w}:h={h}", case.v360);
-    let ff = ffmpeg(&[
-        "-i",
-        for_ff.to_str().unwrap(),
-        "-vf",
-        &filter,
-        "-f",
-        "rawvideo",
-        "-pix_fmt",
-        "rgb48le",
-        "-",
-    ]);
+    let ff = v360_raw(&for_ff, &filter);
     assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
     let out = dir.join("out_mb.png");
     let size = case.size.to_string();
@@ -369,19 +393,7 @@ fn compare_packed(dir: &Path, case: &Packed) {
             ) else {
                 panic!("{}: texel ({x}, {y}) is black", case.layout);
             };
-            // One pixel: ffmpeg's own neighbours, leaving out those across a seam between
-            // cells (more than twice as far as the nearest).
-            let near: Vec<f64> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
-                .iter()
-                .filter_map(|(dx, dy)| ffd((x as i64 + dx) as u32, (y as i64 + dy) as u32))
-                .map(|n| df.angle_between(n))
-                .collect();
-            let min = near.iter().cloned().fold(f64::INFINITY, f64::min);
-            let tol = near
-                .iter()
-                .cloned()
-                .filter(|&a| a <= 2.0 * min)
-                .fold(0.0, f64::max);
+            let tol = ffmpeg_pixel(&ffd, x, y, df);
             let e = df.angle_between(dm);
             worst = worst.max(e / tol);
             compared += 1;
@@ -435,5 +447,189 @@ fn cube_layouts_land_where_v360_puts_them() {
     ];
     for case in &cases {
         compare_packed(dir.path(), case);
+    }
+}
+
+/// One comparison of stereo pairs: `v360=e:OUT:in_stereo=I:out_stereo=O` against
+/// `mirrorball convert --from latlong --in-stereo I --to TO --stereo O` from the same
+/// lat-long pair. The left eye is coded with its directions and the right eye with their
+/// opposites, so an eye taken from the wrong half, or put in the wrong half, is half a turn
+/// off.
+struct Pair {
+    /// Input arrangement, v360's and mirrorball's name alike.
+    in_stereo: &'static str,
+    /// v360's output with its options.
+    v360: &'static str,
+    to: &'static str,
+    /// mirrorball's `--layout`, for cube outputs.
+    layout: Option<&'static str>,
+    /// Output arrangement.
+    out_stereo: &'static str,
+    size: u32,
+}
+
+fn compare_pair(dir: &Path, case: &Pair) {
+    use mirrorball_core::{Layout, Stereo};
+    let (ew, eh) = (128, 64);
+    let src = ProjectionSpec::parse("latlong")
+        .unwrap()
+        .build(Some((ew, eh)))
+        .unwrap();
+    let (sin, sout): (Stereo, Stereo) = (
+        case.in_stereo.parse().unwrap(),
+        case.out_stereo.parse().unwrap(),
+    );
+    // The input pair: each eye coded as FFmpeg or mirrorball reads it, joined.
+    let pair = |align: bool| {
+        let eye = |sign| {
+            let codes = coded(&src, ew, eh, align, sign);
+            let data = codes.iter().flat_map(|c| c.map(|v| v as f32)).collect();
+            mirrorball_core::Image::from_vec(ew, eh, 3, data).unwrap()
+        };
+        let eyes = [eye(1.0), eye(-1.0)];
+        let joined = sin.join(eyes[..sin.eyes()].to_vec()).unwrap();
+        let codes: Vec<[u16; 3]> = joined
+            .data()
+            .chunks(3)
+            .map(|c| [c[0] as u16, c[1] as u16, c[2] as u16])
+            .collect();
+        (joined.width(), joined.height(), codes)
+    };
+    let (for_mb, for_ff) = (dir.join("pair_mb.png"), dir.join("pair_ff.png"));
+    let (pw, ph, codes) = pair(false);
+    write_rgb48(&for_mb, pw, ph, &codes);
+    let (_, _, codes) = pair(true);
+    write_rgb48(&for_ff, pw, ph, &codes);
+
+    let dst = ProjectionSpec::parse(case.to).unwrap().build(None).unwrap();
+    let (lw, lh) = dst.layer_extent(case.size);
+    let (w, h) = match case.layout {
+        Some(l) => l
+            .parse::<Layout>()
+            .unwrap()
+            .extent(dst.layer_count(), lw, lh),
+        None => (lw, lh),
+    };
+    let (fw, fh) = sout.extent(w, h);
+    let filter = format!(
+        "v360=e:{}:in_stereo={}:out_stereo={}:interp=line:w={w}:h={h}",
+        case.v360, case.in_stereo, case.out_stereo
+    );
+    let ff = v360_raw(&for_ff, &filter);
+    assert_eq!(ff.len(), (fw * fh * 6) as usize, "{filter}: output size");
+    let out = dir.join("pair_out.png");
+    let size = case.size.to_string();
+    let mut args = vec![
+        "convert",
+        for_mb.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--from",
+        "latlong",
+        "--in-stereo",
+        case.in_stereo,
+        "--to",
+        case.to,
+        "--stereo",
+        case.out_stereo,
+        "--size",
+        &size,
+        "--precision",
+        "16",
+        "-q",
+    ];
+    if let Some(l) = case.layout {
+        args.extend(["--layout", l]);
+    }
+    ok(&args);
+    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
+    let img = &mb.layers[0];
+    assert_eq!((img.width(), img.height()), (fw, fh), "{filter}");
+    let ffd = |x: u32, y: u32| {
+        let k = ((y * fw + x) * 6) as usize;
+        decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
+    };
+    let (mut compared, mut worst) = (0, 0.0f64);
+    for e in 0..sout.eyes() {
+        let (ox, oy) = match sout {
+            Stereo::SideBySide => (e as u32 * w, 0),
+            Stereo::TopBottom => (0, e as u32 * h),
+            Stereo::Mono => (0, 0),
+        };
+        // Which input eye this output eye shows, by the sign of its codes: v360's rule.
+        let sign = if sin.source_eye(e) == 0 { 1.0 } else { -1.0 };
+        for y in oy + 1..oy + h - 1 {
+            for x in ox + 1..ox + w - 1 {
+                let m = [0, 1, 2]
+                    .map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64));
+                let (Some(df), Some(dm)) = (ffd(x, y), decode(m)) else {
+                    panic!("{filter}: texel ({x}, {y}) is black");
+                };
+                let tol = ffmpeg_pixel(&ffd, x, y, df);
+                let err = df.angle_between(dm);
+                worst = worst.max(err / tol);
+                compared += 1;
+                assert!(
+                    err <= tol,
+                    "{} ({}) vs {filter}: eye {e}, texel ({x}, {y}) differs by {:.3}° (a pixel \
+                     is {:.3}°): ffmpeg {df}, mirrorball {dm}",
+                    case.to,
+                    case.out_stereo,
+                    err.to_degrees(),
+                    tol.to_degrees()
+                );
+                // And the eye is the one v360's rule names: a lat-long output's texel shows
+                // its own direction, times the source eye's sign.
+                if case.to == "latlong" {
+                    let uv = DVec2::new(
+                        (x - ox) as f64 / w as f64 + 0.5 / w as f64,
+                        (y - oy) as f64 / h as f64 + 0.5 / h as f64,
+                    );
+                    let want = sign * dst.uv_to_dir(0, uv).unwrap();
+                    assert!(
+                        dm.angle_between(want) <= 2.0 * tol,
+                        "{filter}: eye {e} at ({x}, {y}) shows {dm}, not {want}"
+                    );
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{:>30} {:<8} ↔ {:<70} {compared} texels, worst {worst:.3} of a pixel",
+        case.to, case.out_stereo, filter
+    );
+    assert!(compared > 1000, "{filter}: {compared} texels compared");
+}
+
+#[test]
+fn stereo_pairs_land_where_v360_puts_them() {
+    if !have_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let p = |in_stereo, v360, to, layout, out_stereo, size| Pair {
+        in_stereo,
+        v360,
+        to,
+        layout,
+        out_stereo,
+        size,
+    };
+    let cases = [
+        p("sbs", "c3x2", "cube", Some("c3x2"), "sbs", 24),
+        p("tb", "e", "latlong", None, "sbs", 96),
+        p(
+            "2d",
+            "flat:h_fov=100:v_fov=70",
+            "perspective:hfov=100:vfov=70",
+            None,
+            "tb",
+            64,
+        ),
+        p("sbs", "e", "latlong", None, "2d", 96),
+        p("tb", "e", "latlong", None, "tb", 64),
+        p("2d", "e", "latlong", None, "sbs", 64),
+    ];
+    for case in &cases {
+        compare_pair(dir.path(), case);
     }
 }

@@ -388,6 +388,7 @@ fn exr_uncompressed_files_are_byte_for_byte_what_the_exr_crate_writes() {
                         declared: latlong.then_some(MapInfo {
                             projection: mirrorball_core::LatLong.into(),
                             layout: None,
+                            stereo: Default::default(),
                         }),
                         ..WriteOptions::default()
                     };

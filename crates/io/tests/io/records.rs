@@ -40,6 +40,7 @@ fn every_flat_container_with_text_gives_back_what_it_recorded() {
             MapInfo {
                 projection: fisheye,
                 layout: None,
+                stereo: Default::default(),
             },
             (16, 16),
         ),
@@ -47,6 +48,7 @@ fn every_flat_container_with_text_gives_back_what_it_recorded() {
             MapInfo {
                 projection: paraboloid,
                 layout: Some(Layout::VerticalStrip),
+                stereo: Default::default(),
             },
             (8, 16),
         ),
@@ -90,6 +92,7 @@ fn a_ktx2_cube_records_its_projection() {
     let info = MapInfo {
         projection: ProjectionKind::Cube.default_projection(),
         layout: None,
+        stereo: Default::default(),
     };
     write_cube(&path, &[faces], &declared(info)).unwrap();
     let loaded = read(&path, &Default::default()).unwrap();
@@ -142,6 +145,7 @@ fn an_exr_with_projection_and_layout_is_the_same_bytes_every_time() {
     let info = MapInfo {
         projection: ProjectionKind::Cube.default_projection(),
         layout: Some(Layout::HorizontalCross),
+        stereo: Default::default(),
     };
     let img = picture(8, 6);
     let first = dir.path().join("c0.exr");
@@ -158,4 +162,50 @@ fn an_exr_with_projection_and_layout_is_the_same_bytes_every_time() {
         .unwrap()
         .unwrap();
     assert_eq!(back, info);
+}
+
+#[test]
+fn a_stereo_pair_is_recorded_with_its_eyes_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let mercator = ProjectionKind::Mercator.default_projection();
+    let cube = ProjectionKind::Cube.default_projection();
+    for (info, (w, h), text) in [
+        (
+            MapInfo {
+                projection: cube,
+                layout: Some(Layout::HorizontalStrip),
+                stereo: mirrorball_core::Stereo::TopBottom,
+            },
+            (24, 8),
+            "tb/hstrip",
+        ),
+        (
+            MapInfo {
+                projection: mercator,
+                layout: Some(Layout::Separate),
+                stereo: mirrorball_core::Stereo::SideBySide,
+            },
+            (32, 16),
+            "sbs/separate",
+        ),
+    ] {
+        assert_eq!(info.texts().1.as_deref(), Some(text));
+        for ext in ["exr", "hdr", "png", "jpg"] {
+            let path = dir.path().join(format!("s.{ext}"));
+            write_image(&path, &picture(w, h), &declared(info)).unwrap();
+            let back = read(&path, &Default::default())
+                .unwrap()
+                .recorded
+                .unwrap()
+                .unwrap();
+            assert_eq!(back.stereo, info.stereo, "{ext}");
+            assert_eq!(back.layout, info.layout, "{ext}");
+            assert_eq!(back.projection.to_string(), info.projection.to_string());
+        }
+    }
+    // A pair that cannot halve is an unreadable record, said by name.
+    let e = MapInfo::from_texts("latlong", Some("sbs/separate"), 33, 16).unwrap_err();
+    assert!(e.contains(LAYOUT_KEY) && e.contains("even width"), "{e}");
+    let e = MapInfo::from_texts("latlong", Some("3d/separate"), 32, 16).unwrap_err();
+    assert!(e.contains("3d/separate"), "{e}");
 }

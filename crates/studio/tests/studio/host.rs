@@ -6,7 +6,7 @@ use mirrorball_core::glam::{Mat4, Vec3};
 use mirrorball_core::{EnvMap, Image, ProjectionKind};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{Builtin, Camera, Material, Object, Scene, Settings};
-use mirrorball_studio::{Host, Opened, Running, SceneView, Studio};
+use mirrorball_studio::{Export, Host, Opened, Running, SceneView, Studio};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -58,7 +58,26 @@ impl Host for TestHost {
             settings: Settings::default(),
             exposure: 0.0,
             tone: Tone::Clamp,
+            source: None,
+            builtins: vec![Some((Builtin::Sphere, 16))],
         }
+    }
+    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String> {
+        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+        let path = dir.path().join(format!("export.{format}"));
+        let opts = mirrorball_io::WriteOptions::default();
+        match what {
+            Export::Map(map) if map.layers().len() == 1 => {
+                mirrorball_io::write_image(&path, &map.layers()[0], &opts)
+            }
+            Export::Map(map) => mirrorball_io::write_cube(&path, &[map.layers().to_vec()], &opts),
+            Export::Chain(chain) => {
+                let faces: Vec<Vec<Image>> = chain.iter().map(|l| l.layers().to_vec()).collect();
+                mirrorball_io::write_cube(&path, &faces, &opts)
+            }
+        }
+        .map_err(|e| e.to_string())?;
+        std::fs::read(&path).map_err(|e| e.to_string())
     }
 }
 

@@ -54,7 +54,13 @@ fn a_good_request_is_served() {
 fn a_request_without_the_token_is_refused() {
     let r = start(&[]);
     let host = format!("127.0.0.1:{}", r.port);
-    for target in ["/", "/api/state", "/web/studio.js", "/web/glsl/cube.glsl"] {
+    for target in [
+        "/",
+        "/api/state",
+        "/web/studio.js",
+        "/web/glsl/cube.glsl",
+        "/api/export?what=map&format=exr",
+    ] {
         let a = request(r.port, "GET", target, &[("Host", &host)], b"");
         assert_eq!(a.status, 401, "{target}: {}", a.text());
         assert!(!a.text().contains("envUv"), "{target} gave the shader away");

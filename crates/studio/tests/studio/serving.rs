@@ -1,6 +1,7 @@
 //! What the server gives the page, and how it takes bad files.
 
 use crate::host::{latlong_exr, own, start};
+use mirrorball_studio::Running;
 
 fn json(a: &crate::host::Answer) -> serde_json::Value {
     serde_json::from_slice(&a.body).unwrap_or_else(|_| panic!("not JSON: {}", a.text()))
@@ -70,51 +71,58 @@ fn a_bad_file_on_the_command_line_is_an_error_before_serving() {
     assert!(e.starts_with(&cut.display().to_string()), "{e}");
 }
 
+/// `GET query` of the environment, answered 200: the payload's JSON header, its length, and
+/// the body.
+fn environment(r: &Running, query: &str) -> (serde_json::Value, usize, Vec<u8>) {
+    let a = own(r, "GET", &format!("/api/environment?{query}"), b"");
+    assert_eq!(a.status, 200, "{query}: {}", a.text());
+    assert_eq!(&a.body[..4], b"MBTX");
+    let n = u32::from_le_bytes(a.body[4..8].try_into().unwrap()) as usize;
+    let h = serde_json::from_slice(&a.body[8..8 + n]).unwrap();
+    (h, n, a.body)
+}
+
 #[test]
 fn the_environment_comes_padded_in_its_own_and_other_projections() {
     let dir = tempfile::tempdir().unwrap();
     let r = start(&[latlong_exr(dir.path())]);
-    let a = own(
-        &r,
-        "GET",
-        "/api/environment?projection=native&precision=float",
-        b"",
-    );
-    assert_eq!(a.status, 200, "{}", a.text());
-    assert_eq!(&a.body[..4], b"MBTX");
-    let n = u32::from_le_bytes(a.body[4..8].try_into().unwrap()) as usize;
-    let h: serde_json::Value = serde_json::from_slice(&a.body[8..8 + n]).unwrap();
+    let (h, n, body) = environment(&r, "projection=native&precision=float");
     assert_eq!(
         (h["texelWidth"].as_u64(), h["texelHeight"].as_u64()),
         (Some(18), Some(10))
     );
-    assert_eq!(a.body.len(), 8 + n + 18 * 10 * 16);
+    assert_eq!(body.len(), 8 + n + 18 * 10 * 16);
     // Texel (0, 0) of the map is at (1, 1) of the padded layer; (−1, 0) wraps to (15, 0).
     let f = |x: usize, y: usize, c: usize| {
         let i = 8 + n + ((y * 18 + x) * 4 + c) * 4;
-        f32::from_le_bytes(a.body[i..i + 4].try_into().unwrap())
+        f32::from_le_bytes(body[i..i + 4].try_into().unwrap())
     };
     assert_eq!((f(1, 1, 0), f(1, 1, 1)), (0.0, 0.0));
     assert_eq!((f(0, 1, 0), f(0, 1, 1)), (15.0 / 16.0, 0.0));
-    let a = own(
-        &r,
-        "GET",
-        "/api/environment?projection=cube&size=8&precision=half",
-        b"",
-    );
-    assert_eq!(a.status, 200, "{}", a.text());
-    let n = u32::from_le_bytes(a.body[4..8].try_into().unwrap()) as usize;
-    let h: serde_json::Value = serde_json::from_slice(&a.body[8..8 + n]).unwrap();
+    let (h, n, body) = environment(&r, "projection=cube&size=8&precision=half");
     assert_eq!(
         (h["projection"].as_str(), h["layers"].as_u64()),
         (Some("cube"), Some(6))
     );
-    assert_eq!(a.body.len(), 8 + n + 6 * 10 * 10 * 8);
+    assert_eq!(body.len(), 8 + n + 6 * 10 * 10 * 8);
+    // With the mip chain: 8², 4², 2², 1² faces, each padded, in one atlas a face.
+    let (h, n, body) = environment(&r, "projection=cube&size=8&precision=half&mips=1");
+    assert_eq!(
+        h["levels"],
+        serde_json::json!([[0, 0, 8, 8], [10, 0, 4, 4], [10, 6, 2, 2], [10, 10, 1, 1]])
+    );
+    let (w, ht) = (
+        h["texelWidth"].as_u64().unwrap(),
+        h["texelHeight"].as_u64().unwrap(),
+    );
+    assert_eq!((w, ht), (16, 13));
+    assert_eq!(body.len(), 8 + n + 6 * (w * ht) as usize * 8);
     for bad in [
         "projection=cube&size=0",
         "projection=nonsense",
         "precision=double",
-        "projection=octahedral",
+        "projection=dual-fisheye",
+        "mips=2",
     ] {
         let a = own(&r, "GET", &format!("/api/environment?{bad}"), b"");
         assert!(
@@ -154,6 +162,19 @@ fn meshes_come_in_world_space() {
         );
     }
     assert_eq!(own(&r, "GET", "/api/mesh/1", b"").status, 404);
+    // The built-in sphere tessellated otherwise: the render crate's mesh at that level.
+    let a = own(&r, "GET", "/api/mesh/0?tessellation=32", b"");
+    assert_eq!(a.status, 200, "{}", a.text());
+    let want = mirrorball_render::Builtin::Sphere.mesh(32);
+    let counts = [0, 4].map(|o| u32::from_le_bytes(a.body[o..o + 4].try_into().unwrap()));
+    assert_eq!(
+        counts,
+        [want.positions.len() as u32, want.triangles.len() as u32]
+    );
+    for bad in ["tessellation=0", "tessellation=100000", "tessellation=x"] {
+        let a = own(&r, "GET", &format!("/api/mesh/0?{bad}"), b"");
+        assert_eq!(a.status, 400, "{bad}: {}", a.text());
+    }
     r.stop();
 }
 
@@ -164,10 +185,73 @@ fn the_grid_holds_the_cores_answers() {
     assert_eq!(a.status, 200);
     let count = u32::from_le_bytes(a.body[..4].try_into().unwrap()) as usize;
     assert_eq!(count, 6 * 81);
-    assert_eq!(a.body.len(), 40 + 36 * count);
+    // Count, the frame (9 floats), the parameters (4), then nine floats a direction.
+    assert_eq!(a.body.len(), 56 + 36 * count);
     assert_eq!(
         own(&r, "GET", "/api/grid?projection=cube&n=100000", b"").status,
         400
     );
+    r.stop();
+}
+
+#[test]
+fn exports_are_the_hosts_files_and_bad_requests_say_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = start(&[latlong_exr(dir.path())]);
+    // The map as loaded: an EXR the io crate reads back with the loaded texels.
+    let a = own(&r, "GET", "/api/export?what=map&format=exr", b"");
+    assert_eq!(a.status, 200, "{}", a.text());
+    assert_eq!(
+        a.header("content-disposition"),
+        Some("attachment; filename=\"environment-native.exr\"")
+    );
+    let file = dir.path().join("back.exr");
+    std::fs::write(&file, &a.body).unwrap();
+    let back = mirrorball_io::read(&file, &mirrorball_io::Limits::default()).unwrap();
+    assert_eq!((back.layers[0].width(), back.layers[0].height()), (16, 8));
+    // Converted as the page asks: a cube into KTX2.
+    let a = own(
+        &r,
+        "GET",
+        "/api/export?what=map&format=ktx2&projection=cube&size=8",
+        b"",
+    );
+    assert_eq!(a.status, 200, "{}", a.text());
+    assert_eq!(&a.body[1..7], b"KTX 20");
+    for (target, status, says) in [
+        (
+            "/api/export?what=map&format=bmp",
+            400,
+            "'bmp' is not one of",
+        ),
+        (
+            "/api/export?what=scene&format=exr",
+            400,
+            "'scene' is not map or chain",
+        ),
+        ("/api/export?what=chain&format=exr", 400, "ktx2 or dds"),
+        (
+            "/api/export?what=chain&format=ktx2",
+            404,
+            "no prefiltered chain",
+        ),
+        (
+            "/api/export?what=map&format=exr&projection=nonsense",
+            400,
+            "projection",
+        ),
+    ] {
+        let a = own(&r, "GET", target, b"");
+        assert_eq!(a.status, status, "{target}: {}", a.text());
+        let m = json(&a)["error"].as_str().unwrap().to_string();
+        assert!(m.contains(says), "{target}: {m}");
+    }
+    // Once the page is lit, its chain: every level in one KTX2.
+    let a = own(&r, "GET", "/api/lighting?size=8", b"");
+    assert_eq!(a.status, 200, "{}", a.text());
+    let a = own(&r, "GET", "/api/export?what=chain&format=ktx2", b"");
+    assert_eq!(a.status, 200, "{}", a.text());
+    let levels = u32::from_le_bytes(a.body[40..44].try_into().unwrap());
+    assert_eq!(levels, 4);
     r.stop();
 }

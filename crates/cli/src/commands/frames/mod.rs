@@ -28,7 +28,8 @@ pub use pipe::PixFmt;
 /// `convert`'s flags for frames, pipes and batches.
 #[derive(Args, Debug, Clone, Default)]
 pub struct FramesArgs {
-    /// Size of the raw frames read from standard input (input `-`), WIDTHxHEIGHT.
+    /// Size of the raw frames read from standard input (input `-`), WIDTHxHEIGHT: the whole
+    /// picture (both eyes of a stereo pair, --in-stereo).
     #[arg(long, value_name = "WxH")]
     pub in_size: Option<String>,
     /// Pixel format of raw frames through `-` (standard input and output), named as

@@ -165,6 +165,7 @@ impl Packing {
     }
 
     /// The packed frame's width and height.
+    #[cfg(test)]
     pub fn extent(&self) -> (u32, u32) {
         (self.width, self.height)
     }

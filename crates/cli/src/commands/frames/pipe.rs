@@ -5,6 +5,7 @@
 //! PNG), so that a frame through a pipe and the same frame through a PNG file convert
 //! alike; float formats carry linear light.
 
+#[cfg(test)]
 use super::packing::Packing;
 use crate::error::CliError;
 use mirrorball_core::color::linear_to_srgb;

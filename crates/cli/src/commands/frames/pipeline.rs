@@ -1,17 +1,18 @@
 //! The frame loop: one thread reads (and decodes) frame k+1 while another converts frame k
 //! with the planned `Remap` and a third writes frame k−1. The stages are joined by channels
 //! that hold one frame each, and buffers go back to the stage that fills them, so at most
-//! three source maps and three outputs exist whatever the number of frames (their memory is
-//! [`FRAMES_IN_FLIGHT`] of each), and a long run allocates nothing after its first frames.
-//! Each stage's heavy loops are parallel (rayon), so the two cores share whichever stages
-//! have work.
+//! three source frames and three outputs exist whatever the number of frames (their memory
+//! is [`FRAMES_IN_FLIGHT`] of each), and a long run allocates nothing after its first
+//! frames. Each stage's heavy loops are parallel (rayon), so the two cores share whichever
+//! stages have work.
 //!
-//! An output is whatever the converter makes for the writer: a map (encoded by the writer
-//! into files), or a raw frame's bytes already encoded (the converter encodes each row as
-//! the `Remap` makes it, so the frame never exists as floats).
+//! A frame is one map per eye ([`Eyes`]): one for `2d`, two for a stereo pair. An output is
+//! whatever the converter makes for the writer: the output eyes ([`convert_eyes`], written
+//! to files or packed), or a raw frame's bytes already encoded (each row encoded as the
+//! `Remap` makes it, so the frame never exists as floats).
 
 use crate::error::CliError;
-use mirrorball_core::EnvMap;
+use mirrorball_core::{EnvMap, Remap, Stereo};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender};
 
@@ -28,16 +29,19 @@ pub struct Meta {
     pub input: String,
 }
 
-/// Reads the next frame, given a source map that has come back for reuse (when one has);
+/// A frame's maps, one per eye, the left first.
+pub type Eyes = Vec<EnvMap>;
+
+/// Reads the next frame, given source maps that have come back for reuse (when they have);
 /// `None` at the end.
-pub type Next<'a> =
-    dyn FnMut(Option<EnvMap>) -> Option<Result<(Meta, EnvMap), CliError>> + Send + 'a;
+pub type Next<'a> = dyn FnMut(Option<Eyes>) -> Option<Result<(Meta, Eyes), CliError>> + Send + 'a;
 /// Converts a source frame into an output of the writer's kind, reusing its memory.
-pub type Convert<'a, O> = dyn Fn(&Meta, &EnvMap, &mut O) -> Result<(), CliError> + Sync + 'a;
+pub type Convert<'a, O> = dyn Fn(&Meta, &Eyes, &mut O) -> Result<(), CliError> + Sync + 'a;
 /// Writes a converted frame.
 pub type Put<'a, O> = dyn FnMut(&Meta, &O) -> Result<(), CliError> + Send + 'a;
 
 /// Runs the loop until `next` ends or a stage fails; `done` counts the frames written.
+/// Source frames are arranged as `from`; `fresh_output` makes a frame of output eyes.
 /// The first error of the reader, the converter or the writer (in that order: a failing
 /// stage makes the others stop without one) is returned after every frame before it was
 /// written.
@@ -48,9 +52,9 @@ pub fn run<O: Send>(
     put: &mut Put<'_, O>,
     done: &AtomicU64,
 ) -> Result<(), CliError> {
-    let (src_tx, src_rx) = sync_channel::<(Meta, EnvMap)>(1);
+    let (src_tx, src_rx) = sync_channel::<(Meta, Eyes)>(1);
     let (out_tx, out_rx) = sync_channel::<(Meta, O)>(1);
-    let (src_back_tx, src_back_rx) = channel::<EnvMap>();
+    let (src_back_tx, src_back_rx) = channel::<Eyes>();
     let (out_back_tx, out_back_rx) = channel::<O>();
     std::thread::scope(|s| {
         let reader = s.spawn(move || read_stage(next, src_tx, src_back_rx));
@@ -71,8 +75,8 @@ pub fn run<O: Send>(
 
 fn read_stage(
     next: &mut Next<'_>,
-    tx: std::sync::mpsc::SyncSender<(Meta, EnvMap)>,
-    back: Receiver<EnvMap>,
+    tx: std::sync::mpsc::SyncSender<(Meta, Eyes)>,
+    back: Receiver<Eyes>,
 ) -> Result<(), CliError> {
     loop {
         let spare = back.try_recv().ok();
@@ -88,12 +92,48 @@ fn read_stage(
     }
 }
 
+/// Makes every output eye of `out` from source frame `src` (arranged as `from`) with
+/// `remap`: each from its `Stereo::source_eye`, an eye made from the same source eye as the
+/// one before it copied.
+pub fn convert_eyes(
+    (remap, from): (&Remap, Stereo),
+    meta: &Meta,
+    src: &Eyes,
+    out: &mut Eyes,
+) -> Result<(), CliError> {
+    for e in 0..out.len() {
+        let eye = from.source_eye(e);
+        if e > 0 && from.source_eye(e - 1) == eye {
+            let (made, rest) = out.split_at_mut(e);
+            for (to, from) in rest[0].layers_mut().iter_mut().zip(made[e - 1].layers()) {
+                to.data_mut().copy_from_slice(from.data());
+            }
+            continue;
+        }
+        let src_eye = src.get(eye).ok_or_else(|| {
+            CliError::input(format!(
+                "{}: {} eye(s), where the first frame had {}",
+                meta.input,
+                src.len(),
+                from.eyes()
+            ))
+        })?;
+        remap.apply_into(src_eye, &mut out[e]).map_err(|err| {
+            CliError::input(format!(
+                "{}: {err} (every frame must have the first's projection and size)",
+                meta.input
+            ))
+        })?;
+    }
+    Ok(())
+}
+
 fn convert_stage<O>(
     convert: &Convert<'_, O>,
     fresh_output: &(dyn Fn() -> O + Sync),
-    rx: Receiver<(Meta, EnvMap)>,
+    rx: Receiver<(Meta, Eyes)>,
     tx: std::sync::mpsc::SyncSender<(Meta, O)>,
-    src_back: Sender<EnvMap>,
+    src_back: Sender<Eyes>,
     out_back: Receiver<O>,
 ) -> Result<(), CliError> {
     let mut made = 0;

@@ -11,14 +11,14 @@ use super::log::{Log, Status};
 use super::packing::Packing;
 use super::pattern::{Frame, Pattern, Printf};
 use super::pipe::{self, PixFmt};
-use super::pipeline::{self, Meta, FRAMES_IN_FLIGHT};
+use super::pipeline::{self, Eyes, Meta, FRAMES_IN_FLIGHT};
 use super::shard::Shard;
-use crate::commands::convert::Plan;
+use crate::commands::convert::{times, Plan};
 use crate::error::CliError;
 use crate::progress::with_progress;
 use crate::spec::bad;
 use crate::{budget, load, save, ConvertArgs};
-use mirrorball_core::{EnvMap, Image, Layout, Projection, Remap, WorldProjection};
+use mirrorball_core::{EnvMap, Image, Layout, Projection, Remap, Stereo, WorldProjection};
 use serde_json::json;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -84,6 +84,11 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
             ));
         };
         let (w, h) = pipe::parse_size("--in-size", size)?;
+        if let Some(s) = a.in_stereo.as_deref() {
+            crate::choice::parse_flag::<Stereo>("--in-stereo", s)?
+                .eye_extent(w, h)
+                .map_err(|e| CliError::request(format!("--in-size {size}: {e}")))?;
+        }
         Input::Pipe { w, h, fmt }
     } else {
         if f.in_size.is_some() {
@@ -236,13 +241,15 @@ struct Reader<'a> {
     at: usize,
     stdin: std::io::Stdin,
     bytes: Vec<u8>,
-    /// The pipe's projection and layout, once decided by the first frame.
+    /// The pipe's projection and layout (of each eye), once decided by the first frame.
     decided: Option<(Projection, Layout)>,
+    /// How the input pictures hold their eyes, once the first frame is read.
+    stereo: Option<Stereo>,
     limits: mirrorball_io::Limits,
 }
 
 impl Reader<'_> {
-    fn next(&mut self, spare: Option<EnvMap>) -> Option<Result<(Meta, EnvMap), CliError>> {
+    fn next(&mut self, spare: Option<Eyes>) -> Option<Result<(Meta, Eyes), CliError>> {
         match &self.input {
             Input::Files(frames) => {
                 let fr = frames.get(self.at)?.clone();
@@ -265,14 +272,16 @@ impl Reader<'_> {
         }
     }
 
-    fn read_file(&self, fr: &Frame) -> Result<(Meta, EnvMap), CliError> {
+    fn read_file(&mut self, fr: &Frame) -> Result<(Meta, Eyes), CliError> {
         let name = fr.path.to_string_lossy().into_owned();
-        let mut src = load::load(
+        let mut src = load::load_eyes(
             &name,
             self.plan.input.from.as_ref(),
             self.plan.input.layout,
+            (self.plan.in_stereo, self.plan.stereo),
             &self.limits,
         )?;
+        self.stereo.get_or_insert(src.stereo);
         let lines = src.prepare(&name, self.plan.input.keep_invalid);
         if !self.a.quiet {
             // What was decided, for the first frame; warnings for every frame.
@@ -282,7 +291,10 @@ impl Reader<'_> {
                 .filter(|(i, _)| self.at == 1 || *i > 0)
                 .for_each(|(_, l)| eprintln!("{l}"));
         }
-        Ok((meta(fr.number, name), src.env))
+        Ok((
+            meta(fr.number, name),
+            std::iter::once(src.env).chain(src.right).collect(),
+        ))
     }
 
     fn decode(
@@ -291,23 +303,37 @@ impl Reader<'_> {
         w: u32,
         h: u32,
         fmt: PixFmt,
-        spare: Option<EnvMap>,
-    ) -> Result<(Meta, EnvMap), CliError> {
+        spare: Option<Eyes>,
+    ) -> Result<(Meta, Eyes), CliError> {
         let name = format!("frame {n} of standard input");
-        // A one-picture map's layer comes back whole; unpacked layouts are cut afresh.
+        let stereo = self.plan.in_stereo.unwrap_or_default();
+        self.stereo = Some(stereo);
+        let reads = stereo.eyes_read(self.plan.stereo);
+        // A one-picture map's layer comes back whole; unpacked layouts and eyes are cut
+        // afresh.
         let mut img = match (spare, self.decided) {
-            (Some(env), Some((_, Layout::Separate))) => env.into_layers().swap_remove(0),
+            (Some(mut eyes), Some((_, Layout::Separate))) if stereo == Stereo::Mono => {
+                eyes.swap_remove(0).into_layers().swap_remove(0)
+            }
             _ => Image::new(w, h, 3),
         };
         fmt.decode(&self.bytes, &mut img);
-        let env = match self.decided {
-            Some((proj, layout)) => layout
-                .unpack_owned(img, proj)
-                .map_err(|e| CliError::input(format!("{name}: {e}")))?,
+        let eyes = match self.decided {
+            Some((proj, layout)) => stereo
+                .split(img, reads)
+                .map_err(|e| CliError::request(format!("{name}: {e}")))?
+                .into_iter()
+                .map(|eye| {
+                    layout
+                        .unpack_owned(eye, proj)
+                        .map_err(|e| CliError::input(format!("{name}: {e}")))
+                })
+                .collect::<Result<Eyes, CliError>>()?,
             None => {
-                let (env, decided) = load::interpret(
+                let (left, right, decided) = load::interpret_eyes(
                     "-",
                     img,
+                    (stereo, reads),
                     self.plan.input.from.as_ref(),
                     self.plan.input.layout,
                     None,
@@ -316,21 +342,21 @@ impl Reader<'_> {
                 )?;
                 let layout = match self.plan.input.layout {
                     Some(l) => l,
-                    None => Layout::from_extent(w, h, env.layers().len())
+                    None => Layout::from_extent(left.width(), left.height(), left.layers().len())
                         .map(|l| l.0)
                         .unwrap_or(Layout::Separate),
                 };
                 if !self.a.quiet {
                     eprintln!(
                         "reading {w}x{h} {fmt} frames from standard input: {} — {decided}",
-                        env.projection().name()
+                        left.projection().name()
                     );
                 }
-                self.decided = Some((*env.projection(), layout));
-                env
+                self.decided = Some((*left.projection(), layout));
+                std::iter::once(left).chain(right).collect()
             }
         };
-        Ok((meta(n, name), env))
+        Ok((meta(n, name), eyes))
     }
 }
 
@@ -359,6 +385,7 @@ fn convert_frames(
         stdin: std::io::stdin(),
         bytes: Vec::new(),
         decided: None,
+        stereo: None,
         limits: mirrorball_io::Limits::default(),
     };
     let t0 = Instant::now();
@@ -367,10 +394,12 @@ fn convert_frames(
             "standard input ended before the first frame",
         ));
     };
-    let (meta0, src0) = first?;
+    let (meta0, eyes0) = first?;
+    let from = reader.stereo.unwrap_or_default();
+    let src0 = &eyes0[0];
     let size = plan
         .size
-        .unwrap_or_else(|| save::default_size(&src0, dst.kind()));
+        .unwrap_or_else(|| save::default_size(src0, dst.kind()));
     let (w, h) = dst.layer_extent(size);
     let c = src0.channels();
     let remap = Remap::with_extent(
@@ -387,8 +416,13 @@ fn convert_frames(
         0,
         (FRAMES_IN_FLIGHT + 1)
             * (frame_bytes(
-                src0.width() as u64 * src0.height() as u64 * src0.layers().len() as u64,
-            ) + 2 * frame_bytes(w as u64 * h as u64 * dst.layer_count() as u64))
+                src0.width() as u64
+                    * src0.height() as u64
+                    * src0.layers().len() as u64
+                    * eyes0.len() as u64,
+            ) + 2 * frame_bytes(
+                w as u64 * h as u64 * dst.layer_count() as u64 * plan.stereo.eyes() as u64,
+            ))
             + remap.memory_bytes() as u64,
         "a smaller --size",
     )?;
@@ -403,41 +437,43 @@ fn convert_frames(
             } else {
                 layout.extent(dst.layer_count(), w, h)
             };
+            let (pw, ph) = plan.stereo.extent(pw, ph);
             if !a.quiet {
                 eprintln!(
-                    "writing {pw}x{ph} {fmt} frames to standard output: {} {w}x{h}{} ({layout})",
+                    "writing {pw}x{ph} {fmt} frames to standard output: {} {w}x{h}{} ({layout}{})",
                     dst.name(),
-                    times(dst.layer_count())
+                    times(dst.layer_count()),
+                    match plan.stereo {
+                        Stereo::Mono => String::new(),
+                        s => format!(", each eye of a {s} pair"),
+                    }
                 );
             }
-            // Where every packed texel comes from, once: frames are encoded straight from
-            // the layers, or from each row as the Remap makes it; a layout whose texels are
-            // not all copies (EAC's border) is packed frame by frame.
-            let packing = Packing::new(layout, dst, (w, h));
-            if let Some(p) = &packing {
-                debug_assert_eq!(p.extent(), (pw, ph));
-            } else if (layout == Layout::Separate || !layout.fits(dst.layer_count()))
-                && dst.layer_count() > 1
-            {
-                return Err(CliError::request(format!(
-                    "--layout {layout} does not fit {}",
-                    dst.name()
-                )));
-            }
+            // Where every packed texel of a 2d frame comes from, once: frames are encoded
+            // straight from the layers, or from each row as the Remap makes it. A layout
+            // whose texels are not all copies (EAC's border) and stereo pairs are packed
+            // frame by frame.
+            let packing = (plan.stereo == Stereo::Mono)
+                .then(|| Packing::new(layout, dst, (w, h)))
+                .flatten();
             Some((layout, packing, *fmt))
         }
         _ => None,
     };
-
     let t_plan = t0.elapsed();
-    let fresh = || {
-        let layers = (0..dst.layer_count())
-            .map(|_| Image::new(w, h, c))
-            .collect();
-        EnvMap::new(dst, layers).expect("layers of the plan's shape")
+
+    let fresh = || -> Eyes {
+        (0..plan.stereo.eyes())
+            .map(|_| {
+                let layers = (0..dst.layer_count())
+                    .map(|_| Image::new(w, h, c))
+                    .collect();
+                EnvMap::new(dst, layers).expect("layers of the plan's shape")
+            })
+            .collect()
     };
-    let mut first = Some((meta0, src0));
-    let mut next = |spare: Option<EnvMap>| first.take().map(Ok).or_else(|| reader.next(spare));
+    let mut first = Some((meta0, eyes0));
+    let mut next = |spare: Option<Eyes>| first.take().map(Ok).or_else(|| reader.next(spare));
     let stdout = std::io::stdout();
     let logged = |m: &Meta, out: String, t: Instant| {
         log.line(
@@ -447,11 +483,33 @@ fn convert_frames(
             None,
         );
     };
-    let misfit = |m: &Meta, e: mirrorball_core::RemapError| {
-        CliError::input(format!(
-            "{}: {e} (every frame must have the first's projection and size)",
-            m.input
-        ))
+    let mut bytes = Vec::new();
+    let mut put = |m: &Meta, eyes: &Eyes| -> Result<(), CliError> {
+        let t = Instant::now();
+        let out: String = match (&output, &packed) {
+            (Output::Pipe(_), Some((layout, packing, fmt))) => {
+                let env = &eyes[0];
+                match packing {
+                    Some(p) => p.encode_layers(*fmt, env.layers(), &mut bytes),
+                    None => {
+                        let pic = save::pack_eyes(eyes, plan.stereo, *layout)
+                            .map_err(|e| e.context(format!("--layout {layout}")))?;
+                        Packing::single(pic.width(), pic.height()).encode_layers(
+                            *fmt,
+                            std::slice::from_ref(&pic),
+                            &mut bytes,
+                        );
+                    }
+                }
+                pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
+                "-".into()
+            }
+            (Output::Files(p), _) => save_frame(eyes, &p.path(m.number), plan)?,
+            (Output::File(s), _) => save_frame(eyes, Path::new(s), plan)?,
+            _ => unreachable!("a pipe has its format"),
+        };
+        logged(m, out, t);
+        Ok(())
     };
     let t1 = Instant::now();
     let done = with_progress("frames", total, a.quiet, |counter| {
@@ -460,8 +518,13 @@ fn convert_frames(
             // Rows made and encoded together: no float copy of the output frame.
             Some((_, Some(packing), fmt)) if packing.along_rows() => pipeline::run(
                 &mut next,
-                &|m: &Meta, src: &EnvMap, bytes: &mut Vec<u8>| {
-                    let rows = remap.rows(src).map_err(|e| misfit(m, e))?;
+                &|m: &Meta, src: &Eyes, bytes: &mut Vec<u8>| {
+                    let rows = remap.rows(&src[0]).map_err(|e| {
+                        CliError::input(format!(
+                            "{}: {e} (every frame must have the first's projection and size)",
+                            m.input
+                        ))
+                    })?;
                     packing.encode_rows(*fmt, &rows, bytes);
                     Ok(())
                 },
@@ -475,49 +538,19 @@ fn convert_frames(
                 },
                 &done,
             ),
-            _ => {
-                let mut bytes = Vec::new();
-                pipeline::run(
-                    &mut next,
-                    &|m: &Meta, src: &EnvMap, out: &mut EnvMap| {
-                        remap.apply_into(src, out).map_err(|e| misfit(m, e))
-                    },
-                    &fresh,
-                    &mut |m: &Meta, env: &EnvMap| {
-                        let t = Instant::now();
-                        let out: String = match (&output, &packed) {
-                            (Output::Pipe(_), Some((_, Some(packing), fmt))) => {
-                                packing.encode_layers(*fmt, env.layers(), &mut bytes);
-                                pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
-                                "-".into()
-                            }
-                            (Output::Pipe(_), Some((layout, None, fmt))) => {
-                                let pic = layout.pack(env).ok_or_else(|| {
-                                    CliError::request(format!(
-                                        "--layout {layout} does not fit {}",
-                                        dst.name()
-                                    ))
-                                })?;
-                                let (pw, ph) = (pic.width(), pic.height());
-                                Packing::single(pw, ph).encode_layers(
-                                    *fmt,
-                                    std::slice::from_ref(&pic),
-                                    &mut bytes,
-                                );
-                                pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
-                                "-".into()
-                            }
-                            (Output::Files(p), _) => save_frame(env, &p.path(m.number), plan)?,
-                            (Output::File(s), _) => save_frame(env, Path::new(s), plan)?,
-                            _ => unreachable!("a pipe has its format"),
-                        };
-                        logged(m, out, t);
-                        counter.fetch_add(1, Ordering::Relaxed);
-                        Ok(())
-                    },
-                    &done,
-                )
-            }
+            _ => pipeline::run(
+                &mut next,
+                &|m: &Meta, src: &Eyes, out: &mut Eyes| {
+                    pipeline::convert_eyes((&remap, from), m, src, out)
+                },
+                &fresh,
+                &mut |m: &Meta, e: &Eyes| {
+                    put(m, e)?;
+                    counter.fetch_add(1, Ordering::Relaxed);
+                    Ok(())
+                },
+                &done,
+            ),
         };
         (r, done.load(Ordering::Relaxed))
     });
@@ -540,18 +573,9 @@ fn convert_frames(
     result
 }
 
-/// " x6" after a layer's size, for maps of several layers.
-fn times(layers: usize) -> String {
-    if layers > 1 {
-        format!(" x{layers}")
-    } else {
-        String::new()
-    }
-}
-
 /// Writes one frame's file(s) through io's atomic writes; the name for the log.
-fn save_frame(env: &EnvMap, path: &Path, plan: &Plan) -> Result<String, CliError> {
+fn save_frame(eyes: &[EnvMap], path: &Path, plan: &Plan) -> Result<String, CliError> {
     let s = path.to_string_lossy().into_owned();
-    save::save(env, &s, &plan.save)?;
+    save::save_eyes(eyes, plan.stereo, &s, &plan.save)?;
     Ok(s)
 }

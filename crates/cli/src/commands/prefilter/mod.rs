@@ -6,7 +6,7 @@
 //! bright split) → one lobe per level (progress bar) → KTX2/DDS cube with the chain, or one
 //! image per level → SH JSON → preview PNG (outputs.rs)`.
 
-mod outputs;
+pub(crate) mod outputs;
 mod plan;
 
 use crate::budget;

@@ -55,8 +55,7 @@ pub(super) fn check_parent(p: &Path, what: &str) -> Result<(), CliError> {
 pub(super) fn write_chain(plan: &Plan, chain: &[EnvMap]) -> Result<Vec<String>, CliError> {
     let mut written = Vec::new();
     if plan.format.is_cube_container() {
-        let faces: Vec<Vec<Image>> = chain.iter().map(|l| l.layers().to_vec()).collect();
-        mirrorball_io::write_cube(Path::new(&plan.output), &faces, &plan.save.write)?;
+        write_cube_chain(Path::new(&plan.output), chain, &plan.save.write)?;
         written.push(plan.output.clone());
     } else {
         for (i, level) in chain.iter().enumerate() {
@@ -65,6 +64,18 @@ pub(super) fn write_chain(plan: &Plan, chain: &[EnvMap]) -> Result<Vec<String>, 
         }
     }
     Ok(written)
+}
+
+/// A cube chain (level 0 first) as one KTX2 or DDS file (by `path`'s extension): what
+/// `prefilter` writes, and the studio's download of its chain.
+pub(crate) fn write_cube_chain(
+    path: &Path,
+    chain: &[EnvMap],
+    write: &WriteOptions,
+) -> Result<(), CliError> {
+    let faces: Vec<Vec<Image>> = chain.iter().map(|l| l.layers().to_vec()).collect();
+    mirrorball_io::write_cube(path, &faces, write)?;
+    Ok(())
 }
 
 /// A level's lobe as the JSON names it.

@@ -9,7 +9,7 @@
 mod material;
 mod output;
 mod plan;
-mod schema;
+pub(crate) mod schema;
 
 use crate::budget;
 use crate::error::CliError;
@@ -75,13 +75,40 @@ fn load_scene(plan: &RenderPlan) -> Result<Scene, CliError> {
 }
 
 /// What `mirrorball render` with `a` would draw, loaded, with its camera, settings,
-/// exposure and tone curve: what `mirrorball studio` shows.
+/// exposure and tone curve, and per object the built-in and tessellation it was made from
+/// (none for a mesh file): what `mirrorball studio` shows.
+#[allow(clippy::type_complexity)]
 pub fn studio_scene(
     a: &RenderArgs,
-) -> Result<(Scene, Camera, Settings, f32, tone::Tone), CliError> {
+) -> Result<
+    (
+        Scene,
+        Camera,
+        Settings,
+        f32,
+        tone::Tone,
+        Vec<Option<(mirrorball_render::Builtin, u32)>>,
+    ),
+    CliError,
+> {
     let plan = RenderPlan::new(a)?;
     let scene = load_scene(&plan)?;
-    Ok((scene, plan.camera, plan.settings, plan.exposure, plan.tone))
+    let builtins = plan
+        .objects
+        .iter()
+        .map(|o| match o.source {
+            MeshSource::Builtin(b, l) => Some((b, l)),
+            MeshSource::File(_) => None,
+        })
+        .collect();
+    Ok((
+        scene,
+        plan.camera,
+        plan.settings,
+        plan.exposure,
+        plan.tone,
+        builtins,
+    ))
 }
 
 /// The environment map `file`, sanitized unless asked not to, converted as `--env-as` says.

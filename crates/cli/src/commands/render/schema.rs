@@ -82,6 +82,49 @@ pub(super) fn apply(plan: &mut RenderPlan, path: &Path, given: &[String]) -> Res
     plan.camera.validate().map_err(|e| bad("camera", e))
 }
 
+/// The scene file at `path` as JSON that means the same wherever it is written: the file
+/// checked as `render` reads it, then its environment's file and each mesh that is not a
+/// built-in made absolute (they are relative to the scene file's folder). The studio
+/// exports the scene from it.
+pub fn portable(path: &Path) -> Result<serde_json::Value, CliError> {
+    let scene = Scene::read(path)?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let mut v: serde_json::Value = if scene.is_toml() {
+        toml::from_str(&text).map_err(|e| scene.error(e.to_string()))?
+    } else {
+        serde_json::from_str(&text).map_err(|e| scene.error(e.to_string()))?
+    };
+    let absolute = |f: &str| -> serde_json::Value {
+        let p = scene.relative(f);
+        std::path::absolute(&p)
+            .map_or(p, |a| a.to_string_lossy().into_owned())
+            .into()
+    };
+    if let Some(file) = v.pointer("/environment/file").and_then(|f| f.as_str()) {
+        let file = absolute(file);
+        v["environment"]["file"] = file;
+    }
+    if let Some(meshes) = v.get_mut("meshes").and_then(|m| m.as_array_mut()) {
+        for m in meshes {
+            if let Some(name) = m.get("mesh").and_then(|n| n.as_str()) {
+                if Builtin::from_name(name).is_none() {
+                    let file = absolute(name);
+                    m["mesh"] = file;
+                }
+            }
+        }
+    }
+    Ok(v)
+}
+
+/// Whether `path` names a TOML scene (else JSON).
+fn is_toml(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+}
+
 /// A scene file read, with what its messages and relative paths need.
 struct Scene<'a> {
     file: SceneFile,
@@ -104,11 +147,7 @@ impl<'a> Scene<'a> {
                 format!("{name}: cannot read the scene file: {e}{hint}"),
             )
         })?;
-        let is_toml = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-        let file: SceneFile = if is_toml {
+        let file: SceneFile = if is_toml(path) {
             toml::from_str(&text)
                 .map_err(|e| CliError::input(format!("{name}: not a valid TOML scene: {e}")))?
         } else {
@@ -116,6 +155,11 @@ impl<'a> Scene<'a> {
                 .map_err(|e| CliError::input(format!("{name}: not a valid JSON scene: {e}")))?
         };
         Ok(Scene { file, path })
+    }
+
+    /// Whether the file is TOML (by its extension; else JSON).
+    fn is_toml(&self) -> bool {
+        is_toml(self.path)
     }
 
     /// A path the file gives, relative to the file's folder unless absolute.
