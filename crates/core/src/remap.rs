@@ -197,19 +197,20 @@ impl Remap {
             Vec::with_capacity(n),
         );
         for layer in 0..n {
-            let rows: Vec<PlannedRow> = (0..job.h as usize)
-                .into_par_iter()
+            // Each row's lookups are planned in place; its taps, few, are gathered after.
+            let mut t = vec![EMPTY; job.w as usize * job.h as usize];
+            let rows: Vec<PlannedRow> = t
+                .par_chunks_mut(job.w as usize)
+                .enumerate()
                 .map_init(
                     || (RowScratch::new(job.w as usize), PointScratch::new()),
-                    |(s, ps), y| plan_row(&job, (sw, sh), s, ps, layer, y),
+                    |(s, ps), (y, texels)| plan_row(&job, (sw, sh), s, ps, layer, y, texels),
                 )
                 .collect();
-            let mut t = Vec::with_capacity(job.w as usize * job.h as usize);
             let (mut g, mut k) = (Vec::new(), Vec::new());
             let mut starts = Vec::with_capacity(rows.len() + 1);
             starts.push((0u32, 0u32));
             for r in rows {
-                t.extend_from_slice(&r.texels);
                 g.extend_from_slice(&r.groups);
                 k.extend_from_slice(&r.taps);
                 starts.push((g.len() as u32, k.len() as u32));
@@ -403,12 +404,8 @@ impl<'a> RemapRows<'a> {
             *p = l.data();
         }
         match self.c {
-            3 => self
-                .remap
-                .fill_row::<3>(&self.pyr, &planes, layer, y, row),
-            _ => self
-                .remap
-                .fill_row::<4>(&self.pyr, &planes, layer, y, row),
+            3 => self.remap.fill_row::<3>(&self.pyr, &planes, layer, y, row),
+            _ => self.remap.fill_row::<4>(&self.pyr, &planes, layer, y, row),
         }
     }
 }
@@ -536,9 +533,8 @@ fn sum_taps<const C: usize>(taps: &[Tap], level: &[Image], out: &mut [f32]) {
     }
 }
 
-/// One planned output row.
+/// One planned output row's taps (its lookups are written into the plan in place).
 struct PlannedRow {
-    texels: Vec<Texel>,
     groups: Vec<Group>,
     taps: Vec<Tap>,
 }
@@ -578,10 +574,10 @@ fn plan_row(
     ps: &mut PointScratch,
     layer: usize,
     y: usize,
+    texels: &mut [Texel],
 ) -> PlannedRow {
     job.locate(s, layer, y);
     let mut row = PlannedRow {
-        texels: vec![EMPTY; job.w as usize],
         groups: Vec::new(),
         taps: Vec::new(),
     };
@@ -610,7 +606,7 @@ fn plan_row(
         // inside the layer, else as taps that cross the seam.
         row.taps.truncate(start);
         match interior(sw, sh, lk.layer, lk.u, lk.v) {
-            Some(t) => row.texels[x] = t,
+            Some(t) => texels[x] = t,
             None => {
                 push_bilinear(&job.sproj, (sw, sh), lk, 1.0, &mut row.taps);
                 row.close(x, 0, start, 1.0);

@@ -278,25 +278,28 @@ impl PyramidPlan {
 fn block_weights(proj: &Projection, layer: usize, w: u32, h: u32) -> Vec<[f32; 4]> {
     let (nw, nh) = half_extent(w, h);
     let mut out = vec![[0.0f32; 4]; nw as usize * nh as usize];
-    out.par_chunks_mut(nw as usize)
-        .enumerate()
-        .for_each_init(
-            || (vec![None; w as usize], vec![None; w as usize]),
-            |(d0, d1), (y, row)| {
-                let ys = [(2 * y as u32).min(h - 1), (2 * y as u32 + 1).min(h - 1)];
-                proj.row_dirs(layer, ys[0], w, h, d0);
-                proj.row_dirs(layer, ys[1], w, h, d1);
-                for (x, wt) in row.iter_mut().enumerate() {
-                    let xs = [(2 * x).min(w as usize - 1), (2 * x + 1).min(w as usize - 1)];
-                    let dens = |d: &[Option<(DVec3, f64)>], sx: usize| {
-                        d[sx].map_or(0.0, |(_, dn)| dn).max(1e-12)
-                    };
-                    let q = [dens(d0, xs[0]), dens(d0, xs[1]), dens(d1, xs[0]), dens(d1, xs[1])];
-                    let sum: f64 = q.iter().sum();
-                    *wt = q.map(|v| (v / sum) as f32);
-                }
-            },
-        );
+    out.par_chunks_mut(nw as usize).enumerate().for_each_init(
+        || (vec![None; w as usize], vec![None; w as usize]),
+        |(d0, d1), (y, row)| {
+            let ys = [(2 * y as u32).min(h - 1), (2 * y as u32 + 1).min(h - 1)];
+            proj.row_dirs(layer, ys[0], w, h, d0);
+            proj.row_dirs(layer, ys[1], w, h, d1);
+            for (x, wt) in row.iter_mut().enumerate() {
+                let xs = [(2 * x).min(w as usize - 1), (2 * x + 1).min(w as usize - 1)];
+                let dens = |d: &[Option<(DVec3, f64)>], sx: usize| {
+                    d[sx].map_or(0.0, |(_, dn)| dn).max(1e-12)
+                };
+                let q = [
+                    dens(d0, xs[0]),
+                    dens(d0, xs[1]),
+                    dens(d1, xs[0]),
+                    dens(d1, xs[1]),
+                ];
+                let sum: f64 = q.iter().sum();
+                *wt = q.map(|v| (v / sum) as f32);
+            }
+        },
+    );
     out
 }
 
@@ -317,7 +320,8 @@ fn downsample_into(img: &Image, weights: &[[f32; 4]], out: &mut Image) {
             for (x, (o, q)) in row.chunks_exact_mut(c).zip(wts).enumerate() {
                 let (a, b) = ((2 * x).min(w - 1) * c, (2 * x + 1).min(w - 1) * c);
                 for i in 0..c {
-                    o[i] = q[0] * r0[a + i] + q[1] * r0[b + i] + q[2] * r1[a + i] + q[3] * r1[b + i];
+                    o[i] =
+                        q[0] * r0[a + i] + q[1] * r0[b + i] + q[2] * r1[a + i] + q[3] * r1[b + i];
                 }
             }
         });
