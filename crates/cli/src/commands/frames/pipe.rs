@@ -203,7 +203,7 @@ impl SrgbTable {
                 .map(|k| code(TABLE_FROM + ((k as u32) << PIECE_SHIFT)) as f32)
                 .collect();
             let direct = if scale <= 255.0 {
-                let n = ((1.0f32.to_bits() - TABLE_FROM) >> DIRECT_SHIFT) as u32;
+                let n = (1.0f32.to_bits() - TABLE_FROM) >> DIRECT_SHIFT;
                 (0..n)
                     .map(|k| {
                         let centre = TABLE_FROM + (k << DIRECT_SHIFT) + (1 << (DIRECT_SHIFT - 1));
@@ -231,7 +231,7 @@ impl SrgbTable {
     /// keeps 0 over NaN), or `None` above it; `scale` at and above 1.
     #[inline(always)]
     fn ends(&self, l: f32) -> Option<u32> {
-        if !(l > mirrorball_core::color::SRGB_LINEAR_KNEE as f32) {
+        if l.is_nan() || l <= mirrorball_core::color::SRGB_LINEAR_KNEE as f32 {
             return Some(
                 (l.max(0.0) * (mirrorball_core::color::SRGB_SLOPE as f32 * self.scale) + 0.5)
                     as u32,
