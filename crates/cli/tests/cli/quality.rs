@@ -14,7 +14,7 @@ fn edge_for_budget(kind: ProjectionKind, budget: f64) -> u32 {
 }
 
 /// Recorded log-PSNR (dB) at 1× budget: city, venice, studio, sky.
-const RECORDED: [(ProjectionKind, [f64; 4]); 16] = [
+const RECORDED: [(ProjectionKind, [f64; 4]); 18] = [
     (ProjectionKind::Cube, [43.76, 41.30, 39.36, 43.91]),
     (ProjectionKind::Sphere, [40.88, 35.12, 38.93, 42.85]),
     (ProjectionKind::Paraboloid, [43.00, 40.31, 39.89, 43.96]),
@@ -37,12 +37,14 @@ const RECORDED: [(ProjectionKind, [f64; 4]); 16] = [
     (ProjectionKind::Sinusoidal, [44.88, 47.24, 41.81, 44.86]),
     (ProjectionKind::Perspective, [40.15, 38.35, 50.74, 42.54]),
     (ProjectionKind::Pannini, [44.27, 39.20, 47.27, 43.15]),
+    (ProjectionKind::Eac, [45.05, 42.89, 40.11, 43.60]),
+    (ProjectionKind::DualFisheye, [43.90, 42.39, 39.30, 43.44]),
 ];
 
 /// Recorded log-PSNR (dB) at 4× budget for the newer projections (measured by this test's
 /// own output, opt-level 2): city, venice, studio, sky.
 /// A new projection is one row here and one in [`RECORDED`].
-const RECORDED_4X: [(ProjectionKind, [f64; 4]); 7] = [
+const RECORDED_4X: [(ProjectionKind, [f64; 4]); 9] = [
     (ProjectionKind::Cylindrical, [45.71, 42.18, 38.72, 51.48]),
     (
         ProjectionKind::CylindricalEqualArea,
@@ -53,6 +55,8 @@ const RECORDED_4X: [(ProjectionKind, [f64; 4]); 7] = [
     (ProjectionKind::Sinusoidal, [46.30, 44.07, 39.42, 44.00]),
     (ProjectionKind::Perspective, [39.80, 38.07, 50.48, 42.29]),
     (ProjectionKind::Pannini, [44.02, 38.83, 47.10, 42.87]),
+    (ProjectionKind::Eac, [46.64, 43.77, 39.75, 43.90]),
+    (ProjectionKind::DualFisheye, [47.29, 44.05, 39.79, 44.72]),
 ];
 
 #[test]
