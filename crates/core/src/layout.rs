@@ -443,6 +443,17 @@ impl Layout {
         None
     }
 
+    /// The texels of [`Layout::pack`]'s picture of a map of projection `p` with layers of
+    /// `n`×`n` texels that are looked up in a direction rather than copied from a layer
+    /// texel, as `(x, y, direction)` row by row: EAC's two-texel border (`pack` reads each
+    /// with [`EnvMap::sample`]); none for every other layout.
+    pub fn looked_up_texels(self, p: &Projection, n: u32) -> Vec<(u32, u32, DVec3)> {
+        match self {
+            Layout::Cells(cells) => cells.looked_up(p, n),
+            _ => Vec::new(),
+        }
+    }
+
     /// Packs the layers of `env` into one picture (unused cross cells are black with zero
     /// alpha). For [`Layout::Separate`] the map must have a single layer.
     pub fn pack(self, env: &EnvMap) -> Option<Image> {
@@ -604,25 +615,33 @@ fn pack_cells(cells: &CubeCells, env: &EnvMap) -> Image {
     let ch = env.channels();
     let mut out = Image::new(w, h, ch);
     let layers = env.layers();
-    let mut inside = vec![!cells.eac_pad; if cells.eac_pad { (w * h) as usize } else { 0 }];
     cells.each_texel(n, |i, px, py, fx, fy| {
         out.set(px, py, layers[cells.faces[i] as usize].get(fx, fy));
-        if cells.eac_pad {
-            inside[(py * w + px) as usize] = true;
-        }
     });
-    if cells.eac_pad {
-        let p = env.projection();
-        for py in 0..h {
-            for px in 0..w {
-                if !inside[(py * w + px) as usize] {
-                    let v = env.sample(cells.border_dir(p, n, px, py));
-                    out.set(px, py, &v[..ch]);
-                }
-            }
-        }
+    for (px, py, d) in cells.looked_up(env.projection(), n) {
+        let v = env.sample(d);
+        out.set(px, py, &v[..ch]);
     }
     out
+}
+
+impl CubeCells {
+    /// The texels of the picture (faces of `n` texels, a map of projection `p`) that show
+    /// no face texel but are looked up in a direction: EAC's two-texel border, each in
+    /// [`CubeCells::border_dir`]'s direction; none without the padding. Row by row.
+    fn looked_up(&self, p: &Projection, n: u32) -> Vec<(u32, u32, DVec3)> {
+        if !self.eac_pad {
+            return Vec::new();
+        }
+        let (w, h) = self.extent(n);
+        let mut inside = vec![false; (w * h) as usize];
+        self.each_texel(n, |_, px, py, _, _| inside[(py * w + px) as usize] = true);
+        (0..h)
+            .flat_map(|py| (0..w).map(move |px| (px, py)))
+            .filter(|&(px, py)| !inside[(py * w + px) as usize])
+            .map(|(px, py)| (px, py, self.border_dir(p, n, px, py)))
+            .collect()
+    }
 }
 
 /// [`Layout::unpack`] for v360's cells.

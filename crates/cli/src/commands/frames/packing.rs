@@ -8,6 +8,7 @@
 //! layout `pack` knows (cells turned or not) is encoded as `pack` would place it.
 
 use super::pipe::{PixFmt, SrgbTable};
+use mirrorball_core::glam::DVec3;
 use mirrorball_core::{EnvMap, Image, Layout, Projection, RemapRows, WorldProjection};
 use rayon::prelude::*;
 
@@ -45,13 +46,16 @@ pub struct Packing {
     gaps: bool,
     /// Every run lies along a layer row, so rows made one at a time can be encoded.
     along_rows: bool,
+    /// Packed texels looked up in a direction, not copied (EAC's border): `(index, dir)`,
+    /// read from each frame's map as `Layout::pack` reads them.
+    lookups: Vec<(u32, DVec3)>,
 }
 
 impl Packing {
     /// The packing of `dst`'s `w`×`h` layers by `layout` (a single layer, or `Separate`,
-    /// is the layer itself); `None` if the layout does not fit `dst`, or if it places
-    /// texels that are not copies of one layer texel (EAC's border, looked up in each
-    /// border texel's direction): such frames are packed with `Layout::pack`.
+    /// is the layer itself); `None` if the layout does not fit `dst`. Texels the layout
+    /// looks up in a direction (EAC's border: `Layout::looked_up_texels`) are kept as
+    /// lookups, made from each frame's map ([`Packing::encode_map`]).
     pub fn new(layout: Layout, dst: Projection, (w, h): (u32, u32)) -> Option<Packing> {
         let n = dst.layer_count();
         if n == 1 || layout == Layout::Separate {
@@ -77,6 +81,16 @@ impl Packing {
         let pic = layout.pack(&probe)?;
         drop(probe);
         let (pw, ph) = (pic.width(), pic.height());
+        let mut looked_up = vec![false; pw as usize * ph as usize];
+        let lookups: Vec<(u32, DVec3)> = layout
+            .looked_up_texels(&dst, w)
+            .into_iter()
+            .map(|(x, y, d)| {
+                let i = y * pw + x;
+                looked_up[i as usize] = true;
+                (i, d)
+            })
+            .collect();
         let mut runs: Vec<Run> = Vec::new();
         let mut row_starts = Vec::with_capacity(ph as usize + 1);
         let mut gaps = false;
@@ -84,12 +98,15 @@ impl Packing {
             row_starts.push(runs.len() as u32);
             let first = runs.len();
             for (at, t) in row.chunks_exact(3).enumerate() {
+                if looked_up[r * pw as usize + at] {
+                    continue;
+                }
                 if t[0] == 0.0 {
                     gaps = true;
                     continue;
                 }
-                // A texel `pack` made by looking up a direction (EAC's border) holds a blend
-                // of positions, not one: such a layout is packed frame by frame instead.
+                // Every other texel is a copy of one layer texel (a blend of positions here
+                // would be a layout this does not know).
                 if t.iter().any(|v| v.fract() != 0.0)
                     || t[0] as usize > n
                     || t[1] >= w as f32
@@ -128,7 +145,7 @@ impl Packing {
             }
         }
         row_starts.push(runs.len() as u32);
-        let along_rows = runs.iter().all(Run::along_row);
+        let along_rows = lookups.is_empty() && runs.iter().all(Run::along_row);
         Some(Packing {
             width: pw,
             height: ph,
@@ -137,6 +154,7 @@ impl Packing {
             runs,
             gaps,
             along_rows,
+            lookups,
         })
     }
 
@@ -161,6 +179,7 @@ impl Packing {
             runs,
             gaps: false,
             along_rows: true,
+            lookups: Vec::new(),
         }
     }
 
@@ -191,6 +210,42 @@ impl Packing {
                 &data[y * w * c..(y + 1) * w * c]
             }))
         });
+    }
+
+    /// Encodes `env` (the packing's projection and size) as one `fmt` frame into `out`, as
+    /// `fmt` would encode `Layout::pack`'s picture: the copied texels from its layers, the
+    /// looked-up ones (EAC's border) read from it in their directions.
+    pub fn encode_map(&self, fmt: PixFmt, env: &EnvMap, out: &mut Vec<u8>) {
+        self.encode_layers(fmt, env.layers(), out);
+        if self.lookups.is_empty() {
+            return;
+        }
+        let c = env.channels();
+        let values: Vec<f32> = self
+            .lookups
+            .par_iter()
+            .flat_map_iter(|&(_, d)| {
+                let v = env.sample(d);
+                (0..c).map(move |k| v[k])
+            })
+            .collect();
+        let table = fmt.table();
+        let n = self.width as usize * self.height as usize;
+        for (&(i, _), v) in self.lookups.iter().zip(values.chunks_exact(c)) {
+            let i = i as usize;
+            match fmt {
+                PixFmt::Gbrpf32le => {
+                    for (plane, k) in [(0, 1), (1, 2), (2, 0)] {
+                        let at = (plane * n + i) * 4;
+                        out[at..at + 4].copy_from_slice(&v[k].to_le_bytes());
+                    }
+                }
+                _ => {
+                    let px = fmt.pixel_bytes();
+                    fmt.encode_texels(table, v, c, &mut out[i * px..(i + 1) * px]);
+                }
+            }
+        }
     }
 
     /// Encodes the frame whose rows `rows` makes (a `Remap` of the packing's layers) into
@@ -281,11 +336,26 @@ fn gather<'s, 'r>(
     into: &'s mut Vec<f32>,
     row: impl Fn(usize) -> &'r [f32],
 ) -> &'s [f32] {
-    into.clear();
-    for k in 0..run.len as i64 {
-        let x = (run.x as i64 + run.dx as i64 * k) as usize;
-        let y = (run.y as i64 + run.dy as i64 * k) as usize;
-        into.extend_from_slice(&row(y)[x * c..(x + 1) * c]);
+    match c {
+        3 => gather_c::<3, _>(run, into, row),
+        _ => gather_c::<4, _>(run, into, row),
+    }
+}
+
+/// [`gather`] for `C` channels, each texel copied as one fixed-size piece.
+#[inline(always)]
+fn gather_c<'s, 'r, const C: usize, R: Fn(usize) -> &'r [f32]>(
+    run: &Run,
+    into: &'s mut Vec<f32>,
+    row: R,
+) -> &'s [f32] {
+    into.resize(run.len as usize * C, 0.0);
+    for (k, t) in into.chunks_exact_mut(C).enumerate() {
+        let x = (run.x as i64 + run.dx as i64 * k as i64) as usize;
+        let y = (run.y as i64 + run.dy as i64 * k as i64) as usize;
+        let src: &[f32; C] = row(y)[x * C..(x + 1) * C].try_into().expect("C floats");
+        let dst: &mut [f32; C] = t.try_into().expect("C floats");
+        *dst = *src;
     }
     into
 }
@@ -367,8 +437,24 @@ mod tests {
             (8, 4)
         );
         assert!(Packing::new(Layout::Separate, cube, (8, 8)).is_none());
-        // EAC's border texels are looked up, not copied: no packing, `pack` per frame.
+        // EAC's border texels are looked up, not copied: read from the map in their
+        // directions, the same bytes as `pack`'s picture encoded.
         let eac = ProjectionKind::Eac.default_projection();
-        assert!(Packing::new(Layout::default_for(ProjectionKind::Eac), eac, (16, 16)).is_none());
+        let layout = Layout::default_for(ProjectionKind::Eac);
+        let env = EnvMap::new(eac, layers(eac, 16, 16)).unwrap();
+        let p = Packing::new(layout, eac, (16, 16)).unwrap();
+        assert!(!p.along_rows() && !p.lookups.is_empty());
+        let pic = layout.pack(&env).unwrap();
+        for fmt in [
+            PixFmt::Rgb24,
+            PixFmt::Rgb48le,
+            PixFmt::Rgbf32le,
+            PixFmt::Gbrpf32le,
+        ] {
+            let (mut want, mut got) = (Vec::new(), Vec::new());
+            fmt.encode(&pic, &mut want);
+            p.encode_map(fmt, &env, &mut got);
+            assert!(want == got, "eac {fmt}: bytes differ");
+        }
     }
 }

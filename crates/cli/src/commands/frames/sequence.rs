@@ -450,9 +450,8 @@ fn convert_frames(
                 );
             }
             // Where every packed texel of a 2d frame comes from, once: frames are encoded
-            // straight from the layers, or from each row as the Remap makes it. A layout
-            // whose texels are not all copies (EAC's border) and stereo pairs are packed
-            // frame by frame.
+            // straight from the layers (EAC's border looked up in the map), or from each
+            // row as the Remap makes it. Stereo pairs are packed frame by frame.
             let packing = (plan.stereo == Stereo::Mono)
                 .then(|| Packing::new(layout, dst, (w, h)))
                 .flatten();
@@ -490,7 +489,7 @@ fn convert_frames(
             (Output::Pipe(_), Some((layout, packing, fmt))) => {
                 let env = &eyes[0];
                 match packing {
-                    Some(p) => p.encode_layers(*fmt, env.layers(), &mut bytes),
+                    Some(p) => p.encode_map(*fmt, env, &mut bytes),
                     None => {
                         let pic = save::pack_eyes(eyes, plan.stereo, *layout)
                             .map_err(|e| e.context(format!("--layout {layout}")))?;
