@@ -19,6 +19,7 @@
 import { existsSync, writeFileSync } from 'node:fs';
 import { execFileSync } from 'node:child_process';
 import path from 'node:path';
+import { loadavg } from 'node:os';
 import { browser, studio, openStudio, tempDir, ROOT } from '../tests/browser/lib.mjs';
 
 const FRAMES = Number(process.env.FRAMES || 30);
@@ -73,6 +74,7 @@ async function timedGet(url, what) {
 const CUBE = '/api/environment?projection=cube&size=1024&precision=half';
 const EVICT = '/api/environment?projection=cube&size=8&precision=half';
 
+const loadBefore = loadavg()[0];
 const tmp = tempDir('mirrorball-studio-speed-');
 const chromium = await browser();
 const rows = [];
@@ -178,7 +180,7 @@ try {
 const head = ['measure', 'median', 'worst'];
 const width = head.map((h, i) => Math.max(h.length, ...rows.map((r) => r[i].length)));
 const line = (r) => `| ${r.map((c, i) => c.padEnd(width[i])).join(' | ')} |`;
-console.log(`mirrorball studio speed: ${BUILD} build (${path.relative(ROOT, BINARY) || BINARY}), Chromium SwiftShader WebGL2`);
+console.log(`mirrorball studio speed: ${BUILD} build (${path.relative(ROOT, BINARY) || BINARY}), Chromium SwiftShader WebGL2; load average ${loadBefore.toFixed(2)} before, ${loadavg()[0].toFixed(2)} after`);
 console.log(line(head));
 console.log(`|${width.map((w) => '-'.repeat(w + 2)).join('|')}|`);
 for (const r of rows) console.log(line(r));
