@@ -23,7 +23,7 @@ import { loadavg } from 'node:os';
 import { browser, studio, openStudio, tempDir, ROOT } from '../tests/browser/lib.mjs';
 
 const FRAMES = Number(process.env.FRAMES || 30);
-const COLD = Number(process.env.COLD || 2);
+const COLD = Number(process.env.COLD || 3);
 
 if (!process.env.MIRRORBALL) {
   const release = path.join(ROOT, 'target', 'release', 'mirrorball');
