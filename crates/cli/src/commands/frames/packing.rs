@@ -230,7 +230,10 @@ impl Packing {
             })
             .collect();
         let table = fmt.table();
-        let n = self.width as usize * self.height as usize;
+        let (n, px) = (
+            self.width as usize * self.height as usize,
+            fmt.pixel_bytes(),
+        );
         for (&(i, _), v) in self.lookups.iter().zip(values.chunks_exact(c)) {
             let i = i as usize;
             match fmt {
@@ -240,10 +243,7 @@ impl Packing {
                         out[at..at + 4].copy_from_slice(&v[k].to_le_bytes());
                     }
                 }
-                _ => {
-                    let px = fmt.pixel_bytes();
-                    fmt.encode_texels(table, v, c, &mut out[i * px..(i + 1) * px]);
-                }
+                _ => fmt.encode_texels(table, v, c, &mut out[i * px..(i + 1) * px]),
             }
         }
     }

@@ -12,7 +12,7 @@
 //! `Remap` makes it, so the frame never exists as floats).
 
 use crate::error::CliError;
-use mirrorball_core::{EnvMap, Remap, Stereo};
+use mirrorball_core::{EnvMap, Remap, RemapError, Stereo};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender};
 
@@ -92,6 +92,14 @@ fn read_stage(
     }
 }
 
+/// The error of a frame the plan was not made for.
+pub fn misfit(meta: &Meta, err: RemapError) -> CliError {
+    CliError::input(format!(
+        "{}: {err} (every frame must have the first's projection and size)",
+        meta.input
+    ))
+}
+
 /// Makes every output eye of `out` from source frame `src` (arranged as `from`) with
 /// `remap`: each from its `Stereo::source_eye`, an eye made from the same source eye as the
 /// one before it copied.
@@ -118,12 +126,9 @@ pub fn convert_eyes(
                 from.eyes()
             ))
         })?;
-        remap.apply_into(src_eye, &mut out[e]).map_err(|err| {
-            CliError::input(format!(
-                "{}: {err} (every frame must have the first's projection and size)",
-                meta.input
-            ))
-        })?;
+        remap
+            .apply_into(src_eye, &mut out[e])
+            .map_err(|err| misfit(meta, err))?;
     }
     Ok(())
 }

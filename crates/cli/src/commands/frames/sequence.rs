@@ -518,12 +518,7 @@ fn convert_frames(
             Some((_, Some(packing), fmt)) if packing.along_rows() => pipeline::run(
                 &mut next,
                 &|m: &Meta, src: &Eyes, bytes: &mut Vec<u8>| {
-                    let rows = remap.rows(&src[0]).map_err(|e| {
-                        CliError::input(format!(
-                            "{}: {e} (every frame must have the first's projection and size)",
-                            m.input
-                        ))
-                    })?;
+                    let rows = remap.rows(&src[0]).map_err(|e| pipeline::misfit(m, e))?;
                     packing.encode_rows(*fmt, &rows, bytes);
                     Ok(())
                 },
