@@ -52,7 +52,11 @@ export async function serve(bakedDir) {
 export async function browser() {
   return chromium.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
+    // --ignore-gpu-blocklist gives WebGL2 on SwiftShader, and with it Skia's accelerated 2D
+    // canvas on SwiftShader too, which Chromium never picks for a software renderer itself:
+    // there the studio's map panel (a 2D canvas) held the next WebGL read back 15-50 s a
+    // frame. The 2D canvases stay in software, as on a machine without a GPU.
+    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--disable-accelerated-2d-canvas'],
   });
 }
 
@@ -238,6 +242,7 @@ export async function studio(files = []) {
 /// its console messages and errors.
 export async function openStudio(chromium, url) {
   const page = await chromium.newPage({ deviceScaleFactor: 1 });
+  await carrying(page);
   const logs = [];
   page.on('console', (m) => logs.push(m.text()));
   page.on('pageerror', (e) => logs.push(String(e)));
@@ -245,6 +250,36 @@ export async function openStudio(chromium, url) {
   await page.waitForFunction(() => window.studio, null, { timeout: 60000 });
   await page.evaluate(() => window.studio.ready);
   return { page, logs };
+}
+
+/// `window.carry(typed)` on every document `page` opens: a typed array's bytes as base64.
+/// Playwright carries a plain array out of a page number by number (15 s for one 640×480
+/// RGBA picture); a string crosses at once. [`carried`] turns it back into numbers.
+export async function carrying(page) {
+  await page.addInitScript(() => {
+    window.carry = (a) => {
+      const u = new Uint8Array(a.buffer, a.byteOffset, a.byteLength);
+      let s = '';
+      for (let i = 0; i < u.length; i += 0x8000) s += String.fromCharCode.apply(null, u.subarray(i, i + 0x8000));
+      return btoa(s);
+    };
+  });
+}
+
+/// The typed array (`Type`, Uint8Array unless told) that `window.carry` made `b64` of.
+export function carried(b64, Type = Uint8Array) {
+  const bytes = new Uint8Array(Buffer.from(b64, 'base64'));
+  return new Type(bytes.buffer, 0, bytes.length / Type.BYTES_PER_ELEMENT);
+}
+
+/// The studio viewport's pixels on `page` (opened by [`openStudio`] or made [`carrying`]):
+/// `{ width, height, data }`, RGBA8, top row first.
+export async function viewportPixels(page) {
+  const p = await page.evaluate(() => {
+    const p = window.studio.pixels();
+    return { width: p.width, height: p.height, data: window.carry(p.data) };
+  });
+  return { ...p, data: carried(p.data) };
 }
 
 /// A studio viewport's RGBA8 pixels `gpu` against `mirrorball render`'s picture `full` of

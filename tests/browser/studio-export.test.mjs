@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, run, tempDir, readPng, studio, openStudio, againstRender, ROOT } from './lib.mjs';
+import { browser, run, tempDir, readPng, studio, openStudio, viewportPixels, againstRender, ROOT } from './lib.mjs';
 
 let chromium;
 let work;
@@ -63,10 +63,7 @@ test('the map, the GGX chain and the screenshot download from the page, and mirr
     const shot = await clickDownload(page, '#screenshot');
     assert.equal(path.basename(shot), 'mirrorball-viewport.png');
     const png = readPng(readFileSync(shot));
-    const px = await page.evaluate(() => {
-      const p = window.studio.pixels();
-      return { width: p.width, height: p.height, data: Array.from(p.data) };
-    });
+    const px = await viewportPixels(page);
     assert.equal(png.width, px.width);
     assert.equal(png.height, px.height);
     assert.equal(png.channels, 4);
@@ -98,10 +95,7 @@ test('the scene exported from an orbited embed view renders with mirrorball rend
   const s = await studio([scene]);
   try {
     const { page, logs } = await openStudio(chromium, `${s.url}&view=viewport&mode=2&yaw=0.6&pitch=0.35&distance=2.8`);
-    const got = await page.evaluate(() => {
-      const p = window.studio.pixels();
-      return { width: p.width, height: p.height, data: Array.from(p.data), file: window.studio.sceneFile() };
-    });
+    const got = { ...(await viewportPixels(page)), file: await page.evaluate(() => window.studio.sceneFile()) };
     await page.close();
     assert.deepEqual(logs.filter((l) => /error/i.test(l)), []);
     assert.equal(got.file.indexing, 'vertex');

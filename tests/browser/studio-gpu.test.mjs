@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, studio, run, tempDir, readPng, againstRender, ROOT } from './lib.mjs';
+import { browser, studio, run, tempDir, readPng, againstRender, carrying, viewportPixels, ROOT } from './lib.mjs';
 
 
 let chromium;
@@ -103,10 +103,11 @@ test('the embed view draws the mirror sphere as mirrorball render does in every 
     for (const proj of kinds) {
       const size = 128;
       const page = await chromium.newPage({ deviceScaleFactor: 1 });
+      await carrying(page);
       await page.goto(`${s.url}&view=viewport&mode=3&projection=${proj}&size=${size}`);
       await page.waitForFunction(() => window.studio, null, { timeout: 60000 });
       await page.evaluate(() => window.studio.ready);
-      const gpu = await page.evaluate(() => Array.from(window.studio.pixels().data));
+      const gpu = (await viewportPixels(page)).data;
       await page.close();
       const png = (extra) => {
         const out = path.join(work.dir, `cpu-${proj}-${extra.length}.png`);

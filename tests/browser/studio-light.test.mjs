@@ -7,7 +7,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, run, tempDir, studio, openStudio, ROOT } from './lib.mjs';
+import { browser, run, tempDir, studio, openStudio, viewportPixels, carried, ROOT } from './lib.mjs';
 
 let chromium;
 let work;
@@ -162,7 +162,7 @@ const SCENE = {
 async function embedded(url) {
   const { page, logs } = await openStudio(chromium, url);
   try {
-    return await page.evaluate(async () => {
+    const got = await page.evaluate(async () => {
       const st = window.studio;
       const p = st.pixels();
       const surf = await st.sim.surface();
@@ -170,9 +170,9 @@ async function embedded(url) {
       return {
         width: p.width,
         height: p.height,
-        data: Array.from(p.data),
-        position: Array.from(surf.position),
-        normal: Array.from(surf.normal),
+        data: window.carry(p.data),
+        position: window.carry(surf.position),
+        normal: window.carry(surf.normal),
         eye: st.camera().eye,
         tint: s.objects[0].material.tint,
         exposure: s.exposure,
@@ -182,6 +182,12 @@ async function embedded(url) {
         header: st.view.lighting && st.view.lighting.header,
       };
     });
+    return {
+      ...got,
+      data: carried(got.data),
+      position: carried(got.position, Float32Array),
+      normal: carried(got.normal, Float32Array),
+    };
   } catch (e) {
     throw new Error(`${e}\n${logs.join('\n')}`);
   } finally {
@@ -240,8 +246,8 @@ test("the lit sphere's pixels are mirrorball prefilter's chain and SH9 of the sa
       const { page } = await openStudio(chromium, `${base}&material=ggx&roughness=0`);
       const levels = await page.evaluate(async () => {
         const l = window.studio.P.parseLighting(await (await window.studio.G.api(`/api/lighting?size=64&mapping=linear`)).arrayBuffer());
-        return l.levels.map((x) => Array.from(x));
-      });
+        return l.levels.map((x) => window.carry(x));
+      }).then((ls) => ls.map((x) => carried(x, Uint16Array)));
       await page.close();
       let worst = 0;
       levels.forEach((bits, m) => {
@@ -301,7 +307,7 @@ test('the lighting panel shows the progress, the slider moves the level, the URL
         /* the page is closing */
       }
     }, 50);
-    const mirror = await page.evaluate(() => Array.from(window.studio.pixels().data));
+    const mirror = (await viewportPixels(page)).data;
     await page.selectOption('#material', 'ggx');
     await page.waitForFunction(() => window.studio.view.lighting !== null, null, { timeout: 120000 });
     await page.evaluate(() => window.studio.redraw());
@@ -309,7 +315,7 @@ test('the lighting panel shows the progress, the slider moves the level, the URL
     assert.ok(seen.some((t) => /prefiltering on the server/.test(t)), `no progress shown: ${JSON.stringify(seen.slice(0, 5))}`);
     const status = await page.textContent('#lighting-status');
     assert.match(status, /^level 2\.50 of 6 \(linear: level = roughness \* \(levels - 1\)\)$/);
-    const lit = await page.evaluate(() => Array.from(window.studio.pixels().data));
+    const lit = (await viewportPixels(page)).data;
     await page.evaluate(() => {
       const slider = document.getElementById('roughness');
       slider.value = '1';
@@ -317,7 +323,7 @@ test('the lighting panel shows the progress, the slider moves the level, the URL
       return window.studio.redraw();
     });
     assert.match(await page.textContent('#lighting-status'), /^level 5\.00 of 6/);
-    const rough = await page.evaluate(() => Array.from(window.studio.pixels().data));
+    const rough = (await viewportPixels(page)).data;
     const meanDiff = (a, b) => a.reduce((acc, v, i) => acc + Math.abs(v - b[i]), 0) / a.length;
     assert.ok(meanDiff(mirror, lit) > 0.5, 'the GGX material draws as the mirror');
     assert.ok(meanDiff(lit, rough) > 0.2, 'the slider does not change the picture');

@@ -8,7 +8,7 @@ import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, run, tempDir, studio, openStudio, ROOT } from './lib.mjs';
+import { browser, run, tempDir, studio, openStudio, viewportPixels, carried, ROOT } from './lib.mjs';
 import { uvToDir, heatOf } from '../../crates/studio/web/sim.js';
 
 let chromium;
@@ -82,8 +82,8 @@ test("sim.js's uvToDir inverts the core's direction→uv on a dense grid", async
   const page = await open(s.url);
   try {
     for (const [kind, spec] of [['latlong', 'latlong'], ['cube', 'cube'], ['sphere', 'sphere'], ['sphere', 'sphere:look=+x'], ['paraboloid', 'paraboloid'], ['paraboloid', 'paraboloid:look=0,1,0']]) {
-      const buf = await page.evaluate(async (spec) => Array.from(new Uint8Array(await (await window.studio.G.api(`/api/grid?projection=${encodeURIComponent(spec)}&n=64`)).arrayBuffer())), spec);
-      const b = Uint8Array.from(buf).buffer;
+      const buf = await page.evaluate(async (spec) => window.carry(new Uint8Array(await (await window.studio.G.api(`/api/grid?projection=${encodeURIComponent(spec)}&n=64`)).arrayBuffer())), spec);
+      const b = carried(buf).buffer;
       const count = new DataView(b).getUint32(0, true);
       const frame = Array.from(new Float32Array(b, 4, 9));
       const values = new Float32Array(b, 56, 9 * count);
@@ -124,10 +124,10 @@ test("the door at 70° under mode 1: the texels read and the heat map's worst an
     const got = await page.evaluate(() => {
       const sim = window.studio.sim;
       const { worst, mean, count, invalid } = sim.heatStats;
-      return { record: Array.from(sim.record), worst, mean, count, invalid, text: document.getElementById('sim-stats').textContent };
+      return { record: window.carry(sim.record), worst, mean, count, invalid, text: document.getElementById('sim-stats').textContent };
     });
     await page.screenshot({ path: path.join(process.env.STUDIO_SHOTS || work.dir, 'studio-sim-door-heat.png') });
-    const gpu = Float32Array.from(got.record);
+    const gpu = carried(got.record, Float32Array);
     const st1 = cpuSt(file, ['--mode', '1', ...LATLONG]);
     const st3 = cpuSt(file, ['--mode', '3', ...LATLONG]);
     assert.equal(gpu.length, st1.length);
@@ -203,17 +203,17 @@ test('a view set on the page reopens from its URL with the same pixels', async (
     await page.evaluate(() => window.studio.redraw());
     const url = page.url();
     for (const k of ['mode=2', 'projection=cube', 'yaw=', 'pitch=', 'distance=', 'heat=1']) assert.ok(url.includes(k), `${url} lacks ${k}`);
-    const a = await page.evaluate(() => Array.from(window.studio.pixels().data));
+    const a = (await viewportPixels(page)).data;
     const again = await open(url);
     try {
-      const b = await again.evaluate(() => Array.from(window.studio.pixels().data));
+      const b = (await viewportPixels(again)).data;
       const same = await again.evaluate(() => [window.studio.view.mode, window.studio.view.projection, window.studio.sim.heat]);
       assert.deepEqual(same, [2, 'cube', true]);
       let differ = 0;
       for (let i = 0; i < a.length; i++) if (a[i] !== b[i]) differ++;
       assert.equal(differ, 0, `${differ} bytes differ`);
       const plain = await open(s.url);
-      const c = await plain.evaluate(() => Array.from(window.studio.pixels().data));
+      const c = (await viewportPixels(plain)).data;
       await plain.close();
       assert.ok(c.some((x, i) => x !== a[i]), 'the reopened view is the default one');
     } finally {
@@ -232,8 +232,9 @@ test("the door's triangle edges in texture space enclose every texel it read (mo
       const page = await open(`${s.url}&mode=${mode}&projection=latlong&size=256`);
       const r = await page.evaluate(() => {
         const sim = window.studio.sim;
-        return { corners: sim.edgeLines.corners.map((c) => Array.from(c)), lines: sim.edgeLines.lines, record: Array.from(sim.record) };
+        return { corners: sim.edgeLines.corners.map((c) => Array.from(c)), lines: sim.edgeLines.lines, record: window.carry(sim.record) };
       });
+      r.record = carried(r.record, Float32Array);
       await page.close();
       assert.equal(r.corners.length, 2, 'the door is two triangles');
       if (mode === 1) {

@@ -7,7 +7,7 @@ import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { deflateSync, crc32 } from 'node:zlib';
 import path from 'node:path';
-import { browser, run, tempDir, readPng, studio, openStudio, ROOT } from './lib.mjs';
+import { browser, run, tempDir, readPng, studio, openStudio, viewportPixels, ROOT } from './lib.mjs';
 
 let chromium;
 let work;
@@ -104,7 +104,7 @@ test('the page switches projection and mode, and orbits by dragging', async () =
   const s = await studio([VENICE]);
   const { page } = await open(s.url);
   try {
-    const grab = () => page.evaluate(() => Array.from(window.studio.pixels().data));
+    const grab = async () => (await viewportPixels(page)).data;
     const meanDiff = (a, b) => a.reduce((acc, v, i) => acc + Math.abs(v - b[i]), 0) / a.length;
     const latlong = await grab();
     // Another projection of the same environment draws nearly the same picture.
@@ -213,10 +213,7 @@ function inner(coverage, w, h) {
  */
 async function compare(s, scene, { name, mode, proj, size, query = '' }) {
   const { page, logs } = await open(`${s.url}&view=viewport&mode=${mode}&projection=${proj}&size=${size}${query}`);
-  const gpu = await page.evaluate(() => {
-    const p = window.studio.pixels();
-    return { width: p.width, height: p.height, data: Array.from(p.data) };
-  });
+  const gpu = await viewportPixels(page);
   if (process.env.STUDIO_SHOTS) await page.screenshot({ path: path.join(process.env.STUDIO_SHOTS, `studio-${name}.png`) });
   await page.close();
   const args = ['--mode', String(mode), '--env-as', proj, '--env-size', String(size)];
@@ -255,7 +252,7 @@ async function compare(s, scene, { name, mode, proj, size, query = '' }) {
     }
     const both = new Uint8Array(3 * w * h * 4);
     for (let y = 0; y < h; y++) {
-      both.set(Uint8Array.from(gpu.data.slice(4 * w * y, 4 * w * (y + 1))), 12 * w * y);
+      both.set(gpu.data.subarray(4 * w * y, 4 * w * (y + 1)), 12 * w * y);
       both.set(full.data.subarray(4 * w * y, 4 * w * (y + 1)), 12 * w * y + 4 * w);
       both.set(diff.subarray(4 * w * y, 4 * w * (y + 1)), 12 * w * y + 8 * w);
     }
