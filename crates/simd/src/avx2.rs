@@ -53,6 +53,21 @@ impl X8 {
     pub fn u32s(self, a: &[u32; 8]) -> I32x8 {
         I32x8(unsafe { _mm256_loadu_si256(a.as_ptr() as *const __m256i) })
     }
+    /// Lane `k` is `table[idx[k]]`, each index clamped to the table (`0..table.len()`):
+    /// a table lookup of eight lanes at once (one `vpgatherdps`).
+    ///
+    /// # Panics
+    /// If `table` is empty or longer than `i32::MAX`.
+    #[inline(always)]
+    pub fn gather(self, table: &[f32], idx: I32x8) -> F32x8 {
+        assert!(!table.is_empty() && table.len() <= i32::MAX as usize);
+        unsafe {
+            let last = _mm256_set1_epi32(table.len() as i32 - 1);
+            let i = _mm256_min_epi32(_mm256_max_epi32(idx.0, _mm256_setzero_si256()), last);
+            // Every index is now inside `table`.
+            F32x8(_mm256_i32gather_ps::<4>(table.as_ptr(), i))
+        }
+    }
     /// Lane `k` set where bit `k` of `bits` is.
     #[inline(always)]
     pub fn mask(self, bits: u32) -> M32x8 {
@@ -221,6 +236,19 @@ impl I32x8 {
     #[inline(always)]
     pub fn eq(self, o: I32x8) -> M32x8 {
         M32x8(unsafe { _mm256_castsi256_ps(_mm256_cmpeq_epi32(self.0, o.0)) })
+    }
+    /// Each lane's bits shifted right by `n`, zeros shifted in (0 from `n` ≥ 32).
+    #[inline(always)]
+    pub fn shr(self, n: u32) -> I32x8 {
+        I32x8(unsafe { _mm256_srl_epi32(self.0, _mm_cvtsi32_si128(n.min(32) as i32)) })
+    }
+}
+
+impl BitAnd for I32x8 {
+    type Output = I32x8;
+    #[inline(always)]
+    fn bitand(self, o: I32x8) -> I32x8 {
+        I32x8(unsafe { _mm256_and_si256(self.0, o.0) })
     }
 }
 

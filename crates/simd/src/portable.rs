@@ -346,6 +346,22 @@ impl I32x8 {
     pub fn from_u32s(a: &[u32; 8]) -> I32x8 {
         I32x8(a.map(|x| x as i32))
     }
+    /// Each lane's bits shifted right by `n`, zeros shifted in (0 from `n` ≥ 32).
+    #[inline(always)]
+    pub fn shr(self, n: u32) -> I32x8 {
+        I32x8(
+            self.0
+                .map(|x| (x as u32).checked_shr(n).unwrap_or(0) as i32),
+        )
+    }
+}
+
+impl BitAnd for I32x8 {
+    type Output = I32x8;
+    #[inline(always)]
+    fn bitand(self, o: I32x8) -> I32x8 {
+        I32x8(std::array::from_fn(|k| self.0[k] & o.0[k]))
+    }
 }
 
 impl Mul for I32x8 {
@@ -405,6 +421,16 @@ impl X8 {
     #[inline(always)]
     pub fn mask(self, bits: u32) -> M32x8 {
         M32x8::from_bitmask(bits)
+    }
+    /// Lane `k` is `table[idx[k]]`, each index clamped to the table (`0..table.len()`).
+    ///
+    /// # Panics
+    /// If `table` is empty or longer than `i32::MAX`.
+    #[inline(always)]
+    pub fn gather(self, table: &[f32], idx: I32x8) -> F32x8 {
+        assert!(!table.is_empty() && table.len() <= i32::MAX as usize);
+        let last = table.len() as i32 - 1;
+        F32x8(idx.0.map(|i| table[i.clamp(0, last) as usize]))
     }
 }
 

@@ -225,6 +225,26 @@ macro_rules! check8 {
                 assert_eq!((pi + pj).to_array(), (qi + qj).to_array());
                 assert_eq!((pi - pj).to_array(), (qi - qj).to_array());
                 assert_eq!((pi * pj).to_array(), (qi * qj).to_array());
+                assert_eq!((pi & pj).to_array(), (qi & qj).to_array());
+                for n in [0, 1, 7, 14, 31, 32, 40] {
+                    assert_eq!(pj.shr(n).to_array(), qj.shr(n).to_array(), "{n}");
+                }
+                // Indices in, below and above the table: clamped alike.
+                let table: Vec<f32> = (0..37).map(|k| k as f32 * 0.5 - 3.0).collect();
+                let idx = (pi & px.splat_i32(63)) - px.splat_i32(13);
+                let qidx = (qi & x8.splat_i32(63)) - x8.splat_i32(13);
+                same(px.gather(&table, idx), x8.gather(&table, qidx));
+                let edge = [-5, 0, 36, 37, i32::MIN, i32::MAX, 1, 2];
+                let want: [f32; 8] = edge.map(|i| table[i.clamp(0, 36) as usize]);
+                let edge = edge.map(|x| x as u32);
+                assert_eq!(
+                    bits(x8.gather(&table, x8.u32s(&edge)).to_array()),
+                    bits(want)
+                );
+                assert_eq!(
+                    bits(px.gather(&table, px.u32s(&edge)).to_array()),
+                    bits(want)
+                );
                 for (x, y) in [
                     (pi.gt(pj), qi.gt(qj)),
                     (pi.lt(pj), qi.lt(qj)),

@@ -10,6 +10,7 @@ use super::packing::Packing;
 use crate::error::CliError;
 use mirrorball_core::color::linear_to_srgb;
 use mirrorball_core::{choice_traits, Choice, Image};
+use mirrorball_simd::{x8_kernel, F32x8, I32x8, X8};
 use rayon::prelude::*;
 use std::io::{ErrorKind, Read, Write};
 use std::sync::OnceLock;
@@ -133,6 +134,24 @@ impl PixFmt {
         dst: &mut [u8],
     ) {
         let px = self.pixel_bytes();
+        // RGB texels are their values in order, each one code: eight at a time, the few
+        // left over one by one (the same codes: `SrgbTable::codes_x8`).
+        if let (PixFmt::Rgb24 | PixFmt::Rgb48le, Some(t), 3, Some(x8)) = (self, table, c, X8::get())
+        {
+            let bytes = px / 3;
+            let done = encode_x8(x8, t, src, dst, bytes);
+            for (d, &s) in dst[done * bytes..]
+                .chunks_exact_mut(bytes)
+                .zip(&src[done..])
+            {
+                if bytes == 1 {
+                    d[0] = t.code8(s) as u8;
+                } else {
+                    d.copy_from_slice(&(t.code16(s) as u16).to_le_bytes());
+                }
+            }
+            return;
+        }
         match (self, table) {
             (PixFmt::Rgb24, Some(t)) => {
                 for (d, s) in dst.chunks_exact_mut(px).zip(src.chunks_exact(c)) {
@@ -178,8 +197,9 @@ pub struct SrgbTable {
     /// Code value (scaled, not rounded) at the start of each 2⁹-per-octave piece, and one
     /// past the end.
     at: Vec<f32>,
-    /// For 8-bit codes: the code of each 2¹²-per-octave piece.
-    direct: Vec<u8>,
+    /// For 8-bit codes: the code of each 2¹²-per-octave piece (as `f32`, for the eight-lane
+    /// table lookup).
+    direct: Vec<f32>,
     scale: f32,
 }
 
@@ -207,7 +227,7 @@ impl SrgbTable {
                 (0..n)
                     .map(|k| {
                         let centre = TABLE_FROM + (k << DIRECT_SHIFT) + (1 << (DIRECT_SHIFT - 1));
-                        code(centre).round() as u8
+                        code(centre).round() as f32
                     })
                     .collect()
             } else {
@@ -249,6 +269,33 @@ impl SrgbTable {
         self.direct[((l.to_bits() - TABLE_FROM) >> DIRECT_SHIFT) as usize] as u32
     }
 
+    /// [`SrgbTable::code8`] or [`SrgbTable::code16`] (the table's) of eight values at once:
+    /// the same arithmetic lane by lane, so the same codes (tested).
+    #[inline(always)]
+    fn codes_x8(&self, x8: X8, l: F32x8) -> I32x8 {
+        let zero = x8.splat(0.0);
+        let knee = x8.splat(mirrorball_core::color::SRGB_LINEAR_KNEE as f32);
+        let slope = x8.splat(mirrorball_core::color::SRGB_SLOPE as f32 * self.scale);
+        // `ends`: NaN and negatives to 0 (`gt` is false for NaN).
+        let linear = l.gt(zero).select(l, zero) * slope + x8.splat(0.5);
+        let rel = l.to_bits() - x8.splat_i32(TABLE_FROM as i32);
+        // Lanes outside the table's range read a clamped entry, and are not chosen.
+        let table = if self.direct.is_empty() {
+            let k = rel.shr(PIECE_SHIFT);
+            let t = (rel & x8.splat_i32((1 << PIECE_SHIFT) - 1)).to_f32()
+                * x8.splat(1.0 / (1 << PIECE_SHIFT) as f32);
+            let (a, b) = (
+                x8.gather(&self.at, k),
+                x8.gather(&self.at, k + x8.splat_i32(1)),
+            );
+            a + (b - a) * t + x8.splat(0.5)
+        } else {
+            x8.gather(&self.direct, rel.shr(DIRECT_SHIFT))
+        };
+        let above = l.ge(x8.splat(1.0)).select(x8.splat(self.scale), table);
+        l.gt(knee).select(above, linear).trunc_i32()
+    }
+
     /// [`SrgbTable::code`] of a 16-bit table.
     #[inline(always)]
     pub fn code16(&self, l: f32) -> u32 {
@@ -260,6 +307,27 @@ impl SrgbTable {
         let t = (rel & ((1 << PIECE_SHIFT) - 1)) as f32 * (1.0 / (1 << PIECE_SHIFT) as f32);
         let (a, b) = (self.at[k], self.at[k + 1]);
         (a + (b - a) * t + 0.5) as u32
+    }
+}
+
+x8_kernel! {
+    /// Encodes the values of `src` eight at a time with `t` into `dst`, `bytes` (1 or 2,
+    /// little-endian) a code, as far as whole groups of eight fit both; returns how many.
+    fn encode_x8(x8: X8, t: &SrgbTable, src: &[f32], dst: &mut [u8], bytes: usize) -> usize {
+        let n = src.len().min(dst.len() / bytes) / 8 * 8;
+        for (s, d) in src[..n].chunks_exact(8).zip(dst.chunks_exact_mut(8 * bytes)) {
+            let codes = t.codes_x8(x8, x8.load(s)).to_array();
+            if bytes == 1 {
+                for (d, c) in d.iter_mut().zip(codes) {
+                    *d = c as u8;
+                }
+            } else {
+                for (d, c) in d.chunks_exact_mut(2).zip(codes) {
+                    d.copy_from_slice(&(c as u16).to_le_bytes());
+                }
+            }
+        }
+        n
     }
 }
 
@@ -351,6 +419,65 @@ mod tests {
             assert_eq!(t.code(7.0), scale as u32);
             assert_eq!(t.code(1.0), scale as u32);
             assert_eq!(t.code(0.0), 0);
+        }
+    }
+
+    #[test]
+    fn the_eight_lane_codes_are_the_scalar_ones() {
+        // Every value class: NaN, infinities, negatives, zero, denormals, the linear
+        // segment and its knee, each table piece's ends, and a dense sweep of [0, 1.1].
+        let mut values = vec![
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -1.0,
+            -0.0,
+            0.0,
+            1e-40,
+            f32::MIN_POSITIVE,
+            0.0031308,
+            f32::from_bits(0.0031308f32.to_bits() + 1),
+            f32::from_bits(TABLE_FROM),
+            f32::from_bits(TABLE_FROM - 1),
+            f32::from_bits(1.0f32.to_bits() - 1),
+            1.0,
+            7.0,
+        ];
+        values.extend((0..=400_000).map(|i| (i as f32 / 400_000.0).powi(2) * 1.1));
+        values.extend(
+            (TABLE_FROM..1.0f32.to_bits())
+                .step_by(4093)
+                .map(f32::from_bits),
+        );
+        while values.len() % 8 != 0 {
+            values.push(0.5);
+        }
+        for scale in [255.0f32, 65535.0] {
+            let t = SrgbTable::get(scale);
+            let x8 = X8::get();
+            let Some(x8) = x8 else { return };
+            for v in values.chunks_exact(8) {
+                let got = t.codes_x8(x8, x8.load(v)).to_array();
+                let want: [i32; 8] = std::array::from_fn(|k| t.code(v[k]) as i32);
+                assert_eq!(got, want, "{v:?} at {scale}");
+            }
+            // And through the encoder, whose tail is scalar.
+            let (fmt, bytes) = if scale > 255.0 {
+                (PixFmt::Rgb48le, 2)
+            } else {
+                (PixFmt::Rgb24, 1)
+            };
+            let n = 3 * 1001;
+            let mut dst = vec![0u8; n * bytes];
+            fmt.encode_texels(Some(t), &values[..n], 3, &mut dst);
+            for (k, &v) in values[..n].iter().enumerate() {
+                let code = if bytes == 1 {
+                    dst[k] as u32
+                } else {
+                    u16::from_le_bytes([dst[2 * k], dst[2 * k + 1]]) as u32
+                };
+                assert_eq!(code, t.code(v), "value {k}: {v}");
+            }
         }
     }
 
