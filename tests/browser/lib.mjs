@@ -238,6 +238,18 @@ export async function studio(files = []) {
   return { url, stop: () => proc.kill('SIGTERM'), stderr: () => stderr };
 }
 
+/// `POST /api/directions?projection=PROJECTION` to studio `s` (as [`studio`] starts it)
+/// with `body` (a Float32Array of (u, v, layer) triples): the response, and its body as
+/// f32 direction triples when it succeeded.
+export async function directions(s, projection, body) {
+  const url = new URL(s.url);
+  url.pathname = '/api/directions';
+  url.searchParams.set('projection', projection);
+  const r = await fetch(url, { method: 'POST', body });
+  const bytes = new Uint8Array(await r.arrayBuffer());
+  return { status: r.status, text: () => new TextDecoder().decode(bytes), dirs: r.ok ? new Float32Array(bytes.buffer) : null };
+}
+
 /// A new page of `chromium` at the studio's `url`, once the page is ready; `logs` collects
 /// its console messages and errors.
 export async function openStudio(chromium, url) {

@@ -1,15 +1,16 @@
 // The studio's simulator view in headless Chromium: the record pass's texture coordinates
 // against `mirrorball render --aovs` (the CPU rasteriser's (u, v, layer) read, decoded by
 // ffmpeg), the heat map's worst and mean against the same numbers from the CPU's channels,
-// the texel under the cursor, and the view reopened from its URL. sim.js's uvToDir is first
-// checked against the core on the server's direction grid.
+// the texel under the cursor, and the view reopened from its URL. The server's directions
+// of texture coordinates (what the heat map measures with) are first checked against the
+// core's direction grid.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, run, tempDir, studio, openStudio, viewportPixels, carried, ROOT } from './lib.mjs';
-import { uvToDir, heatOf } from '../../crates/studio/web/sim.js';
+import { browser, run, tempDir, studio, openStudio, viewportPixels, carried, directions, ROOT } from './lib.mjs';
+import { heatOf, lookupsOf, angleDeg } from '../../crates/studio/web/sim.js';
 
 let chromium;
 let work;
@@ -77,39 +78,53 @@ function cpuSt(file, args) {
   return rgba;
 }
 
-test("sim.js's uvToDir inverts the core's direction→uv on a dense grid", async () => {
+test("the server's directions of texture coordinates are the core's grid directions, in every projection the viewport draws", async () => {
   const s = await studio();
-  const page = await open(s.url);
   try {
-    for (const [kind, spec] of [['latlong', 'latlong'], ['cube', 'cube'], ['sphere', 'sphere'], ['sphere', 'sphere:look=+x'], ['paraboloid', 'paraboloid'], ['paraboloid', 'paraboloid:look=0,1,0']]) {
-      const buf = await page.evaluate(async (spec) => window.carry(new Uint8Array(await (await window.studio.G.api(`/api/grid?projection=${encodeURIComponent(spec)}&n=64`)).arrayBuffer())), spec);
-      const b = carried(buf).buffer;
+    const specs = ['latlong', 'cube', 'sphere', 'sphere:look=+x', 'paraboloid', 'paraboloid:look=0,1,0', 'eac', 'continuous-cube', 'fisheye:fov=200:lens=equisolid:look=1,0,0', 'hammer', 'octahedral', 'perspective:hfov=120:vfov=80:yaw=30:pitch=-20:roll=10', 'pannini:d=2:hfov=200:vfov=100:yaw=-45'];
+    for (const spec of specs) {
+      const url = new URL(s.url);
+      url.pathname = '/api/grid';
+      url.searchParams.set('projection', spec);
+      url.searchParams.set('n', '64');
+      const b = await (await fetch(url)).arrayBuffer();
       const count = new DataView(b).getUint32(0, true);
-      const frame = Array.from(new Float32Array(b, 4, 9));
       const values = new Float32Array(b, 56, 9 * count);
-      let worst = 0;
-      let checked = 0;
+      // The grid's own points (u, v multiples of 1/64, exact in f32): the core made each
+      // direction from them, so the server's direction of them is that direction to f32.
+      const rows = [];
       for (let i = 0; i < count; i++) {
-        const d = Array.from(values.subarray(9 * i, 9 * i + 3));
-        const l = Math.hypot(...d);
-        const got = uvToDir(kind, frame, Array.from(values.subarray(9 * i + 3, 9 * i + 6)));
-        if (values[9 * i + 5] < 0) continue;
-        assert.ok(got, `${spec}: no direction for ${values.subarray(9 * i + 3, 9 * i + 6)}`);
-        const dot = Math.min(1, (got[0] * d[0] + got[1] * d[1] + got[2] * d[2]) / l);
-        // The uv are f32 (steps of 6e-8); the sphere map's theta = 2 asin(rho) turns a step
-        // of rho into 2/sqrt(1 - rho^2) times as much angle towards the rim.
-        const [u, v] = values.subarray(9 * i + 3, 9 * i + 5);
-        const rho2 = kind === 'sphere' ? (2 * u - 1) ** 2 + (1 - 2 * v) ** 2 : 0;
-        const tolerance = 1e-5 + (2.5 * 1.2e-7) / Math.sqrt(Math.max(1e-12, 1 - rho2));
-        worst = Math.max(worst, Math.acos(dot) / tolerance);
-        checked++;
+        const [u, v] = values.subarray(9 * i + 6, 9 * i + 8);
+        if (Number.isInteger(u * 64) && Number.isInteger(v * 64)) rows.push(i);
       }
-      console.log(`${spec}: ${checked} directions, worst error ${worst.toFixed(3)} of the tolerance (1e-5 rad, the sphere map's widened by its rim's conditioning)`);
-      assert.ok(checked > 2000, `${spec}: ${checked} directions`);
-      assert.ok(worst <= 1, `${spec}: worst ${worst} of the tolerance`);
+      const body = new Float32Array(3 * rows.length);
+      rows.forEach((i, k) => body.set(values.subarray(9 * i + 6, 9 * i + 9), 3 * k));
+      const { dirs } = await directions(s, spec, body);
+      assert.equal(dirs.length, body.length);
+      let worst = 0;
+      rows.forEach((i, k) => {
+        const d = Array.from(values.subarray(9 * i, 9 * i + 3));
+        const got = Array.from(dirs.subarray(3 * k, 3 * k + 3));
+        assert.ok(got.every(Number.isFinite), `${spec}: no direction for ${body.subarray(3 * k, 3 * k + 3)}`);
+        worst = Math.max(worst, (angleDeg(got, d) * Math.PI) / 180);
+      });
+      console.log(`${spec}: ${rows.length} grid points, worst ${worst.toExponential(2)} rad from the grid's direction`);
+      assert.ok(rows.length > 2000, `${spec}: ${rows.length} points`);
+      assert.ok(worst <= 2e-7, `${spec}: worst ${worst} rad`);
     }
+    // Texture coordinates with no direction: NaN, whatever is wrong with them.
+    const { dirs } = await directions(s, 'cube', new Float32Array([0.5, 0.5, 6, 0.5, 0.5, -1, NaN, 0.5, 0, Infinity, 0.5, 0, 0.5, 0.5, 5]));
+    assert.ok(dirs.subarray(0, 12).every(Number.isNaN), `${dirs}`);
+    assert.deepEqual(Array.from(dirs.subarray(12), (x) => x + 0), [0, 0, -1], 'the centre of -Z');
+    const off = await directions(s, 'sphere', new Float32Array([0.999, 0.999, 0]));
+    assert.ok(off.dirs.every(Number.isNaN), 'a point off the sphere map disk');
+    const bad = await directions(s, 'cube', new Uint8Array(13));
+    assert.equal(bad.status, 400);
+    assert.match(bad.text(), /f32 triples/);
+    const unknown = await directions(s, 'nonsense', new Float32Array(3));
+    assert.equal(unknown.status, 400);
+    assert.match(unknown.text(), /projection/);
   } finally {
-    await page.close();
     s.stop();
   }
 });
@@ -139,7 +154,8 @@ test("the door at 70° under mode 1: the texels read and the heat map's worst an
       both++;
       if (Math.abs(gpu[4 * i] - st1[4 * i]) * 256 <= 1 && Math.abs(gpu[4 * i + 1] - st1[4 * i + 1]) * 128 <= 1) within++;
     }
-    const cpu = heatOf('latlong', null, st1, st3);
+    const { pixels, body } = lookupsOf(st1, st3);
+    const cpu = heatOf(st1.length / 4, pixels, (await directions(s, 'latlong', body)).dirs);
     console.log(`door mode 1: ${within} of ${both} pixels read the CPU's texel (within one); page: ${got.text}`);
     console.log(`CPU channels: worst ${cpu.worst.toFixed(3)}°, mean ${cpu.mean.toFixed(3)}° over ${cpu.count} pixels`);
     assert.ok(both > 3000, `${both} covered pixels`);
@@ -175,7 +191,7 @@ test('the texel under the cursor is ringed where the CPU read it, and moves with
       assert.ok(Math.min(dx, 256 - dx) <= 1 && Math.abs(hv.texel[1] - want[1]) <= 1, `ring at ${hv.texel}, the CPU's texel ${want}`);
       assert.ok(Math.abs(Math.hypot(...hv.normal) - 1) < 1e-5);
       // The reflected vector drawn is the one whose texel is ringed.
-      const r = uvToDir('latlong', null, hv.uvl);
+      const r = (await directions(s, 'latlong', new Float32Array(hv.uvl))).dirs;
       const rl = Math.hypot(...hv.reflected);
       assert.ok(Math.acos(Math.min(1, hv.reflected.reduce((a, c, k) => a + c * r[k], 0) / rl)) < 1e-3);
       seen.push(hv.texel.join());

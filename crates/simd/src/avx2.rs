@@ -239,7 +239,7 @@ impl I32x8 {
     }
     /// Each lane's bits shifted right by `n`, zeros shifted in (0 from `n` ≥ 32).
     #[inline(always)]
-    pub fn shr(self, n: u32) -> I32x8 {
+    pub fn shift_right(self, n: u32) -> I32x8 {
         I32x8(unsafe { _mm256_srl_epi32(self.0, _mm_cvtsi32_si128(n.min(32) as i32)) })
     }
 }

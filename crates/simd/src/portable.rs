@@ -348,7 +348,7 @@ impl I32x8 {
     }
     /// Each lane's bits shifted right by `n`, zeros shifted in (0 from `n` ≥ 32).
     #[inline(always)]
-    pub fn shr(self, n: u32) -> I32x8 {
+    pub fn shift_right(self, n: u32) -> I32x8 {
         I32x8(
             self.0
                 .map(|x| (x as u32).checked_shr(n).unwrap_or(0) as i32),

@@ -8,6 +8,7 @@
 //! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float&mips=0\|1` | the environment's texels, with its mip chain for `mips=1` ([`texture`]) |
 //! | `GET /api/mesh/I?tessellation=N` | object `I` in world space ([`geometry`]); a built-in tessellated `N` (`state::MAX_TRIANGLES` at most) |
 //! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
+//! | `POST /api/directions?projection=native\|SPEC` | the core's direction of each `(u, v, layer)` of the body, in the map `/api/environment` sends for the same `projection` ([`grid::directions`]) |
 //! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
 //! | `GET /api/lighting/progress` | `{"done", "total", "busy"}`: rows of the prefilter running |
 //! | `GET /api/export?what=map\|chain&format=EXT&projection=…&size=N` | a file to download, written by the [`Host`]: the map (as loaded, or converted as `/api/environment` converts it) or the last prefiltered chain |
@@ -174,6 +175,10 @@ fn serve(
             .route("/api/environment", get(environment))
             .route("/api/mesh/{i}", get(mesh))
             .route("/api/grid", get(grid_of))
+            .route(
+                "/api/directions",
+                post(directions_of).layer(DefaultBodyLimit::max(12 * grid::MAX_LOOKUPS)),
+            )
             .route("/api/lighting", get(lighting_of))
             .route("/api/lighting/progress", get(lighting_progress))
             .route("/api/export", get(export))
@@ -564,6 +569,37 @@ async fn grid_of(Query(q): Query<HashMap<String, String>>) -> Response {
     };
     match tokio::task::spawn_blocking(move || grid::encode(&p, n)).await {
         Ok(b) => binary(b),
+        Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+    }
+}
+
+async fn directions_of(
+    Shared(app): Shared<AppState>,
+    Query(q): Query<HashMap<String, String>>,
+    body: Result<Bytes, BytesRejection>,
+) -> Response {
+    let body = match body {
+        Ok(b) => b,
+        Err(e) => return bad(e.status(), e.body_text()),
+    };
+    let spec = q.get("projection").map_or("native", String::as_str);
+    // The projection of the map /api/environment sends for the same `projection`.
+    let p = if spec == "native" {
+        let s = app.state.lock().expect("state");
+        match &s.view.scene.environment {
+            Some(e) if gpu_kind(e.map.projection()).is_some() => *e.map.projection(),
+            Some(_) => mirrorball_core::ProjectionKind::LatLong.default_projection(),
+            None => return bad(StatusCode::NOT_FOUND, "no environment is loaded"),
+        }
+    } else {
+        match ProjectionSpec::parse(spec).and_then(|s| s.build(None)) {
+            Ok(p) => p,
+            Err(e) => return bad(StatusCode::BAD_REQUEST, format!("projection: {e}")),
+        }
+    };
+    match tokio::task::spawn_blocking(move || grid::directions(&p, &body)).await {
+        Ok(Ok(b)) => binary(b),
+        Ok(Err(m)) => bad(StatusCode::BAD_REQUEST, m),
         Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
     }
 }

@@ -6,7 +6,8 @@
 // the environment in its layout, the texels the frame read marked pink, the texel under the
 // cursor ringed; the viewport's overlay draws that pixel's normal (green) and reflected
 // vector (red). The heat map: per covered pixel, the angle between the direction the mode
-// looked up (its texel's uvToDir) and mode 3's exact reflected direction (likewise).
+// looked up and mode 3's exact reflected direction, each the core's direction of the texel
+// read (the server's `/api/directions`: the page holds no inverse of any projection).
 
 /** The most triangles whose texture-space edges the map shows (the first ones drawn). */
 const EDGE_TRIANGLES = 4096;
@@ -20,68 +21,6 @@ export function layoutOf(kind) {
   return { grid: [1, 1], cells: [[0, 0]] };
 }
 
-/**
- * Texture coordinates (u, v, layer) of a map of `kind` (frame: 9 numbers, column-major:
- * right, up, axis, for the disk maps) -> unit direction, or null where nothing is seen.
- * The inverses of the shaders' envUv, as core's `uv_to_dir`:
- * - lat-long (latlong.rs): lambda = 2pi(u - 1/2), phi = pi(1/2 - v),
- *   d = (sin lambda cos phi, sin phi, -cos lambda cos phi);
- * - cube (cube.rs, OpenGL 4.6 table 8.19 read backwards): sc = 2u - 1, tc = 2v - 1 on the
- *   face's major axis;
- * - sphere map (azimuthal.rs `SphereMap`): a = 2u - 1, b = 1 - 2v, rho = |(a, b)| <= 1 =
- *   sin(theta/2), so cos theta = 1 - 2 rho^2, sin theta = 2 rho sqrt(1 - rho^2);
- * - dual paraboloid (`DualParaboloid`): rho = tan(theta/2), cos theta = (1 - rho^2)/(1 + rho^2),
- *   sin theta = 2 rho/(1 + rho^2); layer 1 is layer 0's frame turned half a turn about up.
- */
-export function uvToDir(kind, frame, [u, v, layer]) {
-  if (!(layer >= 0) || !Number.isFinite(u) || !Number.isFinite(v)) return null;
-  let d;
-  if (kind === 'latlong') {
-    const lam = 2 * Math.PI * (u - 0.5);
-    const phi = Math.PI * (0.5 - v);
-    return [Math.sin(lam) * Math.cos(phi), Math.sin(phi), -Math.cos(lam) * Math.cos(phi)];
-  } else if (kind === 'cube') {
-    const sc = 2 * u - 1;
-    const tc = 2 * v - 1;
-    d = [
-      [1, -tc, -sc],
-      [-1, -tc, sc],
-      [sc, 1, tc],
-      [sc, -1, -tc],
-      [sc, -tc, 1],
-      [-sc, -tc, -1],
-    ][Math.round(layer)];
-    if (!d) return null;
-  } else if (kind === 'sphere' || kind === 'paraboloid') {
-    const a = 2 * u - 1;
-    const b = 1 - 2 * v;
-    // Texture coordinates in f32 put rim points up to ~1e-7 outside the disk: taken as on it.
-    let r2 = a * a + b * b;
-    if (r2 > 1 + 1e-6) return null;
-    r2 = Math.min(r2, 1);
-    const rho = Math.sqrt(r2);
-    let cos;
-    let sinOverRho;
-    if (kind === 'sphere') {
-      cos = 1 - 2 * r2;
-      sinOverRho = 2 * Math.sqrt(1 - r2);
-    } else {
-      cos = (1 - r2) / (1 + r2);
-      sinOverRho = 2 / (1 + r2);
-    }
-    let l = [a * sinOverRho, b * sinOverRho, cos];
-    if (rho === 0) l = [0, 0, cos];
-    if (kind === 'paraboloid' && Math.round(layer) === 1) l = [-l[0], l[1], -l[2]];
-    else if (Math.round(layer) > 0) return null;
-    const f = frame;
-    d = [0, 1, 2].map((k) => f[k] * l[0] + f[3 + k] * l[1] + f[6 + k] * l[2]);
-  } else {
-    return null;
-  }
-  const n = Math.hypot(...d);
-  return d.map((x) => x / n);
-}
-
 /** The angle between unit vectors a and b in degrees (atan2 of |a x b| and a.b: exact near 0). */
 export function angleDeg(a, b) {
   const c = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
@@ -89,32 +28,49 @@ export function angleDeg(a, b) {
 }
 
 /**
- * The heat map's numbers from two record passes (RGBA floats, (u, v, layer, ·) a pixel):
- * per pixel covered in both, the angle between the texels' directions; `invalid` counts
- * covered pixels whose mode read nothing (layer < 0 or not finite). Returns the angles
- * (NaN where not compared), worst, mean and the count.
+ * The (u, v, layer) of the pixels covered in the exact record pass (RGBA floats, one pixel
+ * each), the mode's first and then the exact pass's, as f32 triples: what the server turns
+ * into directions (`POST /api/directions`, the core's uv_to_dir). Returns them with the
+ * pixels' indices.
  */
-export function heatOf(kind, frame, mode, exact) {
-  const n = mode.length / 4;
+export function lookupsOf(mode, exact) {
+  const pixels = [];
+  for (let i = 0; i < exact.length / 4; i++) if (exact[4 * i + 3] > 0) pixels.push(i);
+  const m = pixels.length;
+  const body = new Float32Array(6 * m);
+  pixels.forEach((i, k) => {
+    body.set(mode.subarray(4 * i, 4 * i + 3), 3 * k);
+    body.set(exact.subarray(4 * i, 4 * i + 3), 3 * (m + k));
+  });
+  return { pixels, body };
+}
+
+/**
+ * The heat map's numbers: `n` pixels, of which `pixels` are covered, `dirs` the directions of
+ * their mode's texels then of their exact texels (f32 triples, NaN where a texel has none).
+ * Per covered pixel the angle between the two; `invalid` counts covered pixels whose mode
+ * read nothing. Returns the angles (NaN where not compared), worst, mean and the count.
+ */
+export function heatOf(n, pixels, dirs) {
+  const m = pixels.length;
   const angles = new Float32Array(n).fill(NaN);
   let worst = 0;
   let sum = 0;
   let count = 0;
   let invalid = 0;
-  for (let i = 0; i < n; i++) {
-    if (!(exact[4 * i + 3] > 0)) continue;
-    const b = uvToDir(kind, frame, exact.subarray(4 * i, 4 * i + 3));
-    const a = uvToDir(kind, frame, mode.subarray(4 * i, 4 * i + 3));
-    if (!a || !b) {
+  pixels.forEach((i, k) => {
+    const a = Array.from(dirs.subarray(3 * k, 3 * k + 3));
+    const b = Array.from(dirs.subarray(3 * (m + k), 3 * (m + k) + 3));
+    if (![...a, ...b].every(Number.isFinite)) {
       invalid++;
-      continue;
+      return;
     }
     const e = angleDeg(a, b);
     angles[i] = e;
     worst = Math.max(worst, e);
     sum += e;
     count++;
-  }
+  });
   return { angles, worst, mean: count ? sum / count : 0, count, invalid };
 }
 
@@ -168,7 +124,6 @@ export function attach(studio) {
     map: null, // { key, width, height, image, cells, grid }
     programs: new Map(),
     targets: null,
-    uvToDir,
     heatOf,
   };
   // The view in the URL: the orbit (yaw, pitch, distance), read once.
@@ -668,7 +623,9 @@ export function attach(studio) {
     sim.heatStats = null;
     if (sim.heat && view.mode !== 3) {
       const exact = await recordInto(t.exact, 3);
-      sim.heatStats = heatOf(h.projection, h.frame, sim.record, exact);
+      const { pixels, body } = lookupsOf(sim.record, exact);
+      const r = await G.api(`/api/directions?projection=${encodeURIComponent(view.projection)}`, { method: 'POST', body });
+      sim.heatStats = heatOf(exact.length / 4, pixels, new Float32Array(await r.arrayBuffer()));
     }
     await mapPicture();
     sim.edgeLines = sim.edges && view.mode !== 3 ? await edges(view.mode) : null;

@@ -281,7 +281,7 @@ impl SrgbTable {
         let rel = l.to_bits() - x8.splat_i32(TABLE_FROM as i32);
         // Lanes outside the table's range read a clamped entry, and are not chosen.
         let table = if self.direct.is_empty() {
-            let k = rel.shr(PIECE_SHIFT);
+            let k = rel.shift_right(PIECE_SHIFT);
             let t = (rel & x8.splat_i32((1 << PIECE_SHIFT) - 1)).to_f32()
                 * x8.splat(1.0 / (1 << PIECE_SHIFT) as f32);
             let (a, b) = (
@@ -290,7 +290,7 @@ impl SrgbTable {
             );
             a + (b - a) * t + x8.splat(0.5)
         } else {
-            x8.gather(&self.direct, rel.shr(DIRECT_SHIFT))
+            x8.gather(&self.direct, rel.shift_right(DIRECT_SHIFT))
         };
         let above = l.ge(x8.splat(1.0)).select(x8.splat(self.scale), table);
         l.gt(knee).select(above, linear).trunc_i32()
