@@ -2,7 +2,9 @@
 // started on a bundled scene, the page opened in headless Chromium (SwiftShader WebGL2) at a
 // given view (the URL holds it), a screenshot of the whole page saved under docs/img/.
 //
-//     cargo build -p mirrorball-cli && node tests/browser/screenshots.mjs
+//     cargo build -p mirrorball-cli && node tests/browser/screenshots.mjs [FILE.png…]
+//
+// (only the named pictures when some are named).
 //
 // Not a test (the tests hold the pixels to the CPU renderer); a picture maker.
 import path from 'node:path';
@@ -14,11 +16,14 @@ const VIEWS = [
   ['studio-heatmap.png', 'examples/scenes/zimmons-door.json', 'mode=1&heat=1&marks=0&edges=0', [1100, 740]],
   ['studio-lighting.png', 'examples/scenes/chrome-pair.json', 'mode=3&material=ggx&roughness=0.45', [1100, 450]],
   ['studio-cones.png', 'examples/scenes/bunny-cones.json', 'mode=4', [1100, 500]],
+  ['studio-analysis.png', 'examples/scenes/zimmons-door.json', 'mode=3&projection=eac&analysis=1&analysis-size=256&marks=0&edges=0', [1100, 1250]],
 ];
+const only = process.argv.slice(2);
 
 const chromium = await browser();
 try {
   for (const [file, scene, keys, [width, height]] of VIEWS) {
+    if (only.length && !only.includes(file)) continue;
     const s = await studio([path.join(ROOT, scene)]);
     try {
       const { page, logs } = await openStudio(chromium, `${s.url}&${keys}`);
@@ -28,6 +33,7 @@ try {
         await page.waitForFunction(() => /level/.test(document.getElementById('lighting-status')?.textContent ?? ''), null, { timeout: 120000 });
       }
       await page.evaluate(() => window.studio.ready);
+      await page.evaluate(() => window.studio.analysis.ready);
       await page.waitForTimeout(1500);
       const out = path.join(ROOT, 'docs', 'img', file);
       await page.screenshot({ path: out });

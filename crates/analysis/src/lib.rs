@@ -47,4 +47,7 @@ pub mod profile;
 pub mod report;
 pub mod texels;
 
-pub use report::{analyze, html, json, Analysis, Config, Figure, Report, Sizing};
+pub use report::{
+    analyze, analyze_projection, html, json, Analysis, Config, Figure, ProjectionEntry, Report,
+    Sizing,
+};

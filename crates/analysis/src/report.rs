@@ -344,9 +344,6 @@ pub fn analyze(cfg: &Config) -> Analysis {
         .iter()
         .map(|p| (*p, cfg.sizing.size_for(p)))
         .collect();
-    let draw_size =
-        |p: &Projection, n: u32| size_for_budget(p, cfg.drawing_budget.min(texel_count(p, n)));
-
     let mut stages = Vec::new();
     let mut lap = {
         let mut t = Instant::now();
@@ -361,17 +358,7 @@ pub fn analyze(cfg: &Config) -> Analysis {
         || {
             let per: Vec<(ProjectionEntry, (Projection, Vec<LayerField>))> = sized
                 .iter()
-                .map(|(p, n)| {
-                    let (stats, _) = scan(p, *n, false);
-                    let ds = draw_size(p, *n);
-                    let (_, f) = scan(p, ds, true);
-                    let entry = ProjectionEntry {
-                        stats,
-                        profile: profile(p, *n),
-                        cone: cone_region(p, ds, &cfg.cone),
-                    };
-                    (entry, (*p, f.expect("kept")))
-                })
+                .map(|(p, n)| measure(p, *n, cfg.drawing_budget, &cfg.cone))
                 .collect();
             let (entries, fields): (Vec<_>, Vec<_>) = per.into_iter().unzip();
             // Brute force at no more than 6×256² texels a projection: it converges like 1/n,
@@ -427,6 +414,46 @@ pub fn analyze(cfg: &Config) -> Analysis {
     Analysis { report, figures }
 }
 
+/// One projection's numbers at edge `n` and its fields at the drawing budget (no more texels
+/// than at `n`).
+fn measure(
+    p: &Projection,
+    n: u32,
+    drawing_budget: u64,
+    cone: &Cone,
+) -> (ProjectionEntry, (Projection, Vec<LayerField>)) {
+    let (stats, _) = scan(p, n, false);
+    let ds = size_for_budget(p, drawing_budget.min(texel_count(p, n)));
+    let (_, f) = scan(p, ds, true);
+    let entry = ProjectionEntry {
+        stats,
+        profile: profile(p, n),
+        cone: cone_region(p, ds, cone),
+    };
+    (entry, (*p, f.expect("kept")))
+}
+
+/// One projection measured and drawn as [`analyze`] measures and draws each of its own (a
+/// [`Config`] with `p` alone, sized `size`, the default cone): its numbers, and the
+/// report's solid-angle, anisotropy and Zimmons figures of it alone, the same documents
+/// `mirrorball analyze --projection P --size N` writes (tested). For the studio's analysis
+/// panel: no indexing studies, rims or claims.
+pub fn analyze_projection(
+    p: &Projection,
+    size: u32,
+    drawing_budget: u64,
+) -> (ProjectionEntry, Vec<Figure>) {
+    let (entry, fields) = measure(p, size, drawing_budget, &greene_cone());
+    let entries = std::slice::from_ref(&entry);
+    let fields = std::slice::from_ref(&fields);
+    let figures = vec![
+        solid_angle_figure(entries, drawing_budget, fields),
+        anisotropy_figure(entries, fields),
+        zimmons_figure(entries),
+    ];
+    (entry, figures)
+}
+
 /// The report as pretty-printed JSON. Non-finite numbers become `null`.
 pub fn json(report: &Report) -> String {
     serde_json::to_string_pretty(report).expect("a report serialises")
@@ -478,13 +505,16 @@ fn grid(title: &str, panels: &[(String, u32, u32, Vec<u8>)], scale: Option<&Colo
     let (pw, ph) = (270.0, 230.0);
     let top = 30.0;
     let bar = if scale.is_some() { 70.0 } else { 10.0 };
-    let w = cols as f64 * pw + 20.0;
+    // Wide enough for the title and the colour bar (one projection alone: the studio's
+    // panel, `analyze --projection P`), the panels centred.
+    let w = (cols as f64 * pw + 20.0).max(560.0);
+    let left = (w - cols as f64 * pw) / 2.0;
     let h = top + rows as f64 * ph + bar;
     let mut body = plot::text(w / 2.0, 20.0, title, 15.0, "middle", "font-weight=\"bold\"");
     for (i, (name, iw, ih, rgba)) in panels.iter().enumerate() {
         let (c, r) = (i % cols, i / cols);
         body += &heat_panel(
-            10.0 + c as f64 * pw,
+            left + c as f64 * pw,
             top + r as f64 * ph,
             pw - 10.0,
             ph - 8.0,
@@ -502,9 +532,9 @@ fn grid(title: &str, panels: &[(String, u32, u32, Vec<u8>)], scale: Option<&Colo
 
 fn figures(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Vec<Figure> {
     vec![
-        solid_angle_figure(r, fields),
-        anisotropy_figure(r, fields),
-        zimmons_figure(r),
+        solid_angle_figure(&r.projections, r.drawing_budget, fields),
+        anisotropy_figure(&r.projections, fields),
+        zimmons_figure(&r.projections),
         cone_figure(r, fields),
         indexing_line_figure(r),
         indexing_quad_sphere_figure(r),
@@ -522,7 +552,11 @@ fn size_label(t: &TexelStats) -> String {
 }
 
 /// Solid angle per texel.
-fn solid_angle_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Figure {
+fn solid_angle_figure(
+    entries: &[ProjectionEntry],
+    drawing_budget: u64,
+    fields: &[(Projection, Vec<LayerField>)],
+) -> Figure {
     let sa = ColorScale {
         lo: 1.0 / 64.0,
         hi: 8.0,
@@ -533,7 +567,7 @@ fn solid_angle_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> F
         .iter()
         .enumerate()
         .map(|(i, (p, f))| {
-            let t = &r.projections[i].stats;
+            let t = &entries[i].stats;
             let total: u64 = f.iter().map(|l| (l.width * l.height) as u64).sum();
             let share = equal_share(total);
             let layers = f
@@ -564,7 +598,7 @@ fn solid_angle_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> F
              its share. Drawn at a budget of {} texels per projection (the numbers under each \
              name are at the analysed size); cubes as a horizontal cross, the paraboloid \
              front | back.",
-            r.drawing_budget
+            drawing_budget
         ),
         svg: grid(
             "Solid angle per texel, relative to an equal share",
@@ -575,7 +609,10 @@ fn solid_angle_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> F
 }
 
 /// Anisotropy.
-fn anisotropy_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Figure {
+fn anisotropy_figure(
+    entries: &[ProjectionEntry],
+    fields: &[(Projection, Vec<LayerField>)],
+) -> Figure {
     let an = ColorScale {
         lo: 1.0,
         hi: 16.0,
@@ -586,7 +623,7 @@ fn anisotropy_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Fi
         .iter()
         .enumerate()
         .map(|(k, (p, f))| {
-            let t = &r.projections[k].stats;
+            let t = &entries[k].stats;
             let layers = f
                 .iter()
                 .map(|l| {
@@ -623,12 +660,14 @@ fn anisotropy_figure(r: &Report, fields: &[(Projection, Vec<LayerField>)]) -> Fi
 }
 
 /// Zimmons' one-dimensional measure.
-fn zimmons_figure(r: &Report) -> Figure {
-    let n = r.projections.len();
+fn zimmons_figure(entries: &[ProjectionEntry]) -> Figure {
+    let n = entries.len();
     let cols = 5usize.min(n.max(1));
     let rows = n.div_ceil(cols);
     let (pw, ph) = (300.0, 240.0);
-    let w = cols as f64 * pw;
+    // Wide enough for the title and the legend, the charts centred.
+    let w = (cols as f64 * pw).max(760.0);
+    let left = (w - cols as f64 * pw) / 2.0;
     let h = 36.0 + rows as f64 * ph;
     let h = h + 22.0;
     let mut body = plot::text(
@@ -658,7 +697,7 @@ fn zimmons_figure(r: &Report) -> Figure {
         );
         body += &plot::text(lx + 30.0, 44.0, name, 12.0, "start", "");
     }
-    for (i, e) in r.projections.iter().enumerate() {
+    for (i, e) in entries.iter().enumerate() {
         let (c, row) = (i % cols, i / cols);
         let pr = &e.profile;
         let series = pr
@@ -706,7 +745,7 @@ fn zimmons_figure(r: &Report) -> Figure {
             legend: Legend::None,
             ..Default::default()
         };
-        body += &chart.draw(c as f64 * pw, 58.0 + row as f64 * ph, pw, ph);
+        body += &chart.draw(left + c as f64 * pw, 58.0 + row as f64 * ph, pw, ph);
     }
     Figure {
         id: "analysis-zimmons-1d".into(),

@@ -93,7 +93,7 @@ pub const MAX_LOOKUPS: usize = 2 * 4096 * 2160;
 /// a layer the map does not have, a point off a disk). The simulator's heat map measures
 /// its angles between these, so that the page holds no inverse of any projection.
 pub fn directions(p: &Projection, body: &[u8]) -> Result<Vec<u8>, String> {
-    if body.len() % 12 != 0 || body.len() / 12 > MAX_LOOKUPS {
+    if !body.len().is_multiple_of(12) || body.len() / 12 > MAX_LOOKUPS {
         return Err(format!(
             "the body must be (u, v, layer) f32 triples, at most {MAX_LOOKUPS}: {} bytes",
             body.len()

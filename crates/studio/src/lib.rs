@@ -19,6 +19,7 @@
 //! reads scenes and environments as its `render` and `convert` commands do, with their
 //! messages, and this crate never opens a file by itself.
 
+pub mod analysis;
 pub mod geometry;
 pub mod grid;
 pub mod guard;

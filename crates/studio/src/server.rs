@@ -9,6 +9,7 @@
 //! | `GET /api/mesh/I?tessellation=N` | object `I` in world space ([`geometry`]); a built-in tessellated `N` (`state::MAX_TRIANGLES` at most) |
 //! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
 //! | `POST /api/directions?projection=native\|SPEC` | the core's direction of each `(u, v, layer)` of the body, in the map `/api/environment` sends for the same `projection` ([`grid::directions`]) |
+//! | `GET /api/analysis?projection=native\|SPEC&size=N&fov=DEG&aspect=A&forward=X,Y,Z&up=X,Y,Z` | the projection of that map measured and drawn by the analysis crate (`analyze_projection`: what `mirrorball analyze --projection P --size N` writes of it), and the share of its texels the camera's frustum sees |
 //! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
 //! | `GET /api/lighting/progress` | `{"done", "total", "busy"}`: rows of the prefilter running |
 //! | `GET /api/export?what=map\|chain&format=EXT&projection=…&size=N` | a file to download, written by the [`Host`]: the map (as loaded, or converted as `/api/environment` converts it) or the last prefiltered chain |
@@ -179,6 +180,7 @@ fn serve(
                 "/api/directions",
                 post(directions_of).layer(DefaultBodyLimit::max(12 * grid::MAX_LOOKUPS)),
             )
+            .route("/api/analysis", get(analysis_of))
             .route("/api/lighting", get(lighting_of))
             .route("/api/lighting/progress", get(lighting_progress))
             .route("/api/export", get(export))
@@ -573,6 +575,48 @@ async fn grid_of(Query(q): Query<HashMap<String, String>>) -> Response {
     }
 }
 
+/// The projection of the map `/api/environment` sends for the same `projection` query.
+fn shown_projection(
+    app: &App,
+    q: &HashMap<String, String>,
+) -> Result<mirrorball_core::Projection, (StatusCode, String)> {
+    let spec = q.get("projection").map_or("native", String::as_str);
+    if spec == "native" {
+        let s = app.state.lock().expect("state");
+        match &s.view.scene.environment {
+            Some(e) if gpu_kind(e.map.projection()).is_some() => Ok(*e.map.projection()),
+            Some(_) => Ok(mirrorball_core::ProjectionKind::LatLong.default_projection()),
+            None => Err((StatusCode::NOT_FOUND, "no environment is loaded".into())),
+        }
+    } else {
+        ProjectionSpec::parse(spec)
+            .and_then(|s| s.build(None))
+            .map_err(|e| (StatusCode::BAD_REQUEST, format!("projection: {e}")))
+    }
+}
+
+async fn analysis_of(
+    Shared(app): Shared<AppState>,
+    Query(q): Query<HashMap<String, String>>,
+) -> Response {
+    let p = match shown_projection(&app, &q) {
+        Ok(p) => p,
+        Err((status, why)) => return bad(status, why),
+    };
+    let camera = match crate::analysis::Camera::from_query(&q) {
+        Ok(c) => c,
+        Err(e) => return bad(StatusCode::BAD_REQUEST, e),
+    };
+    let size = match crate::analysis::size_of(&p, q.get("size").map(String::as_str)) {
+        Ok(n) => n,
+        Err(e) => return bad(StatusCode::BAD_REQUEST, e),
+    };
+    match tokio::task::spawn_blocking(move || crate::analysis::encode(&p, size, &camera)).await {
+        Ok(j) => Json(j).into_response(),
+        Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+    }
+}
+
 async fn directions_of(
     Shared(app): Shared<AppState>,
     Query(q): Query<HashMap<String, String>>,
@@ -582,20 +626,9 @@ async fn directions_of(
         Ok(b) => b,
         Err(e) => return bad(e.status(), e.body_text()),
     };
-    let spec = q.get("projection").map_or("native", String::as_str);
-    // The projection of the map /api/environment sends for the same `projection`.
-    let p = if spec == "native" {
-        let s = app.state.lock().expect("state");
-        match &s.view.scene.environment {
-            Some(e) if gpu_kind(e.map.projection()).is_some() => *e.map.projection(),
-            Some(_) => mirrorball_core::ProjectionKind::LatLong.default_projection(),
-            None => return bad(StatusCode::NOT_FOUND, "no environment is loaded"),
-        }
-    } else {
-        match ProjectionSpec::parse(spec).and_then(|s| s.build(None)) {
-            Ok(p) => p,
-            Err(e) => return bad(StatusCode::BAD_REQUEST, format!("projection: {e}")),
-        }
+    let p = match shown_projection(&app, &q) {
+        Ok(p) => p,
+        Err((status, why)) => return bad(status, why),
     };
     match tokio::task::spawn_blocking(move || grid::directions(&p, &body)).await {
         Ok(Ok(b)) => binary(b),

@@ -20,6 +20,7 @@ const FILES: &[(&str, &str, &str)] = files![
     "studio.js": "js",
     "gl.js": "js",
     "sim.js": "js",
+    "analysis.js": "js",
     "glsl/math.glsl": "glsl",
     "panels.js": "js",
     "glsl/latlong.glsl": "glsl",

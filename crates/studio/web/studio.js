@@ -571,4 +571,7 @@ const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw,
 const sim = await import(`./sim.js?token=${encodeURIComponent(token)}`);
 handle.sim = sim.attach(handle);
 handle.ready = ready.then(() => handle.sim.ready);
+// The analysis panel (analysis.js), measured once the view is ready when the URL asks.
+const analysis = await import(`./analysis.js?token=${encodeURIComponent(token)}`);
+handle.analysis = analysis.attach(handle);
 window.studio = handle;
