@@ -87,11 +87,14 @@ export function run(args) {
 
 const EXAMPLES = path.join(ROOT, 'target', 'debug', 'examples');
 
-/// Builds the bake crate's examples once (`cargo build -p mirrorball-bake --examples`).
+/// Builds the workspace's examples once (the bake crate's are used here). The whole workspace
+/// rather than `-p mirrorball-bake`: its dependencies then have the features `cargo test
+/// --workspace` built them with, so after the README's test command (CI) nothing is
+/// rebuilt; one crate alone would unify them otherwise and rebuild them (a minute in CI).
 let built = false;
 function buildExamples() {
   if (built) return;
-  execFileSync('cargo', ['build', '-q', '-p', 'mirrorball-bake', '--examples'], { cwd: ROOT, stdio: 'inherit' });
+  execFileSync('cargo', ['build', '-q', '--workspace', '--examples'], { cwd: ROOT, stdio: 'inherit' });
   built = true;
 }
 
