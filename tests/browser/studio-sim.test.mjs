@@ -171,6 +171,33 @@ test("the door at 70° under mode 1: the texels read and the heat map's worst an
   }
 });
 
+test("the heat map in a newer projection: the door under mode 2 on an equi-angular cube, worst and mean as the CPU renderer's", async () => {
+  const file = scene('door');
+  const s = await studio([file]);
+  const page = await open(`${s.url}&mode=2&projection=eac&size=64&heat=1`);
+  try {
+    const got = await page.evaluate(() => {
+      const { worst, mean, count, invalid } = window.studio.sim.heatStats;
+      return { worst, mean, count, invalid, text: document.getElementById('sim-stats').textContent };
+    });
+    const EAC = ['--env-as', 'eac', '--env-size', '64'];
+    const st2 = cpuSt(file, ['--mode', '2', ...EAC]);
+    const st3 = cpuSt(file, ['--mode', '3', ...EAC]);
+    const { pixels, body } = lookupsOf(st2, st3);
+    const cpu = heatOf(st2.length / 4, pixels, (await directions(s, 'eac', body)).dirs);
+    console.log(`door mode 2 on EAC: page ${got.text}; CPU channels: worst ${cpu.worst.toFixed(3)}°, mean ${cpu.mean.toFixed(3)}° over ${cpu.count} pixels`);
+    assert.ok(cpu.count > 3000, `${cpu.count} covered pixels`);
+    assert.equal(got.invalid, 0);
+    assert.ok(cpu.worst > 0.5, `mode 2's error on the grazing door is known to be large: ${cpu.worst}°`);
+    assert.ok(Math.abs(got.worst - cpu.worst) <= 0.02 * cpu.worst, `worst ${got.worst}° against the CPU's ${cpu.worst}°`);
+    assert.ok(Math.abs(got.mean - cpu.mean) <= 0.01 * cpu.mean, `mean ${got.mean}° against the CPU's ${cpu.mean}°`);
+    assert.ok(Math.abs(got.count - cpu.count) <= 0.01 * cpu.count);
+  } finally {
+    await page.close();
+    s.stop();
+  }
+});
+
 test('the texel under the cursor is ringed where the CPU read it, and moves with the cursor', async () => {
   const file = scene('sphere');
   const s = await studio([file]);
