@@ -59,9 +59,9 @@ export function heatOf(n, pixels, dirs) {
   let count = 0;
   let invalid = 0;
   pixels.forEach((i, k) => {
-    const a = Array.from(dirs.subarray(3 * k, 3 * k + 3));
-    const b = Array.from(dirs.subarray(3 * (m + k), 3 * (m + k) + 3));
-    if (![...a, ...b].every(Number.isFinite)) {
+    const a = dirs.subarray(3 * k, 3 * k + 3);
+    const b = dirs.subarray(3 * (m + k), 3 * (m + k) + 3);
+    if (!a.every(Number.isFinite) || !b.every(Number.isFinite)) {
       invalid++;
       return;
     }
