@@ -360,6 +360,64 @@ impl Reader<'_> {
     }
 }
 
+/// What a plan is made for: the source's projection, layer extent and layer count, and the
+/// output's layer extent.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Shape {
+    from: Projection,
+    extent: (u32, u32),
+    layers: usize,
+    out: (u32, u32),
+}
+
+impl Shape {
+    fn of(src: &EnvMap, out: (u32, u32)) -> Shape {
+        Shape {
+            from: *src.projection(),
+            extent: (src.width(), src.height()),
+            layers: src.layers().len(),
+            out,
+        }
+    }
+
+    fn plan(&self, dst: Projection, plan: &Plan) -> Remap {
+        Remap::with_extent(
+            self.from,
+            self.extent,
+            self.layers,
+            dst,
+            self.out,
+            &plan.resample,
+        )
+    }
+}
+
+/// The plan for a `w`×`h` raw frame, decided as the pipe's first frame will be (its shape
+/// alone decides it): `None` where that decision fails or the frames would not fit in memory
+/// (the real frame then says why, before anything of this size is made).
+fn plan_for_blank(plan: &Plan, dst: Projection, w: u32, h: u32) -> Option<(Shape, Remap)> {
+    let frame = budget::f32_texels(w as u64 * h as u64, 3);
+    budget::check("", 0, (FRAMES_IN_FLIGHT + 1) * frame, "").ok()?;
+    let stereo = plan.in_stereo.unwrap_or_default();
+    let (left, _, _) = load::interpret_eyes(
+        "-",
+        Image::new(w, h, 3),
+        (stereo, stereo.eyes_read(plan.stereo)),
+        plan.input.from.as_ref(),
+        plan.input.layout,
+        None,
+        None,
+        |_| String::new(),
+    )
+    .ok()?;
+    let size = plan
+        .size
+        .unwrap_or_else(|| save::default_size(&left, dst.kind()));
+    let shape = Shape::of(&left, dst.layer_extent(size));
+    drop(left);
+    Some((shape, shape.plan(dst, plan)))
+}
+
 fn meta(number: u64, input: String) -> Meta {
     Meta { number, input }
 }
@@ -389,7 +447,19 @@ fn convert_frames(
         limits: mirrorball_io::Limits::default(),
     };
     let t0 = Instant::now();
-    let Some(first) = reader.next(None) else {
+    // A pipe's frames have the shape --in-size says, so the conversion is planned while the
+    // first frame is on its way (the producer starting and sending it), and used when that
+    // frame turns out to have the shape it was planned for (else planned again).
+    let blank = match &reader.input {
+        Input::Pipe { w, h, .. } => Some((*w, *h)),
+        Input::Files(_) => None,
+    };
+    let (first, early) = std::thread::scope(|s| {
+        let early = blank.map(|(w, h)| s.spawn(move || plan_for_blank(plan, dst, w, h)));
+        let first = reader.next(None);
+        (first, early.and_then(|e| e.join().ok().flatten()))
+    });
+    let Some(first) = first else {
         return Err(CliError::input(
             "standard input ended before the first frame",
         ));
@@ -402,14 +472,11 @@ fn convert_frames(
         .unwrap_or_else(|| save::default_size(src0, dst.kind()));
     let (w, h) = dst.layer_extent(size);
     let c = src0.channels();
-    let remap = Remap::with_extent(
-        *src0.projection(),
-        (src0.width(), src0.height()),
-        src0.layers().len(),
-        dst,
-        (w, h),
-        &plan.resample,
-    );
+    let shape0 = Shape::of(src0, (w, h));
+    let remap = match early {
+        Some((shape, remap)) if shape == shape0 => remap,
+        _ => shape0.plan(dst, plan),
+    };
     let frame_bytes = |env_texels: u64| budget::f32_texels(env_texels, c as u64);
     budget::check(
         &format!("frames of {} {w}x{h}x{}", dst.name(), dst.layer_count()),
