@@ -17,6 +17,7 @@ const VIEWS = [
   ['studio-lighting.png', 'examples/scenes/chrome-pair.json', 'mode=3&material=ggx&roughness=0.45', [1100, 450]],
   ['studio-cones.png', 'examples/scenes/bunny-cones.json', 'mode=4', [1100, 500]],
   ['studio-analysis.png', 'examples/scenes/zimmons-door.json', 'mode=3&projection=eac&analysis=1&analysis-size=256&marks=0&edges=0', [1100, 1250]],
+  ['studio-twin.png', 'examples/scenes/chrome-pair.json', 'mode=3&object=teapot&twin=1&yaw=0.5&pitch=0.3&distance=3.4', [1100, 420]],
 ];
 const only = process.argv.slice(2);
 

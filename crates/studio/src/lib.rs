@@ -59,4 +59,13 @@ pub trait Host: Send + Sync + 'static {
     /// `what` written as a file of container `format` (one of [`EXPORT_FORMATS`]), as the
     /// embedding program writes its own outputs: the file's bytes, or why it cannot be.
     fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String>;
+    /// The meshes the embedding program bundles, which the page offers beside the
+    /// built-ins (none unless it says).
+    fn bundled_meshes(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// The bundled mesh `name` (one of [`Host::bundled_meshes`]).
+    fn bundled_mesh(&self, name: &str) -> Result<mirrorball_render::Mesh, String> {
+        Err(format!("no bundled mesh {name}"))
+    }
 }

@@ -13,10 +13,11 @@
 //! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
 //! | `GET /api/lighting/progress` | `{"done", "total", "busy"}`: rows of the prefilter running |
 //! | `GET /api/export?what=map\|chain&format=EXT&projection=…&size=N` | a file to download, written by the [`Host`]: the map (as loaded, or converted as `/api/environment` converts it) or the last prefiltered chain |
-//! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit) |
+//! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit): a scene, an environment or a mesh |
+//! | `POST /api/object?name=scene\|BUILTIN\|BUNDLED&tessellation=N` | shows one object in place of the scene's (a built-in, or a mesh the [`Host`] bundles), or the scene's own again |
 
 use crate::guard::Guard;
-use crate::state::{gpu_kind, State};
+use crate::state::{gpu_kind, ObjectChoice, State};
 use crate::{geometry, grid, lighting, texture, web, Export, Host, EXPORT_FORMATS};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
@@ -27,7 +28,8 @@ use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{Json, Router};
 use mirrorball_core::projection::ProjectionSpec;
-use mirrorball_core::{resample, EnvMap, ResampleOptions};
+use mirrorball_core::{resample, Choice, EnvMap, ResampleOptions};
+use mirrorball_render::Builtin;
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -119,6 +121,7 @@ impl Studio {
     /// cannot be bound, is an error before anything is served.
     pub fn start(&self, host: Arc<dyn Host>, files: &[PathBuf]) -> Result<Running, String> {
         let mut state = State::new(host.default_scene());
+        state.bundled = host.bundled_meshes();
         for f in files {
             state.apply(host.open(f)?);
         }
@@ -184,6 +187,7 @@ fn serve(
             .route("/api/lighting", get(lighting_of))
             .route("/api/lighting/progress", get(lighting_progress))
             .route("/api/export", get(export))
+            .route("/api/object", post(object))
             .route(
                 "/api/upload",
                 post(upload).layer(DefaultBodyLimit::max(limit)),
@@ -508,6 +512,19 @@ struct MeshQuery {
     tessellation: Option<u32>,
 }
 
+/// Refuses a tessellation of built-in `b` past [`crate::state::MAX_TRIANGLES`].
+fn tessellation(b: Builtin, level: u32) -> Result<(), String> {
+    let max = b.max_tessellation(crate::state::MAX_TRIANGLES);
+    if (1..=max).contains(&level) {
+        return Ok(());
+    }
+    Err(format!(
+        "tessellation: {level} is outside 1..={max} for the {} (at most {} triangles)",
+        b.name(),
+        crate::state::MAX_TRIANGLES
+    ))
+}
+
 async fn mesh(
     Shared(app): Shared<AppState>,
     UrlPath(i): UrlPath<usize>,
@@ -528,16 +545,8 @@ async fn mesh(
                     format!("tessellation: object {i} is a mesh file, not a built-in"),
                 );
             };
-            let max = b.max_tessellation(crate::state::MAX_TRIANGLES);
-            if !(1..=max).contains(&level) {
-                return bad(
-                    StatusCode::BAD_REQUEST,
-                    format!(
-                        "tessellation: {level} is outside 1..={max} for the {} (at most {} triangles)",
-                        b.name(),
-                        crate::state::MAX_TRIANGLES
-                    ),
-                );
+            if let Err(m) = tessellation(b, level) {
+                return bad(StatusCode::BAD_REQUEST, m);
             }
             o.mesh = Arc::new(b.mesh(level));
             Some(o)
@@ -678,6 +687,61 @@ async fn upload(
         }
         Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
     }
+}
+
+#[derive(Deserialize)]
+struct ObjectQuery {
+    name: Option<String>,
+    tessellation: Option<u32>,
+}
+
+async fn object(Shared(app): Shared<AppState>, Query(q): Query<ObjectQuery>) -> Response {
+    let Some(name) = q.name else {
+        return bad(
+            StatusCode::BAD_REQUEST,
+            "object: give ?name=scene, a built-in or a bundled mesh",
+        );
+    };
+    let bundled = app.host.bundled_meshes();
+    let choice = if name == "scene" {
+        ObjectChoice::Scene
+    } else if let Some(b) = Builtin::from_name(&name) {
+        let max = b.max_tessellation(crate::state::MAX_TRIANGLES);
+        let level = q
+            .tessellation
+            .unwrap_or_else(|| b.default_tessellation().min(max));
+        if let Err(m) = tessellation(b, level) {
+            return bad(StatusCode::BAD_REQUEST, m);
+        }
+        ObjectChoice::Builtin(b, level)
+    } else if bundled.contains(&name.as_str()) {
+        let host = app.host.clone();
+        let read = tokio::task::spawn_blocking(move || {
+            let mesh = host.bundled_mesh(&name);
+            (name, mesh)
+        })
+        .await;
+        match read {
+            Ok((name, Ok(mesh))) => ObjectChoice::Mesh {
+                name,
+                mesh: Box::new(mesh),
+            },
+            Ok((_, Err(m))) => return bad(StatusCode::INTERNAL_SERVER_ERROR, m),
+            Err(e) => return bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
+        }
+    } else {
+        let known: Vec<&str> = (["scene"].into_iter())
+            .chain(Builtin::ALL.iter().map(|b| b.name()))
+            .chain(bundled.iter().copied())
+            .collect();
+        return bad(
+            StatusCode::BAD_REQUEST,
+            format!("object: unknown '{name}' (known: {})", known.join(", ")),
+        );
+    };
+    let mut s = app.state.lock().expect("state");
+    s.show_object(choice);
+    Json(s.describe()).into_response()
 }
 
 /// Opens `url` in the desktop's browser (`xdg-open`, `open`, `start`); failing to is not an

@@ -1,10 +1,12 @@
 //! What the studio has loaded, and what the page is told about it.
 
+use mirrorball_core::glam::Mat4;
 use mirrorball_core::glam::{DVec3, Mat3};
 use mirrorball_core::{Choice, CylinderRule, EnvMap, Frame, Lens, Projection, RadialMap};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{
-    Attach, Builtin, Camera, CameraLens, Environment, Indexing, Material, Scene, Settings,
+    Attach, Builtin, Camera, CameraLens, Environment, Indexing, Material, Mesh, Object, Scene,
+    Settings,
 };
 use serde_json::{json, Value};
 use std::sync::Arc;
@@ -36,6 +38,28 @@ pub enum Opened {
     /// An environment map: replaces the scene's environment (world-attached, bilinear,
     /// intensity 1 if the scene had none).
     Environment { name: String, map: Box<EnvMap> },
+    /// A mesh file: shown in place of the scene's objects, as a mirror of unit size
+    /// (`Mesh::normalizing_transform`, as `render` frames mesh files).
+    Mesh { name: String, mesh: Box<Mesh> },
+}
+
+/// What the page may show in place of the scene's objects (`POST /api/object`).
+pub enum ObjectChoice {
+    /// The scene's own objects again.
+    Scene,
+    /// One built-in at the origin, at a tessellation.
+    Builtin(Builtin, u32),
+    /// One mesh (a file uploaded, or one the embedding program bundles), called `name`.
+    Mesh { name: String, mesh: Box<Mesh> },
+}
+
+/// The scene's own objects, kept while another is shown: the objects, their built-ins and
+/// the scene file.
+#[derive(Clone)]
+struct SceneObjects {
+    objects: Vec<Object>,
+    builtins: Vec<Option<(Builtin, u32)>>,
+    source: Option<Value>,
 }
 
 /// Everything loaded.
@@ -45,6 +69,11 @@ pub struct State {
     pub errors: Vec<String>,
     /// Bumped on every change, so that the page knows to fetch again.
     pub generation: u64,
+    /// What is shown in place of the scene's objects (`None`: the scene's own), and the
+    /// scene's objects kept meanwhile.
+    shown: Option<(String, SceneObjects)>,
+    /// The meshes the embedding program bundles ([`crate::Host::bundled_meshes`]).
+    pub bundled: &'static [&'static str],
 }
 
 /// The most triangles the page may ask a built-in to be tessellated into.
@@ -59,13 +88,22 @@ impl State {
             view,
             errors: Vec::new(),
             generation: 1,
+            shown: None,
+            bundled: &[],
         }
     }
 
     /// Takes in what a file held.
     pub fn apply(&mut self, opened: Opened) {
         match opened {
-            Opened::Scene(v) => self.view = *v,
+            Opened::Scene(v) => {
+                self.view = *v;
+                self.shown = None;
+            }
+            Opened::Mesh { name, mesh } => {
+                self.show_object(ObjectChoice::Mesh { name, mesh });
+                return;
+            }
             Opened::Environment { name, map } => {
                 let env = match self.view.scene.environment.take() {
                     Some(e) => Environment {
@@ -83,10 +121,73 @@ impl State {
                 };
                 self.view.scene.environment = Some(env);
                 self.view.source = None;
+                if let Some((_, kept)) = &mut self.shown {
+                    kept.source = None;
+                }
                 self.view.name = format!("{} with {name}", self.view.name);
             }
         }
         self.generation += 1;
+    }
+
+    /// Shows `choice` in place of the scene's objects: one mirror, with the scene's camera,
+    /// environment and settings. A built-in stays in the scene file the page exports
+    /// (`meshes` becomes that built-in); a mesh has no path a scene file could name, so the
+    /// page cannot export the scene while it is shown.
+    pub fn show_object(&mut self, choice: ObjectChoice) {
+        let v = &mut self.view;
+        let kept = || SceneObjects {
+            objects: v.scene.objects.clone(),
+            builtins: v.builtins.clone(),
+            source: v.source.clone(),
+        };
+        let kept = match self.shown.take() {
+            Some((_, k)) => k,
+            None => kept(),
+        };
+        let (name, object, builtin, source) = match choice {
+            ObjectChoice::Scene => {
+                v.scene.objects = kept.objects;
+                v.builtins = kept.builtins;
+                v.source = kept.source;
+                self.generation += 1;
+                return;
+            }
+            ObjectChoice::Builtin(b, level) => {
+                let object = Object {
+                    mesh: Arc::new(b.mesh(level)),
+                    model: Mat4::IDENTITY,
+                    material: Material::mirror(),
+                };
+                let source = kept.source.clone().map(|mut s| {
+                    s["meshes"] = json!([{
+                        "mesh": b.name(),
+                        "tessellation": level,
+                        "material": {"kind": "mirror"},
+                    }]);
+                    s
+                });
+                (b.name().to_string(), object, Some((b, level)), source)
+            }
+            ObjectChoice::Mesh { name, mesh } => {
+                let object = Object {
+                    model: mesh.normalizing_transform(),
+                    mesh: Arc::from(mesh),
+                    material: Material::mirror(),
+                };
+                (name, object, None, None)
+            }
+        };
+        v.scene.objects = vec![object];
+        v.builtins = vec![builtin];
+        v.source = source;
+        self.shown = Some((name, kept));
+        self.generation += 1;
+    }
+
+    /// The name of what is shown in place of the scene's objects, or `None`.
+    pub fn shown_object(&self) -> Option<&str> {
+        self.shown.as_ref().map(|(n, _)| n.as_str())
     }
 
     /// Records a message for the page.
@@ -103,6 +204,11 @@ impl State {
         json!({
             "generation": self.generation,
             "scene": describe_scene(&self.view),
+            "object": self.shown_object(),
+            "objectChoices": (["scene"].into_iter())
+                .chain(Builtin::ALL.iter().map(|b| b.name()))
+                .chain(self.bundled.iter().copied())
+                .collect::<Vec<_>>(),
             "errors": self.errors,
         })
     }
@@ -299,4 +405,127 @@ pub fn params_of(p: &Projection) -> [f32; 4] {
         _ => [0.0; 4],
     };
     v.map(|x| x as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mirrorball_core::glam::Vec3;
+
+    fn view() -> SceneView {
+        SceneView {
+            name: "scene.json".into(),
+            scene: Scene {
+                objects: vec![Object {
+                    mesh: Arc::new(Builtin::Sphere.mesh(12)),
+                    model: Mat4::from_translation(Vec3::new(0.0, 0.5, 0.0)),
+                    material: Material::Mirror {
+                        tint: [1.0, 0.5, 0.5],
+                    },
+                }],
+                environment: None,
+                background: true,
+            },
+            camera: Camera::perspective(Vec3::new(0.0, 0.0, 3.5), Vec3::ZERO, 40.0, 64, 48),
+            settings: Settings::default(),
+            exposure: 0.0,
+            tone: Tone::Clamp,
+            source: Some(
+                json!({"meshes": [{"mesh": "sphere", "tessellation": 12}], "indexing": "pixel"}),
+            ),
+            builtins: vec![Some((Builtin::Sphere, 12))],
+        }
+    }
+
+    fn triangles(s: &State) -> Vec<usize> {
+        let objects = &s.view.scene.objects;
+        objects.iter().map(|o| o.mesh.triangles.len()).collect()
+    }
+
+    #[test]
+    fn an_object_shown_in_place_of_the_scenes_and_the_scenes_again() {
+        let mut s = State::new(view());
+        let own = (
+            triangles(&s),
+            s.view.builtins.clone(),
+            s.view.source.clone(),
+        );
+        s.show_object(ObjectChoice::Builtin(Builtin::Teapot, 2));
+        assert_eq!(s.shown_object(), Some("teapot"));
+        assert_eq!(triangles(&s), vec![Builtin::Teapot.mesh(2).triangles.len()]);
+        assert_eq!(s.view.scene.objects[0].model, Mat4::IDENTITY);
+        assert_eq!(s.view.builtins, vec![Some((Builtin::Teapot, 2))]);
+        // The scene file names the built-in, and keeps the rest.
+        let src = s.view.source.clone().unwrap();
+        assert_eq!(
+            src["meshes"],
+            json!([{"mesh": "teapot", "tessellation": 2, "material": {"kind": "mirror"}}])
+        );
+        assert_eq!(src["indexing"], "pixel");
+        // Another object replaces it; the scene's own come back whole.
+        s.show_object(ObjectChoice::Builtin(Builtin::Torus, 8));
+        s.show_object(ObjectChoice::Scene);
+        assert_eq!(s.shown_object(), None);
+        assert_eq!(
+            (
+                triangles(&s),
+                s.view.builtins.clone(),
+                s.view.source.clone()
+            ),
+            own
+        );
+        assert_eq!(
+            s.view.scene.objects[0].model,
+            Mat4::from_translation(Vec3::new(0.0, 0.5, 0.0))
+        );
+        let described = s.describe();
+        assert_eq!(described["object"], Value::Null);
+        assert_eq!(described["objectChoices"][0], "scene");
+    }
+
+    #[test]
+    fn a_mesh_has_no_scene_file_and_a_new_environment_leaves_none_to_restore() {
+        let mut s = State::new(view());
+        // A mesh 10 units across, framed to unit size at the origin as render frames files.
+        let mut big = Builtin::Cube
+            .mesh(1)
+            .transformed(Mat4::from_scale(Vec3::splat(5.0)));
+        big.compute_normals();
+        s.apply(Opened::Mesh {
+            name: "big.obj".into(),
+            mesh: Box::new(big),
+        });
+        assert_eq!(s.shown_object(), Some("big.obj"));
+        assert_eq!(s.view.source, None);
+        assert_eq!(s.view.builtins, vec![None]);
+        let o = &s.view.scene.objects[0];
+        let (lo, hi) = o.mesh.transformed(o.model).bounds().unwrap();
+        assert!((hi - Vec3::ONE).abs().max_element() < 1e-5, "{hi}");
+        assert!((lo + Vec3::ONE).abs().max_element() < 1e-5, "{lo}");
+        // The environment replaced meanwhile: the scene's objects come back without a file.
+        let img = mirrorball_core::Image::new(8, 4, 3);
+        let map = EnvMap::new(
+            mirrorball_core::ProjectionKind::LatLong.default_projection(),
+            vec![img],
+        )
+        .unwrap();
+        s.apply(Opened::Environment {
+            name: "sky.exr".into(),
+            map: Box::new(map),
+        });
+        s.show_object(ObjectChoice::Scene);
+        assert_eq!(
+            triangles(&s),
+            vec![Builtin::Sphere.mesh(12).triangles.len()]
+        );
+        assert_eq!(s.view.source, None);
+        // A scene opened forgets what was shown.
+        s.show_object(ObjectChoice::Builtin(Builtin::Quad, 1));
+        s.apply(Opened::Scene(Box::new(view())));
+        assert_eq!(s.shown_object(), None);
+        assert_eq!(
+            triangles(&s),
+            vec![Builtin::Sphere.mesh(12).triangles.len()]
+        );
+    }
 }

@@ -595,6 +595,11 @@ export function attach(studio) {
     p.set('lightsize', String(view.lightSize));
     p.set('paraboloid', view.paraboloid);
     if (view.tessellation) p.set('tessellation', String(view.tessellation));
+    else p.delete('tessellation');
+    if (view.state?.object) p.set('object', view.state.object);
+    else p.delete('object');
+    if (view.attach) p.set('attach', view.attach);
+    p.set('twin', view.twin ? '1' : '0');
     if (view.size) p.set('size', String(view.size));
     if (view.orbit) {
       p.set('yaw', String(view.orbit.yaw));

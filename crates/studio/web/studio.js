@@ -5,7 +5,11 @@
 // `roughness` the objects' material, the prefiltered ones lit by the server's chain (level 0
 // `lightsize`² a face) and SH9 (panels.js, lighting.glsl); `paraboloid=hardware` draws a
 // dual paraboloid as the hardware did (two textures, the alpha choosing: paraboloid_hw.glsl);
-// `tessellation=N` re-tessellates the built-in objects (the slider). `window.studio` is the
+// `tessellation=N` re-tessellates the built-in objects (the slider); `object=NAME` shows a
+// built-in or the bundled bunny in place of the scene's objects (the server's `/api/object`;
+// a mesh file opened by the picker too); `attach=world|eye` attaches the map to the world or
+// to the eye whatever the scene says; `twin=1` draws the same view with the map attached the
+// other way beside the viewport (Zimmons' figure 18, view dependence). `window.studio` is the
 // page's handle for tests and later views (simulator, overlays) to plug into.
 
 const params = new URLSearchParams(location.search);
@@ -35,6 +39,9 @@ const view = {
   projection: params.get('projection') || 'native',
   size: params.get('size') ? Number(params.get('size')) : null,
   paraboloid: params.get('paraboloid') === 'hardware' ? 'hardware' : 'exact',
+  // The map's attachment (null: the scene's), and the other one drawn beside (`twin`).
+  attach: ['world', 'eye'].includes(params.get('attach')) ? params.get('attach') : null,
+  twin: params.get('twin') === '1',
   // The built-in objects' tessellation (null: the scene's).
   tessellation: params.get('tessellation') ? Number(params.get('tessellation')) : null,
   env: null, // { header, texture, halves (a dual paraboloid's two 2D textures) }
@@ -67,8 +74,11 @@ function show(messages) {
   );
 }
 
+/** What the URL asked for that could not be done. */
+const linkNotes = [];
+
 function report(error) {
-  const notes = view.state?.scene?.notes || [];
+  const notes = [...linkNotes, ...(view.state?.scene?.notes || [])];
   const errors = view.state?.errors || [];
   const message = error ? String(error.message || error) : null;
   show([
@@ -78,10 +88,43 @@ function report(error) {
   ]);
 }
 
-async function loadState() {
+/** The map's attachment now: the page's choice, or the scene's. */
+function attachNow() {
+  return view.attach ?? view.state?.scene.environment?.attach ?? 'world';
+}
+
+/** The object selector: the server's choices, and what it shows now. */
+function showObjects() {
+  const st = view.state;
+  const select = document.getElementById('object');
+  const names = [...st.objectChoices];
+  if (st.object && !names.includes(st.object)) names.push(st.object);
+  const label = (n) => (n === 'scene' ? "the scene's" : n === 'quad' ? 'quad (door)' : n);
+  select.replaceChildren(
+    ...names.map((n) => {
+      const o = document.createElement('option');
+      o.value = n;
+      o.textContent = label(n);
+      return o;
+    }),
+  );
+  select.value = st.object ?? 'scene';
+}
+
+/** What the server shows, the controls that depend on it and the objects' meshes. */
+async function loadObjects() {
   view.state = await (await G.api('/api/state')).json();
+  document.getElementById('scene-name').textContent = view.state.scene.name;
+  document.getElementById('attach').value = attachNow();
+  document.getElementById('twin').checked = view.twin;
+  showObjects();
+  showTessellation();
+  await loadMeshes();
+}
+
+async function loadState() {
+  await loadObjects();
   const s = view.state.scene;
-  document.getElementById('scene-name').textContent = s.name;
   if (view.mode === null) view.mode = Number(params.get('mode') || s.mode);
   document.getElementById('mode').value = String(view.mode);
   document.getElementById('projection').value = view.projection;
@@ -92,8 +135,6 @@ async function loadState() {
   canvas.height = s.camera.height;
   canvas.style.width = `${s.camera.width}px`;
   canvas.style.height = `${s.camera.height}px`;
-  showTessellation();
-  await loadMeshes();
   await loadEnvironment();
   report();
 }
@@ -253,7 +294,8 @@ function camera() {
 /**
  * Draws the scene; `pass` (the simulator's, sim.js) may draw it into `framebuffer` with
  * `program(background)` instead of the viewport's, clear to `clear`, leave the background
- * out (`background: false`) and draw each mesh itself (`drawMesh(mesh)`).
+ * out (`background: false`), draw each mesh itself (`drawMesh(mesh)`) and attach the map
+ * otherwise (`attach`: 'world' or 'eye').
  */
 async function draw(pass = {}) {
   const s = view.state.scene;
@@ -284,7 +326,7 @@ async function draw(pass = {}) {
     gl.uniform3fv(u('uEye'), cam.eye);
     gl.uniform1i(u('uPersp'), persp ? 1 : 0);
     gl.uniform3fv(u('uForward'), forward);
-    gl.uniform1i(u('uAttachEye'), env.attach === 'eye' ? 1 : 0);
+    gl.uniform1i(u('uAttachEye'), (pass.attach ?? attachNow()) === 'eye' ? 1 : 0);
     if (h.frame) gl.uniformMatrix3fv(u('uFrame'), false, new Float32Array(h.frame));
     if (h.params) gl.uniform4fv(u('uParams'), new Float32Array(h.params));
     gl.activeTexture(gl.TEXTURE0);
@@ -354,8 +396,8 @@ function redraw() {
   return drawing;
 }
 
-/** The viewport's pixels, RGBA, top row first. */
-function pixels() {
+/** The pixels of the framebuffer bound for reading, RGBA, top row first. */
+function readRgba() {
   const w = canvas.width;
   const h = canvas.height;
   const raw = new Uint8Array(w * h * 4);
@@ -363,6 +405,68 @@ function pixels() {
   const out = new Uint8Array(w * h * 4);
   for (let y = 0; y < h; y++) out.set(raw.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
   return { width: w, height: h, data: out };
+}
+
+/** The viewport's pixels, RGBA, top row first. */
+function pixels() {
+  return readRgba();
+}
+
+/**
+ * The twin beside the viewport: the same view drawn with the map attached the other way
+ * into a target of the viewport's size and format (RGBA8, a depth buffer), shown on a 2D
+ * canvas. `twin.last` keeps its pixels (RGBA, top row first) for tests.
+ */
+const twin = { target: null, last: null };
+async function drawTwin() {
+  const figure = document.getElementById('twin-figure');
+  const caption = document.getElementById('viewport-caption');
+  const on = view.twin && !embed && view.env;
+  figure.hidden = !on;
+  caption.hidden = !on;
+  if (!on) return;
+  const w = canvas.width;
+  const h = canvas.height;
+  let t = twin.target;
+  if (!t || t.w !== w || t.h !== h) {
+    if (t) {
+      gl.deleteFramebuffer(t.fb);
+      gl.deleteTexture(t.color);
+      gl.deleteRenderbuffer(t.depth);
+    }
+    const color = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, color);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, w, h);
+    const depth = gl.createRenderbuffer();
+    gl.bindRenderbuffer(gl.RENDERBUFFER, depth);
+    gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, w, h);
+    const fb = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, color, 0);
+    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, depth);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    t = twin.target = { fb, color, depth, w, h };
+  }
+  const mine = attachNow();
+  const other = mine === 'eye' ? 'world' : 'eye';
+  await draw({ framebuffer: t.fb, attach: other });
+  gl.bindFramebuffer(gl.FRAMEBUFFER, t.fb);
+  twin.last = readRgba();
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  const c = document.getElementById('twin-canvas');
+  c.width = w;
+  c.height = h;
+  c.getContext('2d').putImageData(new ImageData(new Uint8ClampedArray(twin.last.data.buffer), w, h), 0, 0);
+  const says = (a) => (a === 'eye' ? 'attached to the eye (it turns with the camera)' : 'attached to the world (it stays as the camera moves)');
+  caption.textContent = `the viewport, the map ${says(mine)}`;
+  document.getElementById('twin-caption').textContent = `beside it, the map ${says(other)}`;
+}
+
+/** Shows `name` (`scene`, a built-in or a bundled mesh) in place of the scene's objects. */
+async function chooseObject(name) {
+  await G.api(`/api/object?name=${encodeURIComponent(name)}`, { method: 'POST' });
+  view.tessellation = null;
+  await loadObjects();
 }
 
 async function upload(file) {
@@ -416,6 +520,23 @@ document.getElementById('tessellation').addEventListener('change', async (e) => 
   } catch (err) {
     report(err);
   }
+  redraw();
+});
+document.getElementById('object').addEventListener('change', async (e) => {
+  try {
+    await chooseObject(e.target.value);
+    report();
+  } catch (err) {
+    report(err);
+  }
+  redraw();
+});
+document.getElementById('attach').addEventListener('change', (e) => {
+  view.attach = e.target.value;
+  redraw();
+});
+document.getElementById('twin').addEventListener('change', (e) => {
+  view.twin = e.target.checked;
   redraw();
 });
 document.getElementById('paraboloid').addEventListener('change', (e) => {
@@ -486,7 +607,7 @@ async function exportFile(what) {
 function sceneFile() {
   const s = view.state.scene;
   if (!s.source) {
-    throw new Error('the scene came from no scene file, or its environment was replaced: only a scene opened from a file exports (its meshes and environment are named by path)');
+    throw new Error('the scene came from no scene file, its environment was replaced, or a mesh file is shown in place of its objects: only a scene opened from a file exports (its meshes and environment are named by path)');
   }
   if (view.projection !== 'native') {
     throw new Error(`the viewport shows the environment converted to ${view.projection}, which a scene file cannot say (render's --env-as): choose "as loaded" to export the scene`);
@@ -500,7 +621,16 @@ function sceneFile() {
   out.camera = Object.assign({}, out.camera, { eye: cam.eye, target: c.target, up: c.up, width: c.width, height: c.height });
   out.indexing = ['texgen', 'vertex', 'pixel'][view.mode - 1];
   out.supersample = 1;
-  if (out.environment) out.environment.filter = 'bilinear';
+  if (out.environment) {
+    out.environment.filter = 'bilinear';
+    out.environment.attach = attachNow();
+  }
+  // The slider's tessellation, for the built-ins (the server names them in `meshes`).
+  if (view.tessellation && out.meshes) {
+    out.meshes.forEach((m, i) => {
+      if (s.objects[i]?.builtin) m.tessellation = view.tessellation;
+    });
+  }
   return out;
 }
 
@@ -560,13 +690,23 @@ document.addEventListener('keydown', (e) => {
 
 const ready = (async () => {
   if (!gl) throw new Error('this browser has no WebGL2');
+  // A link names the object it showed: shown again (the server's objects are the page's).
+  const asked = params.get('object');
+  if (asked) {
+    const st = await (await G.api('/api/state')).json();
+    if ((st.object ?? 'scene') !== asked) {
+      if (st.objectChoices.includes(asked)) await G.api(`/api/object?name=${encodeURIComponent(asked)}`, { method: 'POST' });
+      else linkNotes.push(`the link showed the object ${asked}, which is not here: open its file again`);
+    }
+  }
   await loadState();
   await redraw();
   await ensureLighting();
 })();
 ready.catch(report);
 
-const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting, sceneFile };
+afterDraw.push(drawTwin);
+const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting, sceneFile, twin, attachNow, chooseObject };
 // The simulator panel and the view state in the URL (sim.js); `ready` waits for both.
 const sim = await import(`./sim.js?token=${encodeURIComponent(token)}`);
 handle.sim = sim.attach(handle);

@@ -17,8 +17,8 @@ use std::sync::Arc;
 
 #[derive(Args, Debug)]
 pub struct StudioArgs {
-    /// A scene file (.json or .toml, as `render` reads it) and/or an environment map (any
-    /// file `convert` reads).
+    /// A scene file (.json or .toml, as `render` reads it), an environment map (any file
+    /// `convert` reads) and/or a mesh (.obj, .glb, .gltf) shown in place of the scene's objects.
     files: Vec<String>,
     /// Port on 127.0.0.1 (0: any free one).
     #[arg(long, default_value_t = 0)]
@@ -138,6 +138,42 @@ impl CliHost {
             map: Box::new(map),
         })
     }
+
+    /// The mesh file at `path`, called `name` in messages (as `render` reads mesh files).
+    fn mesh(path: &Path, name: &str) -> Result<mirrorball_render::Mesh, String> {
+        let shown = path.display().to_string();
+        mirrorball_render::load_mesh(path).map_err(|e| e.to_string().replace(&shown, name))
+    }
+
+    /// `read` of `bytes` stored as a file with extension `ext` in a folder of its own,
+    /// removed afterwards (the readers take paths).
+    fn stored<T>(
+        name: &str,
+        ext: &str,
+        bytes: &[u8],
+        read: impl FnOnce(&Path) -> Result<T, String>,
+    ) -> Result<T, String> {
+        let dir =
+            private_dir("upload").map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
+        let path = dir.join(format!("upload.{ext}"));
+        let result = std::fs::write(&path, bytes)
+            .map_err(|e| format!("{name}: cannot store the upload: {e}"))
+            .and_then(|()| read(&path));
+        let _ = std::fs::remove_dir_all(&dir);
+        result
+    }
+}
+
+/// The Stanford bunny the repository bundles (`assets/meshes/bunny.obj`, CC0 as its README
+/// says), offered by the page beside the built-ins.
+const BUNNY: &[u8] = include_bytes!("../../../../assets/meshes/bunny.obj");
+
+fn is_mesh(p: &Path) -> bool {
+    p.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        ["obj", "glb", "gltf"]
+            .iter()
+            .any(|m| e.eq_ignore_ascii_case(m))
+    })
 }
 
 impl Host for CliHost {
@@ -145,6 +181,13 @@ impl Host for CliHost {
         if is_scene(path) {
             let v = scene_view(Some(path)).map_err(|e| e.to_string())?;
             return Ok(Opened::Scene(Box::new(v)));
+        }
+        if is_mesh(path) {
+            let name = path.display().to_string();
+            return Ok(Opened::Mesh {
+                mesh: Box::new(CliHost::mesh(path, &name)?),
+                name,
+            });
         }
         CliHost::environment(path, &path.display().to_string())
     }
@@ -162,14 +205,27 @@ impl Host for CliHost {
                  the files a scene names are read only when named there"
             ));
         }
-        let dir =
-            private_dir("upload").map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
-        let path = dir.join(format!("upload.{ext}"));
-        let result = std::fs::write(&path, bytes)
-            .map_err(|e| format!("{name}: cannot store the upload: {e}"))
-            .and_then(|()| CliHost::environment(&path, name));
-        let _ = std::fs::remove_dir_all(&dir);
-        result
+        if is_mesh(Path::new(name)) {
+            return CliHost::stored(name, ext, bytes, |path| {
+                let mesh = CliHost::mesh(path, name)?;
+                Ok(Opened::Mesh {
+                    name: name.to_string(),
+                    mesh: Box::new(mesh),
+                })
+            });
+        }
+        CliHost::stored(name, ext, bytes, |path| CliHost::environment(path, name))
+    }
+
+    fn bundled_meshes(&self) -> &'static [&'static str] {
+        &["bunny"]
+    }
+
+    fn bundled_mesh(&self, name: &str) -> Result<mirrorball_render::Mesh, String> {
+        match name {
+            "bunny" => CliHost::stored(name, "obj", BUNNY, |path| CliHost::mesh(path, name)),
+            _ => Err(format!("no bundled mesh {name}")),
+        }
     }
 
     fn default_scene(&self) -> SceneView {
