@@ -3,7 +3,8 @@
 // draws the exported scene; the side-by-side view of the two attachments (Zimmons' figure
 // 18: attached to the eye, the picture of a sphere does not change as the camera orbits it;
 // attached to the world, it does); a mesh file opened by the picker in place of the
-// objects, the bundled bunny, a broken mesh refused on the page, and bad requests.
+// objects, the bundled bunny, a broken mesh refused on the page, and bad requests; the
+// background's pan blur (Greene §9) against `mirrorball render --pan-blur`.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
@@ -227,6 +228,36 @@ test('a mesh picked on the page replaces the objects, the bundled bunny is offer
     throw new Error(`${e.stack}\n${logs.join('\n')}`);
   } finally {
     await page.close();
+    s.stop();
+  }
+});
+
+test("the pan blur (Greene §9) draws the background as mirrorball render --pan-blur does", async () => {
+  const scene = sceneFile('pan.json', { meshes: [{ mesh: 'sphere', tessellation: 48 }] });
+  const s = await studio([scene]);
+  try {
+    const grab = async (keys) => {
+      const { page, logs } = await openStudio(chromium, `${s.url}&view=viewport&${keys}`);
+      const px = await viewportPixels(page);
+      await page.close();
+      assert.deepEqual(logs.filter((l) => /error/i.test(l)), []);
+      return px;
+    };
+    const sharp = await grab('panblur=0');
+    for (const deg of [12, -4]) {
+      const got = await grab(`panblur=${deg}`);
+      const out = path.join(work.dir, `pan${deg}.png`);
+      const cover = path.join(work.dir, `pan${deg}-cover.png`);
+      run(['render', scene, '--ss', '1', '--pan-blur', String(deg), '-o', out, '--quiet']);
+      run(['render', scene, '--ss', '1', '--pan-blur', String(deg), '-o', cover, '--quiet', '--no-background']);
+      const { n, within, bg, bgWithin } = againstRender(got.data, readPng(readFileSync(out)), readPng(readFileSync(cover)));
+      const blurred = differing(got.data, sharp.data, 2) / got.data.length;
+      console.log(`pan blur ${deg}°: background ${((100 * bgWithin) / bg).toFixed(2)}% of ${bg} within 2/255 of render, objects ${((100 * within) / n).toFixed(2)}% of ${n}; ${(100 * blurred).toFixed(1)}% of bytes differ from the sharp frame`);
+      assert.ok(bgWithin / bg >= 0.99);
+      assert.ok(within / n >= 0.99);
+      assert.ok(blurred > 0.1, 'the blur shows');
+    }
+  } finally {
     s.stop();
   }
 });

@@ -600,6 +600,8 @@ export function attach(studio) {
     else p.delete('object');
     if (view.attach) p.set('attach', view.attach);
     p.set('twin', view.twin ? '1' : '0');
+    if (view.panBlur) p.set('panblur', String(view.panBlur));
+    else p.delete('panblur');
     if (view.size) p.set('size', String(view.size));
     if (view.orbit) {
       p.set('yaw', String(view.orbit.yaw));

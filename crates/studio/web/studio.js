@@ -9,7 +9,9 @@
 // built-in or the bundled bunny in place of the scene's objects (the server's `/api/object`;
 // a mesh file opened by the picker too); `attach=world|eye` attaches the map to the world or
 // to the eye whatever the scene says; `twin=1` draws the same view with the map attached the
-// other way beside the viewport (Zimmons' figure 18, view dependence). `window.studio` is the
+// other way beside the viewport (Zimmons' figure 18, view dependence); `panblur=DEG` blurs
+// the background as a camera panning that far since the last frame (Greene §9, as `render
+// --pan-blur DEG`; viewport.frag `sweep`). `window.studio` is the
 // page's handle for tests and later views (simulator, overlays) to plug into.
 
 const params = new URLSearchParams(location.search);
@@ -42,6 +44,9 @@ const view = {
   // The map's attachment (null: the scene's), and the other one drawn beside (`twin`).
   attach: ['world', 'eye'].includes(params.get('attach')) ? params.get('attach') : null,
   twin: params.get('twin') === '1',
+  // Greene §9's motion blur of the background: the degrees the camera panned (about its up
+  // axis, positive to the left) since the previous frame, as `render --pan-blur` (0: none).
+  panBlur: Number.isFinite(Number(params.get('panblur'))) ? Math.max(-90, Math.min(90, Number(params.get('panblur')))) : 0,
   // The built-in objects' tessellation (null: the scene's).
   tessellation: params.get('tessellation') ? Number(params.get('tessellation')) : null,
   env: null, // { header, texture, halves (a dual paraboloid's two 2D textures) }
@@ -117,6 +122,8 @@ async function loadObjects() {
   document.getElementById('scene-name').textContent = view.state.scene.name;
   document.getElementById('attach').value = attachNow();
   document.getElementById('twin').checked = view.twin;
+  document.getElementById('pan-blur').value = String(view.panBlur);
+  document.getElementById('pan-blur-value').textContent = `${view.panBlur}°`;
   showObjects();
   showTessellation();
   await loadMeshes();
@@ -277,6 +284,23 @@ function lookAt(eye, target, up) {
   return [s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0, -dot(s, eye), -dot(u, eye), dot(f, eye), 1];
 }
 
+/**
+ * The previous frame's camera of a pan by `degrees` (render's camera.rs `Camera::panned`):
+ * the target turned about the eye by the angle about the camera's up axis, then looked at
+ * with the scene's up, as the CPU makes it. Its view matrix.
+ */
+function pannedView(eye, view3, degrees) {
+  const c = view.state.scene.camera;
+  const a = (degrees * Math.PI) / 180;
+  const k = [view3[1], view3[5], view3[9]]; // the camera's up
+  const v = [c.target[0] - eye[0], c.target[1] - eye[1], c.target[2] - eye[2]];
+  // Rodrigues: v cos a + (k x v) sin a + k (k.v)(1 - cos a).
+  const kxv = [k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]];
+  const kv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+  const t = [0, 1, 2].map((i) => eye[i] + v[i] * Math.cos(a) + kxv[i] * Math.sin(a) + k[i] * kv * (1 - Math.cos(a)));
+  return lookAt(eye, t, c.up);
+}
+
 /** The camera now: the scene's, or the orbited one. */
 function camera() {
   const c = view.state.scene.camera;
@@ -351,6 +375,13 @@ async function draw(pass = {}) {
     gl.uniform3fv(u('uRayRight'), right.map((x) => x * ty * aspect));
     gl.uniform3fv(u('uRayUp'), up.map((x) => x * ty));
     gl.uniform2f(u('uViewportSize'), canvas.width, canvas.height);
+    gl.uniform1i(u('uPanBlur'), view.panBlur ? 1 : 0);
+    if (view.panBlur) {
+      const pv = pannedView(cam.eye, v, view.panBlur);
+      gl.uniform3fv(u('uPrevForward'), [-pv[2], -pv[6], -pv[10]]);
+      gl.uniform3fv(u('uPrevRayRight'), [pv[0], pv[4], pv[8]].map((x) => x * ty * aspect));
+      gl.uniform3fv(u('uPrevRayUp'), [pv[1], pv[5], pv[9]].map((x) => x * ty));
+    }
     if (view.lighting) {
       gl.activeTexture(gl.TEXTURE1);
       gl.bindTexture(gl.TEXTURE_CUBE_MAP, view.lighting.texture);
@@ -529,6 +560,11 @@ document.getElementById('object').addEventListener('change', async (e) => {
   } catch (err) {
     report(err);
   }
+  redraw();
+});
+document.getElementById('pan-blur').addEventListener('input', (e) => {
+  view.panBlur = Number(e.target.value);
+  document.getElementById('pan-blur-value').textContent = `${view.panBlur}°`;
   redraw();
 });
 document.getElementById('attach').addEventListener('change', (e) => {

@@ -4,7 +4,8 @@
 // (`texgen_read`) and render/cone.rs (mode 4: the pixel's cone), read through the
 // projection's envUv, shown as display.glsl says. The background is the camera's rays
 // (render/background.rs, camera.rs `Rays::ray`), in mode 4 filtered over the cone of the
-// pixel's corner rays as the CPU filters it. CONE_READ (gl.js `coneRead`) is cone.glsl's
+// pixel's corner rays as the CPU filters it, or blurred along the path it swept since the
+// previous frame (`sweep`, a panning camera). CONE_READ (gl.js `coneRead`) is cone.glsl's
 // coneRead (the CPU's trilinear) or coneReadAnisotropic (in the place of its EWA). With
 // PARA_HW defined (a dual paraboloid drawn as the hardware did, modes 1-3),
 // paraboloid_hw.glsl comes after cone.glsl and its paraRead reads instead of envRead.
@@ -42,11 +43,72 @@ vec3 lookup(vec3 d) {
 #endif
 }
 
+#if BACKGROUND
+// Camera-rotation motion blur (Greene §9; render/blur.rs `sweep`, `Settings::motion_from`):
+// the previous frame's camera is this one panned by the page's angle (camera.rs
+// `Camera::panned`), its rays uPrevForward + uPrevRayRight x + uPrevRayUp y as cameraRay's.
+uniform bool uPanBlur;
+uniform vec3 uPrevForward;
+uniform vec3 uPrevRayRight;
+uniform vec3 uPrevRayUp;
+
+// The previous frame's camera ray through window position w, as cameraRay.
+vec3 prevCameraRay(vec2 w) {
+    vec2 ndc = 2.0 * w / uViewportSize - 1.0;
+    return uPersp ? normalizeOrZero(uPrevForward + uPrevRayRight * ndc.x + uPrevRayUp * ndc.y) : uPrevForward;
+}
+
+// Spherical interpolation from unit a to unit b, `angle` apart, at t (blur.rs `slerp`).
+vec3 slerp(vec3 a, vec3 b, float angle, float t) {
+    if (angle < 1e-9) {
+        return a;
+    }
+    float s = sin(angle);
+    if (abs(s) < 1e-9) {
+        return normalizeOrZero(a * (1.0 - t) + b * t);
+    }
+    return normalizeOrZero(a * (sin((1.0 - t) * angle) / s) + b * (sin(t * angle) / s));
+}
+
+// The path from d0 to d1 (attached, unit), sampled about once per texel along its length
+// (at most 64 samples) and averaged. The texel's angular size at d1 is the square root of
+// its solid angle, 1 / sqrt(W H |det J|), J = d(u, v)/d(t1, t2) found by envUv's central
+// differences (cone.glsl `uvAlong`): the CPU's density_of_dir / (W H), whose square root it
+// takes. Where J is not found (a step leaves the layer), 64 samples.
+vec3 sweep(vec3 d0, vec3 d1) {
+    float angle = mbAtan2(length(cross(d0, d1)), dot(d0, d1));
+    vec3 at = envUv(d1);
+    vec3 t1 = vec3(d1.z, 0.0, -d1.x);
+    t1 = dot(t1, t1) > 1e-20 ? normalize(t1) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(d1, t1);
+    vec2 j1;
+    vec2 j2;
+    int n = 64;
+    if (at.z >= 0.0 && uvAlong(d1, t1, at, j1) && uvAlong(d1, t2, at, j2)) {
+        float det = abs(j1.x * j2.y - j1.y * j2.x);
+        float texel = max(1.0 / sqrt(float(uEnvSize.x) * float(uEnvSize.y) * det), 1e-9);
+        n = int(clamp(ceil(angle / texel), 1.0, 64.0));
+    }
+    vec3 acc = vec3(0.0);
+    for (int k = 0; k < 64; k++) {
+        if (k >= n) {
+            break;
+        }
+        acc += lookup(slerp(d0, d1, angle, (float(k) + 0.5) / float(n)));
+    }
+    return acc / float(n);
+}
+#endif
+
 void main() {
 #if BACKGROUND
     vec3 o;
     vec3 dir;
     cameraRay(gl_FragCoord.xy, o, dir);
+    if (uPanBlur) {
+        outColor = vec4(display(sweep(attach(prevCameraRay(gl_FragCoord.xy)), attach(dir))), 1.0);
+        return;
+    }
 #if MODE == 4
     vec3 corners[4];
     for (int k = 0; k < 4; k++) {
