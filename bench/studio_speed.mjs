@@ -4,6 +4,8 @@
 //      environment) in headless Chromium's SwiftShader WebGL2, for each indexing mode 1-4:
 //      median and worst over FRAMES draws, each timed from the page's `window.studio.draw()`
 //      to `gl.finish()` and a one-pixel `readPixels` (which waits for the frame to be done);
+//      then the viewport with its twin (side by side) redrawn, and a Greene live frame (the
+//      six-face capture, the view, the Omnimax frame) at 6×128² and 6×256²;
 //   2. the server's time to deliver a 1024² cube from a 4096×2048 EXR
 //      (`GET /api/environment?projection=cube&size=1024&precision=half`, from node's fetch,
 //      to the last byte): cold (the server keeps only its last conversion, so a tiny one is
@@ -105,6 +107,43 @@ try {
       if (size[0] !== 1280 || size[1] !== 720) throw new Error(`mode ${mode}: the viewport is ${size.join('×')}, not 1280×720`);
       if (logs.length) console.error(`mode ${mode}: the page said: ${logs.join(' | ')}`);
       rows.push([`viewport frame, mode ${mode} (1280×720, ${FRAMES} draws)`, ms(median(times)), ms(Math.max(...times))]);
+      await page.close();
+    }
+    // The viewport with its twin (side by side: the same view drawn again, the map attached
+    // the other way, read back and shown on a 2D canvas), mode 3.
+    {
+      const { page, logs } = await openStudio(chromium, `${s1.url}&mode=3&twin=1&marks=0&edges=0`);
+      const times = await page.evaluate(async (n) => {
+        const { redraw, view } = window.studio;
+        const out = [];
+        for (let i = 0; i < 3 + n; i++) {
+          const t0 = performance.now();
+          await redraw();
+          if (i >= 3) out.push(performance.now() - t0);
+        }
+        return { out, size: [view.state.scene.camera.width, view.state.scene.camera.height] };
+      }, FRAMES);
+      if (logs.length) console.error(`twin: the page said: ${logs.join(' | ')}`);
+      rows.push([`viewport + twin + simulator, mode 3 (${times.size.join('×')}, ${FRAMES} redraws)`, ms(median(times.out)), ms(Math.max(...times.out))]);
+      await page.close();
+    }
+    // Greene live: the capture (6 faces), the view and the Omnimax frame, each waited for.
+    for (const size of [128, 256]) {
+      const { page, logs } = await openStudio(chromium, `${s1.url}&greene=1&greene-size=${size}`);
+      const t = await page.evaluate(async (n) => {
+        const g = window.studio.greene;
+        await g.ready;
+        g.pause();
+        const out = [];
+        for (let i = 0; i < 3 + n; i++) {
+          const f = g.renderAt(0.1 * i);
+          if (i >= 3) out.push(f);
+        }
+        return out;
+      }, FRAMES);
+      if (logs.length) console.error(`Greene live: the page said: ${logs.join(' | ')}`);
+      const part = (k) => ms(median(t.map((f) => f[k])));
+      rows.push([`Greene live frame, 6×${size}² capture (capture ${part('captureMs')}, view ${part('viewMs')}, Omnimax ${part('omniMs')}; ${FRAMES} frames)`, ms(median(t.map((f) => f.totalMs))), ms(Math.max(...t.map((f) => f.totalMs)))]);
       await page.close();
     }
   } finally {

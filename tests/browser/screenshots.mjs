@@ -17,7 +17,8 @@ const VIEWS = [
   ['studio-lighting.png', 'examples/scenes/chrome-pair.json', 'mode=3&material=ggx&roughness=0.45', [1100, 450]],
   ['studio-cones.png', 'examples/scenes/bunny-cones.json', 'mode=4', [1100, 500]],
   ['studio-analysis.png', 'examples/scenes/zimmons-door.json', 'mode=3&projection=eac&analysis=1&analysis-size=256&marks=0&edges=0', [1100, 1250]],
-  ['studio-twin.png', 'examples/scenes/chrome-pair.json', 'mode=3&object=teapot&twin=1&yaw=0.5&pitch=0.3&distance=3.4', [1100, 420]],
+  ['studio-greene.png', 'examples/scenes/chrome-pair.json', 'mode=3&greene=1&marks=0&edges=0', [1100, 1000]],
+  ['studio-twin.png', 'examples/scenes/zimmons-door.json', 'mode=3&object=teapot&twin=1&attach=world&yaw=0.5&pitch=0.3&distance=3.0&marks=0&edges=0', [1100, 760]],
 ];
 const only = process.argv.slice(2);
 
@@ -36,6 +37,14 @@ try {
       await page.evaluate(() => window.studio.ready);
       await page.evaluate(() => window.studio.analysis.ready);
       await page.waitForTimeout(1500);
+      // Greene live animates: one frame of a fixed time, the loop paused.
+      if (keys.includes('greene=1')) {
+        await page.evaluate(async () => {
+          await window.studio.greene.ready;
+          window.studio.greene.pause();
+          await window.studio.greene.renderAt(2.6);
+        });
+      }
       const out = path.join(ROOT, 'docs', 'img', file);
       await page.screenshot({ path: out });
       console.log(`${out}${logs.length ? ` (page said: ${logs.join(' | ')})` : ''}`);

@@ -52,6 +52,13 @@ const FILES: &[(&str, &str, &str)] = files![
     "glsl/sim-record.glsl": "glsl",
     "glsl/sim-surface.frag": "glsl",
     "glsl/sim-map.frag": "glsl",
+    "greene.js": "js",
+    "glsl/greene-background.frag": "glsl",
+    "glsl/greene-object.vert": "glsl",
+    "glsl/greene-object.frag": "glsl",
+    "glsl/greene-mirror.frag": "glsl",
+    "glsl/greene-fisheye-inverse.glsl": "glsl",
+    "glsl/greene-omnimax.frag": "glsl",
 ];
 
 /// The embedded file `name`: its content type and contents.

@@ -750,4 +750,6 @@ handle.ready = ready.then(() => handle.sim.ready);
 // The analysis panel (analysis.js), measured once the view is ready when the URL asks.
 const analysis = await import(`./analysis.js?token=${encodeURIComponent(token)}`);
 handle.analysis = analysis.attach(handle);
+const greene = await import(`./greene.js?token=${encodeURIComponent(token)}`);
+handle.greene = greene.attach(handle);
 window.studio = handle;
