@@ -280,9 +280,11 @@ export function coneRead(filter) {
  * The viewport's program for `kind`, indexing `mode` (1–4), objects or the background, the
  * objects in `material` (a name of `MATERIALS`; the prefiltered ones add lighting.glsl);
  * `paraboloid: 'hardware'` draws a dual paraboloid from its two textures; `filter` is the
- * environment's (mode 4: `coneRead`).
+ * environment's (mode 4: `coneRead`); `panBlur` makes the background's program blur along
+ * the pan (viewport.frag `sweep`: a program of its own, because SwiftShader pays for the
+ * sweep's loop even where a uniform skips it, 2.5 times the sharp frame).
  */
-export async function viewportProgram(gl, { kind, layers, mode, background, material = 'mirror', paraboloid, filter }) {
+export async function viewportProgram(gl, { kind, layers, mode, background, material = 'mirror', paraboloid, filter, panBlur = false }) {
   const m = MATERIALS[material];
   if (m === undefined) throw new Error(`material '${material}' is not ${Object.keys(MATERIALS).join(', ')}`);
   const hw = paraboloidHardware(kind, mode, paraboloid);
@@ -290,7 +292,8 @@ export async function viewportProgram(gl, { kind, layers, mode, background, mate
     `#define MODE ${mode}\n#define TEXGEN ${texgenOf(kind, layers)}\n` +
     `#define BACKGROUND ${background ? 1 : 0}\n#define MATERIAL ${background ? 0 : m}\n` +
     `#define CONE_READ ${coneRead(filter)}\n` +
-    (hw ? '#define PARA_HW 1\n' : '');
+    (hw ? '#define PARA_HW 1\n' : '') +
+    (background && panBlur ? '#define PAN_BLUR 1\n' : '');
   const proj = await projectionSource(kind);
   const vs = HEADER + defines + proj + '\n' + (await glsl('texgen.glsl')) + '\n' + (await glsl('viewport.vert'));
   const fs =

@@ -259,11 +259,12 @@ async function program(background) {
   const material = background ? 'mirror' : materialNow();
   const paraboloid = view.paraboloid;
   const filter = view.state.scene.environment.filter;
-  const key = `${kind} ${h.layers} ${view.mode} ${background} ${material} ${paraboloid} ${filter}`;
+  const panBlur = background && view.panBlur !== 0;
+  const key = `${kind} ${h.layers} ${view.mode} ${background} ${material} ${paraboloid} ${filter} ${panBlur}`;
   if (!view.programs.has(key)) {
     view.programs.set(
       key,
-      await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background, material, paraboloid, filter }),
+      await G.viewportProgram(gl, { kind, layers: h.layers, mode: view.mode, background, material, paraboloid, filter, panBlur }),
     );
   }
   return view.programs.get(key);
@@ -375,7 +376,6 @@ async function draw(pass = {}) {
     gl.uniform3fv(u('uRayRight'), right.map((x) => x * ty * aspect));
     gl.uniform3fv(u('uRayUp'), up.map((x) => x * ty));
     gl.uniform2f(u('uViewportSize'), canvas.width, canvas.height);
-    gl.uniform1i(u('uPanBlur'), view.panBlur ? 1 : 0);
     if (view.panBlur) {
       const pv = pannedView(cam.eye, v, view.panBlur);
       gl.uniform3fv(u('uPrevForward'), [-pv[2], -pv[6], -pv[10]]);

@@ -43,11 +43,11 @@ vec3 lookup(vec3 d) {
 #endif
 }
 
-#if BACKGROUND
+#if BACKGROUND && defined(PAN_BLUR)
 // Camera-rotation motion blur (Greene §9; render/blur.rs `sweep`, `Settings::motion_from`):
 // the previous frame's camera is this one panned by the page's angle (camera.rs
 // `Camera::panned`), its rays uPrevForward + uPrevRayRight x + uPrevRayUp y as cameraRay's.
-uniform bool uPanBlur;
+// Compiled in only with PAN_BLUR (gl.js `viewportProgram`'s `panBlur`).
 uniform vec3 uPrevForward;
 uniform vec3 uPrevRayRight;
 uniform vec3 uPrevRayUp;
@@ -105,11 +105,9 @@ void main() {
     vec3 o;
     vec3 dir;
     cameraRay(gl_FragCoord.xy, o, dir);
-    if (uPanBlur) {
-        outColor = vec4(display(sweep(attach(prevCameraRay(gl_FragCoord.xy)), attach(dir))), 1.0);
-        return;
-    }
-#if MODE == 4
+#if defined(PAN_BLUR)
+    outColor = vec4(display(sweep(attach(prevCameraRay(gl_FragCoord.xy)), attach(dir))), 1.0);
+#elif MODE == 4
     vec3 corners[4];
     for (int k = 0; k < 4; k++) {
         cameraRay(gl_FragCoord.xy + MB_CORNERS[k], o, corners[k]);
