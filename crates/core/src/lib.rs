@@ -18,6 +18,7 @@
 
 mod axis_map;
 pub mod choice;
+mod codes;
 pub mod color;
 mod envmap;
 mod fault;
@@ -31,6 +32,7 @@ mod resample;
 
 pub use axis_map::AxisMap;
 pub use choice::{Choice, UnknownName};
+pub use codes::{Codes, CodesError};
 pub use envmap::{
     bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, bilinear_mix,
     bilinear_taps, count_invalid, CornerLanes, EnvMap, EnvMapError, Stats,

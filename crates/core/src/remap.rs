@@ -17,10 +17,11 @@
 //! Memory: 8 bytes per output texel, plus 16 bytes per tap of the few texels that are
 //! integrated or straddle a seam (a 6×1024² cube from a 4096×2048 lat-long: about 60 MB).
 
-use crate::envmap::{bilinear_blend, lerp4, seam_taps};
+use crate::codes::{CodeWidth, Narrow, Wide};
+use crate::envmap::{bilinear_blend, bilinear_mix, lerp4, seam_taps};
 use crate::projection::{Projection, WorldProjection};
 use crate::resample::{Job, PointScratch, Pyramid, PyramidPlan, RowScratch};
-use crate::{EnvMap, Image, ResampleOptions};
+use crate::{Codes, EnvMap, Image, ResampleOptions};
 use mirrorball_simd::{prefetch, F32x4};
 use rayon::prelude::*;
 use std::fmt;
@@ -86,6 +87,9 @@ pub enum RemapError {
     /// The output map given to [`Remap::apply_into`] is not the plan's output shape, or its
     /// channel count differs from the source's.
     Output,
+    /// [`Remap::rows_coded`] was given codes for a plan whose source is not one layer read
+    /// as it is (see [`Remap::takes_codes`]).
+    Codes,
 }
 
 impl fmt::Display for RemapError {
@@ -104,6 +108,9 @@ impl fmt::Display for RemapError {
             RemapError::Output => f.write_str(
                 "the output map is not the plan's output projection and size, or its channel \
                  count differs from the source's",
+            ),
+            RemapError::Codes => f.write_str(
+                "the plan's source is not one layer read as it is, so it cannot be read as codes",
             ),
         }
     }
@@ -322,39 +329,78 @@ impl Remap {
         Ok(RemapRows::new(self, src))
     }
 
+    /// Whether the plan's source can be given as [`Codes`] ([`Remap::rows_coded`]): it is
+    /// one layer, and its projection reads it as it is (no overlap blended first).
+    pub fn takes_codes(&self) -> bool {
+        self.src_layers == 1 && !self.job.sproj.blends_overlap()
+    }
+
+    /// [`Remap::rows`] of a source held as integer codes (a raw video frame as it arrives):
+    /// every row the same bits as [`Remap::rows`] of the float map the codes' table decodes
+    /// them into, with no float copy of the source made (only its mip levels, where the
+    /// plan reads any, are floats). The plan must [take codes](Remap::takes_codes), and the
+    /// codes be the plan's source extent.
+    pub fn rows_coded<'a>(&'a self, src: Codes<'a>) -> Result<RemapRows<'a>, RemapError> {
+        if !self.takes_codes() {
+            return Err(RemapError::Codes);
+        }
+        if src.extent() != self.src_extent {
+            let (w, h) = src.extent();
+            return Err(RemapError::Extent {
+                expected: (1, self.src_extent.0, self.src_extent.1),
+                found: (1, w, h),
+            });
+        }
+        Ok(RemapRows::coded(self, src))
+    }
+
     /// Fills output row `y` of `layer`: the bilinear pass, then the taps, then exposure.
     #[inline(always)]
     fn fill_row<const C: usize>(
         &self,
         pyr: &Pyramid,
-        planes: &[&[f32]; MAX_LAYERS],
+        base: Base<'_>,
         layer: usize,
         y: usize,
         row: &mut [f32],
     ) {
         let w = self.job.w as usize;
-        let stride = self.src_extent.0 as usize * C;
+        let sw = self.src_extent.0 as usize;
         let (groups, taps, starts) = (
             &self.groups[layer],
             &self.taps[layer],
             &self.row_starts[layer],
         );
-        let single = self.src_layers == 1;
-        gather_row::<C>(
-            &self.texels[layer][y * w..(y + 1) * w],
-            planes,
-            single,
-            stride,
-            row,
-        );
+        let entries = &self.texels[layer][y * w..(y + 1) * w];
+        match base {
+            Base::Floats(planes) => {
+                gather_row::<C>(entries, planes, self.src_layers == 1, sw * C, row)
+            }
+            Base::Codes(c) if c.wide() => {
+                gather_row_codes::<Wide>(entries, c.bytes(), Wide::table(c.table()), sw, row)
+            }
+            Base::Codes(c) => {
+                gather_row_codes::<Narrow>(entries, c.bytes(), Narrow::table(c.table()), sw, row)
+            }
+        }
         let ((g0, t0), (g1, _)) = (starts[y], starts[y + 1]);
         let mut k = t0 as usize;
         for g in &groups[g0 as usize..g1 as usize] {
-            let level = pyr.level(g.level as usize);
             let group = &taps[k..k + g.count as usize];
             k += g.count as usize;
-            if let Some(o) = row.get_mut(g.x as usize * C..(g.x as usize + 1) * C) {
-                sum_taps::<C>(group, level, o);
+            let Some(o) = row.get_mut(g.x as usize * C..(g.x as usize + 1) * C) else {
+                continue;
+            };
+            match base {
+                Base::Codes(c) if g.level == 0 => {
+                    let n = c.extent().0 as usize * c.extent().1 as usize;
+                    if c.wide() {
+                        sum_taps_codes::<Wide>(group, c.bytes(), Wide::table(c.table()), n, o)
+                    } else {
+                        sum_taps_codes::<Narrow>(group, c.bytes(), Narrow::table(c.table()), n, o)
+                    }
+                }
+                _ => sum_taps::<C>(group, pyr.level(g.level as usize), o),
             }
         }
         let scale = self.job.scale;
@@ -368,12 +414,21 @@ impl Remap {
     }
 }
 
+/// Where a [`RemapRows`]' base level is read: the source's float layers, or its codes.
+#[derive(Clone, Copy)]
+enum Base<'a> {
+    Floats(&'a [&'a [f32]; MAX_LAYERS]),
+    Codes(Codes<'a>),
+}
+
 /// A source made ready for a [`Remap`]: output rows made one at a time (see
 /// [`Remap::rows`]), each exactly as [`Remap::apply_into`] makes it.
 pub struct RemapRows<'a> {
     remap: &'a Remap,
     pyr: Pyramid<'a>,
     c: usize,
+    /// The base level as codes, where [`Remap::rows_coded`] made these rows.
+    codes: Option<Codes<'a>>,
 }
 
 impl<'a> RemapRows<'a> {
@@ -383,6 +438,17 @@ impl<'a> RemapRows<'a> {
             remap,
             pyr: Pyramid::planned(src, &remap.pyramid, spare),
             c: src.channels(),
+            codes: None,
+        }
+    }
+
+    fn coded(remap: &'a Remap, src: Codes<'a>) -> RemapRows<'a> {
+        let spare = std::mem::take(&mut *remap.spare.lock().unwrap_or_else(|e| e.into_inner()));
+        RemapRows {
+            remap,
+            pyr: Pyramid::planned_codes(src, &remap.pyramid, spare),
+            c: 3,
+            codes: Some(src),
         }
     }
 
@@ -398,14 +464,19 @@ impl<'a> RemapRows<'a> {
     pub fn row_into(&self, layer: usize, y: usize, row: &mut [f32]) {
         assert!(layer < self.remap.texels.len() && y < self.remap.job.h as usize);
         assert_eq!(row.len(), self.row_len());
+        if let Some(codes) = self.codes {
+            let base = Base::Codes(codes);
+            return self.remap.fill_row::<3>(&self.pyr, base, layer, y, row);
+        }
         // The base as the pyramid holds it (a dual fisheye's overlap blended).
         let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
         for (p, l) in planes.iter_mut().zip(self.pyr.level(0)) {
             *p = l.data();
         }
+        let base = Base::Floats(&planes);
         match self.c {
-            3 => self.remap.fill_row::<3>(&self.pyr, &planes, layer, y, row),
-            _ => self.remap.fill_row::<4>(&self.pyr, &planes, layer, y, row),
+            3 => self.remap.fill_row::<3>(&self.pyr, base, layer, y, row),
+            _ => self.remap.fill_row::<4>(&self.pyr, base, layer, y, row),
         }
     }
 }
@@ -529,6 +600,83 @@ fn sum_taps<const C: usize>(taps: &[Tap], level: &[Image], out: &mut [f32]) {
     }
     let lanes = acc.to_array();
     for c in 0..C {
+        out[c] = lanes[c] + tail[c];
+    }
+}
+
+/// [`gather_row_lanes`] of a one-layer source held as codes (`sw` texels a row): each
+/// texel's four source texels read through the table and blended with [`bilinear_mix`],
+/// so every value is the float path's to the bit (the float source being the table's
+/// decoding of the codes).
+#[inline(always)]
+fn gather_row_codes<W: CodeWidth>(
+    entries: &[Texel],
+    bytes: &[u8],
+    table: W::Table<'_>,
+    sw: usize,
+    row: &mut [f32],
+) {
+    const Q: f32 = 1.0 / 65536.0;
+    let n = row.len();
+    let texel_bytes = W::TEXEL_BYTES;
+    let read = |k: usize| {
+        let [r, g, b] = W::texel(bytes, table, k);
+        F32x4::from_array([r, g, b, 0.0])
+    };
+    for (x, t) in entries.iter().enumerate() {
+        if let Some(a) = entries.get(x + AHEAD) {
+            let i = (a.idx & INDEX_MASK) as usize * texel_bytes;
+            if a.idx != NO_TEXEL && i + sw * texel_bytes < bytes.len() {
+                let p = bytes.as_ptr().wrapping_add(i);
+                prefetch(p);
+                prefetch(p.wrapping_add(sw * texel_bytes));
+            }
+        }
+        let o = x * 3;
+        if t.idx == NO_TEXEL {
+            row[o..o + 3].fill(0.0);
+            continue;
+        }
+        let i = (t.idx & INDEX_MASK) as usize;
+        let v = bilinear_mix(
+            [read(i), read(i + 1), read(i + sw), read(i + sw + 1)],
+            t.fx as f32 * Q,
+            t.fy as f32 * Q,
+        );
+        if o + 4 <= n {
+            v.store(&mut row[o..]);
+        } else {
+            row[o..o + 3].copy_from_slice(&v.to_array()[..3]);
+        }
+    }
+}
+
+/// [`sum_taps`] of a one-layer source of `texels` texels held as codes: the same sums in
+/// the same order (the last texel, which [`sum_taps`] cannot read four floats at, added
+/// apart as there), so the same bits.
+#[inline(always)]
+fn sum_taps_codes<W: CodeWidth>(
+    taps: &[Tap],
+    bytes: &[u8],
+    table: W::Table<'_>,
+    texels: usize,
+    out: &mut [f32],
+) {
+    let mut acc = F32x4::splat(0.0);
+    let mut tail = [0.0f32; 3];
+    for t in taps {
+        let i = (t.idx & INDEX_MASK) as usize;
+        let v = W::texel(bytes, table, i);
+        if i * 3 + 4 <= texels * 3 {
+            acc = acc + F32x4::splat(t.w) * F32x4::from_array([v[0], v[1], v[2], 0.0]);
+        } else {
+            for c in 0..3 {
+                tail[c] += t.w * v[c];
+            }
+        }
+    }
+    let lanes = acc.to_array();
+    for c in 0..3 {
         out[c] = lanes[c] + tail[c];
     }
 }

@@ -15,9 +15,10 @@
 //!
 //! The work runs in parallel over rows with rayon and allocates nothing per texel.
 
+use crate::codes::{CodeWidth, Narrow, Wide};
 use crate::envmap::{bilinear32, bilinear32_quad, bilinear_corner, bilinear_corner4, lerp_quad};
 use crate::projection::{DirRun, Lookup, Projection, WorldProjection};
-use crate::{EnvMap, Image};
+use crate::{Codes, EnvMap, Image};
 use glam::{DMat3, DVec3};
 use mirrorball_simd::{prefetch as prefetch_line, F32x4, M32x4};
 use rayon::prelude::*;
@@ -185,29 +186,75 @@ impl<'a> Pyramid<'a> {
     pub(crate) fn planned(
         src: &'a EnvMap,
         plan: &PyramidPlan,
-        mut spare: Vec<Vec<Image>>,
+        spare: Vec<Vec<Image>>,
     ) -> Pyramid<'a> {
         let base = match src.projection().blend_overlap(src.layers()) {
             Some(blended) => std::borrow::Cow::Owned(blended),
             None => std::borrow::Cow::Borrowed(src.layers()),
         };
+        Pyramid::build(base, None, plan, spare)
+    }
+
+    /// [`Pyramid::planned`] of a one-layer source held as codes: the levels below the base
+    /// (the first made from the codes through their table, so the same bits as from the
+    /// float layer they decode to); the base itself is not kept (empty), its reads being
+    /// the codes' own.
+    pub(crate) fn planned_codes(
+        src: Codes<'_>,
+        plan: &PyramidPlan,
+        spare: Vec<Vec<Image>>,
+    ) -> Pyramid<'a> {
+        Pyramid::build(std::borrow::Cow::Owned(Vec::new()), Some(src), plan, spare)
+    }
+
+    fn build(
+        base: std::borrow::Cow<'a, [Image]>,
+        codes: Option<Codes<'_>>,
+        plan: &PyramidPlan,
+        mut spare: Vec<Vec<Image>>,
+    ) -> Pyramid<'a> {
         spare.truncate(plan.levels.len());
         let mut levels: Vec<Vec<Image>> = Vec::with_capacity(plan.levels.len());
         let mut spare = spare.into_iter();
         for weights in &plan.levels {
-            let prev = levels.last().map(|l| l.as_slice()).unwrap_or(&base);
+            let prev = levels.last().map(|l| l.as_slice());
             let mut next = spare.next().unwrap_or_default();
-            next.truncate(prev.len());
-            for (layer, (img, w)) in prev.iter().zip(weights).enumerate() {
-                let (nw, nh) = half_extent(img.width(), img.height());
-                let fits = next.get(layer).is_some_and(|o: &Image| {
-                    (o.width(), o.height(), o.channels()) == (nw, nh, img.channels())
-                });
+            // What this level halves: the level above, or the base (its float layers, or
+            // the codes' one layer).
+            let shapes: Vec<(u32, u32, usize)> = match (prev, codes) {
+                (Some(p), _) => p
+                    .iter()
+                    .map(|i| (i.width(), i.height(), i.channels()))
+                    .collect(),
+                (None, Some(c)) => vec![(c.extent().0, c.extent().1, 3)],
+                (None, None) => base
+                    .iter()
+                    .map(|i| (i.width(), i.height(), i.channels()))
+                    .collect(),
+            };
+            next.truncate(shapes.len());
+            for (layer, (&(w, h, c), wts)) in shapes.iter().zip(weights).enumerate() {
+                let (nw, nh) = half_extent(w, h);
+                let fits = next
+                    .get(layer)
+                    .is_some_and(|o: &Image| (o.width(), o.height(), o.channels()) == (nw, nh, c));
                 if !fits {
                     next.truncate(layer);
-                    next.push(Image::new(nw, nh, img.channels()));
+                    next.push(Image::new(nw, nh, c));
                 }
-                downsample_into(img, w, &mut next[layer]);
+                let out = &mut next[layer];
+                match (prev, codes) {
+                    (Some(p), _) => downsample_into(&p[layer], wts, out),
+                    (None, Some(cd)) if cd.wide() => {
+                        let t = Wide::table(cd.table());
+                        downsample_texels((w, h), |i| Wide::texel(cd.bytes(), t, i), wts, out)
+                    }
+                    (None, Some(cd)) => {
+                        let t = Narrow::table(cd.table());
+                        downsample_texels((w, h), |i| Narrow::texel(cd.bytes(), t, i), wts, out)
+                    }
+                    (None, None) => downsample_into(&base[layer], wts, out),
+                }
             }
             levels.push(next);
         }
@@ -306,22 +353,48 @@ fn block_weights(proj: &Projection, layer: usize, w: u32, h: u32) -> Vec<[f32; 4
 /// Halves `img` into `out` (its size from [`half_extent`]), each 2×2 block averaged with
 /// `weights` ([`block_weights`] of `img`'s layer and size).
 fn downsample_into(img: &Image, weights: &[[f32; 4]], out: &mut Image) {
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    let nw = out.width() as usize;
-    let c = img.channels();
+    let (w, h, c) = (img.width(), img.height(), img.channels());
     let data = img.data();
+    if c == 3 {
+        downsample_texels(
+            (w, h),
+            |i| [data[3 * i], data[3 * i + 1], data[3 * i + 2]],
+            weights,
+            out,
+        )
+    } else {
+        downsample_texels::<4>(
+            (w, h),
+            |i| data[4 * i..4 * i + 4].try_into().unwrap(),
+            weights,
+            out,
+        )
+    }
+}
+
+/// [`downsample_into`] of a layer of `w`×`h` texels of `C` channels read by `texel` (its
+/// row-major index): each texel of `out` its 2×2 block's weighted sum, in one order, so
+/// that any source holding the same values gives the same bits.
+#[inline(always)]
+fn downsample_texels<const C: usize>(
+    (w, h): (u32, u32),
+    texel: impl Fn(usize) -> [f32; C] + Sync,
+    weights: &[[f32; 4]],
+    out: &mut Image,
+) {
+    let (w, h) = (w as usize, h as usize);
+    let nw = out.width() as usize;
     out.data_mut()
-        .par_chunks_mut(nw * c)
+        .par_chunks_mut(nw * C)
         .zip(weights.par_chunks(nw))
         .enumerate()
         .for_each(|(y, (row, wts))| {
-            let r0 = &data[(2 * y).min(h - 1) * w * c..][..w * c];
-            let r1 = &data[(2 * y + 1).min(h - 1) * w * c..][..w * c];
-            for (x, (o, q)) in row.chunks_exact_mut(c).zip(wts).enumerate() {
-                let (a, b) = ((2 * x).min(w - 1) * c, (2 * x + 1).min(w - 1) * c);
-                for i in 0..c {
-                    o[i] =
-                        q[0] * r0[a + i] + q[1] * r0[b + i] + q[2] * r1[a + i] + q[3] * r1[b + i];
+            let (r0, r1) = ((2 * y).min(h - 1) * w, (2 * y + 1).min(h - 1) * w);
+            for (x, (o, q)) in row.chunks_exact_mut(C).zip(wts).enumerate() {
+                let (a, b) = ((2 * x).min(w - 1), (2 * x + 1).min(w - 1));
+                let (p0, p1, p2, p3) = (texel(r0 + a), texel(r0 + b), texel(r1 + a), texel(r1 + b));
+                for i in 0..C {
+                    o[i] = q[0] * p0[i] + q[1] * p1[i] + q[2] * p2[i] + q[3] * p3[i];
                 }
             }
         });

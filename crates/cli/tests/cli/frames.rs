@@ -346,6 +346,60 @@ fn ffmpeg_to_mirrorball_to_ffmpeg_is_the_frames_converted_as_pngs() {
     }
 }
 
+/// The first raw frame is converted from its decoded maps (it decides what the frames are),
+/// the later ones straight from their codes (`Remap::rows_coded`): one frame sent three
+/// times comes out as three identical frames, at 8 and 16 bits, rotated and exposed, into
+/// a cube strip and an equal-area octahedral map.
+#[test]
+fn a_frame_read_as_codes_is_the_frame_read_as_maps() {
+    let d = tempfile::tempdir().unwrap();
+    for (fmt, to) in [
+        ("rgb24", "cube"),
+        ("rgb48le", "cube"),
+        ("rgb24", "equal-area-octahedral"),
+    ] {
+        let raw = d.path().join(format!("in_{fmt}.raw"));
+        let st = Command::new(FFMPEG)
+            .args(["-v", "error", "-y", "-f", "lavfi", "-i"])
+            .arg("testsrc2=size=256x128:rate=5,loop=loop=2:size=1")
+            .args(["-frames:v", "3", "-pix_fmt", fmt, "-f", "rawvideo"])
+            .arg(&raw)
+            .status()
+            .unwrap_or_else(|e| panic!("{FFMPEG} (apt-get install ffmpeg): {e}"));
+        assert!(st.success());
+        let m = Command::new(bin())
+            .args([
+                "convert",
+                "-",
+                "-",
+                "--in-size",
+                "256x128",
+                "--pix-fmt",
+                fmt,
+                "--to",
+                to,
+            ])
+            .args(["--size", "24", "--yaw", "30", "--exposure", "-1"])
+            .stdin(std::fs::File::open(&raw).unwrap())
+            .output()
+            .unwrap();
+        assert!(m.status.success(), "{}", stderr(&m));
+        let got = &m.stdout;
+        assert_eq!(got.len() % 3, 0);
+        let frame = got.len() / 3;
+        assert!(frame > 0);
+        for k in 1..3 {
+            let same = got[k * frame..(k + 1) * frame] == got[..frame];
+            assert!(
+                same,
+                "{fmt} to {to}: frame {k} (codes) differs from frame 0 (maps)"
+            );
+        }
+        let distinct: std::collections::HashSet<&u8> = got[..frame].iter().collect();
+        assert!(distinct.len() > 50, "{fmt} to {to}: the frame has content");
+    }
+}
+
 /// A stereo pair through pipes: ffmpeg's side-by-side frames (two different test sources,
 /// so a swapped eye shows) converted to a top-bottom pair of cube strips are, eye by eye,
 /// each eye cut out by ffmpeg and converted alone as a PNG.

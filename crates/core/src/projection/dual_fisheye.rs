@@ -671,6 +671,10 @@ impl WorldProjection for DualFisheye {
     /// The texels in the band both lenses see, each mixed with the other lens's bilinear
     /// lookup at its direction by [`DualFisheye::blend_weights`]; `None` when the lenses
     /// do not overlap.
+    fn blends_overlap(&self) -> bool {
+        self.overlaps()
+    }
+
     fn blend_overlap(&self, layers: &[Image]) -> Option<Vec<Image>> {
         if !self.overlaps() || layers.len() != 1 {
             return None;

@@ -248,6 +248,12 @@ pub trait WorldProjection {
     fn blend_overlap(&self, _layers: &[Image]) -> Option<Vec<Image>> {
         None
     }
+
+    /// Whether [`WorldProjection::blend_overlap`] changes maps of this projection (some
+    /// direction is seen twice), so that its lookups cannot read a map as it is.
+    fn blends_overlap(&self) -> bool {
+        false
+    }
 }
 
 /// The names of the projections, as the command line spells them.
@@ -652,6 +658,9 @@ impl WorldProjection for Projection {
     }
     fn blend_overlap(&self, layers: &[Image]) -> Option<Vec<Image>> {
         delegate!(self, p => p.blend_overlap(layers))
+    }
+    fn blends_overlap(&self) -> bool {
+        delegate!(self, p => p.blends_overlap())
     }
 }
 

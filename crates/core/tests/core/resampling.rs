@@ -494,3 +494,105 @@ fn a_resampler_refuses_a_buffer_of_the_wrong_size() {
     );
     r.layer_into(0, &mut Image::new(8, 9, 3));
 }
+
+/// A source given as 8- or 16-bit codes (`Remap::rows_coded`) converts to the same bits as
+/// the float map their table decodes them into, through every path of the plan: bilinear
+/// lookups, seam taps, integrated texels on the base and on mip levels, exposure.
+#[test]
+fn a_coded_source_converts_to_the_bits_of_its_decoded_map() {
+    use mirrorball_core::color::srgb_to_linear;
+    use mirrorball_core::{Codes, Remap, RemapError, Rotation};
+    let t8: Vec<f32> = (0..256)
+        .map(|k| srgb_to_linear(k as f64 / 255.0) as f32)
+        .collect();
+    let t16: Vec<f32> = (0..65536)
+        .map(|k| srgb_to_linear(k as f64 / 65535.0) as f32)
+        .collect();
+    let ll = ProjectionKind::LatLong.default_projection();
+    let (sw, sh) = (512u32, 256u32);
+    // Codes from a fixed linear congruential sequence: every byte value, no structure.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut byte = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 56) as u8
+    };
+    let narrow: Vec<u8> = (0..sw * sh * 3).map(|_| byte()).collect();
+    let wide: Vec<u8> = (0..sw * sh * 6).map(|_| byte()).collect();
+    let opts = ResampleOptions {
+        exposure: 0.5,
+        rotation: Rotation::from_euler_deg(20.0, 10.0, 0.0),
+        ..ResampleOptions::default()
+    };
+    let dsts = [
+        (ProjectionKind::Cube.default_projection(), 8u32), // 16 source texels a texel: mips
+        (ProjectionKind::Cube.default_projection(), 200),  // bilinear, seams
+        (ProjectionKind::Octahedral.default_projection(), 64),
+    ];
+    for (codes, what) in [
+        (Codes::u8(&narrow, &t8, (sw, sh)).unwrap(), "8-bit"),
+        (Codes::u16le(&wide, &t16, (sw, sh)).unwrap(), "16-bit"),
+    ] {
+        let decoded = EnvMap::new(ll, vec![codes.to_image()]).unwrap();
+        for (dst, size) in dsts {
+            let plan = Remap::new(ll, (sw, sh), 1, dst, size, &opts);
+            assert!(plan.takes_codes());
+            assert!(plan.tap_count() > 0, "{dst:?} {size}: no taps to test");
+            let floats = plan.rows(&decoded).unwrap();
+            let coded = plan.rows_coded(codes).unwrap();
+            let (w, h) = plan.extent();
+            let (mut a, mut b) = (vec![0.0f32; floats.row_len()], vec![0.0f32; w as usize * 3]);
+            let mut nonzero = 0;
+            for layer in 0..dst.layer_count() {
+                for y in 0..h as usize {
+                    floats.row_into(layer, y, &mut a);
+                    coded.row_into(layer, y, &mut b);
+                    let (ab, bb): (Vec<u32>, Vec<u32>) = (
+                        a.iter().map(|v| v.to_bits()).collect(),
+                        b.iter().map(|v| v.to_bits()).collect(),
+                    );
+                    assert_eq!(ab, bb, "{what} {dst:?} {size}: layer {layer} row {y}");
+                    nonzero += a.iter().filter(|v| **v > 0.0).count();
+                }
+            }
+            assert!(
+                nonzero > (w * h) as usize,
+                "{what} {dst:?}: rows of zeros prove nothing"
+            );
+        }
+    }
+    // Codes of another size, and a plan whose source is six layers, are refused.
+    let plan = Remap::new(
+        ll,
+        (sw, sh),
+        1,
+        ProjectionKind::Cube.default_projection(),
+        8,
+        &opts,
+    );
+    let small = Codes::u8(&narrow[..64 * 32 * 3], &t8, (64, 32)).unwrap();
+    assert!(matches!(
+        plan.rows_coded(small),
+        Err(RemapError::Extent { .. })
+    ));
+    let cube = ProjectionKind::Cube.default_projection();
+    let from_cube = Remap::new(cube, (64, 64), 6, ll, 64, &opts);
+    assert!(!from_cube.takes_codes());
+    let one = Codes::u8(&narrow[..64 * 64 * 3], &t8, (64, 64)).unwrap();
+    assert!(matches!(from_cube.rows_coded(one), Err(RemapError::Codes)));
+    // A dual fisheye whose lenses overlap is read blended, not as it is; one that does not
+    // overlap is read as it is.
+    use mirrorball_core::projection::ProjectionSpec;
+    let lenses = |fov: &str| {
+        ProjectionSpec::parse(&format!("dfisheye:fov={fov}"))
+            .unwrap()
+            .build(Some((128, 64)))
+            .unwrap()
+    };
+    let blended = Remap::new(lenses("200"), (128, 64), 1, ll, 32, &opts);
+    assert!(!blended.takes_codes());
+    let one = Codes::u8(&narrow[..128 * 64 * 3], &t8, (128, 64)).unwrap();
+    assert!(matches!(blended.rows_coded(one), Err(RemapError::Codes)));
+    assert!(Remap::new(lenses("180"), (128, 64), 1, ll, 32, &opts).takes_codes());
+}

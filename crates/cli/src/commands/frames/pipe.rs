@@ -9,7 +9,7 @@
 use super::packing::Packing;
 use crate::error::CliError;
 use mirrorball_core::color::linear_to_srgb;
-use mirrorball_core::{choice_traits, Choice, Image};
+use mirrorball_core::{choice_traits, Choice, Codes, Image};
 use mirrorball_simd::{x8_kernel, F32x8, I32x8, X8};
 use rayon::prelude::*;
 use std::io::{ErrorKind, Read, Write};
@@ -54,6 +54,23 @@ impl PixFmt {
     /// Bytes of a `w`×`h` frame.
     pub fn frame_bytes(self, w: u32, h: u32) -> usize {
         w as usize * h as usize * self.pixel_bytes()
+    }
+
+    /// Whether a frame of this format can be read as it is by a planned `Remap`
+    /// ([`PixFmt::codes`]): the integer formats.
+    pub fn has_codes(self) -> bool {
+        matches!(self, PixFmt::Rgb24 | PixFmt::Rgb48le)
+    }
+
+    /// One `w`×`h` frame's bytes as the codes a `Remap` reads through the same table
+    /// [`PixFmt::decode`] decodes them with (so the same linear values, to the bit); `None`
+    /// for a float format, or bytes that are not one frame.
+    pub fn codes(self, bytes: &[u8], w: u32, h: u32) -> Option<Codes<'_>> {
+        match self {
+            PixFmt::Rgb24 => Codes::u8(bytes, mirrorball_io::srgb8_to_linear(), (w, h)).ok(),
+            PixFmt::Rgb48le => Codes::u16le(bytes, mirrorball_io::srgb16_to_linear(), (w, h)).ok(),
+            PixFmt::Rgbf32le | PixFmt::Gbrpf32le => None,
+        }
     }
 
     /// Decodes `bytes` (one `w`×`h` frame) into `img`, linear RGB.

@@ -32,29 +32,32 @@ pub struct Meta {
 /// A frame's maps, one per eye, the left first.
 pub type Eyes = Vec<EnvMap>;
 
-/// Reads the next frame, given source maps that have come back for reuse (when they have);
-/// `None` at the end.
-pub type Next<'a> = dyn FnMut(Option<Eyes>) -> Option<Result<(Meta, Eyes), CliError>> + Send + 'a;
+/// Reads the next frame (maps, [`Eyes`], or whatever source the converter takes), given a
+/// source frame that has come back for reuse (when one has); `None` at the end.
+pub type Next<'a, S = Eyes> =
+    dyn FnMut(Option<S>) -> Option<Result<(Meta, S), CliError>> + Send + 'a;
 /// Converts a source frame into an output of the writer's kind, reusing its memory.
-pub type Convert<'a, O> = dyn Fn(&Meta, &Eyes, &mut O) -> Result<(), CliError> + Sync + 'a;
+pub type Convert<'a, O, S = Eyes> = dyn Fn(&Meta, &S, &mut O) -> Result<(), CliError> + Sync + 'a;
 /// Writes a converted frame.
 pub type Put<'a, O> = dyn FnMut(&Meta, &O) -> Result<(), CliError> + Send + 'a;
 
 /// Runs the loop until `next` ends or a stage fails; `done` counts the frames written.
-/// Source frames are arranged as `from`; `fresh_output` makes a frame of output eyes.
+/// `fresh_output` makes an output for the converter to fill (at most
+/// [`FRAMES_IN_FLIGHT`] are made; `next` is given a source back to fill once as many
+/// sources are in flight).
 /// The first error of the reader, the converter or the writer (in that order: a failing
 /// stage makes the others stop without one) is returned after every frame before it was
 /// written.
-pub fn run<O: Send>(
-    next: &mut Next<'_>,
-    convert: &Convert<'_, O>,
+pub fn run<S: Send, O: Send>(
+    next: &mut Next<'_, S>,
+    convert: &Convert<'_, O, S>,
     fresh_output: &(dyn Fn() -> O + Sync),
     put: &mut Put<'_, O>,
     done: &AtomicU64,
 ) -> Result<(), CliError> {
-    let (src_tx, src_rx) = sync_channel::<(Meta, Eyes)>(1);
+    let (src_tx, src_rx) = sync_channel::<(Meta, S)>(1);
     let (out_tx, out_rx) = sync_channel::<(Meta, O)>(1);
-    let (src_back_tx, src_back_rx) = channel::<Eyes>();
+    let (src_back_tx, src_back_rx) = channel::<S>();
     let (out_back_tx, out_back_rx) = channel::<O>();
     std::thread::scope(|s| {
         let reader = s.spawn(move || read_stage(next, src_tx, src_back_rx));
@@ -73,13 +76,26 @@ pub fn run<O: Send>(
     })
 }
 
-fn read_stage(
-    next: &mut Next<'_>,
-    tx: std::sync::mpsc::SyncSender<(Meta, Eyes)>,
-    back: Receiver<Eyes>,
+fn read_stage<S>(
+    next: &mut Next<'_, S>,
+    tx: std::sync::mpsc::SyncSender<(Meta, S)>,
+    back: Receiver<S>,
 ) -> Result<(), CliError> {
+    let mut made = 0;
     loop {
-        let spare = back.try_recv().ok();
+        let spare = match back.try_recv() {
+            Ok(s) => Some(s),
+            Err(_) if made < FRAMES_IN_FLIGHT => {
+                made += 1;
+                None
+            }
+            // Every source is in flight: the next to come back is filled (a fresh one each
+            // time would be a frame's memory allocated and faulted in again).
+            Err(_) => match back.recv() {
+                Ok(s) => Some(s),
+                Err(_) => return Ok(()), // the converter stopped: its error is the one to say
+            },
+        };
         match next(spare) {
             None => return Ok(()),
             Some(Err(e)) => return Err(e),
@@ -133,12 +149,12 @@ pub fn convert_eyes(
     Ok(())
 }
 
-fn convert_stage<O>(
-    convert: &Convert<'_, O>,
+fn convert_stage<S, O>(
+    convert: &Convert<'_, O, S>,
     fresh_output: &(dyn Fn() -> O + Sync),
-    rx: Receiver<(Meta, Eyes)>,
+    rx: Receiver<(Meta, S)>,
     tx: std::sync::mpsc::SyncSender<(Meta, O)>,
-    src_back: Sender<Eyes>,
+    src_back: Sender<S>,
     out_back: Receiver<O>,
 ) -> Result<(), CliError> {
     let mut made = 0;

@@ -249,6 +249,25 @@ struct Reader<'a> {
 }
 
 impl Reader<'_> {
+    /// The next raw frame's bytes as they came, into `spare` where one came back: for a
+    /// converter that reads them as codes (`PixFmt::codes`). A pipe's only.
+    fn next_codes(&mut self, spare: Option<Vec<u8>>) -> Option<Result<(Meta, Vec<u8>), CliError>> {
+        let Input::Pipe { w, h, fmt } = self.input else {
+            unreachable!("codes are read from a pipe");
+        };
+        let n = self.at as u64;
+        let mut bytes = spare.unwrap_or_default();
+        bytes.resize(fmt.frame_bytes(w, h), 0);
+        match pipe::read_frame(&mut self.stdin, &mut bytes, n) {
+            Ok(false) => None,
+            Err(e) => Some(Err(e)),
+            Ok(true) => {
+                self.at += 1;
+                Some(Ok((meta(n, format!("frame {n} of standard input")), bytes)))
+            }
+        }
+    }
+
     fn next(&mut self, spare: Option<Eyes>) -> Option<Result<(Meta, Eyes), CliError>> {
         match &self.input {
             Input::Files(frames) => {
@@ -418,6 +437,14 @@ fn plan_for_blank(plan: &Plan, dst: Projection, w: u32, h: u32) -> Option<(Shape
     Some((shape, shape.plan(dst, plan)))
 }
 
+/// A source frame as the coded pipe's converter takes it.
+enum Source {
+    /// Decoded maps (the first frame, read to decide what the frames are).
+    Maps(Eyes),
+    /// A raw frame's bytes as they came, read as codes.
+    Codes(Vec<u8>),
+}
+
 fn meta(number: u64, input: String) -> Meta {
     Meta { number, input }
 }
@@ -526,6 +553,23 @@ fn convert_frames(
         }
         _ => None,
     };
+    // A raw frame of integer codes that is the source's one layer as it is (no eyes to
+    // split, no layout to unpack, no lens overlap to blend) is read by the plan as it came:
+    // no float copy of it is made (`Remap::rows_coded`: the same bytes out).
+    let coded = match (&reader.input, &packed) {
+        (Input::Pipe { w, h, fmt }, Some((_, Some(p), _)))
+            if fmt.has_codes()
+                && p.along_rows()
+                && remap.takes_codes()
+                && from == Stereo::Mono
+                && eyes0.len() == 1
+                && matches!(reader.decided, Some((_, Layout::Separate)))
+                && (src0.width(), src0.height()) == (*w, *h) =>
+        {
+            Some((*w, *h, *fmt))
+        }
+        _ => None,
+    };
     let t_plan = t0.elapsed();
 
     let fresh = || -> Eyes {
@@ -539,7 +583,6 @@ fn convert_frames(
             .collect()
     };
     let mut first = Some((meta0, eyes0));
-    let mut next = |spare: Option<Eyes>| first.take().map(Ok).or_else(|| reader.next(spare));
     let stdout = std::io::stdout();
     let logged = |m: &Meta, out: String, t: Instant| {
         log.line(
@@ -580,7 +623,57 @@ fn convert_frames(
     let t1 = Instant::now();
     let done = with_progress("frames", total, a.quiet, |counter| {
         let done = AtomicU64::new(0);
+        let mut next = |spare: Option<Eyes>| first.take().map(Ok).or_else(|| reader.next(spare));
+        let mut put_bytes = |m: &Meta, bytes: &Vec<u8>| {
+            let t = Instant::now();
+            pipe::write_frame(&mut stdout.lock(), bytes, m.number)?;
+            logged(m, "-".into(), t);
+            counter.fetch_add(1, Ordering::Relaxed);
+            Ok(())
+        };
         let r = match &packed {
+            // Rows made from the frame's codes and encoded together: no float copy of the
+            // source frame or of the output frame (the first frame, read to decide the
+            // projection, is converted from its maps: the same bytes).
+            Some((_, Some(packing), fmt)) if coded.is_some() => {
+                let (iw, ih, ifmt) = coded.expect("a coded pipe");
+                let mut first = first.take().map(|(m, eyes)| (m, Source::Maps(eyes)));
+                let mut next_codes = |spare: Option<Source>| {
+                    if let Some(f) = first.take() {
+                        return Some(Ok(f));
+                    }
+                    let spare = match spare {
+                        Some(Source::Codes(bytes)) => Some(bytes),
+                        _ => None,
+                    };
+                    reader
+                        .next_codes(spare)
+                        .map(|r| r.map(|(m, bytes)| (m, Source::Codes(bytes))))
+                };
+                pipeline::run(
+                    &mut next_codes,
+                    &|m: &Meta, src: &Source, bytes: &mut Vec<u8>| {
+                        let rows = match src {
+                            Source::Maps(eyes) => remap.rows(&eyes[0]),
+                            Source::Codes(c) => {
+                                let codes = ifmt.codes(c, iw, ih).ok_or_else(|| {
+                                    CliError::input(format!(
+                                        "{}: not one {iw}x{ih} {ifmt} frame",
+                                        m.input
+                                    ))
+                                })?;
+                                remap.rows_coded(codes)
+                            }
+                        }
+                        .map_err(|e| pipeline::misfit(m, e))?;
+                        packing.encode_rows(*fmt, &rows, bytes);
+                        Ok(())
+                    },
+                    &Vec::new,
+                    &mut put_bytes,
+                    &done,
+                )
+            }
             // Rows made and encoded together: no float copy of the output frame.
             Some((_, Some(packing), fmt)) if packing.along_rows() => pipeline::run(
                 &mut next,
@@ -590,13 +683,7 @@ fn convert_frames(
                     Ok(())
                 },
                 &Vec::new,
-                &mut |m: &Meta, bytes: &Vec<u8>| {
-                    let t = Instant::now();
-                    pipe::write_frame(&mut stdout.lock(), bytes, m.number)?;
-                    logged(m, "-".into(), t);
-                    counter.fetch_add(1, Ordering::Relaxed);
-                    Ok(())
-                },
+                &mut put_bytes,
                 &done,
             ),
             _ => pipeline::run(

@@ -1,0 +1,249 @@
+//! [`Codes`]: a layer of integer-coded RGB texels read through a table of linear values, as
+//! a raw video frame arrives (ffmpeg's `rgb24` and `rgb48le`), so that a planned
+//! [`Remap`](crate::Remap) reads the frame as it is, with no float copy of it
+//! ([`Remap::rows_coded`](crate::Remap::rows_coded)).
+//!
+//! Every read goes through the table, so a texel read here is, to the bit, the texel of the
+//! float image the same table decodes the codes into: the conversion's results are the
+//! same bits either way (tested), only the memory read differs (a 4096×2048 frame is 25 MB
+//! of 8-bit codes, where its `f32` copy is 100 MB written and then gathered from).
+
+use crate::Image;
+use rayon::prelude::*;
+
+/// One layer of `width`×`height` texels, R, G, B interleaved, each channel one integer code:
+/// one byte, or two bytes little-endian; a code `k` is the linear value `table[k]`.
+#[derive(Clone, Copy, Debug)]
+pub struct Codes<'a> {
+    bytes: &'a [u8],
+    table: &'a [f32],
+    wide: bool,
+    width: u32,
+    height: u32,
+}
+
+/// Why bytes cannot be read as [`Codes`]: the caller's mistake.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CodesError {
+    /// The bytes are not `width × height × 3` codes.
+    Length {
+        /// Bytes a layer of this size holds.
+        expected: usize,
+        /// Bytes given.
+        found: usize,
+    },
+    /// The table does not have an entry for every code (256, or 65536).
+    Table {
+        /// Entries needed.
+        expected: usize,
+        /// Entries given.
+        found: usize,
+    },
+}
+
+impl std::fmt::Display for CodesError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CodesError::Length { expected, found } => {
+                write!(f, "{found} bytes of codes, where the layer has {expected}")
+            }
+            CodesError::Table { expected, found } => {
+                write!(
+                    f,
+                    "a table of {found} values, where the codes need {expected}"
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for CodesError {}
+
+impl<'a> Codes<'a> {
+    /// 8-bit codes (`rgb24`): `bytes` holds `width × height × 3` of them, `table` 256 values.
+    pub fn u8(
+        bytes: &'a [u8],
+        table: &'a [f32],
+        (width, height): (u32, u32),
+    ) -> Result<Codes<'a>, CodesError> {
+        Codes::new(bytes, table, false, (width, height))
+    }
+
+    /// 16-bit little-endian codes (`rgb48le`): `bytes` holds `width × height × 6` bytes,
+    /// `table` 65536 values.
+    pub fn u16le(
+        bytes: &'a [u8],
+        table: &'a [f32],
+        (width, height): (u32, u32),
+    ) -> Result<Codes<'a>, CodesError> {
+        Codes::new(bytes, table, true, (width, height))
+    }
+
+    fn new(
+        bytes: &'a [u8],
+        table: &'a [f32],
+        wide: bool,
+        (width, height): (u32, u32),
+    ) -> Result<Codes<'a>, CodesError> {
+        let size = if wide { 2 } else { 1 };
+        let expected = width as usize * height as usize * 3 * size;
+        if bytes.len() != expected {
+            return Err(CodesError::Length {
+                expected,
+                found: bytes.len(),
+            });
+        }
+        let entries = 1usize << (8 * size);
+        if table.len() != entries {
+            return Err(CodesError::Table {
+                expected: entries,
+                found: table.len(),
+            });
+        }
+        Ok(Codes {
+            bytes,
+            table,
+            wide,
+            width,
+            height,
+        })
+    }
+
+    /// The layer's width and height.
+    pub fn extent(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Whether each code is two bytes.
+    pub(crate) fn wide(&self) -> bool {
+        self.wide
+    }
+
+    /// The codes' bytes.
+    pub(crate) fn bytes(&self) -> &'a [u8] {
+        self.bytes
+    }
+
+    /// The table.
+    pub(crate) fn table(&self) -> &'a [f32] {
+        self.table
+    }
+
+    /// The linear R, G, B of texel `i` (row-major).
+    ///
+    /// # Panics
+    /// If `i` is outside the layer.
+    #[inline(always)]
+    pub fn texel(&self, i: usize) -> [f32; 3] {
+        if self.wide {
+            Wide::texel(self.bytes, Wide::table(self.table), i)
+        } else {
+            Narrow::texel(self.bytes, Narrow::table(self.table), i)
+        }
+    }
+
+    /// The float image the table decodes the codes into (what the coded reads are equal to,
+    /// texel for texel).
+    pub fn to_image(&self) -> Image {
+        let mut img = Image::new(self.width, self.height, 3);
+        let w = self.width as usize;
+        img.data_mut()
+            .par_chunks_mut(w * 3)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, t) in row.chunks_exact_mut(3).enumerate() {
+                    t.copy_from_slice(&self.texel(y * w + x));
+                }
+            });
+        img
+    }
+}
+
+/// How a code width reads a texel: monomorphised into the hot loops, so that they never
+/// branch on the width, and the table's length is checked once, when it becomes a
+/// [`CodeWidth::Table`].
+pub(crate) trait CodeWidth {
+    /// Bytes of one texel (three codes).
+    const TEXEL_BYTES: usize;
+    /// The table as the reads take it (an array: a code never passes its end).
+    type Table<'t>: Copy;
+    /// `table` as this width reads it.
+    ///
+    /// # Panics
+    /// If `table` is not one value per code ([`Codes`] checks that when made).
+    fn table(table: &[f32]) -> Self::Table<'_>;
+    /// The linear R, G, B of texel `i` of `bytes` through `table`.
+    fn texel(bytes: &[u8], table: Self::Table<'_>, i: usize) -> [f32; 3];
+}
+
+/// One byte a channel.
+pub(crate) struct Narrow;
+/// Two bytes a channel, little-endian.
+pub(crate) struct Wide;
+
+impl CodeWidth for Narrow {
+    const TEXEL_BYTES: usize = 3;
+    type Table<'t> = &'t [f32; 256];
+    fn table(table: &[f32]) -> &[f32; 256] {
+        table.try_into().expect("a table of 256 values")
+    }
+    #[inline(always)]
+    fn texel(bytes: &[u8], t: &[f32; 256], i: usize) -> [f32; 3] {
+        let b = &bytes[3 * i..3 * i + 3];
+        [t[b[0] as usize], t[b[1] as usize], t[b[2] as usize]]
+    }
+}
+
+impl CodeWidth for Wide {
+    const TEXEL_BYTES: usize = 6;
+    type Table<'t> = &'t [f32; 65536];
+    fn table(table: &[f32]) -> &[f32; 65536] {
+        table.try_into().expect("a table of 65536 values")
+    }
+    #[inline(always)]
+    fn texel(bytes: &[u8], t: &[f32; 65536], i: usize) -> [f32; 3] {
+        let b = &bytes[6 * i..6 * i + 6];
+        let k = |j: usize| u16::from_le_bytes([b[j], b[j + 1]]) as usize;
+        [t[k(0)], t[k(2)], t[k(4)]]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texels_are_the_table_of_their_codes() {
+        let t8: Vec<f32> = (0..256).map(|k| k as f32 * 0.5).collect();
+        let bytes = [0u8, 1, 255, 7, 8, 9];
+        let c = Codes::u8(&bytes, &t8, (2, 1)).unwrap();
+        assert_eq!(c.texel(0), [0.0, 0.5, 127.5]);
+        assert_eq!(c.texel(1), [3.5, 4.0, 4.5]);
+        assert_eq!(c.to_image().data(), &[0.0, 0.5, 127.5, 3.5, 4.0, 4.5]);
+        let t16: Vec<f32> = (0..65536).map(|k| k as f32).collect();
+        let bytes = [0x01u8, 0x02, 0xff, 0xff, 0, 0];
+        let c = Codes::u16le(&bytes, &t16, (1, 1)).unwrap();
+        assert_eq!(c.texel(0), [513.0, 65535.0, 0.0]);
+    }
+
+    #[test]
+    fn wrong_lengths_and_tables_are_refused() {
+        let t8 = vec![0.0f32; 256];
+        assert_eq!(
+            Codes::u8(&[0; 5], &t8, (2, 1)).unwrap_err(),
+            CodesError::Length {
+                expected: 6,
+                found: 5
+            }
+        );
+        assert_eq!(
+            Codes::u16le(&[0; 6], &t8, (1, 1)).unwrap_err(),
+            CodesError::Table {
+                expected: 65536,
+                found: 256
+            }
+        );
+        // A layer whose byte count overflows nothing: 0×0 holds no codes.
+        assert!(Codes::u8(&[], &t8, (0, 0)).is_ok());
+    }
+}
