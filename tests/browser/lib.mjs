@@ -6,7 +6,7 @@ import { readFile, stat } from 'node:fs/promises';
 import { execFileSync, spawn } from 'node:child_process';
 import { createInterface } from 'node:readline';
 import { inflateSync } from 'node:zlib';
-import { mkdtempSync, rmSync, existsSync, readdirSync } from 'node:fs';
+import { mkdtempSync, rmSync, existsSync, readdirSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -224,6 +224,25 @@ export function mirrorChecks(r, { eye, forward, fov, toWorld }) {
   });
 }
 
+/// Writes `dir/name`, a scene file of one mirror sphere (tessellation 12) over Venice
+/// (bilinear, attached to the world), mode 3, 160×120, `extra` merged in; returns its path.
+export function sphereScene(dir, name, extra = {}) {
+  const file = path.join(dir, name);
+  writeFileSync(
+    file,
+    JSON.stringify({
+      meshes: [{ mesh: 'sphere', tessellation: 12 }],
+      camera: { eye: [0, 0.4, 3.2], target: [0, 0, 0], fov: 40, width: 160, height: 120 },
+      environment: { file: path.join(ROOT, 'assets', 'env', 'venice.exr'), projection: 'latlong', attach: 'world', filter: 'bilinear' },
+      material: { kind: 'mirror' },
+      indexing: 'pixel',
+      background: true,
+      ...extra,
+    }),
+  );
+  return file;
+}
+
 /// Starts `mirrorball studio --no-open --port 0 FILES…` as a person starts it; resolves to
 /// the URL it prints first, a stop and its standard error so far.
 export async function studio(files = []) {
@@ -265,6 +284,22 @@ export async function openStudio(chromium, url) {
   await page.waitForFunction(() => window.studio, null, { timeout: 60000 });
   await page.evaluate(() => window.studio.ready);
   return { page, logs };
+}
+
+/// Starts the studio with `files`, opens its page in `chromium` (the URL with `query`
+/// added) and runs `body({ s, page, logs })`; a failure carries the page's console; the
+/// page and the studio are closed after.
+export async function onStudioPage(chromium, files, query, body) {
+  const s = await studio(files);
+  const { page, logs } = await openStudio(chromium, `${s.url}${query}`);
+  try {
+    await body({ s, page, logs });
+  } catch (e) {
+    throw new Error(`${e.stack}\n${logs.join('\n')}`);
+  } finally {
+    await page.close();
+    s.stop();
+  }
 }
 
 /// `window.carry(typed)` on every document `page` opens: a typed array's bytes as base64.

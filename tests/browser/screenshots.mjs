@@ -12,11 +12,11 @@ import { browser, studio, openStudio, ROOT } from './lib.mjs';
 
 // [file, scene, URL keys beyond the token, page size]: each view of the page the README shows.
 const VIEWS = [
-  ['studio-simulator.png', 'examples/scenes/zimmons-door.json', 'mode=1&marks=1&edges=1', [1100, 420]],
-  ['studio-heatmap.png', 'examples/scenes/zimmons-door.json', 'mode=1&heat=1&marks=0&edges=0', [1100, 740]],
-  ['studio-lighting.png', 'examples/scenes/chrome-pair.json', 'mode=3&material=ggx&roughness=0.45', [1100, 450]],
-  ['studio-cones.png', 'examples/scenes/bunny-cones.json', 'mode=4', [1100, 500]],
-  ['studio-analysis.png', 'examples/scenes/zimmons-door.json', 'mode=3&projection=eac&analysis=1&analysis-size=256&marks=0&edges=0', [1100, 1250]],
+  ['studio-simulator.png', 'examples/scenes/zimmons-door.json', 'mode=1&marks=1&edges=1', [1100, 460]],
+  ['studio-heatmap.png', 'examples/scenes/zimmons-door.json', 'mode=1&heat=1&marks=0&edges=0', [1100, 780]],
+  ['studio-lighting.png', 'examples/scenes/chrome-pair.json', 'mode=3&material=ggx&roughness=0.45', [1100, 580]],
+  ['studio-cones.png', 'examples/scenes/bunny-cones.json', 'mode=4', [1100, 580]],
+  ['studio-analysis.png', 'examples/scenes/zimmons-door.json', 'mode=3&projection=eac&analysis=1&analysis-size=256&marks=0&edges=0', [1100, 1290]],
   ['studio-greene.png', 'examples/scenes/chrome-pair.json', 'mode=3&greene=1&marks=0&edges=0', [1100, 1000]],
   ['studio-twin.png', 'examples/scenes/zimmons-door.json', 'mode=3&object=teapot&twin=1&attach=world&yaw=0.5&pitch=0.3&distance=3.0&marks=0&edges=0', [1100, 760]],
 ];
@@ -26,7 +26,8 @@ const chromium = await browser();
 try {
   for (const [file, scene, keys, [width, height]] of VIEWS) {
     if (only.length && !only.includes(file)) continue;
-    const s = await studio([path.join(ROOT, scene)]);
+    // Named as from the repository's root (the studio runs there): the page shows the name.
+    const s = await studio([scene]);
     try {
       const { page, logs } = await openStudio(chromium, `${s.url}&${keys}`);
       await page.setViewportSize({ width, height });

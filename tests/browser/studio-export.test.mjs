@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, run, tempDir, readPng, studio, openStudio, viewportPixels, againstRender, ROOT } from './lib.mjs';
+import { browser, run, tempDir, readPng, studio, openStudio, viewportPixels, againstRender, sphereScene, onStudioPage, ROOT } from './lib.mjs';
 
 let chromium;
 let work;
@@ -137,4 +137,114 @@ test('the scene exported from an orbited embed view renders with mirrorball rend
   } finally {
     s.stop();
   }
+});
+
+/** A mirror sphere's scene file over `env` (Venice unless told) with its `filter`. */
+function sphereOver(name, filter = 'trilinear', env = { file: VENICE, projection: 'latlong' }) {
+  return sphereScene(work.dir, name, { environment: { ...env, attach: 'world', filter }, supersample: 2 });
+}
+
+/** `mirrorball render` of `scene` with `flags`, and its coverage (`--no-background`). */
+function rendered(scene, flags = []) {
+  const out = path.join(work.dir, 'rendered.png');
+  const cover = path.join(work.dir, 'rendered-cover.png');
+  run(['render', scene, ...flags, '-o', out, '--quiet']);
+  run(['render', scene, ...flags, '-o', cover, '--quiet', '--no-background']);
+  return { full: readPng(readFileSync(out)), cover: readPng(readFileSync(cover)) };
+}
+
+test('the scene exported by the button from a mode-4 view is render cone with its filter; the pan blur is said, with its flag', async () => {
+  // The file says mode 3: the orbited page shows mode 4 (its cones read the trilinear chain).
+  await onStudioPage(chromium, [sphereOver('cones.json')], '&mode=4&yaw=0.6&pitch=0.35&distance=2.8', async ({ page, logs }) => {
+    const check = async (what, flags) => {
+      await page.evaluate(() => window.studio.redraw());
+      const gpu = await viewportPixels(page);
+      const file = await clickDownload(page, '#export-scene');
+      assert.equal(path.basename(file), 'mirrorball-scene.json');
+      const exported = JSON.parse(readFileSync(file, 'utf8'));
+      assert.equal(exported.indexing, 'cone');
+      assert.equal(exported.environment.filter, 'trilinear');
+      const { full, cover } = rendered(file, flags);
+      assert.equal(full.width, gpu.width);
+      assert.equal(full.height, gpu.height);
+      // As studio.test.mjs holds mode 4 with a trilinear environment to render: 99%.
+      const { n, within, bg, bgWithin } = againstRender(gpu.data, full, cover);
+      console.log(`${what}: ${((100 * within) / n).toFixed(2)}% of ${n} covered pixels within 2/255 of render ${flags.join(' ')}, background ${((100 * bgWithin) / bg).toFixed(2)}% of ${bg}`);
+      assert.ok(n > 1000, `${n} covered pixels`);
+      assert.ok(within / n >= 0.99);
+      assert.ok(bgWithin / bg >= 0.99);
+      return gpu;
+    };
+    const sharp = await check('mode 4 export', []);
+    assert.equal(await page.locator('#messages .note', { hasText: 'pan blur' }).count(), 0);
+    // The pan blur has no place in a scene file: the page says the flag that draws it.
+    await page.locator('#pan-blur').fill('12');
+    await page.waitForFunction(() => window.studio.view.panBlur === 12);
+    const blurred = await check('mode 4 export with the pan blur', ['--pan-blur', '12']);
+    const note = await page.textContent('#messages .note >> nth=0');
+    assert.match(note, /mirrorball render mirrorball-scene\.json --pan-blur 12 /);
+    let differ = 0;
+    for (let i = 0; i < sharp.data.length; i++) if (sharp.data[i] !== blurred.data[i]) differ++;
+    assert.ok(differ > sharp.data.length / 20, `the blur shows: ${differ} bytes differ`);
+    assert.deepEqual(logs.filter((l) => /error/i.test(l)), []);
+  });
+  // A dual paraboloid drawn as the hardware did is no scene render draws: refused, said.
+  const para = path.join(work.dir, 'venice-paraboloid.exr');
+  run(['convert', VENICE, '--to', 'paraboloid', '--size', '64', para, '--quiet']);
+  const p = await studio([sphereOver('paraboloid.json', 'bilinear', { file: para, projection: 'paraboloid' })]);
+  try {
+    const { page: hw } = await openStudio(chromium, `${p.url}&mode=3&paraboloid=hardware`);
+    await hw.click('#export-scene');
+    await hw.waitForSelector('#messages .error', { timeout: 30000 });
+    assert.match(await hw.textContent('#messages .error'), /as the hardware did.*choose "exact"/);
+    await hw.close();
+  } finally {
+    p.stop();
+  }
+});
+
+test('the wheel and the + and - keys zoom (the distance the URL and the exported scene give); the arrow keys orbit', async () => {
+  await onStudioPage(chromium, [sphereOver('zoom.json')], '', async ({ page, logs }) => {
+    const now = async () => {
+      await page.evaluate(() => window.studio.redraw());
+      const url = new URLSearchParams(await page.evaluate(() => location.search));
+      const file = JSON.parse(readFileSync(await clickDownload(page, '#export-scene'), 'utf8'));
+      const d = Math.hypot(...file.camera.eye.map((e, k) => e - file.camera.target[k]));
+      return { url: Number(url.get('distance')), yaw: Number(url.get('yaw')), file: d };
+    };
+    const d0 = Math.hypot(0, 0.4, 3.2);
+    // The wheel over the viewport: exp(deltaY / 1000), deltaY as the page received it.
+    await page.evaluate(() => {
+      window.wheeled = 0;
+      window.studio.canvas.addEventListener('wheel', (e) => (window.wheeled += e.deltaY));
+    });
+    const box = await page.locator('#viewport').boundingBox();
+    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.wheel(0, 300);
+    await page.waitForFunction(() => window.wheeled !== 0);
+    const wheeled = await page.evaluate(() => window.wheeled);
+    const out = await now();
+    const want = d0 * Math.exp(wheeled / 1000);
+    console.log(`wheel ${wheeled}: distance ${d0.toFixed(4)} -> URL ${out.url.toFixed(4)}, exported ${out.file.toFixed(4)} (want ${want.toFixed(4)})`);
+    assert.ok(wheeled > 0);
+    assert.ok(Math.abs(out.url - want) < 1e-6 * want);
+    assert.ok(Math.abs(out.file - want) < 1e-5 * want);
+    // '+' twice moves in by 0.9 each, '-' once back out by 1/0.9.
+    await page.keyboard.press('+');
+    await page.keyboard.press('+');
+    const plus = await now();
+    assert.ok(Math.abs(plus.url - want * 0.81) < 1e-6 * want, `after ++: ${plus.url}`);
+    assert.ok(Math.abs(plus.file - want * 0.81) < 1e-5 * want);
+    await page.keyboard.press('-');
+    const minus = await now();
+    assert.ok(Math.abs(minus.url - want * 0.9) < 1e-6 * want, `after -: ${minus.url}`);
+    assert.ok(Math.abs(minus.file - want * 0.9) < 1e-5 * want);
+    // The arrow keys orbit: the yaw turns, the distance stays.
+    await page.keyboard.press('ArrowLeft');
+    const orbited = await now();
+    assert.ok(Math.abs(orbited.yaw - minus.yaw - 0.05) < 1e-9, `yaw ${minus.yaw} -> ${orbited.yaw}`);
+    assert.equal(orbited.url, minus.url);
+    console.log(`keys: ++ ${plus.url.toFixed(4)}, - ${minus.url.toFixed(4)}, ArrowLeft yaw +${(orbited.yaw - minus.yaw).toFixed(3)}, distance kept`);
+    assert.deepEqual(logs.filter((l) => /error/i.test(l)), []);
+  });
 });

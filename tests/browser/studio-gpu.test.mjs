@@ -3,9 +3,9 @@
 // texture coordinates, edges, seams and rims included.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { readFileSync, writeFileSync } from 'node:fs';
+import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, studio, run, tempDir, readPng, againstRender, carrying, viewportPixels, ROOT } from './lib.mjs';
+import { browser, studio, run, tempDir, readPng, againstRender, carrying, viewportPixels, sphereScene } from './lib.mjs';
 
 
 let chromium;
@@ -85,17 +85,9 @@ test("every projection's shader gives the core's texture coordinates on a dense 
 // studio.test.mjs, at a smaller size): 99% of the covered pixels away from the silhouette
 // within 2/255, the background (black where a view or fisheye does not reach) likewise.
 test('the embed view draws the mirror sphere as mirrorball render does in every newer projection (mode 3)', async () => {
-  const scene = path.join(work.dir, 'sphere.json');
-  writeFileSync(
-    scene,
-    JSON.stringify({
-      meshes: [{ mesh: 'sphere', tessellation: 12 }],
-      camera: { eye: [0, 0.4, 3.2], target: [0, 0, 0], fov: 40, width: 96, height: 72 },
-      environment: { file: path.join(ROOT, 'assets', 'env', 'venice.exr'), projection: 'latlong', attach: 'world', filter: 'bilinear' },
-      material: { kind: 'mirror' },
-      background: true,
-    }),
-  );
+  const scene = sphereScene(work.dir, 'sphere.json', {
+    camera: { eye: [0, 0.4, 3.2], target: [0, 0, 0], fov: 40, width: 96, height: 72 },
+  });
   const s = await studio([scene]);
   const bad = [];
   try {

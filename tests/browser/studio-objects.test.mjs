@@ -9,7 +9,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { browser, run, tempDir, readPng, studio, openStudio, viewportPixels, againstRender, carried, ROOT } from './lib.mjs';
+import { browser, run, tempDir, readPng, studio, openStudio, viewportPixels, againstRender, carried, sphereScene, ROOT } from './lib.mjs';
 
 let chromium;
 let work;
@@ -26,22 +26,7 @@ after(async () => {
 });
 
 /** A scene file of one sphere over Venice, `extra` merged in; its path. */
-function sceneFile(name, extra = {}) {
-  const file = path.join(work.dir, name);
-  writeFileSync(
-    file,
-    JSON.stringify({
-      meshes: [{ mesh: 'sphere', tessellation: 12 }],
-      camera: { eye: [0, 0.4, 3.2], target: [0, 0, 0], fov: 40, width: 160, height: 120 },
-      environment: { file: VENICE, projection: 'latlong', attach: 'world', filter: 'bilinear' },
-      material: { kind: 'mirror' },
-      indexing: 'pixel',
-      background: true,
-      ...extra,
-    }),
-  );
-  return file;
-}
+const sceneFile = (name, extra = {}) => sphereScene(work.dir, name, extra);
 
 /** Waits until the page's state says `object` is shown (null: the scene's), then draws. */
 async function shown(page, object) {

@@ -52,8 +52,15 @@ pub const EXPORT_FORMATS: [&str; 6] = ["exr", "hdr", "png", "jpg", "ktx2", "dds"
 pub trait Host: Send + Sync + 'static {
     /// Reads the file `path` named on the command line: a scene file or an environment.
     fn open(&self, path: &Path) -> Result<Opened, String>;
-    /// Reads an uploaded file called `name` whose contents are `bytes`.
-    fn upload(&self, name: &str, bytes: &[u8]) -> Result<Opened, String>;
+    /// Reads an uploaded file called `name` whose contents are `bytes`; `alongside`, the
+    /// files uploaded with it (name and contents), are the only files an uploaded scene may
+    /// name besides what the host bundles.
+    fn upload(
+        &self,
+        name: &str,
+        bytes: &[u8],
+        alongside: &[(String, Vec<u8>)],
+    ) -> Result<Opened, String>;
     /// The scene shown before any scene is opened (an environment alone is shown on it).
     fn default_scene(&self) -> SceneView;
     /// `what` written as a file of container `format` (one of [`EXPORT_FORMATS`]), as the

@@ -13,7 +13,8 @@
 //! | `GET /api/lighting?size=N&mapping=M` | the environment prefiltered: a GGX cube chain and SH9 ([`lighting`]), the last one kept |
 //! | `GET /api/lighting/progress` | `{"done", "total", "busy"}`: rows of the prefilter running |
 //! | `GET /api/export?what=map\|chain&format=EXT&projection=…&size=N` | a file to download, written by the [`Host`]: the map (as loaded, or converted as `/api/environment` converts it) or the last prefiltered chain |
-//! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit): a scene, an environment or a mesh |
+//! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit): a scene, an environment or a mesh; a scene may name the files held for it |
+//! | `POST /api/upload?name=FILE&alongside=1` | a file held, unread, for the scene uploaded next (the files picked or dropped with it; all of them together at most the upload limit); any other upload lets them go |
 //! | `POST /api/object?name=scene\|BUILTIN\|BUNDLED&tessellation=N` | shows one object in place of the scene's (a built-in, or a mesh the [`Host`] bundles), or the scene's own again |
 
 use crate::guard::Guard;
@@ -94,6 +95,8 @@ struct App {
     state: Mutex<State>,
     guard: Guard,
     options: Studio,
+    /// The files uploaded `alongside=1`, by name, for the next upload.
+    held: Mutex<Vec<(String, Vec<u8>)>>,
     /// The last conversion asked for, by its query.
     converted: Mutex<Option<(String, Arc<EnvMap>)>>,
     /// The last prefiltered lighting (and its payload), by its request, and the running
@@ -139,6 +142,7 @@ impl Studio {
                 token: token.clone(),
             },
             options: self.clone(),
+            held: Mutex::new(Vec::new()),
             converted: Mutex::new(None),
             lit: Mutex::new(None),
             lit_progress: Progress::default(),
@@ -669,9 +673,27 @@ async fn upload(
             return bad(e.status(), message);
         }
     };
+    if q.get("alongside").is_some_and(|a| a == "1") {
+        let mut held = app.held.lock().expect("held");
+        held.retain(|(n, _)| *n != name);
+        let total: usize = held.iter().map(|(_, b)| b.len()).sum::<usize>() + body.len();
+        if total > app.options.upload_limit {
+            held.clear();
+            let message = format!(
+                "{name}: the files picked together are larger than the upload limit of {} MiB (mirrorball studio --max-upload)",
+                app.options.upload_limit >> 20
+            );
+            app.state.lock().expect("state").error(message.clone());
+            return bad(StatusCode::PAYLOAD_TOO_LARGE, message);
+        }
+        held.push((name, body.to_vec()));
+        let names: Vec<&str> = held.iter().map(|(n, _)| n.as_str()).collect();
+        return Json(serde_json::json!({ "held": names })).into_response();
+    }
+    let alongside = std::mem::take(&mut *app.held.lock().expect("held"));
     let host = app.host.clone();
     let read = tokio::task::spawn_blocking(move || {
-        let opened = host.upload(&name, &body);
+        let opened = host.upload(&name, &body, &alongside);
         (name, opened)
     })
     .await;

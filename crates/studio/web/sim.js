@@ -599,6 +599,7 @@ export function attach(studio) {
     if (view.state?.object) p.set('object', view.state.object);
     else p.delete('object');
     if (view.attach) p.set('attach', view.attach);
+    else p.delete('attach');
     p.set('twin', view.twin ? '1' : '0');
     if (view.panBlur) p.set('panblur', String(view.panBlur));
     else p.delete('panblur');
@@ -607,6 +608,8 @@ export function attach(studio) {
       p.set('yaw', String(view.orbit.yaw));
       p.set('pitch', String(view.orbit.pitch));
       p.set('distance', String(view.orbit.distance));
+    } else {
+      for (const k of ['yaw', 'pitch', 'distance']) p.delete(k);
     }
     p.set('marks', sim.marks ? '1' : '0');
     p.set('heat', sim.heat ? '1' : '0');

@@ -81,9 +81,11 @@ function show(messages) {
 
 /** What the URL asked for that could not be done. */
 const linkNotes = [];
+/** What the last scene export needs said (the flags render needs beside the file). */
+let exportNote = null;
 
 function report(error) {
-  const notes = [...linkNotes, ...(view.state?.scene?.notes || [])];
+  const notes = [...linkNotes, ...(exportNote ? [exportNote] : []), ...(view.state?.scene?.notes || [])];
   const errors = view.state?.errors || [];
   const message = error ? String(error.message || error) : null;
   show([
@@ -500,9 +502,31 @@ async function chooseObject(name) {
   await loadObjects();
 }
 
-async function upload(file) {
+/** Whether `name` is a scene file's (as the CLI tells them: by the extension). */
+const isScene = (name) => /\.(json|toml)$/i.test(name);
+
+/**
+ * Uploads the files picked or dropped together: with a scene among them, the others first,
+ * held by the server for it (`alongside=1`: the only files an uploaded scene may name
+ * besides the built-ins and the bundled bunny), then the scene; without one, each file in
+ * turn (an environment, a mesh).
+ */
+async function upload(list) {
+  const files = Array.from(list);
+  if (!files.length) return;
+  const scenes = files.filter((f) => isScene(f.name));
+  const send = (f, q = '') => G.api(`/api/upload?name=${encodeURIComponent(f.name)}${q}`, { method: 'POST', body: f });
   try {
-    await G.api(`/api/upload?name=${encodeURIComponent(file.name)}`, { method: 'POST', body: file });
+    if (scenes.length > 1) throw new Error(`${scenes.map((f) => f.name).join(', ')}: open one scene at a time`);
+    if (scenes.length) {
+      for (const f of files) if (f !== scenes[0]) await send(f, '&alongside=1');
+      await send(scenes[0]);
+      // A new scene: its own camera, mode, tessellation and attachment.
+      Object.assign(view, { orbit: null, mode: null, tessellation: null, attach: null });
+      params.delete('mode');
+    } else {
+      for (const f of files) await send(f);
+    }
     view.programs.clear();
     dropLighting();
     await loadState();
@@ -514,9 +538,7 @@ async function upload(file) {
   }
 }
 
-document.getElementById('file').addEventListener('change', (e) => {
-  if (e.target.files[0]) upload(e.target.files[0]);
-});
+document.getElementById('file').addEventListener('change', (e) => upload(e.target.files));
 for (const t of ['dragenter', 'dragover']) {
   document.addEventListener(t, (e) => {
     e.preventDefault();
@@ -527,7 +549,7 @@ document.addEventListener('dragleave', () => (document.body.id = ''));
 document.addEventListener('drop', (e) => {
   e.preventDefault();
   document.body.id = '';
-  if (e.dataTransfer.files[0]) upload(e.dataTransfer.files[0]);
+  upload(e.dataTransfer.files);
 });
 document.getElementById('mode').addEventListener('change', async (e) => {
   view.mode = Number(e.target.value);
@@ -634,11 +656,13 @@ async function exportFile(what) {
 }
 
 /**
- * The scene as a scene file (docs/render-scene.md) that `mirrorball render FILE --ss 1`
- * draws as the viewport does: the file the scene was read from (the server made its paths
- * absolute) with the camera now (orbited or not), the mode, one sample a pixel and the
- * bilinear filter the viewport reads with. Refused, with the reason, where a scene file
- * cannot say what the viewport shows.
+ * The scene as a scene file (docs/render-scene.md) that `mirrorball render FILE` (with
+ * `sceneFlags()`) draws as the viewport does: the file the scene was read from (the server
+ * made its paths absolute; an uploaded scene's as it wrote them) with the camera now
+ * (orbited or not), the mode (render's names: texgen, vertex, pixel, cone), one sample a
+ * pixel and the filter the viewport reads with (modes 1-3 bilinear; mode 4 the scene's
+ * trilinear, else EWA, which the viewport approximates). Refused, with the reason, where
+ * neither a scene file nor render's flags can say what the viewport shows.
  */
 function sceneFile() {
   const s = view.state.scene;
@@ -651,14 +675,19 @@ function sceneFile() {
   if (materialNow() !== 'mirror') {
     throw new Error('the prefiltered materials have no scene-file form: choose the mirror to export the scene');
   }
+  if (view.paraboloid === 'hardware' && view.env?.header.projection === 'paraboloid') {
+    throw new Error('the viewport draws the dual paraboloid as the hardware did (two textures, the alpha test), which mirrorball render does not (it reads the map exactly): choose "exact" to export the scene');
+  }
   const out = JSON.parse(JSON.stringify(s.source));
   const c = s.camera;
   const cam = camera();
   out.camera = Object.assign({}, out.camera, { eye: cam.eye, target: c.target, up: c.up, width: c.width, height: c.height });
-  out.indexing = ['texgen', 'vertex', 'pixel'][view.mode - 1];
+  const indexing = ['texgen', 'vertex', 'pixel', 'cone'][view.mode - 1];
+  if (!indexing) throw new Error(`mode ${view.mode} has no scene-file name`);
+  out.indexing = indexing;
   out.supersample = 1;
   if (out.environment) {
-    out.environment.filter = 'bilinear';
+    out.environment.filter = view.mode === 4 ? (s.environment?.filter === 'trilinear' ? 'trilinear' : 'ewa') : 'bilinear';
     out.environment.attach = attachNow();
   }
   // The slider's tessellation, for the built-ins (the server names them in `meshes`).
@@ -670,11 +699,25 @@ function sceneFile() {
   return out;
 }
 
+/**
+ * What `mirrorball render` needs besides the scene file to draw what the viewport shows:
+ * the pan blur, which scene files do not hold (`--pan-blur DEG`).
+ */
+function sceneFlags() {
+  return view.panBlur ? ['--pan-blur', String(view.panBlur)] : [];
+}
+
 document.getElementById('export-scene').addEventListener('click', () => {
   try {
-    download(new Blob([JSON.stringify(sceneFile(), null, 2)], { type: 'application/json' }), 'mirrorball-scene.json');
+    const file = sceneFile();
+    const flags = sceneFlags();
+    download(new Blob([JSON.stringify(file, null, 2)], { type: 'application/json' }), 'mirrorball-scene.json');
+    exportNote = flags.length
+      ? `the pan blur has no place in a scene file: mirrorball render mirrorball-scene.json ${flags.join(' ')} draws what the viewport shows`
+      : null;
     report();
   } catch (e) {
+    exportNote = null;
     report(e);
   }
 });
@@ -742,7 +785,7 @@ const ready = (async () => {
 ready.catch(report);
 
 afterDraw.push(drawTwin);
-const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting, sceneFile, twin, attachNow, chooseObject };
+const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting, sceneFile, sceneFlags, twin, attachNow, chooseObject };
 // The simulator panel and the view state in the URL (sim.js); `ready` waits for both.
 const sim = await import(`./sim.js?token=${encodeURIComponent(token)}`);
 handle.sim = sim.attach(handle);

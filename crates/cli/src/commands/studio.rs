@@ -164,6 +164,94 @@ impl CliHost {
     }
 }
 
+impl CliHost {
+    /// The uploaded scene `name` (`bytes`, a scene file of extension `ext`), read as `render`
+    /// reads it, the files it names being only these (the studio reads no path a page
+    /// names): a file uploaded `alongside` it, by its file name, or the bunny the binary
+    /// bundles (a path ending in `assets/meshes/bunny.obj`). They are written with the scene
+    /// into a folder of its own, the scene's paths made theirs, and the folder removed once
+    /// read. The scene exports with its paths as it wrote them.
+    fn uploaded_scene(
+        name: &str,
+        ext: &str,
+        bytes: &[u8],
+        alongside: &[(String, Vec<u8>)],
+    ) -> Result<Opened, String> {
+        let dir =
+            private_dir("scene").map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
+        let result = CliHost::scene_in(&dir, name, ext, bytes, alongside);
+        let _ = std::fs::remove_dir_all(&dir);
+        result
+    }
+
+    /// [`CliHost::uploaded_scene`] in the folder `dir`.
+    fn scene_in(
+        dir: &Path,
+        name: &str,
+        ext: &str,
+        bytes: &[u8],
+        alongside: &[(String, Vec<u8>)],
+    ) -> Result<Opened, String> {
+        let stored = |e: std::io::Error| format!("{name}: cannot store the upload: {e}");
+        // Checked as render reads it, with its messages, in the upload's name.
+        let written = dir.join(format!("scene.{ext}"));
+        std::fs::write(&written, bytes).map_err(stored)?;
+        let shown = written.display().to_string();
+        let as_written = super::render::schema::as_written(&written)
+            .map_err(|e| e.to_string().replace(&shown, name))?;
+        let files = dir.join("files");
+        std::fs::create_dir(&files).map_err(stored)?;
+        // What each file the scene names became, to name it as the scene does in messages.
+        let mut renamed: Vec<(String, String)> = Vec::new();
+        let mut resolved = as_written.clone();
+        super::render::schema::map_files(&mut resolved, |f| -> Result<String, String> {
+            let file_name = Path::new(f).file_name().and_then(|n| n.to_str());
+            let bytes: &[u8] = match alongside.iter().find(|(n, _)| Some(n.as_str()) == file_name) {
+                Some((_, b)) => b,
+                None if f.replace('\\', "/").ends_with(BUNNY_PATH) => BUNNY,
+                None => {
+                    return Err(format!(
+                        "{name}: names the file {f}, which the studio may not read: a scene opened on \
+                         the page may name only the built-in objects ({}), the bundled {BUNNY_PATH} \
+                         and files picked or dropped together with it (pick or drop {} with the scene, \
+                         or open the scene from the command line: mirrorball studio SCENE)",
+                        mirrorball_render::Builtin::ALL.map(|b| b.name()).join(", "),
+                        file_name.unwrap_or(f),
+                    ))
+                }
+            };
+            // Each file in a folder of its own, under its own name (its extension says
+            // what it is).
+            let sub = files.join(renamed.len().to_string());
+            std::fs::create_dir(&sub).map_err(stored)?;
+            let path = sub.join(file_name.unwrap_or("file"));
+            std::fs::write(&path, bytes).map_err(stored)?;
+            let path = path.display().to_string();
+            renamed.push((path.clone(), f.to_string()));
+            Ok(path)
+        })?;
+        let scene = dir.join("scene-resolved.json");
+        let text = serde_json::to_string(&resolved).map_err(|e| e.to_string())?;
+        std::fs::write(&scene, text).map_err(stored)?;
+        let shown_resolved = scene.display().to_string();
+        let named = |message: String| {
+            let mut m = message.replace(&shown_resolved, name);
+            for (path, f) in &renamed {
+                m = m.replace(path, f);
+            }
+            m
+        };
+        let mut view = scene_view(Some(&scene)).map_err(|e| named(e.to_string()))?;
+        view.name = name.to_string();
+        view.source = Some(as_written);
+        Ok(Opened::Scene(Box::new(view)))
+    }
+}
+
+/// Where the repository keeps the bundled bunny: an uploaded scene naming a path that ends
+/// so is given the bundled one.
+const BUNNY_PATH: &str = "assets/meshes/bunny.obj";
+
 /// The Stanford bunny the repository bundles (`assets/meshes/bunny.obj`, CC0 as its README
 /// says), offered by the page beside the built-ins.
 const BUNNY: &[u8] = include_bytes!("../../../../assets/meshes/bunny.obj");
@@ -192,7 +280,12 @@ impl Host for CliHost {
         CliHost::environment(path, &path.display().to_string())
     }
 
-    fn upload(&self, name: &str, bytes: &[u8]) -> Result<Opened, String> {
+    fn upload(
+        &self,
+        name: &str,
+        bytes: &[u8],
+        alongside: &[(String, Vec<u8>)],
+    ) -> Result<Opened, String> {
         // Only the name's extension is used: the file is written to a folder of its own.
         let ext = Path::new(name)
             .extension()
@@ -200,10 +293,7 @@ impl Host for CliHost {
             .filter(|e| e.chars().all(|c| c.is_ascii_alphanumeric()))
             .unwrap_or("bin");
         if is_scene(Path::new(name)) {
-            return Err(format!(
-                "{name}: scene files are opened from the command line (`mirrorball studio {name}`): \
-                 the files a scene names are read only when named there"
-            ));
+            return CliHost::uploaded_scene(name, ext, bytes, alongside);
         }
         if is_mesh(Path::new(name)) {
             return CliHost::stored(name, ext, bytes, |path| {

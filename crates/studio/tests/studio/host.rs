@@ -32,7 +32,12 @@ impl Host for TestHost {
     fn open(&self, path: &Path) -> Result<Opened, String> {
         TestHost::read(path, &path.display().to_string())
     }
-    fn upload(&self, name: &str, bytes: &[u8]) -> Result<Opened, String> {
+    fn upload(
+        &self,
+        name: &str,
+        bytes: &[u8],
+        _alongside: &[(String, Vec<u8>)],
+    ) -> Result<Opened, String> {
         let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
         let ext = Path::new(name)
             .extension()

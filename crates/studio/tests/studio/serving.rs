@@ -255,3 +255,32 @@ fn exports_are_the_hosts_files_and_bad_requests_say_what_is_wrong() {
     assert_eq!(levels, 4);
     r.stop();
 }
+
+#[test]
+fn files_held_for_a_scene_are_listed_bounded_together_and_let_go_by_the_next_upload() {
+    let r = start(&[]);
+    let half = vec![0u8; 600 << 10];
+    let a = own(&r, "POST", "/api/upload?name=a.exr&alongside=1", &half);
+    assert_eq!(a.status, 200, "{}", a.text());
+    assert_eq!(json(&a)["held"], serde_json::json!(["a.exr"]));
+    // Held, not read: nothing is loaded yet.
+    let s = json(&own(&r, "GET", "/api/state", b""));
+    assert!(s["scene"]["environment"].is_null());
+    assert_eq!(s["errors"].as_array().map(Vec::len), Some(0));
+    // Each alone is under the 1 MiB limit, the two together over it.
+    let b = own(&r, "POST", "/api/upload?name=b.obj&alongside=1", &half);
+    assert_eq!(b.status, 413, "{}", b.text());
+    assert_eq!(
+        json(&b)["error"],
+        "b.obj: the files picked together are larger than the upload limit of 1 MiB (mirrorball studio --max-upload)"
+    );
+    // Refused, the held files are let go: the next one is held alone.
+    let c = own(&r, "POST", "/api/upload?name=c.exr&alongside=1", b"x");
+    assert_eq!(json(&c)["held"], serde_json::json!(["c.exr"]));
+    // An ordinary upload takes them (here a bad one); the next is held alone again.
+    let d = own(&r, "POST", "/api/upload?name=d.exr", b"not an exr");
+    assert_eq!(d.status, 422, "{}", d.text());
+    let e = own(&r, "POST", "/api/upload?name=e.exr&alongside=1", b"x");
+    assert_eq!(json(&e)["held"], serde_json::json!(["e.exr"]));
+    r.stop();
+}

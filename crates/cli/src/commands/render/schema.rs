@@ -88,34 +88,41 @@ pub(super) fn apply(plan: &mut RenderPlan, path: &Path, given: &[String]) -> Res
 /// exports the scene from it.
 pub fn portable(path: &Path) -> Result<serde_json::Value, CliError> {
     let scene = Scene::read(path)?;
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-    let mut v: serde_json::Value = if scene.is_toml() {
-        toml::from_str(&text).map_err(|e| scene.error(e.to_string()))?
-    } else {
-        serde_json::from_str(&text).map_err(|e| scene.error(e.to_string()))?
-    };
-    let absolute = |f: &str| -> serde_json::Value {
+    let mut v = scene.as_json()?;
+    map_files(&mut v, |f| -> Result<String, CliError> {
         let p = scene.relative(f);
-        std::path::absolute(&p)
-            .map_or(p, |a| a.to_string_lossy().into_owned())
-            .into()
-    };
+        Ok(std::path::absolute(&p).map_or(p, |a| a.to_string_lossy().into_owned()))
+    })?;
+    Ok(v)
+}
+
+/// The scene file at `path` as JSON, checked as `render` reads it (its messages), the files
+/// it names as it wrote them.
+pub fn as_written(path: &Path) -> Result<serde_json::Value, CliError> {
+    Scene::read(path)?.as_json()
+}
+
+/// Replaces each file a scene (as JSON) names, the environment's and each mesh that is not
+/// a built-in, by what `to` makes of it.
+pub fn map_files<E>(
+    v: &mut serde_json::Value,
+    mut to: impl FnMut(&str) -> Result<String, E>,
+) -> Result<(), E> {
     if let Some(file) = v.pointer("/environment/file").and_then(|f| f.as_str()) {
-        let file = absolute(file);
-        v["environment"]["file"] = file;
+        let file = to(file)?;
+        v["environment"]["file"] = file.into();
     }
     if let Some(meshes) = v.get_mut("meshes").and_then(|m| m.as_array_mut()) {
         for m in meshes {
             if let Some(name) = m.get("mesh").and_then(|n| n.as_str()) {
                 if Builtin::from_name(name).is_none() {
-                    let file = absolute(name);
-                    m["mesh"] = file;
+                    let file = to(name)?;
+                    m["mesh"] = file.into();
                 }
             }
         }
     }
-    Ok(v)
+    Ok(())
 }
 
 /// Whether `path` names a TOML scene (else JSON).
@@ -155,6 +162,17 @@ impl<'a> Scene<'a> {
                 .map_err(|e| CliError::input(format!("{name}: not a valid JSON scene: {e}")))?
         };
         Ok(Scene { file, path })
+    }
+
+    /// The file as JSON (a TOML file's tables as JSON objects).
+    fn as_json(&self) -> Result<serde_json::Value, CliError> {
+        let text = std::fs::read_to_string(self.path)
+            .map_err(|e| CliError::input(format!("{}: {e}", self.path.display())))?;
+        if self.is_toml() {
+            toml::from_str(&text).map_err(|e| self.error(e.to_string()))
+        } else {
+            serde_json::from_str(&text).map_err(|e| self.error(e.to_string()))
+        }
     }
 
     /// Whether the file is TOML (by its extension; else JSON).
