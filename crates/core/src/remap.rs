@@ -299,25 +299,7 @@ impl Remap {
     /// projection and size and the source's channel count.
     pub fn apply_into(&self, src: &EnvMap, out: &mut EnvMap) -> Result<(), RemapError> {
         self.check_source(src)?;
-        if *out.projection() != self.job.dst
-            || (out.width(), out.height()) != (self.job.w, self.job.h)
-            || out.channels() != src.channels()
-        {
-            return Err(RemapError::Output);
-        }
-        self.fill(src, out);
-        Ok(())
-    }
-
-    fn fill(&self, src: &EnvMap, out: &mut EnvMap) {
-        let rows = RemapRows::new(self, src);
-        let w = rows.row_len();
-        for (layer, img) in out.layers_mut().iter_mut().enumerate() {
-            img.data_mut()
-                .par_chunks_mut(w)
-                .enumerate()
-                .for_each(|(y, row)| rows.row_into(layer, y, row));
-        }
+        RemapRows::new(self, src).fill(out)
     }
 
     /// Prepares `src` (the projection and size the plan was made for) to be converted a row
@@ -450,6 +432,26 @@ impl<'a> RemapRows<'a> {
             c: 3,
             codes: Some(src),
         }
+    }
+
+    /// Makes every row into `out` (in parallel), reusing its memory: `out` must have the
+    /// plan's output projection and size and the source's channel count.
+    pub fn fill(&self, out: &mut EnvMap) -> Result<(), RemapError> {
+        let job = &self.remap.job;
+        if *out.projection() != job.dst
+            || (out.width(), out.height()) != (job.w, job.h)
+            || out.channels() != self.c
+        {
+            return Err(RemapError::Output);
+        }
+        let w = self.row_len();
+        for (layer, img) in out.layers_mut().iter_mut().enumerate() {
+            img.data_mut()
+                .par_chunks_mut(w)
+                .enumerate()
+                .for_each(|(y, row)| self.row_into(layer, y, row));
+        }
+        Ok(())
     }
 
     /// Floats in one output row (width × the source's channels).

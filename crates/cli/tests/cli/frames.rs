@@ -349,14 +349,16 @@ fn ffmpeg_to_mirrorball_to_ffmpeg_is_the_frames_converted_as_pngs() {
 /// The first raw frame is converted from its decoded maps (it decides what the frames are),
 /// the later ones straight from their codes (`Remap::rows_coded`): one frame sent three
 /// times comes out as three identical frames, at 8 and 16 bits, rotated and exposed, into
-/// a cube strip and an equal-area octahedral map.
+/// a cube strip, an equal-area octahedral map and an equi-angular cube.
 #[test]
 fn a_frame_read_as_codes_is_the_frame_read_as_maps() {
     let d = tempfile::tempdir().unwrap();
+    // The cube strip is encoded as its rows are made; EAC's turned cells from its layers.
     for (fmt, to) in [
         ("rgb24", "cube"),
         ("rgb48le", "cube"),
         ("rgb24", "equal-area-octahedral"),
+        ("rgb48le", "eac"),
     ] {
         let raw = d.path().join(format!("in_{fmt}.raw"));
         let st = Command::new(FFMPEG)

@@ -437,6 +437,26 @@ fn plan_for_blank(plan: &Plan, dst: Projection, w: u32, h: u32) -> Option<(Shape
     Some((shape, shape.plan(dst, plan)))
 }
 
+/// The rows `remap` makes of a coded pipe's source frame: from its maps, or from its bytes
+/// read as codes (`w`×`h` frames of `fmt`).
+fn source_rows<'a>(
+    remap: &'a Remap,
+    (w, h, fmt): (u32, u32, PixFmt),
+    m: &Meta,
+    src: &'a Source,
+) -> Result<mirrorball_core::RemapRows<'a>, CliError> {
+    match src {
+        Source::Maps(eyes) => remap.rows(&eyes[0]),
+        Source::Codes(c) => {
+            let codes = fmt.codes(c, w, h).ok_or_else(|| {
+                CliError::input(format!("{}: not one {w}x{h} {fmt} frame", m.input))
+            })?;
+            remap.rows_coded(codes)
+        }
+    }
+    .map_err(|e| pipeline::misfit(m, e))
+}
+
 /// A source frame as the coded pipe's converter takes it.
 enum Source {
     /// Decoded maps (the first frame, read to decide what the frames are).
@@ -559,7 +579,6 @@ fn convert_frames(
     let coded = match (&reader.input, &packed) {
         (Input::Pipe { w, h, fmt }, Some((_, Some(p), _)))
             if fmt.has_codes()
-                && p.along_rows()
                 && remap.takes_codes()
                 && from == Stereo::Mono
                 && eyes0.len() == 1
@@ -636,7 +655,7 @@ fn convert_frames(
             // source frame or of the output frame (the first frame, read to decide the
             // projection, is converted from its maps: the same bytes).
             Some((_, Some(packing), fmt)) if coded.is_some() => {
-                let (iw, ih, ifmt) = coded.expect("a coded pipe");
+                let codes = coded.expect("a coded pipe");
                 let mut first = first.take().map(|(m, eyes)| (m, Source::Maps(eyes)));
                 let mut next_codes = |spare: Option<Source>| {
                     if let Some(f) = first.take() {
@@ -650,29 +669,35 @@ fn convert_frames(
                         .next_codes(spare)
                         .map(|r| r.map(|(m, bytes)| (m, Source::Codes(bytes))))
                 };
-                pipeline::run(
-                    &mut next_codes,
-                    &|m: &Meta, src: &Source, bytes: &mut Vec<u8>| {
-                        let rows = match src {
-                            Source::Maps(eyes) => remap.rows(&eyes[0]),
-                            Source::Codes(c) => {
-                                let codes = ifmt.codes(c, iw, ih).ok_or_else(|| {
-                                    CliError::input(format!(
-                                        "{}: not one {iw}x{ih} {ifmt} frame",
-                                        m.input
-                                    ))
-                                })?;
-                                remap.rows_coded(codes)
-                            }
-                        }
-                        .map_err(|e| pipeline::misfit(m, e))?;
-                        packing.encode_rows(*fmt, &rows, bytes);
-                        Ok(())
-                    },
-                    &Vec::new,
-                    &mut put_bytes,
-                    &done,
-                )
+                if packing.along_rows() {
+                    pipeline::run(
+                        &mut next_codes,
+                        &|m: &Meta, src: &Source, bytes: &mut Vec<u8>| {
+                            let rows = source_rows(&remap, codes, m, src)?;
+                            packing.encode_rows(*fmt, &rows, bytes);
+                            Ok(())
+                        },
+                        &Vec::new,
+                        &mut put_bytes,
+                        &done,
+                    )
+                } else {
+                    // Turned cells (EAC): the layers made, then packed from them.
+                    pipeline::run(
+                        &mut next_codes,
+                        &|m: &Meta, src: &Source, out: &mut Eyes| {
+                            let rows = source_rows(&remap, codes, m, src)?;
+                            rows.fill(&mut out[0]).map_err(|e| pipeline::misfit(m, e))
+                        },
+                        &fresh,
+                        &mut |m: &Meta, e: &Eyes| {
+                            put(m, e)?;
+                            counter.fetch_add(1, Ordering::Relaxed);
+                            Ok(())
+                        },
+                        &done,
+                    )
+                }
             }
             // Rows made and encoded together: no float copy of the output frame.
             Some((_, Some(packing), fmt)) if packing.along_rows() => pipeline::run(
