@@ -114,19 +114,26 @@ impl Image {
 
     /// Pastes `src` with its top-left corner at (`x`, `y`). Parts outside are clipped.
     pub fn paste(&mut self, src: &Image, x: u32, y: u32) {
-        let c = self.channels.min(src.channels);
+        if x >= self.width {
+            return;
+        }
+        // The part of each source row that lands inside, copied a row at a time.
+        let cols = src.width.min(self.width - x) as usize;
+        let (c, sc, dc) = (self.channels.min(src.channels), src.channels, self.channels);
         for row in 0..src.height {
-            let ty = y + row;
-            if ty >= self.height {
+            let ty = y as usize + row as usize;
+            if ty >= self.height as usize {
                 break;
             }
-            for col in 0..src.width {
-                let tx = x + col;
-                if tx >= self.width {
-                    break;
+            let s = &src.data[row as usize * src.width as usize * sc..][..cols * sc];
+            let at = (ty * self.width as usize + x as usize) * dc;
+            let d = &mut self.data[at..at + cols * dc];
+            if sc == dc {
+                d.copy_from_slice(s);
+            } else {
+                for (d, s) in d.chunks_exact_mut(dc).zip(s.chunks_exact(sc)) {
+                    d[..c].copy_from_slice(&s[..c]);
                 }
-                let v = src.get(col, row);
-                self.set(tx, ty, &v[..c]);
             }
         }
     }
@@ -226,6 +233,45 @@ impl Image {
             height,
             channels,
             data,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Image;
+
+    /// `paste` as a texel-by-texel copy: every texel inside, its first `min(channels)`
+    /// values, the rest of the destination untouched.
+    fn paste_reference(dst: &mut Image, src: &Image, x: u32, y: u32) {
+        for row in 0..src.height() {
+            for col in 0..src.width() {
+                let (tx, ty) = (x + col, y + row);
+                if tx < dst.width() && ty < dst.height() {
+                    let v = src.get(col, row).to_vec();
+                    dst.set(tx, ty, &v);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn paste_copies_each_texel_inside_and_clips_the_rest() {
+        let numbered = |w: u32, h: u32, c: usize, base: f32| {
+            let data = (0..w as usize * h as usize * c)
+                .map(|i| base + i as f32)
+                .collect();
+            Image::from_vec(w, h, c, data).unwrap()
+        };
+        for (dc, sc) in [(3, 3), (4, 4), (4, 3), (3, 4)] {
+            for (x, y) in [(0, 0), (2, 1), (5, 3), (6, 0), (0, 4), (9, 9)] {
+                let src = numbered(4, 3, sc, 1000.0);
+                let mut a = numbered(7, 5, dc, 0.0);
+                let mut b = a.clone();
+                a.paste(&src, x, y);
+                paste_reference(&mut b, &src, x, y);
+                assert_eq!(a.data(), b.data(), "{sc} into {dc} channels at ({x}, {y})");
+            }
         }
     }
 }

@@ -401,6 +401,14 @@ impl Layout {
         }
     }
 
+    /// Where [`Layout::pack`] puts layer `i` of `layers` whole: its cell `(column, row,
+    /// turned 180°)` in the [`Layout::grid`]; `None` for v360's cells (packed texel by
+    /// texel, EAC's with looked-up borders) and for a layer the layout does not hold.
+    pub fn grid_cell(self, i: usize, layers: usize) -> Option<(u32, u32, bool)> {
+        let whole = !matches!(self, Layout::Cells(_)) && self.fits(layers) && i < layers;
+        whole.then(|| self.cell(i))
+    }
+
     /// The cell of layer `i`: `(column, row, turned 180°)`.
     fn cell(self, i: usize) -> (u32, u32, bool) {
         match self {

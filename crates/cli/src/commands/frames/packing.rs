@@ -61,6 +61,73 @@ impl Packing {
         if n == 1 || layout == Layout::Separate {
             return (n == 1).then(|| Packing::single(w, h));
         }
+        if layout.grid_cell(0, n).is_some() {
+            return Some(Packing::of_grid(layout, n, (w, h)));
+        }
+        Packing::probed(layout, dst, (w, h))
+    }
+
+    /// The packing of a layout that puts each of `n` layers whole in a cell of its grid
+    /// (`Layout::grid_cell`: crosses and strips), from the cells alone: a turned cell's
+    /// rows are its layer's, last first, read backwards. The same runs as
+    /// [`Packing::probed`] (tested), without its two copies of the frame's texels.
+    fn of_grid(layout: Layout, n: usize, (w, h): (u32, u32)) -> Packing {
+        let (gc, gr) = layout.grid(n);
+        let mut by_cell = vec![None; (gc * gr) as usize];
+        for i in 0..n {
+            if let Some((col, row, turned)) = layout.grid_cell(i, n) {
+                by_cell[(row * gc + col) as usize] = Some((i as u32, turned));
+            }
+        }
+        let gaps = by_cell.iter().any(Option::is_none);
+        let mut runs = Vec::new();
+        let mut row_starts = Vec::with_capacity((gr * h) as usize + 1);
+        for r in 0..gr * h {
+            row_starts.push(runs.len() as u32);
+            let (row, y) = (r / h, r % h);
+            for col in 0..gc {
+                if let Some((layer, turned)) = by_cell[(row * gc + col) as usize] {
+                    runs.push(match turned {
+                        false => Run {
+                            at: col * w,
+                            len: w,
+                            layer,
+                            x: 0,
+                            y,
+                            dx: 1,
+                            dy: 0,
+                        },
+                        true => Run {
+                            at: col * w,
+                            len: w,
+                            layer,
+                            x: w - 1,
+                            y: h - 1 - y,
+                            // A one-texel run has no direction; the probe calls it +x.
+                            dx: if w > 1 { -1 } else { 1 },
+                            dy: 0,
+                        },
+                    });
+                }
+            }
+        }
+        row_starts.push(runs.len() as u32);
+        Packing {
+            width: gc * w,
+            height: gr * h,
+            layer_width: w,
+            row_starts,
+            runs,
+            gaps,
+            along_rows: true,
+            lookups: Vec::new(),
+        }
+    }
+
+    /// The packing of any layout `Layout::pack` knows, read off a packed probe: a map whose
+    /// texels hold their own layer and position, packed once.
+    fn probed(layout: Layout, dst: Projection, (w, h): (u32, u32)) -> Option<Packing> {
+        let n = dst.layer_count();
         // Every texel says where it is: (layer + 1, x, y), exact in `f32` (sides ≤ 2^16);
         // the packed picture's zeros are cells no layer fills.
         let layers = (0..n)
@@ -391,6 +458,39 @@ mod tests {
                 img
             })
             .collect()
+    }
+
+    /// Crosses and strips, packed from their cells, are what the probe reads off `pack`.
+    #[test]
+    fn a_grid_packing_is_the_probed_packing() {
+        for kind in [ProjectionKind::Cube, ProjectionKind::Paraboloid] {
+            let dst = kind.default_projection();
+            for layout in [
+                Layout::HorizontalCross,
+                Layout::VerticalCross,
+                Layout::HorizontalStrip,
+                Layout::VerticalStrip,
+            ] {
+                for (w, h) in [(1, 1), (2, 2), (5, 5), (7, 3)] {
+                    let probed = Packing::probed(layout, dst, (w, h));
+                    if !layout.fits(dst.layer_count()) {
+                        assert!(probed.is_none() && Packing::new(layout, dst, (w, h)).is_none());
+                        continue;
+                    }
+                    let (a, b) = (Packing::new(layout, dst, (w, h)).unwrap(), probed.unwrap());
+                    let what = format!("{kind:?} {layout} {w}x{h}");
+                    assert_eq!(
+                        (a.width, a.height, a.layer_width),
+                        (b.width, b.height, b.layer_width),
+                        "{what}"
+                    );
+                    assert_eq!(a.row_starts, b.row_starts, "{what}");
+                    assert_eq!(a.runs, b.runs, "{what}");
+                    assert_eq!((a.gaps, a.along_rows), (b.gaps, b.along_rows), "{what}");
+                    assert!(a.lookups.is_empty() && b.lookups.is_empty(), "{what}");
+                }
+            }
+        }
     }
 
     #[test]
