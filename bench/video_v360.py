@@ -22,7 +22,13 @@ pessimistic: the consumer there reads the input's bytes, where mirrorball's 6x10
 frames are 3/4 of them, so the pipeline moves 7/8 of the floor's bytes; where the time
 follows the bytes, the true ceiling is at most 8/7 of the one printed.
 
-    python3 bench/video_v360.py [--frames 24] [--reps 2] [--no-build] [--eac-to eac]
+A stream is longer than 24 frames: `--loops N` feeds the same raw file N times over
+(ffmpeg's `-stream_loop`, on every side alike: mirrorball's producer, v360's input, the
+floor's producer), so a run converts N×frames frames and the one-off costs (mirrorball's
+plan, v360's map tables, the processes starting) weigh as they do on a video of that
+length. The default, 1, is the 24-frame run.
+
+    python3 bench/video_v360.py [--frames 24] [--loops 1] [--reps 2] [--no-build] [--eac-to eac]
 """
 
 import argparse
@@ -63,6 +69,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--frames", type=int, default=24)
     ap.add_argument("--reps", type=int, default=2)
+    ap.add_argument("--loops", type=int, default=1,
+                    help="feed the input this many times over (a longer stream)")
     ap.add_argument("--no-build", action="store_true")
     ap.add_argument("--eac-to", default="eac",
                     help="mirrorball's --to for EAC (skipped when mirrorball refuses it)")
@@ -73,7 +81,9 @@ def main():
         sh(f"cargo build --release -p mirrorball-cli --bin mirrorball", cwd=ROOT)
     data = Path(a.data)
     data.mkdir(parents=True, exist_ok=True)
-    print(f"{os.cpu_count()} CPUs; {a.frames} frames of {W}x{H}; best of {a.reps}")
+    total = a.frames * a.loops
+    print(f"{os.cpu_count()} CPUs; {total} frames of {W}x{H} ({a.frames} made, fed {a.loops} "
+          f"time(s)); best of {a.reps}")
 
     # (name, mirrorball --to and layout, output frame size, v360 output options)
     targets = [("cube 6x1024²", f"--to cube --size {FACE} --layout hstrip", (6 * FACE, FACE),
@@ -90,7 +100,8 @@ def main():
     for pix_fmt in ["rgb24", "rgb48le"]:
         src = data / f"testsrc2-{W}x{H}-{a.frames}.{pix_fmt}.raw"
         make_input(src, pix_fmt, a.frames)
-        feed = f"{FFMPEG} -v error -f rawvideo -pix_fmt {pix_fmt} -s {W}x{H} -i {src}"
+        feed = (f"{FFMPEG} -v error -stream_loop {a.loops - 1} -f rawvideo -pix_fmt {pix_fmt} "
+                f"-s {W}x{H} -i {src}")
         for name, to, size, v360 in targets:
             best = {"mirrorball": 1e9, "v360": 1e9, "floor": 1e9}
             steady = 0.0
@@ -114,9 +125,9 @@ def main():
                 dt, _ = timed(f"{feed} -f rawvideo - | cat | {FFMPEG} -v error -f rawvideo "
                               f"-pix_fmt {pix_fmt} -s {size[0]}x{size[1]} -i - -f null -")
                 best["floor"] = min(best["floor"], dt)
-            fm = a.frames / best["mirrorball"]
-            fv = a.frames / best["v360"]
-            ff = a.frames / best["floor"]
+            fm = total / best["mirrorball"]
+            fv = total / best["v360"]
+            ff = total / best["floor"]
             rows.append((name, pix_fmt, fm, steady, fv, fm / fv, TARGET[pix_fmt], ff / fv))
 
     print()

@@ -37,6 +37,7 @@ mod ldr_io;
 mod meta_text;
 pub mod openexr;
 mod output;
+mod pipe_size;
 mod rgba_png;
 
 pub use alloc::HugePages;
@@ -51,6 +52,7 @@ pub use ktx2_io::{write_ktx2, CubeWrite};
 pub use ldr_io::{lut16 as srgb16_to_linear, lut8 as srgb8_to_linear};
 pub use mirrorball_encode::{Effort, Encoding};
 pub use output::OutputSet;
+pub use pipe_size::{widen_pipe, PIPE_BYTES};
 pub use rgba_png::Rgba8Face;
 
 use atomic::Staged;

@@ -494,6 +494,13 @@ fn convert_frames(
         limits: mirrorball_io::Limits::default(),
     };
     let t0 = Instant::now();
+    // Raw frames cross pipes in 1 MiB rounds, not 64 KiB ones (io's `widen_pipe`).
+    if matches!(reader.input, Input::Pipe { .. }) {
+        mirrorball_io::widen_pipe(std::io::stdin(), mirrorball_io::PIPE_BYTES);
+    }
+    if matches!(output, Output::Pipe(_)) {
+        mirrorball_io::widen_pipe(std::io::stdout(), mirrorball_io::PIPE_BYTES);
+    }
     // A pipe's frames have the shape --in-size says, so the conversion is planned while the
     // first frame is on its way (the producer starting and sending it), and used when that
     // frame turns out to have the shape it was planned for (else planned again).
