@@ -195,9 +195,10 @@ impl CubeCells {
         }
     }
 
-    /// For each texel `(x, y)` of each cell's face, the face texel it shows:
-    /// `f(cell, picture x, picture y, face texel x, face texel y)`.
-    fn each_texel(&self, n: u32, mut f: impl FnMut(usize, u32, u32, u32, u32)) {
+    /// For each texel `(x, y)` of each cell's face (faces of `n` texels), the face texel it
+    /// shows: `f(cell, picture x, picture y, face texel x, face texel y)`, the face being
+    /// `faces[cell]`; cell by cell, each cell's rows top first, each row left to right.
+    pub fn each_texel(&self, n: u32, mut f: impl FnMut(usize, u32, u32, u32, u32)) {
         let n2 = n as i64;
         for i in 0..6 {
             let (ox, oy) = self.origin(i, n);

@@ -3,9 +3,11 @@
 //! planned `Remap` makes it, so that no packed copy of the frame (75 MB of `f32` for a
 //! 6×1024² cube) is made per frame.
 //!
-//! The positions are `Layout::pack`'s own: the plan packs, once, a map whose texels hold
-//! their own layer and position, and reads the runs back off the packed picture, so any
-//! layout `pack` knows (cells turned or not) is encoded as `pack` would place it.
+//! The positions are `Layout::pack`'s own: crosses and strips from the cell each layer
+//! fills (`Layout::grid_cell`), v360's cells from the face texel each of their texels
+//! shows (`CubeCells::each_texel`) and the border texels looked up in a direction; the
+//! tests hold both to a probe, a map whose texels hold their own layer and position packed
+//! by `pack` itself and read back.
 
 use super::pipe::{PixFmt, SrgbTable};
 use mirrorball_core::glam::DVec3;
@@ -30,6 +32,39 @@ impl Run {
     fn along_row(&self) -> bool {
         self.dy == 0 && self.dx.abs() == 1
     }
+}
+
+/// Adds packed texel `at` of a row, read from texel `(x, y)` of `layer`, to the row's runs
+/// (`runs[first..]`): the last run grows where the texel continues it (the same layer, the
+/// next packed texel, and one step on from its end: the second texel of a run sets the
+/// step), else a run starts.
+fn push_texel(runs: &mut Vec<Run>, first: usize, at: u32, layer: u32, x: u32, y: u32) {
+    if let Some(run) = runs[first..].last_mut() {
+        let next = run.at + run.len == at && run.layer == layer;
+        let (dx, dy) = (x as i32 - run.x as i32, y as i32 - run.y as i32);
+        if next && run.len == 1 && dx.abs() + dy.abs() == 1 {
+            (run.dx, run.dy) = (dx, dy);
+            run.len = 2;
+            return;
+        }
+        let end = (
+            run.x as i32 + run.dx * run.len as i32,
+            run.y as i32 + run.dy * run.len as i32,
+        );
+        if next && run.len > 1 && end == (x as i32, y as i32) {
+            run.len += 1;
+            return;
+        }
+    }
+    runs.push(Run {
+        at,
+        len: 1,
+        layer,
+        x,
+        y,
+        dx: 1,
+        dy: 0,
+    });
 }
 
 /// Where every texel of a packed `width`×`height` frame comes from.
@@ -61,10 +96,57 @@ impl Packing {
         if n == 1 || layout == Layout::Separate {
             return (n == 1).then(|| Packing::single(w, h));
         }
-        if layout.grid_cell(0, n).is_some() {
-            return Some(Packing::of_grid(layout, n, (w, h)));
+        match layout {
+            Layout::Cells(cells) => Packing::of_cells(&cells, dst, (w, h)),
+            _ => (layout.grid_cell(0, n).is_some()).then(|| Packing::of_grid(layout, n, (w, h))),
         }
-        Packing::probed(layout, dst, (w, h))
+    }
+
+    /// The packing of v360's cells (`c3x2`, `c6x1`, `c1x6`, `eac`) from the texels each
+    /// cell shows (`CubeCells::each_texel`) and the border texels looked up in a direction
+    /// (`Layout::looked_up_texels`): the same runs as [`Packing::probed`] (tested), without
+    /// its two copies of the frame's texels. `None` where the layout does not take the
+    /// layers (not six square faces).
+    fn of_cells(
+        cells: &mirrorball_core::CubeCells,
+        dst: Projection,
+        (w, h): (u32, u32),
+    ) -> Option<Packing> {
+        if dst.layer_count() != 6 || w != h {
+            return None;
+        }
+        let (pw, ph) = cells.extent(w);
+        let mut rows: Vec<Vec<Run>> = vec![Vec::new(); ph as usize];
+        let mut shown = 0usize;
+        cells.each_texel(w, |i, px, py, fx, fy| {
+            shown += 1;
+            push_texel(&mut rows[py as usize], 0, px, cells.faces[i] as u32, fx, fy);
+        });
+        let lookups: Vec<(u32, DVec3)> = Layout::Cells(*cells)
+            .looked_up_texels(&dst, w)
+            .into_iter()
+            .map(|(x, y, d)| (y * pw + x, d))
+            .collect();
+        let mut runs = Vec::new();
+        let mut row_starts = Vec::with_capacity(ph as usize + 1);
+        for mut row in rows {
+            // Each cell's piece of the row came whole; the pieces, left to right.
+            row.sort_unstable_by_key(|r| r.at);
+            row_starts.push(runs.len() as u32);
+            runs.append(&mut row);
+        }
+        row_starts.push(runs.len() as u32);
+        let along_rows = lookups.is_empty() && runs.iter().all(Run::along_row);
+        Some(Packing {
+            width: pw,
+            height: ph,
+            layer_width: w,
+            row_starts,
+            runs,
+            gaps: shown + lookups.len() < pw as usize * ph as usize,
+            along_rows,
+            lookups,
+        })
     }
 
     /// The packing of a layout that puts each of `n` layers whole in a cell of its grid
@@ -125,7 +207,9 @@ impl Packing {
     }
 
     /// The packing of any layout `Layout::pack` knows, read off a packed probe: a map whose
-    /// texels hold their own layer and position, packed once.
+    /// texels hold their own layer and position, packed once. What the tests hold
+    /// [`Packing::of_grid`] and [`Packing::of_cells`] to: `pack`'s own placement.
+    #[cfg(test)]
     fn probed(layout: Layout, dst: Projection, (w, h): (u32, u32)) -> Option<Packing> {
         let n = dst.layer_count();
         // Every texel says where it is: (layer + 1, x, y), exact in `f32` (sides ≤ 2^16);
@@ -182,33 +266,7 @@ impl Packing {
                     return None;
                 }
                 let (layer, x, y) = (t[0] as u32 - 1, t[1] as u32, t[2] as u32);
-                if let Some(run) = runs[first..].last_mut() {
-                    let next = run.at + run.len == at as u32 && run.layer == layer;
-                    let (dx, dy) = (x as i32 - run.x as i32, y as i32 - run.y as i32);
-                    if next && run.len == 1 && dx.abs() + dy.abs() == 1 {
-                        (run.dx, run.dy) = (dx, dy);
-                        run.len = 2;
-                        continue;
-                    }
-                    let end = (
-                        run.x as i32 + run.dx * run.len as i32,
-                        run.y as i32 + run.dy * run.len as i32,
-                    );
-                    if next && run.len > 1 && end == (x as i32, y as i32) {
-                        run.len += 1;
-                        continue;
-                    }
-                }
-                debug_assert!(r < ph as usize);
-                runs.push(Run {
-                    at: at as u32,
-                    len: 1,
-                    layer,
-                    x,
-                    y,
-                    dx: 1,
-                    dy: 0,
-                });
+                push_texel(&mut runs, first, at as u32, layer, x, y);
             }
         }
         row_starts.push(runs.len() as u32);
@@ -458,6 +516,43 @@ mod tests {
                 img
             })
             .collect()
+    }
+
+    /// v360's cells (every face order and turn string the tests of `layout.rs` use, and EAC's
+    /// padded cells), packed from the texels each cell shows, are what the probe reads off
+    /// `pack`, lookups included.
+    #[test]
+    fn a_cells_packing_is_the_probed_packing() {
+        let cube = ProjectionKind::Cube.default_projection();
+        let eac = ProjectionKind::Eac.default_projection();
+        for (name, dst) in [
+            ("c3x2", cube),
+            ("c6x1", cube),
+            ("c1x6", cube),
+            ("eac", eac),
+            ("eac", cube),
+            ("c3x2:forder=fbrlud:frot=123012", cube),
+            ("c6x1:forder=udfblr:frot=000123", cube),
+        ] {
+            let layout: Layout = name.parse().unwrap();
+            assert!(matches!(layout, Layout::Cells(_)), "{name}");
+            for n in [1, 2, 3, 6] {
+                let (a, b) = (
+                    Packing::new(layout, dst, (n, n)).unwrap(),
+                    Packing::probed(layout, dst, (n, n)).unwrap(),
+                );
+                let what = format!("{name} of {dst:?} at {n}");
+                assert_eq!(
+                    (a.width, a.height, a.layer_width),
+                    (b.width, b.height, b.layer_width),
+                    "{what}"
+                );
+                assert_eq!(a.row_starts, b.row_starts, "{what}");
+                assert_eq!(a.runs, b.runs, "{what}");
+                assert_eq!((a.gaps, a.along_rows), (b.gaps, b.along_rows), "{what}");
+                assert_eq!(a.lookups, b.lookups, "{what}");
+            }
+        }
     }
 
     /// Crosses and strips, packed from their cells, are what the probe reads off `pack`.
