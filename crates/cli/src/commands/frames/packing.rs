@@ -518,6 +518,15 @@ mod tests {
             .collect()
     }
 
+    /// Two packings place every texel alike.
+    fn assert_same(a: &Packing, b: &Packing, what: &str) {
+        let shape = |p: &Packing| (p.width, p.height, p.layer_width, p.gaps, p.along_rows);
+        assert_eq!(shape(a), shape(b), "{what}");
+        assert_eq!(a.row_starts, b.row_starts, "{what}");
+        assert_eq!(a.runs, b.runs, "{what}");
+        assert_eq!(a.lookups, b.lookups, "{what}");
+    }
+
     /// v360's cells (every face order and turn string the tests of `layout.rs` use, and EAC's
     /// padded cells), packed from the texels each cell shows, are what the probe reads off
     /// `pack`, lookups included.
@@ -541,16 +550,7 @@ mod tests {
                     Packing::new(layout, dst, (n, n)).unwrap(),
                     Packing::probed(layout, dst, (n, n)).unwrap(),
                 );
-                let what = format!("{name} of {dst:?} at {n}");
-                assert_eq!(
-                    (a.width, a.height, a.layer_width),
-                    (b.width, b.height, b.layer_width),
-                    "{what}"
-                );
-                assert_eq!(a.row_starts, b.row_starts, "{what}");
-                assert_eq!(a.runs, b.runs, "{what}");
-                assert_eq!((a.gaps, a.along_rows), (b.gaps, b.along_rows), "{what}");
-                assert_eq!(a.lookups, b.lookups, "{what}");
+                assert_same(&a, &b, &format!("{name} of {dst:?} at {n}"));
             }
         }
     }
@@ -573,16 +573,8 @@ mod tests {
                         continue;
                     }
                     let (a, b) = (Packing::new(layout, dst, (w, h)).unwrap(), probed.unwrap());
-                    let what = format!("{kind:?} {layout} {w}x{h}");
-                    assert_eq!(
-                        (a.width, a.height, a.layer_width),
-                        (b.width, b.height, b.layer_width),
-                        "{what}"
-                    );
-                    assert_eq!(a.row_starts, b.row_starts, "{what}");
-                    assert_eq!(a.runs, b.runs, "{what}");
-                    assert_eq!((a.gaps, a.along_rows), (b.gaps, b.along_rows), "{what}");
-                    assert!(a.lookups.is_empty() && b.lookups.is_empty(), "{what}");
+                    assert_same(&a, &b, &format!("{kind:?} {layout} {w}x{h}"));
+                    assert!(a.lookups.is_empty());
                 }
             }
         }
