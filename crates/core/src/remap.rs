@@ -322,6 +322,21 @@ impl Remap {
     /// them into, with no float copy of the source made (only its mip levels, where the
     /// plan reads any, are floats). The plan must [take codes](Remap::takes_codes), and the
     /// codes be the plan's source extent.
+    ///
+    /// ```
+    /// use mirrorball_core::{Codes, EnvMap, ProjectionKind, Remap, ResampleOptions};
+    /// let (ll, cube) = (ProjectionKind::LatLong.default_projection(), ProjectionKind::Cube.default_projection());
+    /// let table: Vec<f32> = (0..256).map(|k| (k as f32 / 255.0).powf(2.2)).collect();
+    /// let bytes: Vec<u8> = (0..64 * 32 * 3).map(|i| (i * 7 % 256) as u8).collect();
+    /// let codes = Codes::u8(&bytes, &table, (64, 32)).unwrap();
+    /// let plan = Remap::new(ll, (64, 32), 1, cube, 8, &ResampleOptions::default());
+    /// let floats = EnvMap::new(ll, vec![codes.to_image()]).unwrap();
+    /// let (a, b) = (plan.rows(&floats).unwrap(), plan.rows_coded(codes).unwrap());
+    /// let (mut ra, mut rb) = (vec![0.0; a.row_len()], vec![0.0; b.row_len()]);
+    /// a.row_into(2, 5, &mut ra);
+    /// b.row_into(2, 5, &mut rb);
+    /// assert_eq!(ra, rb); // the same bits
+    /// ```
     pub fn rows_coded<'a>(&'a self, src: Codes<'a>) -> Result<RemapRows<'a>, RemapError> {
         if !self.takes_codes() {
             return Err(RemapError::Codes);
