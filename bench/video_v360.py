@@ -10,7 +10,7 @@ against ffmpeg's own v360 filter doing the same (`ffmpeg -i in.raw -vf v360=e:c6
 at 8 bits (rgb24) and 16 bits (rgb48le), side by side in one run, the runs interleaved.
 The input is a raw file of testsrc2 frames made once (so that decoding costs neither side
 anything); `-f null` on both sides, so that no encoder counts. mirrorball antialiases (its
-default --max-samples 4); v360 interpolates bilinearly (its default).
+default --max-samples 8); v360 interpolates bilinearly (its default).
 
 Targets (issue 19): mirrorball at least 2x v360's frames per second at 16 bits, 1.5x at 8.
 

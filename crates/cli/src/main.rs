@@ -172,7 +172,7 @@ pub struct ConvertArgs {
     #[arg(long)]
     mips: bool,
     /// Most points per axis when integrating over an output texel (1 = plain bilinear).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = mirrorball_core::ResampleOptions::default().max_samples)]
     max_samples: u32,
     /// Print nothing but errors.
     #[arg(short, long)]

@@ -11,8 +11,11 @@
 //! (1024 rows over π: `1024/2π` cycles per radian), so the source holds the plate faithfully
 //! everywhere while each output (a 64² cube face, 96–128 px views and maps: 5–10 source
 //! texels to its texel) sees frequencies up to 5–12 times its own Nyquist around −Z and its
-//! passband towards +Z. At a 128² cube face mirrorball scores 31.9 dB, v360 19.5 (linear)
-//! and 18.4 (lanczos): 12.4 dB, short of the margin (reported in issue 19's work).
+//! passband towards +Z. The 128² cube face is also scored: 4 source texels to its texel
+//! across, the ratio of issue 19's 4096×2048 → 6×256² example, where `v360` does best
+//! (mirrorball 41.4 dB, v360 19.5 linear and 18.4 lanczos; with `--max-samples 4`
+//! mirrorball scores 31.9 there and 30.9 at 64², footprints over 16 source texels being
+//! integrated on a mip level, whose 2×2 boxes blur).
 //!
 //! **The ground truth** is computed here, independent of mirrorball's resampler: each texel's
 //! `∫f dω / ∫dω` by 16×16-point Gauss–Legendre over the texel in `(u, v)` (core's
@@ -79,6 +82,12 @@ const CASES: &[Case] = &[
     Case {
         to: "cube",
         size: 64,
+        v360: "c6x1",
+        tiles: (6, 1),
+    },
+    Case {
+        to: "cube",
+        size: 128,
         v360: "c6x1",
         tiles: (6, 1),
     },
