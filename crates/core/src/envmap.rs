@@ -551,32 +551,81 @@ fn bilinear_n<const C: usize>(
     uv: DVec2,
     out: &mut [f32],
 ) {
-    let img = &layers[layer];
-    let (w, h) = (img.width() as i64, img.height() as i64);
+    let (w, h) = (layers[layer].width(), layers[layer].height());
+    let v = bilinear_read::<C>(proj, (w, h), layer, uv, |l, x, y| {
+        layers[l].get(x, y).try_into().expect("C channels")
+    });
+    out[..C].copy_from_slice(&v);
+}
+
+/// The arithmetic of every bilinear lookup at `(layer, uv)` of a map of `proj` whose layers
+/// are `w`×`h` texels, the texels read through `texel(layer, x, y)`: inside the layer, the
+/// top and bottom pairs blended across and then down; at an edge, the four
+/// [`seam_taps`] summed with their weights, in order.
+#[inline(always)]
+fn bilinear_read<const C: usize>(
+    proj: &Projection,
+    (w, h): (u32, u32),
+    layer: usize,
+    uv: DVec2,
+    mut texel: impl FnMut(usize, u32, u32) -> [f32; C],
+) -> [f32; C] {
     let x = uv.x * w as f64 - 0.5;
     let y = uv.y * h as f64 - 0.5;
     let (x0, y0) = (floor_i(x), floor_i(y));
     let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
-    let out = &mut out[..C];
-    if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h {
-        let data = img.data();
-        let stride = w as usize * C;
-        let i00 = y0 as usize * stride + x0 as usize * C;
-        let r0 = &data[i00..i00 + 2 * C];
-        let r1 = &data[i00 + stride..i00 + stride + 2 * C];
+    let mut out = [0.0f32; C];
+    if x0 >= 0 && y0 >= 0 && x0 + 1 < w as i64 && y0 + 1 < h as i64 {
+        let (x0, y0) = (x0 as u32, y0 as u32);
+        let (a, b) = (texel(layer, x0, y0), texel(layer, x0 + 1, y0));
+        let (e, f) = (texel(layer, x0, y0 + 1), texel(layer, x0 + 1, y0 + 1));
         for i in 0..C {
-            let top = r0[i] + fx * (r0[C + i] - r0[i]);
-            let bot = r1[i] + fx * (r1[C + i] - r1[i]);
+            let top = a[i] + fx * (b[i] - a[i]);
+            let bot = e[i] + fx * (f[i] - e[i]);
             out[i] = top + fy * (bot - top);
         }
-        return;
+        return out;
     }
-    out.fill(0.0);
-    for (l, tx, ty, wt) in seam_taps(proj, layer, (w as u32, h as u32), (x0, y0), (fx, fy)) {
-        let t = layers[l].get(tx, ty);
+    for (l, tx, ty, wt) in seam_taps(proj, layer, (w, h), (x0, y0), (fx, fy)) {
+        let t = texel(l, tx, ty);
         for i in 0..C {
             out[i] += wt * t[i];
         }
+    }
+    out
+}
+
+/// [`EnvMap::sample`] of a map of `proj` with `w`×`h`-texel layers whose `C`-channel
+/// texels are read through `texel(layer, x, y)` rather than held in layers: the same texels
+/// read, in the same order, blended with the same arithmetic, so the same bits as `sample`
+/// of a map that holds them (tested). For a caller that holds only the few texels some
+/// lookups read (a packed frame's border, made from its faces' edges), or that wants to
+/// know which texels those are (a `texel` that records its arguments). Directions the
+/// projection does not cover read as zero, reading nothing.
+///
+/// ```
+/// use mirrorball_core::{sample_texels, EnvMap, ProjectionKind};
+/// use mirrorball_core::glam::DVec3;
+/// let cube = ProjectionKind::Cube.default_projection();
+/// let env = EnvMap::from_fn(cube, 8, 3, |d| [d.x as f32, d.y as f32, d.z as f32, 1.0]);
+/// let d = DVec3::new(1.0, 0.999, 0.3).normalize(); // next to an edge: across the seam
+/// let mut read = Vec::new();
+/// let v = sample_texels::<3>(&cube, (8, 8), d, |l, x, y| {
+///     read.push((l, x, y));
+///     env.layers()[l].get(x, y).try_into().unwrap()
+/// });
+/// assert_eq!(v, env.sample(d)[..3]);
+/// assert_eq!(read.len(), 4);
+/// ```
+pub fn sample_texels<const C: usize>(
+    proj: &Projection,
+    (w, h): (u32, u32),
+    dir: DVec3,
+    texel: impl FnMut(usize, u32, u32) -> [f32; C],
+) -> [f32; C] {
+    match proj.dir_to_uv(dir) {
+        Some((layer, uv)) => bilinear_read::<C>(proj, (w, h), layer, uv, texel),
+        None => [0.0; C],
     }
 }
 

@@ -35,7 +35,7 @@ pub use choice::{Choice, UnknownName};
 pub use codes::{Codes, CodesError};
 pub use envmap::{
     bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, bilinear_mix,
-    bilinear_taps, count_invalid, CornerLanes, EnvMap, EnvMapError, Stats,
+    bilinear_taps, count_invalid, sample_texels, CornerLanes, EnvMap, EnvMapError, Stats,
 };
 pub use fault::Fault;
 pub use image::Image;

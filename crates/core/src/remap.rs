@@ -85,7 +85,8 @@ pub enum RemapError {
         found: (usize, u32, u32),
     },
     /// The output map given to [`Remap::apply_into`] is not the plan's output shape, or its
-    /// channel count differs from the source's.
+    /// channel count differs from the source's, or the plan makes a laid-out picture
+    /// ([`Remap::laid_out`]), not a map.
     Output,
     /// [`Remap::rows_coded`] was given codes for a plan whose source is not one layer read
     /// as it is (see [`Remap::takes_codes`]).
@@ -107,7 +108,7 @@ impl fmt::Display for RemapError {
             ),
             RemapError::Output => f.write_str(
                 "the output map is not the plan's output projection and size, or its channel \
-                 count differs from the source's",
+                 count differs from the source's, or the plan makes a laid-out picture",
             ),
             RemapError::Codes => f.write_str(
                 "the plan's source is not one layer read as it is, so it cannot be read as codes",
@@ -153,6 +154,9 @@ pub struct Remap {
     row_starts: Vec<Vec<(u32, u32)>>,
     /// The source's mip levels' block weights, as deep as the taps read.
     pyramid: PyramidPlan,
+    /// `Some((width, height))` where the output is one picture laid out from another
+    /// plan's layers ([`Remap::laid_out`]), not the projection's layers.
+    picture: Option<(u32, u32)>,
     /// The last applied source's mip levels, kept to be filled again by the next.
     spare: Mutex<Vec<Vec<Image>>>,
 }
@@ -164,6 +168,7 @@ impl fmt::Debug for Remap {
             .field("src_extent", &self.src_extent)
             .field("to", &self.job.dst)
             .field("extent", &(self.job.w, self.job.h))
+            .field("picture", &self.picture)
             .field("taps", &self.tap_count())
             .finish()
     }
@@ -238,8 +243,120 @@ impl Remap {
             taps,
             row_starts,
             pyramid,
+            picture: None,
             spare: Mutex::new(Vec::new()),
         }
+    }
+
+    /// The plan's output texels laid out as one `width`×`height` picture: texel `(px, py)`
+    /// of the new plan's one output is texel `(x, y)` of layer `layer` of this plan's,
+    /// where `source(px, py)` is `Some((layer, x, y))`, read through the same lookup and
+    /// taps (so the same bits, tested), and zero where it is `None` or names a texel the
+    /// output does not have. For a caller that writes a packed picture of the output (a
+    /// cube's faces in v360's cells, some of them turned) a row at a time, as an encoder
+    /// takes it, without making the output's layers: the new plan's rows come from
+    /// [`RemapRows::row_into`] of layer 0. It converts the same source as this one but has
+    /// no map to fill: [`Remap::apply`], [`Remap::apply_into`] and [`RemapRows::fill`]
+    /// refuse it ([`RemapError::Output`]).
+    ///
+    /// ```
+    /// use mirrorball_core::{EnvMap, ProjectionKind, Remap, ResampleOptions};
+    /// let (ll, cube) = (ProjectionKind::LatLong.default_projection(), ProjectionKind::Cube.default_projection());
+    /// let plan = Remap::new(ll, (64, 32), 1, cube, 8, &ResampleOptions::default());
+    /// // Face 2 turned a quarter: picture row y is face column 7 - y, top to bottom.
+    /// let turned = plan.laid_out((8, 8), |px, py| Some((2, 7 - py, px)));
+    /// let src = EnvMap::from_fn(ll, 64, 3, |d| [d.x as f32, d.y as f32, d.z as f32, 1.0]);
+    /// let faces = plan.apply(&src).unwrap();
+    /// let rows = turned.rows(&src).unwrap();
+    /// let mut row = vec![0.0; rows.row_len()];
+    /// rows.row_into(0, 3, &mut row);
+    /// for px in 0..8 {
+    ///     assert_eq!(row[px as usize * 3..][..3], *faces.layers()[2].get(4, px));
+    /// }
+    /// ```
+    pub fn laid_out(
+        &self,
+        (width, height): (u32, u32),
+        source: impl Fn(u32, u32) -> Option<(usize, u32, u32)> + Sync,
+    ) -> Remap {
+        let (w, h) = self.out_extent();
+        let (w, h) = (w as usize, h as usize);
+        // Each group's first tap, per layer (a row's groups are in order of `x`).
+        let first_tap: Vec<Vec<u32>> = (0..self.texels.len())
+            .map(|l| {
+                let mut k = 0u32;
+                let firsts = self.groups[l].iter().map(|g| {
+                    k += g.count as u32;
+                    k - g.count as u32
+                });
+                firsts.collect()
+            })
+            .collect();
+        let (pw, ph) = (width.max(1) as usize, height.max(1) as usize);
+        let mut t = vec![EMPTY; pw * ph];
+        let rows: Vec<PlannedRow> = t
+            .par_chunks_mut(pw)
+            .enumerate()
+            .map(|(py, entries)| {
+                let mut row = PlannedRow {
+                    groups: Vec::new(),
+                    taps: Vec::new(),
+                };
+                for (px, e) in entries.iter_mut().enumerate() {
+                    let at = source(px as u32, py as u32).filter(|&(l, x, y)| {
+                        l < self.texels.len() && (x as usize) < w && (y as usize) < h
+                    });
+                    let Some((l, x, y)) = at else { continue };
+                    let i = y as usize * w + x as usize;
+                    *e = self.texels[l][i];
+                    let starts = &self.row_starts[l];
+                    let (g0, g1) = (
+                        starts[y as usize].0 as usize,
+                        starts[y as usize + 1].0 as usize,
+                    );
+                    let row_groups = &self.groups[l][g0..g1];
+                    if let Ok(j) = row_groups.binary_search_by_key(&x, |g| g.x) {
+                        let g = row_groups[j];
+                        let k = first_tap[l][g0 + j] as usize;
+                        row.groups.push(Group { x: px as u32, ..g });
+                        row.taps
+                            .extend_from_slice(&self.taps[l][k..k + g.count as usize]);
+                    }
+                }
+                row
+            })
+            .collect();
+        let (mut g, mut k) = (Vec::new(), Vec::new());
+        let mut starts = Vec::with_capacity(ph + 1);
+        starts.push((0u32, 0u32));
+        for r in rows {
+            g.extend_from_slice(&r.groups);
+            k.extend_from_slice(&r.taps);
+            starts.push((g.len() as u32, k.len() as u32));
+        }
+        Remap {
+            job: self.job.clone(),
+            src_extent: self.src_extent,
+            src_layers: self.src_layers,
+            texels: vec![t],
+            groups: vec![g],
+            taps: vec![k],
+            row_starts: vec![starts],
+            pyramid: self.pyramid.clone(),
+            picture: Some((pw as u32, ph as u32)),
+            spare: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The width and height of the output's rows: each layer's, or the laid-out picture's.
+    fn out_extent(&self) -> (u32, u32) {
+        self.picture.unwrap_or((self.job.w, self.job.h))
+    }
+
+    /// `Some((width, height))` for a plan made by [`Remap::laid_out`]: its one output
+    /// picture's extent.
+    pub fn picture(&self) -> Option<(u32, u32)> {
+        self.picture
     }
 
     /// The output projection.
@@ -288,6 +405,9 @@ impl Remap {
     /// Converts `src`, which must have the projection and size the plan was made for.
     pub fn apply(&self, src: &EnvMap) -> Result<EnvMap, RemapError> {
         let rows = self.rows(src)?;
+        if self.picture.is_some() {
+            return Err(RemapError::Output);
+        }
         let (w, h, c) = (self.job.w, self.job.h, src.channels());
         let layers = (0..self.job.dst.layer_count())
             .map(|layer| Image::par_rows(w, h, c, |y, row| rows.row_into(layer, y, row)))
@@ -361,7 +481,7 @@ impl Remap {
         y: usize,
         row: &mut [f32],
     ) {
-        let w = self.job.w as usize;
+        let w = self.out_extent().0 as usize;
         let sw = self.src_extent.0 as usize;
         let (groups, taps, starts) = (
             &self.groups[layer],
@@ -455,6 +575,7 @@ impl<'a> RemapRows<'a> {
         let job = &self.remap.job;
         if *out.projection() != job.dst
             || (out.width(), out.height()) != (job.w, job.h)
+            || self.remap.picture.is_some()
             || out.channels() != self.c
         {
             return Err(RemapError::Output);
@@ -471,7 +592,7 @@ impl<'a> RemapRows<'a> {
 
     /// Floats in one output row (width × the source's channels).
     pub fn row_len(&self) -> usize {
-        self.remap.job.w as usize * self.c
+        self.remap.out_extent().0 as usize * self.c
     }
 
     /// Makes row `y` of output layer `layer` into `row` ([`RemapRows::row_len`] floats).
@@ -479,7 +600,7 @@ impl<'a> RemapRows<'a> {
     /// # Panics
     /// If `layer` or `y` is outside the plan's output, or `row` is not one row long.
     pub fn row_into(&self, layer: usize, y: usize, row: &mut [f32]) {
-        assert!(layer < self.remap.texels.len() && y < self.remap.job.h as usize);
+        assert!(layer < self.remap.texels.len() && y < self.remap.out_extent().1 as usize);
         assert_eq!(row.len(), self.row_len());
         if let Some(codes) = self.codes {
             let base = Base::Codes(codes);

@@ -291,6 +291,7 @@ fn half_extent(w: u32, h: u32) -> (u32, u32) {
 /// source texels' densities at their centres, normalised to sum to 1; a block past an odd
 /// edge repeats its last row or column). A conversion applied frame after frame
 /// ([`crate::Remap`]) keeps one, so that no frame works out a direction.
+#[derive(Clone)]
 pub(crate) struct PyramidPlan {
     /// Per level (the first is half the base), per layer, one entry per texel of that level.
     levels: Vec<Vec<Vec<[f32; 4]>>>,
@@ -769,6 +770,7 @@ impl PointScratch {
 }
 
 /// Everything one output row needs, shared by all rows.
+#[derive(Clone)]
 pub(crate) struct Job {
     pub(crate) dst: Projection,
     pub(crate) sproj: Projection,

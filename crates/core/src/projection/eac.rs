@@ -52,6 +52,16 @@ impl Eac {
     pub fn warp(a: f64) -> f64 {
         a.atan() / FRAC_PI_4
     }
+
+    /// Solid angle per unit `uv` at gnomonic face coordinates `(a, b)`: the cube's
+    /// `4/(1 + a² + b²)^{3/2}` times `da/du · db/dv = (π/2)²(1 + a²)(1 + b²)/4`.
+    #[inline]
+    fn density_at(a: f64, b: f64) -> f64 {
+        let (a2, b2) = (a * a, b * b);
+        let g = 1.0 + a2 + b2;
+        let half_pi = 2.0 * FRAC_PI_4;
+        half_pi * half_pi * (1.0 + a2) * (1.0 + b2) / (g * g.sqrt())
+    }
 }
 
 impl WorldProjection for Eac {
@@ -79,10 +89,30 @@ impl WorldProjection for Eac {
     #[inline]
     fn density(&self, _layer: usize, uv: DVec2) -> f64 {
         let (a, b) = (Eac::unwarp(2.0 * uv.x - 1.0), Eac::unwarp(2.0 * uv.y - 1.0));
-        let (a2, b2) = (a * a, b * b);
-        let g = 1.0 + a2 + b2;
-        let half_pi = 2.0 * FRAC_PI_4;
-        half_pi * half_pi * (1.0 + a2) * (1.0 + b2) / (g * g.sqrt())
+        Eac::density_at(a, b)
+    }
+    /// The default's directions and densities, texel for texel the same bits (tested),
+    /// with the row's gnomonic coordinate worked out once: one `tan` a texel, not four.
+    fn span_dirs(
+        &self,
+        layer: usize,
+        y: u32,
+        w: u32,
+        h: u32,
+        x0: u32,
+        out: &mut [Option<(DVec3, f64)>],
+    ) {
+        let Some(face) = CubeFace::from_index(layer) else {
+            out.fill(None);
+            return;
+        };
+        let v = (y as f64 + 0.5) / h as f64;
+        let b = Eac::unwarp(2.0 * v - 1.0);
+        for (i, o) in out.iter_mut().enumerate() {
+            let u = ((x0 as usize + i) as f64 + 0.5) / w as f64;
+            let a = Eac::unwarp(2.0 * u - 1.0);
+            *o = Some((face.point(a, b).normalize(), Eac::density_at(a, b)));
+        }
     }
     fn texel_solid_angle(&self, _layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
         let (u0, u1) = texel_range(x, w);
@@ -108,6 +138,30 @@ mod tests {
             let phi = golden * i as f64 + 0.1;
             DVec3::new(r * phi.cos(), y, r * phi.sin())
         })
+    }
+
+    /// The hoisted rows are the default's, bit for bit (texel centres and the finer grids
+    /// the resampler integrates on).
+    #[test]
+    fn span_dirs_are_the_defaults() {
+        for (w, h, x0, n) in [(7, 7, 0, 7), (64, 64, 5, 40), (3 * 8, 3 * 8, 9, 6)] {
+            for layer in 0..6 {
+                for y in [0, 1, h / 2, h - 1] {
+                    let mut fast = vec![None; n];
+                    Eac.span_dirs(layer, y, w, h, x0, &mut fast);
+                    let slow: Vec<_> = (0..n)
+                        .map(|i| {
+                            let uv = DVec2::new(
+                                ((x0 as usize + i) as f64 + 0.5) / w as f64,
+                                (y as f64 + 0.5) / h as f64,
+                            );
+                            Some((Eac.uv_to_dir(layer, uv).unwrap(), Eac.density(layer, uv)))
+                        })
+                        .collect();
+                    assert_eq!(fast, slow, "layer {layer} row {y} of {w}x{h}");
+                }
+            }
+        }
     }
 
     #[test]

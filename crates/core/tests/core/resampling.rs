@@ -596,3 +596,138 @@ fn a_coded_source_converts_to_the_bits_of_its_decoded_map() {
     assert!(matches!(blended.rows_coded(one), Err(RemapError::Codes)));
     assert!(Remap::new(lenses("180"), (128, 64), 1, ll, 32, &opts).takes_codes());
 }
+
+/// A plan laid out as a picture makes, at each picture texel, the bits of the face texel it
+/// names, whatever the order (faces turned, mirrored, repeated, gaps), from a float source
+/// and from codes, where the plan has integrated texels and seam taps; the picture plan
+/// fills no map.
+#[test]
+fn a_laid_out_plan_makes_the_bits_of_the_texels_it_names() {
+    use mirrorball_core::{Codes, Remap};
+    let opts = ResampleOptions::default();
+    let ll = ProjectionKind::LatLong.default_projection();
+    let (sw, sh) = (256u32, 128u32);
+    let bytes: Vec<u8> = (0..sw * sh * 3).map(|i| (i * 37 % 251) as u8).collect();
+    let table: Vec<f32> = (0..256).map(|k| (k as f32 / 255.0).powf(2.2)).collect();
+    let codes = Codes::u8(&bytes, &table, (sw, sh)).unwrap();
+    let decoded = EnvMap::new(ll, vec![codes.to_image()]).unwrap();
+    for (dst, size) in [
+        (ProjectionKind::Cube.default_projection(), 13u32),
+        (ProjectionKind::Eac.default_projection(), 16),
+        (ProjectionKind::LatLong.default_projection(), 32),
+    ] {
+        let plan = Remap::new(ll, (sw, sh), 1, dst, size, &opts);
+        assert!(plan.tap_count() > 0, "{dst:?}: no taps to test");
+        let faces = plan.apply(&decoded).unwrap();
+        let (w, h) = plan.extent();
+        let n = dst.layer_count() as u32;
+        // Picture: the faces side by side, every other one turned a quarter (its rows read
+        // down a column), the last column of the picture a gap, one row a repeat.
+        let (pw, ph) = (n * w.max(h) + 1, w.max(h) + 1);
+        let source = |px: u32, py: u32| -> Option<(usize, u32, u32)> {
+            let (cell, cx) = (px / w.max(h), px % w.max(h));
+            let py = if py == ph - 1 { 0 } else { py };
+            if cell >= n {
+                return None;
+            }
+            let (x, y) = if cell % 2 == 1 {
+                (py, w.max(h) - 1 - cx)
+            } else {
+                (cx, py)
+            };
+            (x < w && y < h).then_some((cell as usize, x, y))
+        };
+        let pic = plan.laid_out((pw, ph), source);
+        assert_eq!(pic.picture(), Some((pw, ph)));
+        for rows in [pic.rows(&decoded).unwrap(), pic.rows_coded(codes).unwrap()] {
+            let mut row = vec![f32::NAN; rows.row_len()];
+            assert_eq!(row.len(), pw as usize * 3);
+            let mut shown = 0;
+            for py in 0..ph {
+                rows.row_into(0, py as usize, &mut row);
+                for px in 0..pw {
+                    let got: Vec<u32> = row[px as usize * 3..][..3]
+                        .iter()
+                        .map(|v| v.to_bits())
+                        .collect();
+                    let want: Vec<u32> = match source(px, py) {
+                        Some((l, x, y)) => {
+                            shown += 1;
+                            faces.layers()[l]
+                                .get(x, y)
+                                .iter()
+                                .map(|v| v.to_bits())
+                                .collect()
+                        }
+                        None => vec![0; 3],
+                    };
+                    assert_eq!(got, want, "{dst:?}: picture texel ({px}, {py})");
+                }
+            }
+            assert!(
+                shown >= (n * w * h) as usize,
+                "{dst:?}: not every texel shown"
+            );
+        }
+        // The picture plan converts the same source but fills no map.
+        assert_eq!(
+            pic.apply(&decoded).err(),
+            Some(mirrorball_core::RemapError::Output)
+        );
+        let mut out = faces.clone();
+        assert_eq!(
+            pic.apply_into(&decoded, &mut out).err(),
+            Some(mirrorball_core::RemapError::Output)
+        );
+    }
+}
+
+/// `sample_texels` reads what `EnvMap::sample` reads and blends it to the same bits, inside
+/// layers and across every seam (cube edges and corners, the longitude wrap, the poles).
+#[test]
+fn sample_texels_is_env_maps_sample() {
+    use mirrorball_core::sample_texels;
+    let mut rng = crate::util::Rng(7);
+    let mut next = || rng.f64();
+    for (kind, size) in [
+        (ProjectionKind::Cube, 7u32),
+        (ProjectionKind::Eac, 8),
+        (ProjectionKind::LatLong, 16),
+        (ProjectionKind::Paraboloid, 9),
+    ] {
+        let p = kind.default_projection();
+        let env = EnvMap::from_fn(p, size, 3, |d| {
+            [
+                d.x as f32 * 3.1 + 0.2,
+                (d.y * 7.0).sin() as f32,
+                d.z as f32 * d.x as f32,
+                1.0,
+            ]
+        });
+        let (w, h) = (env.width(), env.height());
+        for k in 0..20_000 {
+            // Half the directions near a face edge or corner (coordinates near ±1).
+            let mut d = DVec3::new(next() * 2.0 - 1.0, next() * 2.0 - 1.0, next() * 2.0 - 1.0);
+            if k % 2 == 0 {
+                let a = (next() * 3.0) as usize;
+                d[a] = d[a].signum() * (d[(a + 1) % 3].abs().max(d[(a + 2) % 3].abs()));
+            }
+            let d = d.normalize();
+            let mut reads = 0;
+            let v = sample_texels::<3>(&p, (w, h), d, |l, x, y| {
+                reads += 1;
+                env.layers()[l].get(x, y).try_into().unwrap()
+            });
+            let want = env.sample(d);
+            assert_eq!(
+                v.map(f32::to_bits),
+                [want[0].to_bits(), want[1].to_bits(), want[2].to_bits()],
+                "{kind:?} {d}"
+            );
+            assert!(
+                reads == 4 || (reads == 0 && v == [0.0; 3]),
+                "{kind:?} {d}: {reads} reads"
+            );
+        }
+    }
+}

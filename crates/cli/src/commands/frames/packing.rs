@@ -1,7 +1,10 @@
 //! Where each texel of a raw output frame comes from, worked out once per run: a frame is
 //! encoded straight into the output bytes from its layers, or from each output row as the
 //! planned `Remap` makes it, so that no packed copy of the frame (75 MB of `f32` for a
-//! 6×1024² cube) is made per frame.
+//! 6×1024² cube) is made per frame. Strips and crosses take each row from a layer row;
+//! packings whose cells are turned (EAC, v360's cells with turns) take it from the plan
+//! laid out as the packed picture (`Remap::laid_out`, [`Packing::lay_out`]), so that no
+//! layer is made as floats for them either.
 //!
 //! The positions are `Layout::pack`'s own: crosses and strips from the cell each layer
 //! fills (`Layout::grid_cell`), v360's cells from the face texel each of their texels
@@ -11,8 +14,13 @@
 
 use super::pipe::{PixFmt, SrgbTable};
 use mirrorball_core::glam::DVec3;
-use mirrorball_core::{EnvMap, Image, Layout, Projection, RemapRows, WorldProjection};
+#[cfg(test)]
+use mirrorball_core::EnvMap;
+use mirrorball_core::{
+    sample_texels, Image, Layout, Projection, Remap, RemapRows, WorldProjection,
+};
 use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// A piece of one packed row taken from one layer: `len` texels written from packed column
 /// `at` on, read from texel `(x, y)` of `layer` on in steps of `(dx, dy)`.
@@ -339,7 +347,9 @@ impl Packing {
 
     /// Encodes `env` (the packing's projection and size) as one `fmt` frame into `out`, as
     /// `fmt` would encode `Layout::pack`'s picture: the copied texels from its layers, the
-    /// looked-up ones (EAC's border) read from it in their directions.
+    /// looked-up ones (EAC's border) read from it in their directions. The reference
+    /// [`Picture::encode_rows`] is held to.
+    #[cfg(test)]
     pub fn encode_map(&self, fmt: PixFmt, env: &EnvMap, out: &mut Vec<u8>) {
         self.encode_layers(fmt, env.layers(), out);
         if self.lookups.is_empty() {
@@ -354,23 +364,64 @@ impl Packing {
                 (0..c).map(move |k| v[k])
             })
             .collect();
-        let table = fmt.table();
-        let (n, px) = (
-            self.width as usize * self.height as usize,
-            fmt.pixel_bytes(),
-        );
-        for (&(i, _), v) in self.lookups.iter().zip(values.chunks_exact(c)) {
-            let i = i as usize;
-            match fmt {
-                PixFmt::Gbrpf32le => {
-                    for (plane, k) in [(0, 1), (1, 2), (2, 0)] {
-                        let at = (plane * n + i) * 4;
-                        out[at..at + 4].copy_from_slice(&v[k].to_le_bytes());
-                    }
-                }
-                _ => fmt.encode_texels(table, v, c, &mut out[i * px..(i + 1) * px]),
+        let at = self.lookups.iter().map(|&(i, _)| i);
+        encode_at(fmt, (self.width, self.height), at, &values, c, out);
+    }
+
+    /// `plan` (of this packing's layers) laid out as the packed picture
+    /// ([`Remap::laid_out`]), for a packing whose runs leave layer rows (turned cells), and
+    /// what encodes the laid-out plan's rows: every row of the picture made and encoded by
+    /// one thread as [`Packing::encode_rows`] makes a strip's, with no map of the faces
+    /// made. The looked-up texels (EAC's border) read a few face texels each
+    /// ([`sample_texels`] on `dst`'s faces): those are made by the laid-out plan too, in
+    /// rows past the picture's, and the lookups blended from them as `Layout::pack` blends
+    /// them from a map (the same bytes, tested).
+    pub fn lay_out(&self, plan: &Remap, dst: &Projection) -> (Remap, Picture) {
+        let (n, (pw, ph)) = (self.layer_width, (self.width, self.height));
+        // The face texels the lookups read, each once, in the order first read.
+        let mut ring: Vec<(usize, u32, u32)> = Vec::new();
+        let mut seen: HashMap<(usize, u32, u32), u32> = HashMap::new();
+        let lookups = self
+            .lookups
+            .iter()
+            .map(|&(at, d)| {
+                let mut reads = Vec::with_capacity(4);
+                sample_texels::<1>(dst, (n, n), d, |l, x, y| {
+                    let id = *seen.entry((l, x, y)).or_insert_with(|| {
+                        ring.push((l, x, y));
+                        ring.len() as u32 - 1
+                    });
+                    reads.push(id);
+                    [0.0]
+                });
+                Lookup { at, d, reads }
+            })
+            .collect();
+        let extra = (ring.len() as u32).div_ceil(pw);
+        let source = |px: u32, py: u32| {
+            if py >= ph {
+                let i = ((py - ph) * pw + px) as usize;
+                return ring.get(i).copied();
             }
-        }
+            let runs = &self.runs[self.row_starts[py as usize] as usize..]
+                [..(self.row_starts[py as usize + 1] - self.row_starts[py as usize]) as usize];
+            let run = runs.iter().find(|r| r.at <= px && px < r.at + r.len)?;
+            let k = (px - run.at) as i64;
+            Some((
+                run.layer as usize,
+                (run.x as i64 + run.dx as i64 * k) as u32,
+                (run.y as i64 + run.dy as i64 * k) as u32,
+            ))
+        };
+        let laid = plan.laid_out((pw, ph + extra), source);
+        let picture = Picture {
+            rows: Packing::single(pw, ph),
+            dst: *dst,
+            n,
+            ring,
+            lookups,
+        };
+        (laid, picture)
     }
 
     /// Encodes the frame whose rows `rows` makes (a `Remap` of the packing's layers) into
@@ -450,6 +501,104 @@ impl Packing {
                     }
                 },
             ),
+        }
+    }
+}
+
+/// A looked-up texel of a packed frame: its index in the frame, its direction, and the
+/// [`Picture`]'s ring texels it reads, in the order [`sample_texels`] reads them.
+#[derive(Clone, Debug)]
+struct Lookup {
+    at: u32,
+    d: DVec3,
+    reads: Vec<u32>,
+}
+
+/// A packed frame made a row at a time by a plan laid out as its picture
+/// ([`Packing::lay_out`]): v360's turned cells (EAC) encoded as a strip's rows are, with
+/// no map of the faces made.
+#[derive(Clone, Debug)]
+pub struct Picture {
+    /// The picture's rows as one layer (texels no face shows are zero, until looked up).
+    rows: Packing,
+    /// The faces' projection and edge, which the lookups are made in.
+    dst: Projection,
+    n: u32,
+    /// The face texels the lookups read, made by the laid-out plan in the rows past the
+    /// picture's, in order.
+    ring: Vec<(usize, u32, u32)>,
+    lookups: Vec<Lookup>,
+}
+
+impl Picture {
+    /// Encodes the frame whose rows `rows` (of the laid-out plan) makes into `out`: the
+    /// picture's rows as they are made, then the looked-up texels from the ring's.
+    pub fn encode_rows(&self, fmt: PixFmt, rows: &RemapRows, out: &mut Vec<u8>) {
+        self.rows.encode_rows(fmt, rows, out);
+        if self.lookups.is_empty() {
+            return;
+        }
+        let (pw, ph) = (self.rows.width as usize, self.rows.height as usize);
+        let c = rows.row_len() / pw;
+        let mut ring = vec![0.0f32; self.ring.len().div_ceil(pw) * pw * c];
+        ring.par_chunks_mut(pw * c)
+            .enumerate()
+            .for_each(|(r, row)| rows.row_into(0, ph + r, row));
+        let values: Vec<f32> = match c {
+            3 => self.looked_up::<3>(&ring),
+            _ => self.looked_up::<4>(&ring),
+        };
+        let at = self.lookups.iter().map(|l| l.at);
+        encode_at(
+            fmt,
+            (self.rows.width, self.rows.height),
+            at,
+            &values,
+            c,
+            out,
+        );
+    }
+
+    /// Every lookup's `C` channels, blended from the ring texels' values as
+    /// [`EnvMap::sample`] blends a map's.
+    fn looked_up<const C: usize>(&self, ring: &[f32]) -> Vec<f32> {
+        self.lookups
+            .par_iter()
+            .flat_map_iter(|l| {
+                let mut k = 0;
+                let v = sample_texels::<C>(&self.dst, (self.n, self.n), l.d, |layer, x, y| {
+                    let id = l.reads[k] as usize;
+                    k += 1;
+                    assert_eq!(self.ring[id], (layer, x, y), "a lookup reads what it read");
+                    ring[id * C..][..C].try_into().expect("C channels")
+                });
+                v.into_iter()
+            })
+            .collect()
+    }
+}
+
+/// Writes `values` (`c` channels each) into the texels `at` of a `w`×`h` `fmt` frame.
+fn encode_at(
+    fmt: PixFmt,
+    (w, h): (u32, u32),
+    at: impl Iterator<Item = u32>,
+    values: &[f32],
+    c: usize,
+    out: &mut [u8],
+) {
+    let table = fmt.table();
+    let (n, px) = (w as usize * h as usize, fmt.pixel_bytes());
+    for (i, v) in at.zip(values.chunks_exact(c)) {
+        let i = i as usize;
+        match fmt {
+            PixFmt::Gbrpf32le => {
+                for (plane, k) in [(0, 1), (1, 2), (2, 0)] {
+                    let at = (plane * n + i) * 4;
+                    out[at..at + 4].copy_from_slice(&v[k].to_le_bytes());
+                }
+            }
+            _ => fmt.encode_texels(table, v, c, &mut out[i * px..(i + 1) * px]),
         }
     }
 }
@@ -642,6 +791,53 @@ mod tests {
             fmt.encode(&pic, &mut want);
             p.encode_map(fmt, &env, &mut got);
             assert!(want == got, "eac {fmt}: bytes differ");
+        }
+    }
+
+    /// A packing with turned cells, made by the plan laid out as its picture, is the
+    /// plan's map packed and encoded (the looked-up border included): the same bytes, in
+    /// every format, for v360's cells with turns and EAC's padded ones, faces of 1 to 16
+    /// texels some of them integrated, from a float source and from codes.
+    #[test]
+    fn a_laid_out_picture_is_the_packed_map_encoded() {
+        use mirrorball_core::Codes;
+        let ll = ProjectionKind::LatLong.default_projection();
+        let cube = ProjectionKind::Cube.default_projection();
+        let eac = ProjectionKind::Eac.default_projection();
+        let (sw, sh) = (128u32, 64u32);
+        let bytes: Vec<u8> = (0..sw * sh * 3).map(|i| (i * 29 % 253) as u8).collect();
+        let codes = Codes::u8(&bytes, mirrorball_io::srgb8_to_linear(), (sw, sh)).unwrap();
+        let src = EnvMap::new(ll, vec![codes.to_image()]).unwrap();
+        for (name, dst) in [
+            ("eac", eac),
+            ("eac", cube),
+            ("c3x2:forder=fbrlud:frot=123012", cube),
+            ("c6x1:forder=udfblr:frot=000123", cube),
+            ("hstrip", cube),
+        ] {
+            let layout: Layout = name.parse().unwrap();
+            for n in [1, 2, 3, 8, 16] {
+                let what = format!("{name} of {dst:?} at {n}");
+                let plan = Remap::with_extent(ll, (sw, sh), 1, dst, (n, n), &Default::default());
+                let made = plan.apply(&src).unwrap();
+                let p = Packing::new(layout, dst, (n, n)).unwrap();
+                let (laid, pic) = p.lay_out(&plan, &dst);
+                assert_eq!(laid.picture().unwrap().0, p.width, "{what}");
+                for fmt in [
+                    PixFmt::Rgb24,
+                    PixFmt::Rgb48le,
+                    PixFmt::Rgbf32le,
+                    PixFmt::Gbrpf32le,
+                ] {
+                    let mut want = Vec::new();
+                    p.encode_map(fmt, &made, &mut want);
+                    for rows in [laid.rows(&src).unwrap(), laid.rows_coded(codes).unwrap()] {
+                        let mut got = vec![9u8; 5];
+                        pic.encode_rows(fmt, &rows, &mut got);
+                        assert!(want == got, "{what} {fmt}: bytes differ");
+                    }
+                }
+            }
         }
     }
 }

@@ -18,7 +18,9 @@ use crate::error::CliError;
 use crate::progress::with_progress;
 use crate::spec::bad;
 use crate::{budget, load, save, ConvertArgs};
-use mirrorball_core::{EnvMap, Image, Layout, Projection, Remap, Stereo, WorldProjection};
+use mirrorball_core::{
+    EnvMap, Image, Layout, Projection, Remap, RemapRows, Stereo, WorldProjection,
+};
 use serde_json::json;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -596,6 +598,21 @@ fn convert_frames(
         }
         _ => None,
     };
+    // A packing whose cells are turned (EAC) is made by the plan laid out as the packed
+    // picture, a row at a time like a strip's (`Packing::lay_out`); the plan of the faces
+    // is let go.
+    let (remap, picture) = match &packed {
+        Some((_, Some(p), _)) if !p.along_rows() => {
+            let (laid, picture) = p.lay_out(&remap, &dst);
+            (laid, Some(picture))
+        }
+        _ => (remap, None),
+    };
+    let encode =
+        |fmt: PixFmt, packing: &Packing, rows: &RemapRows, bytes: &mut Vec<u8>| match &picture {
+            Some(p) => p.encode_rows(fmt, rows, bytes),
+            None => packing.encode_rows(fmt, rows, bytes),
+        };
     let t_plan = t0.elapsed();
 
     let fresh = || -> Eyes {
@@ -623,19 +640,16 @@ fn convert_frames(
         let t = Instant::now();
         let out: String = match (&output, &packed) {
             (Output::Pipe(_), Some((layout, packing, fmt))) => {
-                let env = &eyes[0];
-                match packing {
-                    Some(p) => p.encode_map(*fmt, env, &mut bytes),
-                    None => {
-                        let pic = save::pack_eyes(eyes, plan.stereo, *layout)
-                            .map_err(|e| e.context(format!("--layout {layout}")))?;
-                        Packing::single(pic.width(), pic.height()).encode_layers(
-                            *fmt,
-                            std::slice::from_ref(&pic),
-                            &mut bytes,
-                        );
-                    }
-                }
+                // A 2d frame's packing makes its rows as they are encoded (below), so
+                // only stereo pairs come here, packed whole.
+                debug_assert!(packing.is_none());
+                let pic = save::pack_eyes(eyes, plan.stereo, *layout)
+                    .map_err(|e| e.context(format!("--layout {layout}")))?;
+                Packing::single(pic.width(), pic.height()).encode_layers(
+                    *fmt,
+                    std::slice::from_ref(&pic),
+                    &mut bytes,
+                );
                 pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
                 "-".into()
             }
@@ -676,42 +690,24 @@ fn convert_frames(
                         .next_codes(spare)
                         .map(|r| r.map(|(m, bytes)| (m, Source::Codes(bytes))))
                 };
-                if packing.along_rows() {
-                    pipeline::run(
-                        &mut next_codes,
-                        &|m: &Meta, src: &Source, bytes: &mut Vec<u8>| {
-                            let rows = source_rows(&remap, codes, m, src)?;
-                            packing.encode_rows(*fmt, &rows, bytes);
-                            Ok(())
-                        },
-                        &Vec::new,
-                        &mut put_bytes,
-                        &done,
-                    )
-                } else {
-                    // Turned cells (EAC): the layers made, then packed from them.
-                    pipeline::run(
-                        &mut next_codes,
-                        &|m: &Meta, src: &Source, out: &mut Eyes| {
-                            let rows = source_rows(&remap, codes, m, src)?;
-                            rows.fill(&mut out[0]).map_err(|e| pipeline::misfit(m, e))
-                        },
-                        &fresh,
-                        &mut |m: &Meta, e: &Eyes| {
-                            put(m, e)?;
-                            counter.fetch_add(1, Ordering::Relaxed);
-                            Ok(())
-                        },
-                        &done,
-                    )
-                }
+                pipeline::run(
+                    &mut next_codes,
+                    &|m: &Meta, src: &Source, bytes: &mut Vec<u8>| {
+                        let rows = source_rows(&remap, codes, m, src)?;
+                        encode(*fmt, packing, &rows, bytes);
+                        Ok(())
+                    },
+                    &Vec::new,
+                    &mut put_bytes,
+                    &done,
+                )
             }
             // Rows made and encoded together: no float copy of the output frame.
-            Some((_, Some(packing), fmt)) if packing.along_rows() => pipeline::run(
+            Some((_, Some(packing), fmt)) => pipeline::run(
                 &mut next,
                 &|m: &Meta, src: &Eyes, bytes: &mut Vec<u8>| {
                     let rows = remap.rows(&src[0]).map_err(|e| pipeline::misfit(m, e))?;
-                    packing.encode_rows(*fmt, &rows, bytes);
+                    encode(*fmt, packing, &rows, bytes);
                     Ok(())
                 },
                 &Vec::new,
