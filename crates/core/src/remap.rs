@@ -219,14 +219,7 @@ impl Remap {
                     |(s, ps), (y, texels)| plan_row(&job, (sw, sh), s, ps, layer, y, texels),
                 )
                 .collect();
-            let (mut g, mut k) = (Vec::new(), Vec::new());
-            let mut starts = Vec::with_capacity(rows.len() + 1);
-            starts.push((0u32, 0u32));
-            for r in rows {
-                g.extend_from_slice(&r.groups);
-                k.extend_from_slice(&r.taps);
-                starts.push((g.len() as u32, k.len() as u32));
-            }
+            let (g, k, starts) = PlannedRow::join(rows);
             texels.push(t);
             groups.push(g);
             taps.push(k);
@@ -326,14 +319,7 @@ impl Remap {
                 row
             })
             .collect();
-        let (mut g, mut k) = (Vec::new(), Vec::new());
-        let mut starts = Vec::with_capacity(ph + 1);
-        starts.push((0u32, 0u32));
-        for r in rows {
-            g.extend_from_slice(&r.groups);
-            k.extend_from_slice(&r.taps);
-            starts.push((g.len() as u32, k.len() as u32));
-        }
+        let (g, k, starts) = PlannedRow::join(rows);
         Remap {
             job: self.job.clone(),
             src_extent: self.src_extent,
@@ -825,7 +811,26 @@ struct PlannedRow {
     taps: Vec<Tap>,
 }
 
+/// A plan's groups and taps, and where each row's start (`rows + 1` pairs).
+type Joined = (Vec<Group>, Vec<Tap>, Vec<(u32, u32)>);
+
 impl PlannedRow {
+    /// The rows' groups and taps one after another, each in one allocation of its final
+    /// size (tens of megabytes of taps, not grown by doubling), with each row's start.
+    fn join(rows: Vec<PlannedRow>) -> Joined {
+        let g_len = rows.iter().map(|r| r.groups.len()).sum();
+        let k_len = rows.iter().map(|r| r.taps.len()).sum();
+        let (mut g, mut k) = (Vec::with_capacity(g_len), Vec::with_capacity(k_len));
+        let mut starts = Vec::with_capacity(rows.len() + 1);
+        starts.push((0u32, 0u32));
+        for r in rows {
+            g.extend_from_slice(&r.groups);
+            k.extend_from_slice(&r.taps);
+            starts.push((g.len() as u32, k.len() as u32));
+        }
+        (g, k, starts)
+    }
+
     /// Closes the group of output texel `x` whose taps start at `start`: equal source texels
     /// merged, weights divided by `wsum`.
     fn close(&mut self, x: usize, level: usize, start: usize, wsum: f32) {
