@@ -22,6 +22,11 @@ pessimistic: the consumer there reads the input's bytes, where mirrorball's 6x10
 frames are 3/4 of them, so the pipeline moves 7/8 of the floor's bytes; where the time
 follows the bytes, the true ceiling is at most 8/7 of the one printed.
 
+On a machine with few cores the three processes share them, so the script also counts CPU
+time (every process of each pipeline, user and system): the CPU a frame may take at the
+target's frames per second on every core, against what the pipes alone took. Where the pipes
+alone take more, no converter can reach the target here, however fast.
+
 A stream is longer than 24 frames: `--loops N` feeds the same raw file N times over
 (ffmpeg's `-stream_loop`, on every side alike: mirrorball's producer, v360's input, the
 floor's producer), so a run converts N×frames frames and the one-off costs (mirrorball's
@@ -34,6 +39,7 @@ length. The default, 1, is the 24-frame run.
 import argparse
 import os
 import re
+import resource
 import subprocess
 import sys
 import time
@@ -56,13 +62,21 @@ def make_input(path, pix_fmt, frames):
        f"-pix_fmt {pix_fmt} -f rawvideo {path}")
 
 
+def cpu_of_children():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def timed(cmd):
+    """Wall seconds, CPU seconds of every process of the pipeline (user and system), and
+    standard error."""
+    c = cpu_of_children()
     t = time.perf_counter()
     p = subprocess.run(cmd, shell=True, stderr=subprocess.PIPE, text=True)
     dt = time.perf_counter() - t
     if p.returncode != 0:
         raise RuntimeError(f"{cmd}\n{p.stderr[-2000:]}")
-    return dt, p.stderr
+    return dt, cpu_of_children() - c, p.stderr
 
 
 def main():
@@ -104,42 +118,60 @@ def main():
                 f"-s {W}x{H} -i {src}")
         for name, to, size, v360 in targets:
             best = {"mirrorball": 1e9, "v360": 1e9, "floor": 1e9}
+            cpu = {"mirrorball": 1e9, "floor": 1e9}
             steady = 0.0
             for _ in range(a.reps):
                 # The output frame size is what mirrorball says it writes.
                 if size is None:
-                    _, err = timed(f"{feed} -frames:v 1 -f rawvideo - | {mb} convert - - "
+                    _, _, err = timed(f"{feed} -frames:v 1 -f rawvideo - | {mb} convert - - "
                                    f"--in-size {W}x{H} --pix-fmt {pix_fmt} {to} > /dev/null")
                     m = re.search(r"writing (\d+)x(\d+)", err)
                     size = (int(m.group(1)), int(m.group(2)))
                 mcmd = (f"{feed} -f rawvideo - | {mb} convert - - --in-size {W}x{H} "
                         f"--pix-fmt {pix_fmt} {to} | {FFMPEG} -v error -f rawvideo "
                         f"-pix_fmt {pix_fmt} -s {size[0]}x{size[1]} -i - -f null -")
-                dt, err = timed(mcmd)
+                dt, c, err = timed(mcmd)
                 best["mirrorball"] = min(best["mirrorball"], dt)
+                cpu["mirrorball"] = min(cpu["mirrorball"], c)
                 m = re.search(r"in ([\d.]+)s \(([\d.]+) frames/s; planned in ([\d.]+)s\)", err)
                 if m:
                     steady = max(steady, float(m.group(2)))
-                dt, _ = timed(f"{feed} -vf {v360} -f null -")
+                dt, _, _ = timed(f"{feed} -vf {v360} -f null -")
                 best["v360"] = min(best["v360"], dt)
-                dt, _ = timed(f"{feed} -f rawvideo - | cat | {FFMPEG} -v error -f rawvideo "
+                dt, c, _ = timed(f"{feed} -f rawvideo - | cat | {FFMPEG} -v error -f rawvideo "
                               f"-pix_fmt {pix_fmt} -s {size[0]}x{size[1]} -i - -f null -")
                 best["floor"] = min(best["floor"], dt)
+                cpu["floor"] = min(cpu["floor"], c)
             fm = total / best["mirrorball"]
             fv = total / best["v360"]
             ff = total / best["floor"]
-            rows.append((name, pix_fmt, fm, steady, fv, fm / fv, TARGET[pix_fmt], ff / fv))
+            # CPU time a frame may take, all processes together, for the target's wall time
+            # on every core; what the pipes alone (ffmpeg, cat, ffmpeg) and the mirrorball
+            # pipeline took.
+            allowed = os.cpu_count() * best["v360"] / TARGET[pix_fmt] / total * 1e3
+            cpus = (allowed, cpu["floor"] / total * 1e3, cpu["mirrorball"] / total * 1e3)
+            rows.append((name, pix_fmt, fm, steady, fv, fm / fv, TARGET[pix_fmt], ff / fv, cpus))
 
     print()
     print(f"{'to':14} {'pixels':8} {'mirrorball':>11} {'(no plan)':>10} {'v360':>8} "
           f"{'ratio':>6} {'target':>7} {'ceiling':>8}")
-    for name, pix_fmt, fm, steady, fv, r, t, ceil in rows:
+    for name, pix_fmt, fm, steady, fv, r, t, ceil, _ in rows:
         verdict = "met" if r >= t else ("NOT met" if ceil >= t else "NOT met: over the ceiling")
         print(f"{name:14} {pix_fmt:8} {fm:8.2f} f/s {steady:7.2f} f/s {fv:5.2f} f/s "
               f"{r:5.2f}x {t:5.1f}x {ceil:7.2f}x {verdict}")
     print("\nmirrorball f/s: end to end, wall clock, planning (once per run) included; "
           "(no plan): mirrorball's own count after planning; ceiling: the pipes with cat in "
           "mirrorball's place, over v360 (no converter through pipes can pass 8/7 of it)")
+    print()
+    print(f"{'CPU ms a frame':14} {'pixels':8} {'at target':>10} {'pipes':>7} {'left':>7} "
+          f"{'mirrorball':>11}")
+    for name, pix_fmt, *_, (allowed, pipes, mb) in rows:
+        print(f"{name:14} {pix_fmt:8} {allowed:10.1f} {pipes:7.1f} {allowed - pipes:7.1f} "
+              f"{mb:11.1f}")
+    print("\nat target: every core's time a frame for the target's frames per second; pipes: "
+          "what ffmpeg | cat | ffmpeg took (all three processes); left: what that leaves for "
+          "converting (none: the target is out of reach on this machine whatever converts); "
+          "mirrorball: its whole pipeline (both ffmpeg ends included)")
 
 
 if __name__ == "__main__":
