@@ -475,7 +475,9 @@ impl Packing {
                         for run in runs_of(y) {
                             let span = run.at as usize * 4..(run.at + run.len) as usize * 4;
                             texels(run, row, gathered, &mut |s| {
-                                for (plane, k) in [(&mut *g, 1), (&mut *b, 2), (&mut *r, 0)] {
+                                for (plane, k) in
+                                    [&mut *g, &mut *b, &mut *r].into_iter().zip(PixFmt::PLANES)
+                                {
                                     for (d, s) in plane[span.clone()]
                                         .chunks_exact_mut(4)
                                         .zip(s.chunks_exact(c))
@@ -593,7 +595,7 @@ fn encode_at(
         let i = i as usize;
         match fmt {
             PixFmt::Gbrpf32le => {
-                for (plane, k) in [(0, 1), (1, 2), (2, 0)] {
+                for (plane, k) in PixFmt::PLANES.into_iter().enumerate() {
                     let at = (plane * n + i) * 4;
                     out[at..at + 4].copy_from_slice(&v[k].to_le_bytes());
                 }

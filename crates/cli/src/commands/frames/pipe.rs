@@ -42,6 +42,10 @@ choice_traits!(PixFmt);
 const CHUNK: usize = 1 << 14;
 
 impl PixFmt {
+    /// The channel (0 red, 1 green, 2 blue) each plane of a planar `gbrpf32le` frame holds,
+    /// in the frame's order: ffmpeg's G, B, R.
+    pub const PLANES: [usize; 3] = [1, 2, 0];
+
     /// Bytes of one pixel.
     pub fn pixel_bytes(self) -> usize {
         match self {
