@@ -5,7 +5,7 @@
 //! scripts run the same conversion on a real HDR beside OpenCV).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use mirrorball_core::{resample, EnvMap, ProjectionKind, Remap, ResampleOptions};
+use mirrorball_core::{resample, Codes, EnvMap, ProjectionKind, Remap, ResampleOptions};
 use std::hint::black_box;
 
 fn source() -> EnvMap {
@@ -47,6 +47,27 @@ fn bench(c: &mut Criterion) {
     g.bench_function("forward_new", |b| {
         b.iter(|| black_box(fwd.apply(&src).expect("plan fits")))
     });
+    // A raw video frame as it arrives, 8- and 16-bit codes read through a table of linear
+    // values (`Remap::rows_coded`, as `convert - -` reads a pipe's frames).
+    let narrow: Vec<u8> = (0..4096 * 2048 * 3).map(|i| (i * 7 % 251) as u8).collect();
+    let wide: Vec<u8> = (0..4096 * 2048 * 6).map(|i| (i * 13 % 253) as u8).collect();
+    let t8: Vec<f32> = (0..256).map(|k| (k as f32 / 255.0).powf(2.2)).collect();
+    let t16: Vec<f32> = (0..65536).map(|k| (k as f32 / 65535.0).powf(2.2)).collect();
+    for (name, codes) in [
+        ("forward_codes8_into", Codes::u8(&narrow, &t8, (4096, 2048))),
+        (
+            "forward_codes16_into",
+            Codes::u16le(&wide, &t16, (4096, 2048)),
+        ),
+    ] {
+        let codes = codes.expect("codes of the frame's size");
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let rows = fwd.rows_coded(codes).expect("plan takes codes");
+                rows.fill(&mut out).expect("plan fits")
+            })
+        });
+    }
     g.throughput(Throughput::Elements(4096 * 2048));
     let mut ll = back.apply(&faces).expect("plan fits");
     g.bench_function("back_into", |b| {
