@@ -8,7 +8,7 @@
 //! after a crash or a killed node carries on where it stopped.
 
 use super::log::{Log, Status};
-use super::packing::Packing;
+use super::packing::{Packing, Picture};
 use super::pattern::{Frame, Pattern, Printf};
 use super::pipe::{self, PixFmt};
 use super::pipeline::{self, Eyes, Meta, FRAMES_IN_FLIGHT};
@@ -413,10 +413,57 @@ impl Shape {
     }
 }
 
-/// The plan for a `w`×`h` raw frame, decided as the pipe's first frame will be (its shape
-/// alone decides it): `None` where that decision fails or the frames would not fit in memory
-/// (the real frame then says why, before anything of this size is made).
-fn plan_for_blank(plan: &Plan, dst: Projection, w: u32, h: u32) -> Option<(Shape, Remap)> {
+/// How a pipe writes its frames: the layout, where each packed texel of a 2d frame comes
+/// from (stereo pairs are packed frame by frame), and the pixel format; `None` for files.
+fn pipe_packing(
+    plan: &Plan,
+    output: &Output,
+    dst: Projection,
+    (w, h): (u32, u32),
+) -> Option<(Layout, Option<Packing>, PixFmt)> {
+    let Output::Pipe(fmt) = output else {
+        return None;
+    };
+    let layout = plan
+        .save
+        .layout
+        .unwrap_or_else(|| Layout::default_for(dst.kind()));
+    let packing = (plan.stereo == Stereo::Mono)
+        .then(|| Packing::new(layout, dst, (w, h)))
+        .flatten();
+    Some((layout, packing, *fmt))
+}
+
+/// The conversion of frames of `shape`: its plan, laid out as the packed picture where the
+/// packing turns cells (EAC: [`Packing::lay_out`], the plan of the faces let go), with what
+/// encodes that picture's rows.
+fn plan_frames(
+    shape: &Shape,
+    dst: Projection,
+    plan: &Plan,
+    packing: Option<&Packing>,
+) -> (Remap, Option<Picture>) {
+    let remap = shape.plan(dst, plan);
+    match packing {
+        Some(p) if !p.along_rows() => {
+            let (laid, picture) = p.lay_out(&remap, &dst);
+            (laid, Some(picture))
+        }
+        _ => (remap, None),
+    }
+}
+
+/// The conversion for a `w`×`h` raw frame ([`plan_frames`]), decided as the pipe's first
+/// frame will be (its shape alone decides it): `None` where that decision fails or the
+/// frames would not fit in memory (the real frame then says why, before anything of this
+/// size is made).
+fn plan_for_blank(
+    plan: &Plan,
+    output: &Output,
+    dst: Projection,
+    w: u32,
+    h: u32,
+) -> Option<(Shape, Remap, Option<Picture>)> {
     let frame = budget::f32_texels(w as u64 * h as u64, 3);
     budget::check("", 0, (FRAMES_IN_FLIGHT + 1) * frame, "").ok()?;
     let stereo = plan.in_stereo.unwrap_or_default();
@@ -436,7 +483,10 @@ fn plan_for_blank(plan: &Plan, dst: Projection, w: u32, h: u32) -> Option<(Shape
         .unwrap_or_else(|| save::default_size(&left, dst.kind()));
     let shape = Shape::of(&left, dst.layer_extent(size));
     drop(left);
-    Some((shape, shape.plan(dst, plan)))
+    let packed = pipe_packing(plan, output, dst, shape.out);
+    let packing = packed.as_ref().and_then(|(_, p, _)| p.as_ref());
+    let (remap, picture) = plan_frames(&shape, dst, plan, packing);
+    Some((shape, remap, picture))
 }
 
 /// The rows `remap` makes of a coded pipe's source frame: from its maps, or from its bytes
@@ -511,7 +561,8 @@ fn convert_frames(
         Input::Files(_) => None,
     };
     let (first, early) = std::thread::scope(|s| {
-        let early = blank.map(|(w, h)| s.spawn(move || plan_for_blank(plan, dst, w, h)));
+        let output = &output;
+        let early = blank.map(|(w, h)| s.spawn(move || plan_for_blank(plan, output, dst, w, h)));
         let first = reader.next(None);
         (first, early.and_then(|e| e.join().ok().flatten()))
     });
@@ -529,9 +580,11 @@ fn convert_frames(
     let (w, h) = dst.layer_extent(size);
     let c = src0.channels();
     let shape0 = Shape::of(src0, (w, h));
-    let remap = match early {
-        Some((shape, remap)) if shape == shape0 => remap,
-        _ => shape0.plan(dst, plan),
+    let packed = pipe_packing(plan, &output, dst, (w, h));
+    let packing = packed.as_ref().and_then(|(_, p, _)| p.as_ref());
+    let (remap, picture) = match early {
+        Some((shape, remap, picture)) if shape == shape0 => (remap, picture),
+        _ => plan_frames(&shape0, dst, plan, packing),
     };
     let frame_bytes = |env_texels: u64| budget::f32_texels(env_texels, c as u64);
     budget::check(
@@ -549,39 +602,23 @@ fn convert_frames(
             + remap.memory_bytes() as u64,
         "a smaller --size",
     )?;
-    let packed = match &output {
-        Output::Pipe(fmt) => {
-            let layout = plan
-                .save
-                .layout
-                .unwrap_or_else(|| Layout::default_for(dst.kind()));
-            let (pw, ph) = if layout == Layout::Separate {
-                (w, h)
-            } else {
-                layout.extent(dst.layer_count(), w, h)
-            };
-            let (pw, ph) = plan.stereo.extent(pw, ph);
-            if !a.quiet {
-                eprintln!(
-                    "writing {pw}x{ph} {fmt} frames to standard output: {} {w}x{h}{} ({layout}{})",
-                    dst.name(),
-                    times(dst.layer_count()),
-                    match plan.stereo {
-                        Stereo::Mono => String::new(),
-                        s => format!(", each eye of a {s} pair"),
-                    }
-                );
+    if let (Some((layout, _, fmt)), false) = (&packed, a.quiet) {
+        let (pw, ph) = if *layout == Layout::Separate {
+            (w, h)
+        } else {
+            layout.extent(dst.layer_count(), w, h)
+        };
+        let (pw, ph) = plan.stereo.extent(pw, ph);
+        eprintln!(
+            "writing {pw}x{ph} {fmt} frames to standard output: {} {w}x{h}{} ({layout}{})",
+            dst.name(),
+            times(dst.layer_count()),
+            match plan.stereo {
+                Stereo::Mono => String::new(),
+                s => format!(", each eye of a {s} pair"),
             }
-            // Where every packed texel of a 2d frame comes from, once: frames are encoded
-            // straight from the layers (EAC's border looked up in the map), or from each
-            // row as the Remap makes it. Stereo pairs are packed frame by frame.
-            let packing = (plan.stereo == Stereo::Mono)
-                .then(|| Packing::new(layout, dst, (w, h)))
-                .flatten();
-            Some((layout, packing, *fmt))
-        }
-        _ => None,
-    };
+        );
+    }
     // A raw frame of integer codes that is the source's one layer as it is (no eyes to
     // split, no layout to unpack, no lens overlap to blend) is read by the plan as it came:
     // no float copy of it is made (`Remap::rows_coded`: the same bytes out).
@@ -598,16 +635,8 @@ fn convert_frames(
         }
         _ => None,
     };
-    // A packing whose cells are turned (EAC) is made by the plan laid out as the packed
-    // picture, a row at a time like a strip's (`Packing::lay_out`); the plan of the faces
-    // is let go.
-    let (remap, picture) = match &packed {
-        Some((_, Some(p), _)) if !p.along_rows() => {
-            let (laid, picture) = p.lay_out(&remap, &dst);
-            (laid, Some(picture))
-        }
-        _ => (remap, None),
-    };
+    // Frames are encoded as their rows are made: a strip's or a cross's from its layers'
+    // rows, turned cells' (EAC) from the plan laid out as the packed picture.
     let encode =
         |fmt: PixFmt, packing: &Packing, rows: &RemapRows, bytes: &mut Vec<u8>| match &picture {
             Some(p) => p.encode_rows(fmt, rows, bytes),
