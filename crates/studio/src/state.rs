@@ -93,8 +93,10 @@ impl State {
         }
     }
 
-    /// Takes in what a file held.
+    /// Takes in what a file held. The messages of what was refused before are let go: the
+    /// page shows what went wrong since the last thing that loaded.
     pub fn apply(&mut self, opened: Opened) {
+        self.errors.clear();
         match opened {
             Opened::Scene(v) => {
                 self.view = *v;
@@ -135,6 +137,7 @@ impl State {
     /// (`meshes` becomes that built-in); a mesh has no path a scene file could name, so the
     /// page cannot export the scene while it is shown.
     pub fn show_object(&mut self, choice: ObjectChoice) {
+        self.errors.clear();
         let v = &mut self.view;
         let kept = || SceneObjects {
             objects: v.scene.objects.clone(),
@@ -190,7 +193,7 @@ impl State {
         self.shown.as_ref().map(|(n, _)| n.as_str())
     }
 
-    /// Records a message for the page.
+    /// Records a message for the page, kept until something loads or is shown.
     pub fn error(&mut self, message: String) {
         self.errors.push(message);
         if self.errors.len() > MAX_ERRORS {

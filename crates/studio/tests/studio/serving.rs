@@ -31,6 +31,9 @@ fn a_truncated_exr_upload_is_refused_with_the_readers_message_and_serving_goes_o
     let s = json(&a);
     assert_eq!(s["scene"]["environment"]["projection"], "latlong");
     assert_eq!(s["scene"]["environment"]["width"], 16);
+    // What went wrong before the map loaded is no longer said.
+    let s = json(&own(&r, "GET", "/api/state", b""));
+    assert_eq!(s["errors"].as_array().map(Vec::len), Some(0), "{s}");
     r.stop();
 }
 
