@@ -287,19 +287,34 @@ impl Remap {
             .collect();
         let (pw, ph) = (width.max(1) as usize, height.max(1) as usize);
         let mut t = vec![EMPTY; pw * ph];
+        // Texels ahead of the current one whose entries are asked for now: a turned cell
+        // reads down a column of the plan, which the hardware does not foresee.
+        const AHEAD_LAID: usize = 16;
         let rows: Vec<PlannedRow> = t
             .par_chunks_mut(pw)
             .enumerate()
-            .map(|(py, entries)| {
+            .map_init(Vec::new, |sources, (py, entries)| {
                 let mut row = PlannedRow {
                     groups: Vec::new(),
                     taps: Vec::new(),
                 };
-                for (px, e) in entries.iter_mut().enumerate() {
-                    let at = source(px as u32, py as u32).filter(|&(l, x, y)| {
+                sources.clear();
+                sources.extend((0..pw as u32).map(|px| {
+                    source(px, py as u32).filter(|&(l, x, y)| {
                         l < self.texels.len() && (x as usize) < w && (y as usize) < h
-                    });
-                    let Some((l, x, y)) = at else { continue };
+                    })
+                }));
+                for (px, e) in entries.iter_mut().enumerate() {
+                    if let Some(&Some((l, x, y))) = sources.get(px + AHEAD_LAID) {
+                        prefetch(
+                            self.texels[l]
+                                .as_ptr()
+                                .wrapping_add(y as usize * w + x as usize),
+                        );
+                    }
+                    let Some((l, x, y)) = sources[px] else {
+                        continue;
+                    };
                     let i = y as usize * w + x as usize;
                     *e = self.texels[l][i];
                     let starts = &self.row_starts[l];
