@@ -1,4 +1,5 @@
-// The studio's prefiltered lighting in headless Chromium: the embed view's lit sphere against
+// The studio's prefiltered lighting in headless Chromium: the embed view's lit sphere (and the
+// bundled bunny, a loaded mesh) against
 // `mirrorball prefilter` of the same environment, read back here (its KTX2 chain: each
 // pixel's reflected direction looked up bilinearly at the slider's level, trilinearly
 // between two; its SH JSON: E/π at each pixel's normal), and the page's panel (progress,
@@ -288,6 +289,47 @@ test("the lit sphere's pixels are mirrorball prefilter's chain and SH9 of the sa
     assert.ok(r.n > 3000);
     assert.ok(r.within1 >= 0.995, `${(100 * r.within1).toFixed(2)}% within 1/255`);
     assert.ok(r.worst <= 2, `worst ${r.worst}/255`);
+  } finally {
+    s.stop();
+  }
+});
+
+test("the lit bunny's pixels are prefilter's chain and SH9 too: the lighting on a loaded mesh", async () => {
+  const scene = path.join(work.dir, 'bunny.json');
+  const BUNNY = path.join(ROOT, 'assets', 'meshes', 'bunny.obj');
+  writeFileSync(
+    scene,
+    JSON.stringify({
+      ...SCENE,
+      meshes: [{ mesh: BUNNY, normalize: true }],
+      camera: { ...SCENE.camera, eye: [0, 0.3, 2.2], width: 200, height: 150 },
+    }),
+  );
+  const chainFile = path.join(work.dir, 'bunny-ggx.ktx2');
+  run(['prefilter', VENICE, chainFile, '--lobe', 'ggx', '--size', String(SIZE), '--mapping', 'linear', '--precision', 'half', '--no-preview', '--quiet']);
+  const chain = readKtx2Cube(readFileSync(chainFile));
+  const shFile = path.join(work.dir, 'bunny-lambert.ktx2');
+  run(['prefilter', VENICE, shFile, '--lobe', 'lambert', '--no-preview', '--quiet']);
+  const sh = JSON.parse(readFileSync(path.join(work.dir, 'bunny-lambert.sh.json'), 'utf8'));
+  const s = await studio([scene]);
+  try {
+    const base = `${s.url}&view=viewport&mode=3&lightsize=${SIZE}`;
+    for (const roughness of [0.25, 0.5]) {
+      const got = await embedded(`${base}&material=ggx&roughness=${roughness}`);
+      const r = compare(got, (n, dir) => trilinear(chain, got.level, dir));
+      console.log(
+        `bunny, GGX roughness ${roughness}: ${(100 * r.within1).toFixed(2)}% of ${r.n} pixels within 1/255, ${(100 * r.within2).toFixed(2)}% within 2/255, worst ${r.worst}; ${r.skipped} beside a face edge left out`,
+      );
+      assert.ok(r.n > 3000, `only ${r.n} pixels compared`);
+      assert.ok(r.within1 >= 0.995, `bunny, roughness ${roughness}: ${(100 * r.within1).toFixed(2)}% within 1/255`);
+      assert.ok(r.worst <= 2, `bunny, roughness ${roughness}: worst ${r.worst}/255`);
+    }
+    const got = await embedded(`${base}&material=lambert`);
+    const r = compare(got, (n) => shEval(sh.irradiance_over_pi, n));
+    console.log(`bunny, Lambert SH9: ${(100 * r.within1).toFixed(2)}% of ${r.n} pixels within 1/255, ${(100 * r.within2).toFixed(2)}% within 2/255, worst ${r.worst}`);
+    assert.ok(r.n > 3000);
+    assert.ok(r.within1 >= 0.995, `bunny: ${(100 * r.within1).toFixed(2)}% within 1/255`);
+    assert.ok(r.worst <= 2, `bunny: worst ${r.worst}/255`);
   } finally {
     s.stop();
   }
