@@ -14,13 +14,13 @@ default --max-samples 8); v360 interpolates bilinearly (its default).
 
 Targets (issue 19): mirrorball at least 2x v360's frames per second at 16 bits, 1.5x at 8.
 
-The pipes themselves cost: the same run also times the pipeline with `cat` in mirrorball's
-place (`ffmpeg … - | cat | ffmpeg … -f null -`, frames copied and nothing converted). No
-converter in the middle can beat that floor, so `ceiling` (the floor's frames per second
-over v360's) is about the best ratio this machine allows through pipes. It is slightly
-pessimistic: the consumer there reads the input's bytes, where mirrorball's 6x1024² and 3x2
-frames are 3/4 of them, so the pipeline moves 7/8 of the floor's bytes; where the time
-follows the bytes, the true ceiling is at most 8/7 of the one printed.
+The pipes themselves cost: the same run also times the pipeline with a copier in
+mirrorball's place that converts nothing (this script's `--cut IN OUT`: it reads each input
+frame of IN bytes and writes its first OUT bytes, the output frame's size, through pipes
+widened to 1 MiB as mirrorball widens its own), so every pipe carries exactly the bytes it
+carries in mirrorball's pipeline. No converter in the middle can beat that floor, so
+`ceiling` (the floor's frames per second over v360's) is the best ratio this machine allows
+through pipes.
 
 On a machine with few cores the three processes share them, so the script also counts CPU
 time (every process of each pipeline, user and system): the CPU a frame may take at the
@@ -62,6 +62,31 @@ def make_input(path, pix_fmt, frames):
        f"-pix_fmt {pix_fmt} -f rawvideo {path}")
 
 
+def cut(frame_in, frame_out):
+    """The floor's middle process: each frame of `frame_in` bytes from standard input, its
+    first `frame_out` bytes to standard output; nothing converted."""
+    import fcntl
+    for fd in (0, 1):
+        try:
+            fcntl.fcntl(fd, fcntl.F_SETPIPE_SZ, 1 << 20)
+        except OSError:
+            pass
+    buf = memoryview(bytearray(frame_in))
+    src = open(0, "rb", buffering=0)
+    while True:
+        n = 0
+        while n < frame_in:
+            r = src.readinto(buf[n:])
+            if not r:
+                if n:
+                    sys.exit(f"cut: the input ended {n} bytes into a frame")
+                return 0
+            n += r
+        m = 0
+        while m < frame_out:
+            m += os.write(1, buf[m:frame_out])
+
+
 def cpu_of_children():
     r = resource.getrusage(resource.RUSAGE_CHILDREN)
     return r.ru_utime + r.ru_stime
@@ -80,6 +105,8 @@ def timed(cmd):
 
 
 def main():
+    if len(sys.argv) == 4 and sys.argv[1] == "--cut":
+        return cut(int(sys.argv[2]), int(sys.argv[3]))
     ap = argparse.ArgumentParser()
     ap.add_argument("--frames", type=int, default=24)
     ap.add_argument("--reps", type=int, default=2)
@@ -138,15 +165,19 @@ def main():
                     steady = max(steady, float(m.group(2)))
                 dt, _, _ = timed(f"{feed} -vf {v360} -f null -")
                 best["v360"] = min(best["v360"], dt)
-                dt, c, _ = timed(f"{feed} -f rawvideo - | cat | {FFMPEG} -v error -f rawvideo "
-                              f"-pix_fmt {pix_fmt} -s {size[0]}x{size[1]} -i - -f null -")
+                bpp = 3 if pix_fmt == "rgb24" else 6
+                copier = f"{sys.executable} {Path(__file__).resolve()} --cut {W * H * bpp} " \
+                         f"{size[0] * size[1] * bpp}"
+                dt, c, _ = timed(f"{feed} -f rawvideo - | {copier} | {FFMPEG} -v error "
+                              f"-f rawvideo -pix_fmt {pix_fmt} -s {size[0]}x{size[1]} -i - "
+                              f"-f null -")
                 best["floor"] = min(best["floor"], dt)
                 cpu["floor"] = min(cpu["floor"], c)
             fm = total / best["mirrorball"]
             fv = total / best["v360"]
             ff = total / best["floor"]
             # CPU time a frame may take, all processes together, for the target's wall time
-            # on every core; what the pipes alone (ffmpeg, cat, ffmpeg) and the mirrorball
+            # on every core; what the pipes alone (ffmpeg, copier, ffmpeg) and the mirrorball
             # pipeline took.
             allowed = os.cpu_count() * best["v360"] / TARGET[pix_fmt] / total * 1e3
             cpus = (allowed, cpu["floor"] / total * 1e3, cpu["mirrorball"] / total * 1e3)
@@ -160,8 +191,8 @@ def main():
         print(f"{name:14} {pix_fmt:8} {fm:8.2f} f/s {steady:7.2f} f/s {fv:5.2f} f/s "
               f"{r:5.2f}x {t:5.1f}x {ceil:7.2f}x {verdict}")
     print("\nmirrorball f/s: end to end, wall clock, planning (once per run) included; "
-          "(no plan): mirrorball's own count after planning; ceiling: the pipes with cat in "
-          "mirrorball's place, over v360 (no converter through pipes can pass 8/7 of it)")
+          "(no plan): mirrorball's own count after planning; ceiling: the pipes with a copier in "
+          "mirrorball's place, over v360 (no converter through pipes can pass it)")
     print()
     print(f"{'CPU ms a frame':14} {'pixels':8} {'at target':>10} {'pipes':>7} {'left':>7} "
           f"{'mirrorball':>11}")
@@ -169,7 +200,7 @@ def main():
         print(f"{name:14} {pix_fmt:8} {allowed:10.1f} {pipes:7.1f} {allowed - pipes:7.1f} "
               f"{mb:11.1f}")
     print("\nat target: every core's time a frame for the target's frames per second; pipes: "
-          "what ffmpeg | cat | ffmpeg took (all three processes); left: what that leaves for "
+          "what ffmpeg | copier | ffmpeg took (all three processes); left: what that leaves for "
           "converting (none: the target is out of reach on this machine whatever converts); "
           "mirrorball: its whole pipeline (both ffmpeg ends included)")
 
