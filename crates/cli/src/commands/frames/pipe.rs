@@ -113,21 +113,21 @@ impl PixFmt {
                     }
                 }),
             PixFmt::Gbrpf32le => {
+                // Each channel's plane, in R, G, B order, found through ffmpeg's plane order.
                 let plane = n * 4;
-                // ffmpeg's plane order: G, B, R.
-                let (g, rest) = bytes.split_at(plane);
-                let (b, r) = rest.split_at(plane);
+                let mut planes: [&[u8]; 3] = [&[]; 3];
+                for (i, channel) in Self::PLANES.into_iter().enumerate() {
+                    planes[channel] = &bytes[i * plane..(i + 1) * plane];
+                }
                 data.par_chunks_mut(CHUNK * 3)
                     .enumerate()
                     .for_each(|(k, d)| {
                         let at = k * CHUNK * 4;
                         for (i, t) in d.chunks_exact_mut(3).enumerate() {
                             let o = at + i * 4;
-                            let f =
-                                |p: &[u8]| f32::from_le_bytes([p[o], p[o + 1], p[o + 2], p[o + 3]]);
-                            t[0] = f(r);
-                            t[1] = f(g);
-                            t[2] = f(b);
+                            for (t, p) in t.iter_mut().zip(planes) {
+                                *t = f32::from_le_bytes([p[o], p[o + 1], p[o + 2], p[o + 3]]);
+                            }
                         }
                     });
             }
@@ -528,10 +528,12 @@ mod tests {
                 assert!((a - b).abs() <= tol, "{f}: {a} vs {b}");
             }
         }
-        // gbrpf32le is planar, G first.
+        // gbrpf32le is planar: G, B, R (ffmpeg's order), each plane 15 texels of 4 bytes.
         let mut bytes = Vec::new();
         PixFmt::Gbrpf32le.encode(&img, &mut bytes);
         assert_eq!(&bytes[..4], &img.data()[1].to_le_bytes());
+        assert_eq!(&bytes[60..64], &img.data()[2].to_le_bytes());
+        assert_eq!(&bytes[120..124], &img.data()[0].to_le_bytes());
     }
 
     #[test]
