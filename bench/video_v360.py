@@ -49,6 +49,7 @@ ROOT = Path(__file__).resolve().parent.parent
 FFMPEG = "/usr/bin/ffmpeg"
 W, H, FACE = 4096, 2048, 1024
 TARGET = {"rgb24": 1.5, "rgb48le": 2.0}
+PIXEL_BYTES = {"rgb24": 3, "rgb48le": 6}
 
 
 def sh(cmd, **kw):
@@ -56,7 +57,7 @@ def sh(cmd, **kw):
 
 
 def make_input(path, pix_fmt, frames):
-    if path.exists() and path.stat().st_size == frames * W * H * (3 if pix_fmt == "rgb24" else 6):
+    if path.exists() and path.stat().st_size == frames * W * H * PIXEL_BYTES[pix_fmt]:
         return
     sh(f"{FFMPEG} -v error -y -f lavfi -i testsrc2=size={W}x{H}:rate=30 -frames:v {frames} "
        f"-pix_fmt {pix_fmt} -f rawvideo {path}")
@@ -165,7 +166,7 @@ def main():
                     steady = max(steady, float(m.group(2)))
                 dt, _, _ = timed(f"{feed} -vf {v360} -f null -")
                 best["v360"] = min(best["v360"], dt)
-                bpp = 3 if pix_fmt == "rgb24" else 6
+                bpp = PIXEL_BYTES[pix_fmt]
                 copier = f"{sys.executable} {Path(__file__).resolve()} --cut {W * H * bpp} " \
                          f"{size[0] * size[1] * bpp}"
                 dt, c, _ = timed(f"{feed} -f rawvideo - | {copier} | {FFMPEG} -v error "
