@@ -62,16 +62,30 @@ impl Source {
             env.height(),
             self.decided
         )];
-        if !keep_invalid && self.invalid != 0 {
-            let fixed = self.env.sanitize() + self.right.as_mut().map_or(0, EnvMap::sanitize);
-            if fixed > 0 {
-                lines.push(format!(
-                    "warning: {input}: {fixed} NaN, infinite or negative values set to 0 (--keep-invalid keeps them)"
-                ));
-            }
-        }
+        let maps = std::iter::once(&mut self.env).chain(self.right.as_mut());
+        lines.extend(zero_invalid(input, maps, self.invalid, keep_invalid));
         lines
     }
+}
+
+/// Sets the NaN, infinite and negative colour values of `maps` (what `input` gave) to 0
+/// unless `keep_invalid`, when `invalid` (counted as they were read) says there are any;
+/// the warning that says so, when any were. Every reader's rule: files and raw frames.
+pub fn zero_invalid<'a>(
+    input: &str,
+    maps: impl IntoIterator<Item = &'a mut EnvMap>,
+    invalid: u64,
+    keep_invalid: bool,
+) -> Option<String> {
+    if keep_invalid || invalid == 0 {
+        return None;
+    }
+    let fixed: u64 = maps.into_iter().map(EnvMap::sanitize).sum();
+    (fixed > 0).then(|| {
+        format!(
+            "warning: {input}: {fixed} NaN, infinite or negative values set to 0 (--keep-invalid keeps them)"
+        )
+    })
 }
 
 /// Reads `input` as `plan` says and prepares it ([`Source::prepare`]), saying what was read

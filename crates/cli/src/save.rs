@@ -29,8 +29,14 @@ pub fn default_layout(layers: usize) -> Layout {
     }
 }
 
-/// Checks that `out` can hold a map of `kind` before any work starts.
-pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<Format, CliError> {
+/// Checks that `out` can hold a map of `kind` before any work starts; its folder must exist
+/// unless `folder` says it is made ([`Folder::Made`]).
+pub fn check(
+    out: &str,
+    kind: ProjectionKind,
+    layout: Option<Layout>,
+    folder: Folder,
+) -> Result<Format, CliError> {
     let path = Path::new(out);
     let format = Format::from_path(path).ok_or_else(|| {
         CliError::request(format!(
@@ -70,15 +76,65 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
             )));
         }
     }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(CliError::request(format!(
+    folder.check(out)?;
+    Ok(format)
+}
+
+/// What an output's folder must be before any work.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Folder {
+    /// It exists (one file).
+    Exists,
+    /// It exists, or it is made (a sequence's outputs, [`make_folder`]): its parent exists.
+    Made,
+}
+
+impl Folder {
+    fn check(self, out: &str) -> Result<(), CliError> {
+        let Some(dir) = Path::new(out).parent().filter(|d| !d.as_os_str().is_empty()) else {
+            return Ok(());
+        };
+        if dir.is_dir() {
+            return Ok(());
+        }
+        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+        match self {
+            Folder::Made if dir.exists() => Err(CliError::request(format!(
+                "{out}: {} is a file, not a folder",
+                dir.display()
+            ))),
+            Folder::Made if parent.map_or(true, Path::is_dir) => Ok(()),
+            Folder::Made => Err(CliError::request(format!(
+                "{out}: the folder {} does not exist (a sequence makes its output folder, not its parents)",
+                parent.map(Path::display).expect("a parent that is not a folder")
+            ))),
+            Folder::Exists => Err(CliError::request(format!(
                 "{out}: the folder {} does not exist",
                 dir.display()
-            )));
+            ))),
         }
     }
-    Ok(format)
+}
+
+/// The folder of `out` made when missing ([`Folder::Made`] checked it): the folder, when
+/// this call made it, marked so that an interrupt removes it again if it is left empty
+/// (`mirrorball_io::made_folder`).
+pub fn make_folder(out: &Path) -> Result<Option<PathBuf>, CliError> {
+    let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) else {
+        return Ok(None);
+    };
+    match std::fs::create_dir(dir) {
+        Ok(()) => {
+            mirrorball_io::made_folder(dir);
+            Ok(Some(dir.to_path_buf()))
+        }
+        // Made meanwhile (another shard), or there already.
+        Err(_) if dir.is_dir() => Ok(None),
+        Err(e) => Err(CliError::system(format!(
+            "{}: cannot make the folder: {e}",
+            dir.display()
+        ))),
+    }
 }
 
 /// The layout `out` gets for a map of `layers` layers.
@@ -190,7 +246,7 @@ pub fn save_eyes(
 ) -> Result<Vec<PathBuf>, CliError> {
     let env = &eyes[0];
     let path = Path::new(out);
-    let format = check(out, env.projection().kind(), opts.layout)?;
+    let format = check(out, env.projection().kind(), opts.layout, Folder::Exists)?;
     check_stereo(out, env.layers().len(), stereo, opts)?;
     if format.is_cube_container() {
         let levels: Vec<Vec<Image>> = if opts.mips {

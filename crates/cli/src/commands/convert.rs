@@ -44,7 +44,8 @@ fn parse_compression(c: &str) -> Result<ExrCompression, CliError> {
 }
 
 impl Plan {
-    pub(crate) fn new(a: &ConvertArgs) -> Result<Plan, CliError> {
+    /// The plan of `a`, its output's folder as `folder` says (one file's must exist).
+    pub(crate) fn new(a: &ConvertArgs, folder: save::Folder) -> Result<Plan, CliError> {
         let input = InputPlan::new(&a.input_args)?;
         let to = ProjSpec::parse(&a.to).map_err(|e| bad("--to", e))?;
         let layout = a
@@ -60,7 +61,7 @@ impl Plan {
                 )));
             }
         }
-        let format = save::check(&a.output, to.kind, layout)?;
+        let format = save::check(&a.output, to.kind, layout, folder)?;
         let precision = parse_precision(a.precision.as_deref())?;
         match (format, precision) {
             (Format::Png, Some(Precision::Half | Precision::Float))
@@ -163,7 +164,7 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     if let Some(done) = super::frames::route(&a) {
         return done;
     }
-    let mut plan = Plan::new(&a)?;
+    let mut plan = Plan::new(&a, save::Folder::Exists)?;
     if plan.is_stereo() {
         return convert_pair(&a, &plan);
     }

@@ -9,7 +9,7 @@
 use super::packing::Packing;
 use crate::error::CliError;
 use mirrorball_core::color::linear_to_srgb;
-use mirrorball_core::{choice_traits, Choice, Codes, Image};
+use mirrorball_core::{choice_traits, count_invalid, Choice, Codes, Image};
 use mirrorball_simd::{x8_kernel, F32x8, I32x8, X8};
 use rayon::prelude::*;
 use std::io::{ErrorKind, Read, Write};
@@ -77,8 +77,10 @@ impl PixFmt {
         }
     }
 
-    /// Decodes `bytes` (one `w`×`h` frame) into `img`, linear RGB.
-    pub fn decode(self, bytes: &[u8], img: &mut Image) {
+    /// Decodes `bytes` (one `w`×`h` frame) into `img`, linear RGB. Returns how many values
+    /// are NaN, infinite or negative (`mirrorball_core::count_invalid`, counted as each
+    /// block is decoded): only a float format can hold one.
+    pub fn decode(self, bytes: &[u8], img: &mut Image) -> u64 {
         let n = img.width() as usize * img.height() as usize;
         debug_assert_eq!(img.channels(), 3);
         debug_assert_eq!(bytes.len(), n * self.pixel_bytes());
@@ -93,6 +95,7 @@ impl PixFmt {
                             *d = lut[*s as usize];
                         }
                     });
+                0
             }
             PixFmt::Rgb48le => {
                 let lut = mirrorball_io::srgb16_to_linear();
@@ -103,15 +106,18 @@ impl PixFmt {
                             *d = lut[u16::from_le_bytes([s[0], s[1]]) as usize];
                         }
                     });
+                0
             }
             PixFmt::Rgbf32le => data
                 .par_chunks_mut(CHUNK * 3)
                 .zip(bytes.par_chunks(CHUNK * 12))
-                .for_each(|(d, s)| {
+                .map(|(d, s)| {
                     for (d, s) in d.iter_mut().zip(s.chunks_exact(4)) {
                         *d = f32::from_le_bytes([s[0], s[1], s[2], s[3]]);
                     }
-                }),
+                    count_invalid(d, false)
+                })
+                .sum(),
             PixFmt::Gbrpf32le => {
                 // Each channel's plane, in R, G, B order, found through ffmpeg's plane order.
                 let plane = n * 4;
@@ -121,7 +127,7 @@ impl PixFmt {
                 }
                 data.par_chunks_mut(CHUNK * 3)
                     .enumerate()
-                    .for_each(|(k, d)| {
+                    .map(|(k, d)| {
                         let at = k * CHUNK * 4;
                         for (i, t) in d.chunks_exact_mut(3).enumerate() {
                             let o = at + i * 4;
@@ -129,7 +135,9 @@ impl PixFmt {
                                 *t = f32::from_le_bytes([p[o], p[o + 1], p[o + 2], p[o + 3]]);
                             }
                         }
-                    });
+                        count_invalid(d, false)
+                    })
+                    .sum()
             }
         }
     }

@@ -74,6 +74,8 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
             a.output
         )));
     }
+    let mut first_of_all = None;
+    let mut empty_slice = None;
     let input = if a.input == "-" {
         if shard.is_some() {
             return Err(CliError::request(
@@ -99,17 +101,21 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
                 a.input
             )));
         }
-        let mut frames = match Pattern::parse(&a.input)? {
+        let frames = match Pattern::parse(&a.input)? {
             Some(p) => p.expand(&a.input)?,
             None => vec![Frame {
                 number: 0,
                 path: PathBuf::from(&a.input),
             }],
         };
-        if let Some(s) = shard {
-            frames = frames[s.range(frames.len())].to_vec();
+        // The whole sequence's first frame stands for every shard's in the request's
+        // checks, so that each shard, an empty one too, accepts or refuses alike.
+        first_of_all = Some(frames[0].clone());
+        let slice = shard.map_or(0..frames.len(), |s| s.range(frames.len()));
+        if slice.is_empty() {
+            empty_slice = Some((slice.start, frames.len()));
         }
-        Input::Files(frames)
+        Input::Files(frames[slice].to_vec())
     };
     let output = if a.output == "-" {
         let fmt = out_fmt.ok_or_else(|| {
@@ -125,7 +131,7 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         match Pattern::output(&a.output)? {
             Some(p) => Output::Files(p),
             None => match &input {
-                Input::Files(fr) if fr.len() == 1 && Pattern::parse(&a.input)?.is_none() => {
+                Input::Files(_) if Pattern::parse(&a.input)?.is_none() => {
                     Output::File(a.output.clone())
                 }
                 _ => {
@@ -140,17 +146,18 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
 
     // The request as one frame's conversion, checked by convert's own plan.
     let mut probe = a.clone();
-    probe.input = match &input {
-        Input::Files(fr) => fr[0].path.to_string_lossy().into_owned(),
-        Input::Pipe { .. } => "-".into(),
+    let first_number = first_of_all.as_ref().map_or(0, |fr| fr.number);
+    probe.input = match &first_of_all {
+        Some(fr) => fr.path.to_string_lossy().into_owned(),
+        None => "-".into(),
     };
     probe.output = match &output {
-        Output::Files(p) => p.path(first_number(&input)).to_string_lossy().into_owned(),
+        Output::Files(p) => p.path(first_number).to_string_lossy().into_owned(),
         Output::File(s) => s.clone(),
         // A pipe's frames are packed pictures: checked as an EXR of the same layout.
         Output::Pipe(_) => "frame.exr".into(),
     };
-    let mut plan = Plan::new(&probe)?;
+    let mut plan = Plan::new(&probe, save::Folder::Made)?;
     // `--for`'s engine axes: frames are made by one planned `Remap`, so a cube output takes
     // them as the rotation they are (its texel centres map to texel centres).
     if !plan.orient.is_identity() {
@@ -165,6 +172,15 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         return Err(CliError::request(
             "output -: a raw frame is one picture; give a packed --layout (hcross, vcross, hstrip, vstrip)",
         ));
+    }
+    if let Some((at, len)) = empty_slice {
+        if !a.quiet {
+            eprintln!(
+                "--shard {}: frames {at}..{at} of {len}: this slice is empty, nothing to do",
+                f.shard.as_deref().unwrap_or_default()
+            );
+        }
+        return Ok(());
     }
 
     // Frames from files: outputs named, checked against every input, and those done already.
@@ -224,13 +240,30 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         }
         pipe => pipe,
     };
+    let _folder = match &output {
+        Output::Files(p) => MadeFolder::for_output(&p.path(first_number))?,
+        Output::File(s) => MadeFolder::for_output(Path::new(s))?,
+        Output::Pipe(_) => MadeFolder(None),
+    };
     convert_frames(a, &plan, dst, input, output, log, skipped)
 }
 
-fn first_number(input: &Input) -> u64 {
-    match input {
-        Input::Files(fr) => fr[0].number,
-        Input::Pipe { .. } => 0,
+/// The output folder, made for the frames when missing (`save::make_folder`); removed again
+/// if the run leaves it empty (it failed before its first frame).
+struct MadeFolder(Option<PathBuf>);
+
+impl MadeFolder {
+    fn for_output(out: &Path) -> Result<MadeFolder, CliError> {
+        save::make_folder(out).map(MadeFolder)
+    }
+}
+
+impl Drop for MadeFolder {
+    fn drop(&mut self) {
+        if let Some(dir) = &self.0 {
+            mirrorball_io::keep_folder(dir);
+            let _ = std::fs::remove_dir(dir); // only when empty
+        }
     }
 }
 
@@ -338,8 +371,8 @@ impl Reader<'_> {
             }
             _ => Image::new(w, h, 3),
         };
-        fmt.decode(&self.bytes, &mut img);
-        let eyes = match self.decided {
+        let invalid = fmt.decode(&self.bytes, &mut img);
+        let mut eyes = match self.decided {
             Some((proj, layout)) => stereo
                 .split(img, reads)
                 .map_err(|e| CliError::request(format!("{name}: {e}")))?
@@ -377,6 +410,12 @@ impl Reader<'_> {
                 std::iter::once(left).chain(right).collect()
             }
         };
+        let keep = self.plan.input.keep_invalid;
+        if let Some(warning) = load::zero_invalid(&name, &mut eyes, invalid, keep) {
+            if !self.a.quiet {
+                eprintln!("{warning}");
+            }
+        }
         Ok((meta(n, name), eyes))
     }
 }

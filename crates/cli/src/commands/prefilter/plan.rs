@@ -193,7 +193,7 @@ fn output_format(
     } else {
         level_path(&a.output, 0)
     };
-    let format = save::check(&probe, to.kind, layout)?;
+    let format = save::check(&probe, to.kind, layout, save::Folder::Exists)?;
     if format == Format::Jpeg {
         return Err(CliError::request(format!(
             "{}: prefiltered radiance is HDR; write .exr, .hdr, .ktx2 or .dds (PNG for previews)",
