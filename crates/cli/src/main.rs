@@ -7,6 +7,7 @@ mod budget;
 mod choice;
 mod commands;
 mod error;
+mod fit;
 mod guard;
 mod load;
 mod progress;
@@ -160,7 +161,7 @@ pub struct ConvertArgs {
     #[arg(long = "for", value_name = "ENGINE", value_parser = names::<mirrorball_bake::Engine>())]
     engine: Option<String>,
     /// Exposure in stops (texels times 2^EV).
-    #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = exposure_stops, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
     /// Texel precision: half, float (EXR/KTX2/DDS) or 8, 16 (PNG).
     #[arg(long, value_parser = names::<Precision>())]
@@ -222,7 +223,7 @@ pub struct DemoArgs {
     #[arg(long, default_value_t = 1024)]
     size: u32,
     /// Exposure of the PNG previews, in stops.
-    #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = exposure_stops, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
 }
 
@@ -315,7 +316,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 2)]
     ss: u32,
     /// Exposure in stops.
-    #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = exposure_stops, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
     /// Tone curve for PNG/JPEG.
     #[arg(long, default_value = "aces", value_parser = names::<Tone>())]
@@ -437,7 +438,7 @@ pub struct PrefilterArgs {
     #[arg(long)]
     no_preview: bool,
     /// Exposure of the preview sheet in stops (level 0's mean is shown at 18% grey).
-    #[arg(long, value_parser = finite_f32, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, value_parser = exposure_stops, default_value_t = 0.0, allow_hyphen_values = true)]
     preview_exposure: f32,
     /// Also write the split-sum BRDF table (A, B in red and green) to this .exr or .png.
     #[arg(long)]
@@ -538,6 +539,28 @@ fn finite_f32(s: &str) -> Result<f32, String> {
     let v = finite_f64(s)?;
     if v.abs() > f32::MAX as f64 {
         return Err(format!("'{s}' is too large"));
+    }
+    Ok(v as f32)
+}
+
+/// The exposures a flag takes, in stops: `2^EV` is a normal `f32` (neither 0 nor infinite),
+/// so scaling by it never turns every texel to 0 or to infinity (and 0·∞ into NaN).
+const EXPOSURE_STOPS: std::ops::RangeInclusive<f32> = -126.0..=127.0;
+
+/// An exposure flag's value ([`EXPOSURE_STOPS`]).
+fn exposure_stops(s: &str) -> Result<f32, String> {
+    let v = finite_f64(s)?;
+    if !EXPOSURE_STOPS.contains(&(v as f32)) || v.abs() > f32::MAX as f64 {
+        return Err(format!(
+            "'{s}' stops is outside {}..={}: 2^{s} is {} as a 32-bit float",
+            EXPOSURE_STOPS.start(),
+            EXPOSURE_STOPS.end(),
+            if v > 0.0 {
+                "infinite"
+            } else {
+                "0 or subnormal"
+            }
+        ));
     }
     Ok(v as f32)
 }

@@ -2,6 +2,7 @@
 //! layers, KTX2/DDS cubes get their mip chain.
 
 use crate::error::CliError;
+use crate::fit::{self, Report};
 use crate::load::{layer_names, FACE};
 use mirrorball_core::{EnvMap, Image, Layout, ProjectionKind, Stereo, WorldProjection};
 use mirrorball_filter::MipChain;
@@ -17,6 +18,17 @@ pub struct SaveOptions {
     pub write: WriteOptions,
     /// Write the full mip chain into KTX2/DDS.
     pub mips: bool,
+    /// Write NaN and infinite values where the container holds them (`--keep-invalid`),
+    /// instead of 0.
+    pub keep_invalid: bool,
+}
+
+/// What [`save`] wrote: the files, and what their storage could not hold ([`Report`]).
+pub struct Saved {
+    /// The files written.
+    pub files: Vec<PathBuf>,
+    /// The maps written, measured against the file's storage.
+    pub report: Report,
 }
 
 /// The layout used when the user names none (by layer count; an EAC map's is v360's `eac`:
@@ -185,8 +197,8 @@ pub fn per_part_path(out: &str, placeholder: &str, part: &str) -> PathBuf {
     p.with_file_name(format!("{stem}_{part}.{ext}"))
 }
 
-/// Writes `env` to `out`; returns the files written.
-pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Vec<PathBuf>, CliError> {
+/// Writes `env` to `out`; returns the files written and what they could not hold.
+pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Saved, CliError> {
     save_eyes(std::slice::from_ref(env), Stereo::Mono, out, opts)
 }
 
@@ -237,27 +249,29 @@ pub fn pack_eyes(eyes: &[EnvMap], stereo: Stereo, layout: Layout) -> Result<Imag
 }
 
 /// Writes `eyes` (one map per eye of `stereo`; one map for `2d`) to `out`; returns the
-/// files written. The file records one eye's projection and layout.
+/// files written and what their storage could not hold (each map measured before it is
+/// written: [`fit::measure_maps`]). The file records one eye's projection and layout.
 pub fn save_eyes(
     eyes: &[EnvMap],
     stereo: Stereo,
     out: &str,
     opts: &SaveOptions,
-) -> Result<Vec<PathBuf>, CliError> {
+) -> Result<Saved, CliError> {
     let env = &eyes[0];
     let path = Path::new(out);
     let format = check(out, env.projection().kind(), opts.layout, Folder::Exists)?;
     check_stereo(out, env.layers().len(), stereo, opts)?;
+    let storage = format.storage(opts.write.precision);
     if format.is_cube_container() {
-        let levels: Vec<Vec<Image>> = if opts.mips {
-            MipChain::resampled(env)
-                .into_levels()
-                .into_iter()
-                .map(EnvMap::into_layers)
-                .collect()
+        let chain_made;
+        let chain: &[EnvMap] = if opts.mips {
+            chain_made = MipChain::resampled(env).into_levels();
+            &chain_made
         } else {
-            vec![env.layers().to_vec()]
+            std::slice::from_ref(env)
         };
+        let (chain, report) = fit::measure_maps(chain, storage, opts.keep_invalid);
+        let levels: Vec<Vec<Image>> = chain.iter().map(|l| l.layers().to_vec()).collect();
         let mut write = opts.write;
         write.declared = Some(MapInfo {
             projection: *env.projection(),
@@ -265,8 +279,14 @@ pub fn save_eyes(
             stereo: Default::default(),
         });
         mirrorball_io::write_cube(path, &levels, &write)?;
-        return Ok(vec![path.to_path_buf()]);
+        return Ok(Saved {
+            files: vec![path.to_path_buf()],
+            report,
+        });
     }
+    let (eyes, mut report) = fit::measure_maps(eyes, storage, opts.keep_invalid);
+    report.part = "eye";
+    let env = &eyes[0];
     let n = env.layers().len();
     let kind = env.projection().kind();
     let layout = match opts.layout {
@@ -277,7 +297,8 @@ pub fn save_eyes(
         // Renamed into place together: a failed or interrupted run leaves the set as it was.
         let mut set = OutputSet::new(&per_layer_write(&opts.write, *env.projection()));
         set.push_all(&paths, env.layers())?;
-        return Ok(set.finish()?);
+        let files = set.finish()?;
+        return Ok(Saved { files, report });
     }
     let mut write = opts.write;
     // Recorded in the file, so that reading it back needs no --from.
@@ -286,9 +307,12 @@ pub fn save_eyes(
         layout: Some(layout),
         stereo,
     });
-    let img = pack_eyes(eyes, stereo, layout).map_err(|e| e.context(out))?;
+    let img = pack_eyes(&eyes, stereo, layout).map_err(|e| e.context(out))?;
     mirrorball_io::write_image(path, &img, &write)?;
-    Ok(vec![path.to_path_buf()])
+    Ok(Saved {
+        files: vec![path.to_path_buf()],
+        report,
+    })
 }
 
 /// The options for one file a layer of a `projection` map: each file records the projection

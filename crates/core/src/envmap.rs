@@ -228,19 +228,20 @@ impl EnvMap {
     /// Replaces NaN and infinite colour values by 0 and clamps negative ones to 0. Returns
     /// how many texel values were changed.
     pub fn sanitize(&mut self) -> u64 {
-        let c = self.channels();
-        // Blocks of texels on all cores; within a block, a select rather than a branch
-        // (`v ≥ 0` is false for NaN, `v < ∞` for +∞), so the scan vectorises.
-        self.layers
-            .iter_mut()
-            .map(|img| {
-                img.data_mut()
-                    .par_chunks_mut(c * 16384)
-                    .map(|block| u64::from(sanitize_block(block, c == 4)))
-                    .sum::<u64>()
-            })
-            .sum()
+        self.layers.iter_mut().map(sanitize_layer).sum()
     }
+}
+
+/// [`EnvMap::sanitize`] of one layer (or any image): NaN, infinite and negative colour
+/// values set to 0; returns how many were.
+pub fn sanitize_layer(img: &mut Image) -> u64 {
+    let c = img.channels();
+    // Blocks of texels on all cores; within a block, a select rather than a branch
+    // (`v ≥ 0` is false for NaN, `v < ∞` for +∞), so the scan vectorises.
+    img.data_mut()
+        .par_chunks_mut(c * 16384)
+        .map(|block| u64::from(sanitize_block(block, c == 4)))
+        .sum::<u64>()
 }
 
 /// How many colour values of `texels` [`EnvMap::sanitize`] would change: NaN, infinite or

@@ -35,7 +35,8 @@ pub use choice::{Choice, UnknownName};
 pub use codes::{Codes, CodesError};
 pub use envmap::{
     bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, bilinear_mix,
-    bilinear_taps, count_invalid, sample_texels, CornerLanes, EnvMap, EnvMapError, Stats,
+    bilinear_taps, count_invalid, sample_texels, sanitize_layer, CornerLanes, EnvMap, EnvMapError,
+    Stats,
 };
 pub use fault::Fault;
 pub use image::Image;

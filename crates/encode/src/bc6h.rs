@@ -21,6 +21,8 @@
 //! Decoding, for the readers, is `bcdec_rs`'s; the tests check it, and both encoders,
 //! against a second decoder (`texture2ddecoder`).
 
+use crate::range::Storage;
+use crate::Encoding;
 use half::f16;
 use mirrorball_core::Image;
 use rayon::prelude::*;
@@ -65,13 +67,16 @@ fn clamped(image: &Image, x: usize, y: usize) -> &[f32] {
 }
 
 /// Rows `4·band..4·band + 4` of `image` as little-endian RGBA binary16, padded to `4·bw`
-/// columns by edge replication, into `out` (`4·bw·4·8` bytes).
+/// columns by edge replication, into `out` (`4·bw·4·8` bytes); values fitted to unsigned
+/// BC6H's range ([`crate::Range::fit`]: a sun brighter than 65504 is 65504, never infinity).
 fn band_rgba16(image: &Image, band: usize, bw: usize, out: &mut [u8]) {
+    let range = Storage::Texels(Encoding::Bc6hUnsigned).range();
     for y in 0..4 {
         for x in 0..4 * bw {
             let px = clamped(image, x, 4 * band + y);
             let o = (y * 4 * bw + x) * 8;
-            let rgba = [px[0], px[1], px[2], 1.0].map(|v| f16::from_f32(v).to_le_bytes());
+            let rgb = [0, 1, 2].map(|c| range.fit(c, px[c]));
+            let rgba = [rgb[0], rgb[1], rgb[2], 1.0].map(|v| f16::from_f32(v).to_le_bytes());
             out[o..o + 8].copy_from_slice(rgba.as_flattened());
         }
     }
@@ -107,8 +112,10 @@ pub fn encode_unsigned(image: &Image, effort: Effort, out: &mut Vec<u8>) {
         );
 }
 
-/// Encodes `image` as signed BC6H blocks (row-major) into `out`, replacing its contents.
+/// Encodes `image` as signed BC6H blocks (row-major) into `out`, replacing its contents;
+/// values fitted to signed BC6H's range ([`crate::Range::fit`]).
 pub fn encode_signed(image: &Image, out: &mut Vec<u8>) {
+    let range = Storage::Texels(Encoding::Bc6hSigned).range();
     let (bw, bh) = blocks(image.width(), image.height());
     out.clear();
     out.resize(bw * bh * BLOCK_BYTES, 0);
@@ -119,7 +126,7 @@ pub fn encode_signed(image: &Image, out: &mut Vec<u8>) {
             let mut texels = [[0f32; 3]; 16];
             for (t, texel) in texels.iter_mut().enumerate() {
                 let px = clamped(image, 4 * bx + t % 4, 4 * by + t / 4);
-                *texel = [px[0], px[1], px[2]];
+                *texel = [0, 1, 2].map(|c| range.fit(c, px[c]));
             }
             block.copy_from_slice(&encode_signed_block(&texels));
         });

@@ -3,14 +3,17 @@
 //!
 //! | [`Encoding`] | bytes | what it holds | error | module |
 //! | --- | --- | --- | --- | --- |
-//! | `Rgba16F` | 8 a texel | binary16 R G B A | ½ ulp of half (2⁻¹¹ relative) | here |
+//! | `Rgba16F` | 8 a texel | binary16 R G B A, ≤ 65504 | ½ ulp of half (2⁻¹¹ relative) | here |
 //! | `Rgba32F` | 16 a texel | binary32 R G B A | none | here |
 //! | `Rgb9E5` | 4 a texel | 9-bit mantissas, shared 5-bit exponent, ≤ 65408 | 2⁻¹⁰ of the texel's largest channel | [`shared_exp`] |
 //! | `B10G11R11` | 4 a texel | unsigned 11/11/10-bit floats, ≤ 65024/64512 | 2⁻⁷ (R, G), 2⁻⁶ (B) relative | [`packed_float`] |
 //! | `Rgbd` | 4 a texel | Babylon.js RGBD, ≤ 255 | 8-bit, gamma 2.2 | [`ldr8`] |
 //! | `Rgbm` | 4 a texel | three.js RGBM, range 6 | 8-bit linear | [`ldr8`] |
-//! | `Bc6hUnsigned` | 16 a 4×4 block | BC6H UF16 (Intel ISPC encoder) | lossy, see BENCHMARKS | [`bc6h`] |
-//! | `Bc6hSigned` | 16 a 4×4 block | BC6H SF16 (mode 11 encoder here) | lossy | [`bc6h`] |
+//! | `Bc6hUnsigned` | 16 a 4×4 block | BC6H UF16 (Intel ISPC encoder), ≤ 65504 | lossy, see BENCHMARKS | [`bc6h`] |
+//! | `Bc6hSigned` | 16 a 4×4 block | BC6H SF16 (mode 11 encoder here), ≤ ±65504 | lossy | [`bc6h`] |
+//!
+//! What each encoding (and each flat file's code) can hold is one table, [`range`]: every
+//! encoder writes a value through [`Range::fit`], so no finite value becomes an infinity.
 //!
 //! No file I/O: the containers live in `mirrorball-io`, which calls [`Encoding::encode`]
 //! per face and level and [`Encoding::decode`] when reading.
@@ -20,11 +23,13 @@
 pub mod bc6h;
 pub mod ldr8;
 pub mod packed_float;
+pub mod range;
 pub mod shared_exp;
 
 pub use bc6h::Effort;
 use half::f16;
 use mirrorball_core::Image;
+pub use range::{Clipped, Range, Storage};
 use std::fmt;
 
 /// How the texels of one image are stored.
@@ -154,7 +159,9 @@ impl Encoding {
 
     /// Encodes `image` (RGB or RGBA, linear) into `out`, replacing its contents with
     /// [`Encoding::image_bytes`] bytes: texels in rows, top row first, or 4×4 blocks in rows.
-    /// Unsigned BC6H uses [`Effort::Basic`]; see [`Encoding::encode_with`].
+    /// Values are written as [`Range::fit`] of the encoding's range makes them: a finite
+    /// value past the range as its end, never an infinity. Unsigned BC6H uses
+    /// [`Effort::Basic`]; see [`Encoding::encode_with`].
     pub fn encode(self, image: &Image, out: &mut Vec<u8>) {
         self.encode_with(image, Effort::default(), out);
     }
@@ -169,13 +176,15 @@ impl Encoding {
         out.clear();
         out.reserve(self.image_bytes(image.width(), image.height()));
         let c = image.channels();
+        let range = Storage::Texels(self).range();
         for px in image.data().chunks_exact(c) {
             let rgb = [px[0], px[1], px[2]];
             match self {
                 Encoding::Rgba16F | Encoding::Rgba32F => {
                     let rgba = [px[0], px[1], px[2], if c == 4 { px[3] } else { 1.0 }];
-                    for v in rgba {
+                    for (k, v) in rgba.into_iter().enumerate() {
                         if self == Encoding::Rgba16F {
+                            let v = range.fit(k, v);
                             out.extend_from_slice(&f16::from_f32(v).to_le_bytes());
                         } else {
                             out.extend_from_slice(&v.to_le_bytes());

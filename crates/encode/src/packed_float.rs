@@ -10,7 +10,13 @@
 //! it, infinity included, so a written texel is always finite. The relative error of a
 //! normal value is at most `2^−(m+1)`: 1/128 for R and G, 1/64 for B.
 
-/// Largest finite unsigned float with `mantissa_bits` of mantissa: `(2 − 2^−m)·2^15`.
+/// Largest finite unsigned 11-bit float (R, G): `(2 − 2^−6)·2^15`.
+pub const MAX_11: f32 = 65024.0;
+/// Largest finite unsigned 10-bit float (B): `(2 − 2^−5)·2^15`.
+pub const MAX_10: f32 = 64512.0;
+
+/// Largest finite unsigned float with `mantissa_bits` of mantissa: `(2 − 2^−m)·2^15`
+/// ([`MAX_11`], [`MAX_10`]).
 pub fn max_finite(mantissa_bits: u32) -> f32 {
     (2.0 - 2f32.powi(-(mantissa_bits as i32))) * 32768.0
 }

@@ -21,15 +21,17 @@ use exr::prelude::{
 };
 use mirrorball_core::simd::F32x4;
 use mirrorball_core::{Image, ProjectionKind};
+use mirrorball_encode::{Range, Storage};
 use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-/// Largest finite half-float: values beyond it are clamped when writing half, so that a
-/// bright sun does not turn into infinity.
-const HALF_MAX: f32 = 65504.0;
+/// What half samples hold: values beyond ±65504 are written as it ([`Range::fit`]), so that a
+/// bright sun does not turn into infinity. (Float's fit changes no `f32`: float samples are
+/// written as they are.)
+const HALF: Range = Storage::Texels(mirrorball_encode::Encoding::Rgba16F).range();
 
 /// Reads the first RGB(A) layer of an OpenEXR file as linear `f32` texels.
 ///
@@ -243,8 +245,8 @@ fn image_other(opts: &WriteOptions) -> std::collections::HashMap<Text, Attribute
 /// that the returned [`Staged`] renames into place. `buffers` are kept between
 /// files.
 ///
-/// Half output clamps finite values to ±65504 (the largest half) instead of overflowing to
-/// infinity.
+/// Half output writes finite values beyond ±65504 (the largest half) as it instead of
+/// overflowing to infinity ([`Range::fit`]; NaN and infinities are kept).
 pub fn write(
     path: &Path,
     image: &Image,
@@ -283,14 +285,8 @@ pub fn write(
     let data = image.data();
     let half = sample_type == SampleType::F16;
     let describe = |name: &str| ChannelDescription::named(name, sample_type);
-    // Half clamps to the finite range (NaN stays NaN); float passes values through.
-    let fit = move |v: f32| {
-        if half {
-            v.clamp(-HALF_MAX, HALF_MAX)
-        } else {
-            v
-        }
-    };
+    // Half fits its range; float passes values through (its fit changes none).
+    let fit = move |v: f32| if half { HALF.fit(0, v) } else { v };
 
     if image.channels() == 4 {
         let texels = SpecificChannels {
@@ -491,7 +487,7 @@ pub(crate) struct WriteBuffers {
 /// Lays out `rows` (interleaved texels, `w` a row, `c` channels) as a scan-line block's raw
 /// little-endian bytes in `out` (exactly the block's size): each line its channels one after
 /// another, in the file's order and sample types (`layout`, see [`block_layout`]). Half
-/// samples are clamped to the finite range (NaN stays NaN) and converted a line at a time
+/// samples are fitted to half's range ([`Range::fit`]) and converted a line at a time
 /// (F16C where the processor has it). `lanes` are buffers kept between calls.
 fn pack_lines(
     rows: &[f32],
@@ -515,7 +511,7 @@ fn pack_lines(
             }
             if st == SampleType::F16 {
                 for v in lane.iter_mut() {
-                    *v = v.clamp(-HALF_MAX, HALF_MAX);
+                    *v = HALF.fit(0, *v);
                 }
                 halves.convert_from_f32_slice(lane);
                 for (d, h) in out[at..at + 2 * w].chunks_exact_mut(2).zip(halves.iter()) {

@@ -6,6 +6,7 @@ use crate::{atomic::stage, Error, Format, Limits, Loaded, Staged, WriteOptions};
 use image::codecs::hdr::HdrDecoder;
 use image::{DynamicImage, ImageDecoder};
 use mirrorball_core::Image;
+use mirrorball_encode::{Range, Storage};
 use rayon::prelude::*;
 use std::io::{BufRead, BufReader, Write};
 use std::path::Path;
@@ -13,8 +14,8 @@ use std::path::Path;
 /// Rows encoded per parallel work item.
 const ROWS_PER_BAND: usize = 16;
 
-/// Largest value RGBE holds: mantissa 255 with the largest exponent (byte 255).
-const RGBE_MAX: f32 = 255.0 * (1u128 << 119) as f32;
+/// What RGBE holds (its largest value: mantissa 255 with the largest exponent, byte 255).
+const RGBE: Range = Storage::Rgbe.range();
 
 /// Smallest value written as non-zero (as in Ward's reference encoder).
 const RGBE_MIN: f32 = 1e-32;
@@ -142,9 +143,8 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
 /// The largest mantissa is always at least 128, so a texel never looks like a run-length
 /// marker (`1 1 1 e`) or a new-style scan-line header (`2 2 <128 e`).
 fn to_rgbe(r: f32, g: f32, b: f32) -> [u8; 4] {
-    // `v > 0` is false for NaN and negatives: both become 0.
-    let fit = |v: f32| if v > 0.0 { v.min(RGBE_MAX) } else { 0.0 };
-    let (r, g, b) = (fit(r), fit(g), fit(b));
+    // NaN and negatives become 0, values past the range its largest.
+    let (r, g, b) = (RGBE.fit(0, r), RGBE.fit(1, g), RGBE.fit(2, b));
     let max = r.max(g).max(b);
     if max < RGBE_MIN {
         return [0; 4];

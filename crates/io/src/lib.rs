@@ -50,7 +50,7 @@ pub use gltf_ibl::{read_gltf_ibl, write_gltf_ibl, GltfIbl};
 pub use ktx1_io::{filament_sh_text, write_ktx1};
 pub use ktx2_io::{write_ktx2, CubeWrite};
 pub use ldr_io::{lut16 as srgb16_to_linear, lut8 as srgb8_to_linear};
-pub use mirrorball_encode::{Effort, Encoding};
+pub use mirrorball_encode::{Clipped, Effort, Encoding, Range, Storage};
 pub use output::OutputSet;
 pub use pipe_size::{widen_pipe, PIPE_BYTES};
 pub use rgba_png::Rgba8Face;
@@ -185,6 +185,18 @@ impl Format {
     /// Whether the format holds a whole cube (six faces) in one file.
     pub fn is_cube_container(self) -> bool {
         matches!(self, Format::Ktx2 | Format::Dds)
+    }
+
+    /// How a file of this format written with `precision` (`None`: its natural one) stores
+    /// colour values: its writer writes each as this storage's [`Range::fit`] makes it.
+    pub fn storage(self, precision: Option<Precision>) -> Storage {
+        match (self, precision) {
+            (Format::Hdr, _) => Storage::Rgbe,
+            (Format::Png, Some(Precision::U16)) => Storage::Display16,
+            (Format::Png | Format::Jpeg | Format::Webp, _) => Storage::Display8,
+            (_, Some(Precision::Float)) => Storage::Texels(Encoding::Rgba32F),
+            _ => Storage::Texels(Encoding::Rgba16F),
+        }
     }
 }
 

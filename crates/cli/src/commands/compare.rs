@@ -204,6 +204,7 @@ fn write_diff(diff: &EnvMap, out: &str, worst: f64) -> Result<(), CliError> {
             ..Default::default()
         },
         mips: false,
+        keep_invalid: false,
     };
     save::save(&env, out, &opts)?;
     Ok(())

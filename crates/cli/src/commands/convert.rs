@@ -3,14 +3,15 @@
 use super::InputPlan;
 use crate::budget;
 use crate::error::CliError;
+use crate::fit;
 use crate::guard::Files;
 use crate::progress::{with_progress, with_spinner};
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
 use mirrorball_core::{
-    resample, Axis, AxisMap, EnvMap, Layout, Projection, ProjectionKind, Remap, ResampleOptions,
-    Resampler, Rotation, Stereo, WorldProjection,
+    resample, Axis, AxisMap, EnvMap, Image, Layout, Projection, ProjectionKind, Remap,
+    ResampleOptions, Resampler, Rotation, Stereo, WorldProjection,
 };
 use mirrorball_io::{ExrCompression, Format, OutputSet, Precision, WriteOptions};
 use std::path::PathBuf;
@@ -32,6 +33,12 @@ pub(crate) struct Plan {
     pub(crate) in_stereo: Option<Stereo>,
     /// `--stereo`: how the output picture holds its eyes.
     pub(crate) stereo: Stereo,
+    /// The output's container.
+    pub(crate) format: Format,
+    /// `--exposure`, for the advice when an output cannot hold a value.
+    pub(crate) exposure: f32,
+    /// `--quiet`.
+    pub(crate) quiet: bool,
 }
 
 pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
@@ -101,9 +108,6 @@ impl Plan {
                 rotation = rotation.then(engine.orientation().rotation());
             }
         }
-        if !a.exposure.is_finite() {
-            return Err(CliError::request("--exposure must be a finite number"));
-        }
         let write = WriteOptions {
             precision,
             exr_compression: parse_compression(&a.compression)?,
@@ -114,6 +118,7 @@ impl Plan {
             layout,
             write,
             mips: a.mips,
+            keep_invalid: input.keep_invalid,
         };
         let layers = to.build(None).map_err(|e| bad("--to", e))?.layer_count();
         let stereo_flag = |flag: &str, given: Option<&str>| {
@@ -149,7 +154,22 @@ impl Plan {
             orient,
             in_stereo,
             stereo,
+            format,
+            exposure: a.exposure,
+            quiet: a.quiet,
         })
+    }
+
+    /// Says what `file` could not hold (unless `--quiet`), with the ways to keep it:
+    /// `--precision float` for half, a lower `--exposure`.
+    pub(crate) fn say_clipped(&self, file: &str, report: &fit::Report) {
+        let keep: Vec<String> = fit::precision_advice(report.storage)
+            .into_iter()
+            .chain([fit::exposure_advice("--exposure", self.exposure, report)])
+            .collect();
+        if let (Some(line), false) = (report.line(file, &keep), self.quiet) {
+            eprintln!("{line}");
+        }
     }
 
     /// Whether either side is said to be a stereo pair (a pair a file records, read with
@@ -220,11 +240,14 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     let (files, t_conv, t_write) = match layer_files {
         // One file a layer: each is written as soon as it is made.
         Some(paths) => {
-            with_progress("converting", rows, a.quiet, |counter| {
+            let storage = plan.format.storage(plan.save.write.precision);
+            let report = with_progress("converting", rows, a.quiet, |counter| {
                 plan.resample.progress = Some(counter);
                 let write = save::per_layer_write(&plan.save.write, dst);
-                convert_layers(src, (dst, w, h), &plan.resample, &paths, &write)
+                let fit = LayerFit::new(&src.env, storage, &plan);
+                convert_layers(src, (dst, w, h), &plan.resample, &paths, (&write, fit))
             })?;
+            plan.say_clipped(&a.output, &report);
             (paths, t1.elapsed(), None)
         }
         None => {
@@ -241,10 +264,11 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
             let t_conv = t1.elapsed();
             drop(src);
             let t2 = Instant::now();
-            let files = with_spinner("writing", a.quiet, || {
+            let saved = with_spinner("writing", a.quiet, || {
                 save::save(&out, &a.output, &plan.save)
             })?;
-            (files, t_conv, Some(t2.elapsed()))
+            plan.say_clipped(&a.output, &saved.report);
+            (saved.files, t_conv, Some(t2.elapsed()))
         }
     };
     let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
@@ -272,33 +296,80 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// How the layers written one at a time are measured against their storage: with their
+/// texels' solid angles when the source's largest value, exposed, may be past the storage's
+/// range (resampling averages with non-negative weights, so no output value is larger), so
+/// the map's energy is known whichever layer clips; NaN and infinities replaced by 0 unless
+/// `--keep-invalid`.
+struct LayerFit {
+    storage: mirrorball_io::Storage,
+    weighted: bool,
+    keep_invalid: bool,
+}
+
+impl LayerFit {
+    fn new(src: &EnvMap, storage: mirrorball_io::Storage, plan: &Plan) -> LayerFit {
+        let range = storage.range();
+        let largest = src
+            .layers()
+            .iter()
+            .flat_map(|l| l.data().chunks_exact(l.channels()))
+            .flat_map(|px| &px[..3])
+            .fold(0f32, |m, v| m.max(v.abs()));
+        LayerFit {
+            storage,
+            weighted: !range.display && largest * plan.exposure.exp2() > range.least_max(),
+            keep_invalid: plan.input.keep_invalid,
+        }
+    }
+
+    /// Measures layer `layer` of a `dst` map (`img`), fixing what it must, into `report`.
+    fn layer(&self, dst: Projection, layer: usize, img: &mut Image, report: &mut fit::Report) {
+        let range = self.storage.range();
+        let (w, h) = (img.width(), img.height());
+        let weight = move |x: u32, y: u32| dst.texel_solid_angle(layer, x, y, w, h);
+        let mut m = range.measure(img, self.weighted.then_some(&weight as _));
+        if m.invalid > 0 && !self.keep_invalid {
+            report.replaced += mirrorball_core::sanitize_layer(img);
+            m = range.measure(img, self.weighted.then_some(&weight as _));
+        }
+        match report.parts.first_mut() {
+            Some(p) => *p = p.add(m),
+            None => report.parts.push(m),
+        }
+    }
+}
+
 /// Converts `src` into `dst`'s projection, layers `w`×`h`, one layer after another, and
 /// writes layer `i` to `paths[i]`, the set landing together (`mirrorball_io::OutputSet`): an
 /// interrupted or failed run leaves the old files as they were. One layer is in memory at a
-/// time, its buffer filled again for the next.
+/// time, its buffer filled again for the next. Each layer is measured by `fit` before it is
+/// written; returns what the set could not hold.
 fn convert_layers(
     src: load::Source,
     (dst, w, h): (Projection, u32, u32),
     opts: &ResampleOptions,
     paths: &[PathBuf],
-    write: &WriteOptions,
-) -> Result<(), CliError> {
+    (write, fit): (&WriteOptions, LayerFit),
+) -> Result<fit::Report, CliError> {
     let r = Resampler::new(&src.env, dst, w, h, opts);
     let mut set = OutputSet::new(write);
+    let mut report = fit::Report::new(fit.storage);
     for (layer, path) in paths.iter().enumerate() {
-        let img = match set.spare() {
+        let mut img = match set.spare() {
             Some(mut img) => {
                 r.layer_into(layer, &mut img);
                 img
             }
             None => r.layer(layer),
         };
+        fit.layer(dst, layer, &mut img, &mut report);
         set.push(path, img)?;
     }
     drop(r);
     drop(src);
     set.finish()?;
-    Ok(())
+    Ok(report)
 }
 
 /// `convert` of one file with a stereo pair on either side (`--in-stereo`, `--stereo`): the
@@ -385,9 +456,11 @@ fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
     let t_conv = t1.elapsed();
     let eyes_read = eyes.len();
     drop(eyes);
-    let files = with_spinner("writing", a.quiet, || {
+    let saved = with_spinner("writing", a.quiet, || {
         save::save_eyes(&out, plan.stereo, &a.output, &plan.save)
     })?;
+    plan.say_clipped(&a.output, &saved.report);
+    let files = saved.files;
     if !a.quiet {
         let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
         eprintln!(

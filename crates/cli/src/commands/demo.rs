@@ -122,6 +122,7 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                     layout: Some(layout),
                     write: w,
                     mips: false,
+                    keep_invalid: false,
                 };
                 save::save(
                     &out,
@@ -146,6 +147,7 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                         layout: None,
                         write: exr,
                         mips: true,
+                        keep_invalid: false,
                     };
                     save::save(&out, &dir.join("cube.ktx2").display().to_string(), &m)?;
                     save::save(&out, &dir.join("cube.dds").display().to_string(), &m)?;

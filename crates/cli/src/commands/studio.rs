@@ -336,13 +336,20 @@ impl Host for CliHost {
                     layout: None,
                     write: WriteOptions::default(),
                     mips: false,
+                    keep_invalid: false,
                 },
             )
-            .map(|_| ()),
+            .map(|saved| saved.report),
             Export::Chain(chain) => {
-                outputs::write_cube_chain(&path, chain, &WriteOptions::default())
+                outputs::write_cube_chain(&path, chain, &WriteOptions::default(), false)
             }
         };
+        // Said on the server's terminal: the page downloads the file as it is.
+        let written = written.map(|report| {
+            if let Some(line) = report.line(&format!("export.{format}"), &[]) {
+                eprintln!("{line}");
+            }
+        });
         let result = written
             .map_err(|e| e.to_string().replace(&shown, &format!("export.{format}")))
             .and_then(|()| {

@@ -11,6 +11,7 @@ mod names;
 mod prefilter;
 mod production;
 mod quality;
+mod ranges;
 mod render;
 mod roundtrip;
 mod safety;

@@ -7,4 +7,5 @@ mod imf_envmap;
 mod mutate;
 mod openexr;
 mod quality;
+mod ranges;
 mod records;

@@ -10,9 +10,11 @@ mod plan;
 
 use crate::budget;
 use crate::error::CliError;
+use crate::fit;
 use crate::load;
 use crate::progress::{with_progress, with_spinner};
 use crate::BakeArgs;
+use mirrorball_core::Choice;
 use plan::{BakePlan, Plan};
 use std::time::Instant;
 
@@ -53,11 +55,16 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
         "a smaller --size",
     )?;
     let t1 = Instant::now();
-    let lighting = with_progress("prefilter", plan.bake.rows(), plan.quiet, |counter| {
+    let mut lighting = with_progress("prefilter", plan.bake.rows(), plan.quiet, |counter| {
         plan.prefilter.progress = Some(counter);
         plan.bake.lighting(&env, plan.prefilter.clone())
     });
     drop(env);
+    let report = measure(&mut lighting, &plan);
+    let dir = format!("{}/", plan.dir.display());
+    if let Some(line) = report.line(&dir, &keep_advice(&plan, &report)) {
+        say(line);
+    }
     let t2 = Instant::now();
     let files = with_spinner("writing", plan.quiet, || {
         plan.bake.write(&lighting, &plan.dir)
@@ -74,4 +81,37 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
         t2.elapsed().as_secs_f64()
     ));
     Ok(())
+}
+
+/// The lighting's cubes measured against the bake's encoding (every cube file is written in
+/// it), NaN and infinities the work made replaced by 0 unless `--keep-invalid`: one part a
+/// specular level, then the diffuse cube.
+fn measure(l: &mut mirrorball_bake::Lighting, plan: &BakePlan) -> fit::Report {
+    let storage = mirrorball_io::Storage::Texels(plan.bake.encoding());
+    let keep = plan.input.keep_invalid;
+    let mut report = fit::measure_in_place(&mut l.specular, storage, keep);
+    report.labels = (0..l.specular.len())
+        .map(|i| format!("specular level {i}"))
+        .collect();
+    if let Some(d) = l.diffuse.as_mut() {
+        let mut diffuse = fit::measure_in_place(std::slice::from_mut(d), storage, keep);
+        diffuse.labels = vec!["the diffuse cube".into()];
+        report.extend(diffuse);
+    }
+    report
+}
+
+/// How to keep what the encoding clips: a float encoding where the engine takes one, else a
+/// darker source (and the engine's intensity raised to match).
+fn keep_advice(plan: &BakePlan, report: &fit::Report) -> Vec<String> {
+    let engine = plan.bake.engine;
+    let float = mirrorball_io::Encoding::Rgba32F;
+    if engine.describe().encodings.contains(&float) {
+        return vec![format!("--encoding {}", float.name())];
+    }
+    let n = report.stops_to_fit();
+    vec![format!(
+        "darken the source first (mirrorball convert --exposure -{n}) and raise {engine}'s intensity {}x",
+        1u64.checked_shl(n).map_or("2^n".to_string(), |k| k.to_string())
+    )]
 }

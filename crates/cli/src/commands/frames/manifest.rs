@@ -225,6 +225,7 @@ fn outputs(a: &ConvertArgs) -> Option<Vec<PathBuf>> {
         layout: a.layout.as_deref().and_then(|l| l.parse().ok()),
         write: Default::default(),
         mips: a.mips,
+        keep_invalid: a.input_args.keep_invalid,
     };
     Some(
         save::layer_files(&a.output, layers, &opts)

@@ -820,6 +820,7 @@ fn convert_frames(
 /// Writes one frame's file(s) through io's atomic writes; the name for the log.
 fn save_frame(eyes: &[EnvMap], path: &Path, plan: &Plan) -> Result<String, CliError> {
     let s = path.to_string_lossy().into_owned();
-    save::save_eyes(eyes, plan.stereo, &s, &plan.save)?;
+    let saved = save::save_eyes(eyes, plan.stereo, &s, &plan.save)?;
+    plan.say_clipped(&s, &saved.report);
     Ok(s)
 }

@@ -51,7 +51,13 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
     let t_filter = t1.elapsed();
 
     let t2 = Instant::now();
-    let mut written = outputs::write_chain(&plan, &chain)?;
+    let (mut written, report) = outputs::write_chain(&plan, &chain)?;
+    let keep: Vec<String> = crate::fit::precision_advice(report.storage)
+        .into_iter()
+        .collect();
+    if let Some(line) = report.line(&plan.output, &keep) {
+        say(&plan, line);
+    }
     if let Some(p) = &plan.sh_path {
         let described = Described {
             chain: &chain,

@@ -4,6 +4,7 @@
 
 use super::plan::Plan;
 use crate::error::CliError;
+use crate::fit;
 use crate::load;
 use crate::save;
 use mirrorball_core::glam::DVec2;
@@ -51,31 +52,49 @@ pub(super) fn check_parent(p: &Path, what: &str) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The chain: one cube container, or each level's file(s). Returns the files written.
-pub(super) fn write_chain(plan: &Plan, chain: &[EnvMap]) -> Result<Vec<String>, CliError> {
+/// The chain: one cube container, or each level's file(s). Returns the files written and
+/// what their storage could not hold, each level a part of the report.
+pub(super) fn write_chain(
+    plan: &Plan,
+    chain: &[EnvMap],
+) -> Result<(Vec<String>, fit::Report), CliError> {
     let mut written = Vec::new();
     if plan.format.is_cube_container() {
-        write_cube_chain(Path::new(&plan.output), chain, &plan.save.write)?;
+        let report = write_cube_chain(
+            Path::new(&plan.output),
+            chain,
+            &plan.save.write,
+            plan.save.keep_invalid,
+        )?;
         written.push(plan.output.clone());
-    } else {
-        for (i, level) in chain.iter().enumerate() {
-            let files = save::save(level, &level_path(&plan.output, i), &plan.save)?;
-            written.extend(files.iter().map(|p| p.display().to_string()));
-        }
+        return Ok((written, report));
     }
-    Ok(written)
+    let mut report = fit::Report::new(plan.format.storage(plan.save.write.precision));
+    for (i, level) in chain.iter().enumerate() {
+        let saved = save::save(level, &level_path(&plan.output, i), &plan.save)?;
+        written.extend(saved.files.iter().map(|p| p.display().to_string()));
+        report.extend(saved.report);
+    }
+    Ok((written, report))
 }
 
 /// A cube chain (level 0 first) as one KTX2 or DDS file (by `path`'s extension): what
-/// `prefilter` writes, and the studio's download of its chain.
+/// `prefilter` writes, and the studio's download of its chain. Each level is measured
+/// against the file's storage first (NaN and infinities the work made replaced by 0 unless
+/// `keep_invalid`); returns what the file could not hold.
 pub(crate) fn write_cube_chain(
     path: &Path,
     chain: &[EnvMap],
     write: &WriteOptions,
-) -> Result<(), CliError> {
+    keep_invalid: bool,
+) -> Result<fit::Report, CliError> {
+    let storage = Format::from_path(path)
+        .unwrap_or(Format::Ktx2)
+        .storage(write.precision);
+    let (chain, report) = fit::measure_maps(chain, storage, keep_invalid);
     let faces: Vec<Vec<Image>> = chain.iter().map(|l| l.layers().to_vec()).collect();
     mirrorball_io::write_cube(path, &faces, write)?;
-    Ok(())
+    Ok(report)
 }
 
 /// A level's lobe as the JSON names it.

@@ -63,6 +63,7 @@ impl Plan {
         let window = parse_window(a)?;
         let irradiance = parse_flag::<IrradianceMethod>("--irradiance", &a.irradiance)?;
         let opts = prefilter_options(a)?;
+        let keep_invalid = input.keep_invalid;
         let plan = Plan {
             input,
             source: a.input.clone(),
@@ -90,6 +91,7 @@ impl Plan {
                     ..Default::default()
                 },
                 mips: false,
+                keep_invalid,
             },
             opts,
             quiet: a.quiet,

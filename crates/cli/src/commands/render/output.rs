@@ -112,6 +112,15 @@ fn write_colour(path: &Path, img: &Image, plan: &RenderPlan) -> Result<(), CliEr
     } else {
         img
     };
+    let report = crate::fit::measure_picture(&img, plan.format.storage(None));
+    let keep = [crate::fit::exposure_advice(
+        "--exposure",
+        plan.exposure,
+        &report,
+    )];
+    if let (Some(line), false) = (report.line(&path.display().to_string(), &keep), plan.quiet) {
+        eprintln!("{line}");
+    }
     mirrorball_io::write_image(path, &img, &WriteOptions::default())?;
     Ok(())
 }
