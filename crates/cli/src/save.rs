@@ -3,7 +3,9 @@
 
 use crate::error::CliError;
 use crate::load::{layer_names, FACE};
-use mirrorball_core::{EnvMap, Image, Layout, ProjectionKind, Stereo, WorldProjection};
+use mirrorball_core::{
+    EnvMap, Image, Layout, Projection, ProjectionKind, Stereo, WorldProjection,
+};
 use mirrorball_filter::MipChain;
 use mirrorball_io::{Format, MapInfo, OutputSet, WriteOptions};
 use std::path::{Path, PathBuf};
@@ -29,7 +31,8 @@ pub fn default_layout(layers: usize) -> Layout {
     }
 }
 
-/// Checks that `out` can hold a map of `kind` before any work starts.
+/// Checks that `out` can hold a map of `kind` before any work starts (its folder is
+/// `guard::Files`' to check).
 pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<Format, CliError> {
     let path = Path::new(out);
     let format = Format::from_path(path).ok_or_else(|| {
@@ -70,15 +73,52 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
             )));
         }
     }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(CliError::request(format!(
-                "{out}: the folder {} does not exist",
-                dir.display()
-            )));
-        }
-    }
     Ok(format)
+}
+
+/// The width and height of each picture `out` (checked by [`check`]) holds of a map of
+/// `projection` at `size` (as `--size`), its eyes arranged as `stereo` says: a cube face in
+/// a KTX2/DDS file, a layer in one file a layer, else the packed (and joined) picture.
+pub fn picture_extent(
+    out: &str,
+    projection: Projection,
+    size: u32,
+    opts: &SaveOptions,
+    stereo: Stereo,
+) -> (u64, u64) {
+    let (w, h) = projection.layer_extent(size);
+    let n = projection.layer_count();
+    let format = Format::from_path(Path::new(out));
+    if format.is_some_and(Format::is_cube_container) || layer_files(out, n, opts).is_some() {
+        return (w as u64, h as u64);
+    }
+    let layout = match opts.layout {
+        None if projection.kind() == ProjectionKind::Eac && !out.contains(FACE) => {
+            Layout::default_for(projection.kind())
+        }
+        _ => output_layout(out, n, opts),
+    };
+    let (pw, ph) = layout.extent(n, w, h);
+    let (sw, sh) = stereo.extent(pw, ph);
+    (sw as u64, sh as u64)
+}
+
+/// The sizes (`--size`) of a map of `projection` that `out` holds and mirrorball reads back
+/// ([`crate::size::pictures`]).
+pub fn size_bound(
+    out: &str,
+    projection: Projection,
+    opts: &SaveOptions,
+    stereo: Stereo,
+) -> crate::size::Bound {
+    let format = Format::from_path(Path::new(out)).unwrap_or(Format::Exr);
+    let what = match format.is_cube_container() {
+        true => format!("{out}'s cube face"),
+        false => format!("{out}'s picture"),
+    };
+    crate::size::pictures(format, &what, |s| {
+        picture_extent(out, projection, s, opts, stereo)
+    })
 }
 
 /// The layout `out` gets for a map of `layers` layers.
