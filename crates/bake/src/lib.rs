@@ -195,8 +195,9 @@ impl BakeOptions {
     }
 }
 
-/// Largest level-0 face edge a bake takes.
-pub const MAX_SIZE: u32 = 4096;
+/// Largest level-0 face edge a bake takes: the largest cube face GPUs take
+/// ([`mirrorball_io::MAX_CUBE_FACE`]).
+pub const MAX_SIZE: u32 = mirrorball_io::MAX_CUBE_FACE;
 
 /// Prefiltered lighting, cube faces in OpenGL order and orientation: in mirrorball's world
 /// axes as [`Lighting::from_env`] makes it, in the engine's once [`Lighting::oriented`]

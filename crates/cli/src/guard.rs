@@ -1,8 +1,12 @@
 //! No output may be an input, nor two outputs one file: checked on the files themselves
 //! (device and inode), so that `./s.exr`, `$PWD/s.exr`, `sub/../s.exr`, hard links and
-//! symbolic links are all caught, before anything is written.
+//! symbolic links are all caught, before anything is written. Every output can be written
+//! where it is asked for (its name no folder, its folder there or makeable, writable:
+//! `mirrorball_io::check_writable`), and, once the command knows about how many bytes it
+//! writes, its file system has room for them: all before any input is read.
 
 use crate::error::CliError;
+use mirrorball_io::Folders;
 use std::path::{Path, PathBuf};
 
 /// The files a command reads and writes, gathered while its plan is made.
@@ -10,6 +14,8 @@ use std::path::{Path, PathBuf};
 pub struct Files {
     inputs: Vec<(String, PathBuf)>,
     outputs: Vec<(String, PathBuf)>,
+    /// Which folders of the outputs the command makes.
+    folders: Folders,
 }
 
 impl Files {
@@ -45,9 +51,66 @@ impl Files {
         self
     }
 
+    /// The command makes the outputs' folders as `folders` says (by default none: each
+    /// must exist).
+    pub fn making(&mut self, folders: Folders) -> &mut Files {
+        self.folders = folders;
+        self
+    }
+
     /// Refuses the request when an output is one of the inputs or two outputs are one
-    /// file.
+    /// file, and refuses an output that cannot be written ([`Files::writable`]).
     pub fn check(&self) -> Result<(), CliError> {
+        self.distinct()?;
+        self.writable()
+    }
+
+    /// Refuses an output whose name is a folder, whose folder is missing (beyond what the
+    /// command makes) or cannot be written: the message names the output.
+    pub fn writable(&self) -> Result<(), CliError> {
+        let mut seen = std::collections::HashSet::new();
+        for (what, out) in &self.outputs {
+            // Each folder once: a chain of levels or faces shares one.
+            let folder = mirrorball_io::output_folder(out);
+            if out.is_dir() || seen.insert(folder) {
+                mirrorball_io::check_writable(out, self.folders).map_err(|e| {
+                    CliError::new(
+                        e.fault(),
+                        format!("{what} {}: {}", e.path().display(), e.problem()),
+                    )
+                })?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuses the job when a file system that would hold outputs has less room than
+    /// `bytes`, about what the outputs take in all (each file system is asked for all of
+    /// it: outputs are rarely spread over several).
+    pub fn room(&self, bytes: u64) -> Result<(), CliError> {
+        let mut seen = std::collections::HashSet::new();
+        for (what, out) in &self.outputs {
+            if !seen.insert(mirrorball_io::file_system(out)) {
+                continue;
+            }
+            let Some(free) = mirrorball_io::free_bytes(out) else {
+                continue;
+            };
+            if free < bytes {
+                return Err(CliError::system(format!(
+                    "{what} {}: the outputs need about {}, but its file system ({}) has {} free; free some space or write elsewhere",
+                    out.display(),
+                    crate::budget::human(bytes),
+                    mirrorball_io::output_folder(out).display(),
+                    crate::budget::human(free)
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// No output is an input, no two outputs one file.
+    pub fn distinct(&self) -> Result<(), CliError> {
         for (what_out, out) in &self.outputs {
             for (what_in, inp) in &self.inputs {
                 if mirrorball_io::same_file(inp, out) {

@@ -12,6 +12,7 @@ mod guard;
 mod load;
 mod progress;
 mod save;
+mod size;
 mod spec;
 
 use choice::{names, names_of};
@@ -123,8 +124,8 @@ pub struct ConvertArgs {
     /// Face edge (cubes), width (lat-long, Mercator, cylinders, Hammer, sinusoidal, views) or
     /// diameter (disk maps), in texels; one eye's, for a stereo pair (--stereo).
     /// Default: about the source's resolution (its one eye's).
-    #[arg(long)]
-    size: Option<u32>,
+    #[arg(long, value_parser = size::parse, allow_hyphen_values = true)]
+    size: Option<i64>,
     /// Layout of the output's layers: hcross, vcross, hstrip, vstrip, separate, or v360's
     /// c3x2, c6x1, c1x6 (with `:forder=rludfb:frot=000000`) and eac (EAC's default).
     #[arg(long, value_name = "LAYOUT")]
@@ -220,8 +221,8 @@ pub struct DemoArgs {
     #[arg(long, default_value = "mirrorball-demo")]
     out: String,
     /// Lat-long width of the largest outputs; other projections scale to match.
-    #[arg(long, default_value_t = 1024)]
-    size: u32,
+    #[arg(long, default_value_t = 1024, value_parser = size::parse, allow_hyphen_values = true)]
+    size: i64,
     /// Exposure of the PNG previews, in stops.
     #[arg(long, value_parser = exposure_stops, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
@@ -252,8 +253,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "PROJECTION")]
     env_as: Option<String>,
     /// Size for --env-as (face edge, width or diameter).
-    #[arg(long)]
-    env_size: Option<u32>,
+    #[arg(long, value_parser = size::parse, allow_hyphen_values = true)]
+    env_size: Option<i64>,
     /// Indexing mode: 1|texgen, 2|vertex, 3|pixel, 4|cone.
     #[arg(long, default_value = "pixel", value_parser = names::<Indexing>())]
     mode: String,
@@ -310,7 +311,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = finite_f32, default_value_t = 1000.0)]
     far: f32,
     /// Image size WIDTHxHEIGHT.
-    #[arg(long, default_value = "640x480")]
+    #[arg(long, default_value = "640x480", allow_hyphen_values = true)]
     size: String,
     /// Supersampling: NxN samples per pixel.
     #[arg(long, default_value_t = 2)]
@@ -357,8 +358,13 @@ pub struct AnalyzeArgs {
     projections: Vec<String>,
     /// The same edge size for every projection (cube face edge, lat-long width, disk
     /// diameter).
-    #[arg(long, conflicts_with = "texel_budget")]
-    size: Option<u32>,
+    #[arg(
+        long,
+        conflicts_with = "texel_budget",
+        value_parser = size::parse,
+        allow_hyphen_values = true
+    )]
+    size: Option<i64>,
     /// The same number of texels, all layers together, for every projection (a fair
     /// comparison: 1572864 = six 512² cube faces = one 1254² sphere map). Default: 1572864.
     #[arg(long, value_name = "TEXELS")]
@@ -383,8 +389,8 @@ pub struct PrefilterArgs {
     lobe: String,
     /// Face edge of level 0 (cubes; width or diameter for other projections). Default: 32
     /// for lambert; the source's resolution (a power of two, at most 512) otherwise.
-    #[arg(long)]
-    size: Option<u32>,
+    #[arg(long, value_parser = size::parse, allow_hyphen_values = true)]
+    size: Option<i64>,
     /// Output projection (as --to of convert); KTX2/DDS hold cubes only.
     #[arg(long, default_value = "cube", value_name = "PROJECTION")]
     to: String,
@@ -470,8 +476,8 @@ pub struct BakeArgs {
     /// The folder to write into (made if missing; its parent must exist).
     out_dir: Option<String>,
     /// Face edge of the specular chain's level 0, a power of two.
-    #[arg(long, default_value_t = 256)]
-    size: u32,
+    #[arg(long, default_value_t = 256, value_parser = size::parse, allow_hyphen_values = true)]
+    size: i64,
     /// Texel encoding (default: the engine's; `bake --for list` shows which it takes).
     #[arg(long, value_parser = names::<mirrorball_io::Encoding>())]
     encoding: Option<String>,

@@ -4,7 +4,9 @@
 use crate::error::CliError;
 use crate::fit::{self, Report};
 use crate::load::{layer_names, FACE};
-use mirrorball_core::{EnvMap, Image, Layout, ProjectionKind, Stereo, WorldProjection};
+use mirrorball_core::{
+    EnvMap, Image, Layout, Projection, ProjectionKind, Stereo, WorldProjection,
+};
 use mirrorball_filter::MipChain;
 use mirrorball_io::{Format, MapInfo, OutputSet, WriteOptions};
 use std::path::{Path, PathBuf};
@@ -41,14 +43,9 @@ pub fn default_layout(layers: usize) -> Layout {
     }
 }
 
-/// Checks that `out` can hold a map of `kind` before any work starts; its folder must exist
-/// unless `folder` says it is made ([`Folder::Made`]).
-pub fn check(
-    out: &str,
-    kind: ProjectionKind,
-    layout: Option<Layout>,
-    folder: Folder,
-) -> Result<Format, CliError> {
+/// Checks that `out` can hold a map of `kind` before any work starts (its folder is
+/// `guard::Files`' to check).
+pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<Format, CliError> {
     let path = Path::new(out);
     let format = Format::from_path(path).ok_or_else(|| {
         CliError::request(format!(
@@ -88,49 +85,12 @@ pub fn check(
             )));
         }
     }
-    folder.check(out)?;
     Ok(format)
 }
 
-/// What an output's folder must be before any work.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Folder {
-    /// It exists (one file).
-    Exists,
-    /// It exists, or it is made (a sequence's outputs, [`make_folder`]): its parent exists.
-    Made,
-}
-
-impl Folder {
-    fn check(self, out: &str) -> Result<(), CliError> {
-        let Some(dir) = Path::new(out).parent().filter(|d| !d.as_os_str().is_empty()) else {
-            return Ok(());
-        };
-        if dir.is_dir() {
-            return Ok(());
-        }
-        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-        match self {
-            Folder::Made if dir.exists() => Err(CliError::request(format!(
-                "{out}: {} is a file, not a folder",
-                dir.display()
-            ))),
-            Folder::Made if parent.map_or(true, Path::is_dir) => Ok(()),
-            Folder::Made => Err(CliError::request(format!(
-                "{out}: the folder {} does not exist (a sequence makes its output folder, not its parents)",
-                parent.map(Path::display).expect("a parent that is not a folder")
-            ))),
-            Folder::Exists => Err(CliError::request(format!(
-                "{out}: the folder {} does not exist",
-                dir.display()
-            ))),
-        }
-    }
-}
-
-/// The folder of `out` made when missing ([`Folder::Made`] checked it): the folder, when
-/// this call made it, marked so that an interrupt removes it again if it is left empty
-/// (`mirrorball_io::made_folder`).
+/// The folder of `out` made when missing (`Folders::MakeOne` checked it can be): the
+/// folder, when this call made it, marked so that an interrupt removes it again if it is
+/// left empty (`mirrorball_io::made_folder`).
 pub fn make_folder(out: &Path) -> Result<Option<PathBuf>, CliError> {
     let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) else {
         return Ok(None);
@@ -147,6 +107,51 @@ pub fn make_folder(out: &Path) -> Result<Option<PathBuf>, CliError> {
             dir.display()
         ))),
     }
+}
+
+/// The width and height of each picture `out` (checked by [`check`]) holds of a map of
+/// `projection` at `size` (as `--size`), its eyes arranged as `stereo` says: a cube face in
+/// a KTX2/DDS file, a layer in one file a layer, else the packed (and joined) picture.
+pub fn picture_extent(
+    out: &str,
+    projection: Projection,
+    size: u32,
+    opts: &SaveOptions,
+    stereo: Stereo,
+) -> (u64, u64) {
+    let (w, h) = projection.layer_extent(size);
+    let n = projection.layer_count();
+    let format = Format::from_path(Path::new(out));
+    if format.is_some_and(Format::is_cube_container) || layer_files(out, n, opts).is_some() {
+        return (w as u64, h as u64);
+    }
+    let layout = match opts.layout {
+        None if projection.kind() == ProjectionKind::Eac && !out.contains(FACE) => {
+            Layout::default_for(projection.kind())
+        }
+        _ => output_layout(out, n, opts),
+    };
+    let (pw, ph) = layout.extent(n, w, h);
+    let (sw, sh) = stereo.extent(pw, ph);
+    (sw as u64, sh as u64)
+}
+
+/// The sizes (`--size`) of a map of `projection` that `out` holds and mirrorball reads back
+/// ([`crate::size::pictures`]).
+pub fn size_bound(
+    out: &str,
+    projection: Projection,
+    opts: &SaveOptions,
+    stereo: Stereo,
+) -> crate::size::Bound {
+    let format = Format::from_path(Path::new(out)).unwrap_or(Format::Exr);
+    let what = match format.is_cube_container() {
+        true => format!("{out}'s cube face"),
+        false => format!("{out}'s picture"),
+    };
+    crate::size::pictures(format, &what, |s| {
+        picture_extent(out, projection, s, opts, stereo)
+    })
 }
 
 /// The layout `out` gets for a map of `layers` layers.
@@ -259,7 +264,7 @@ pub fn save_eyes(
 ) -> Result<Saved, CliError> {
     let env = &eyes[0];
     let path = Path::new(out);
-    let format = check(out, env.projection().kind(), opts.layout, Folder::Exists)?;
+    let format = check(out, env.projection().kind(), opts.layout)?;
     check_stereo(out, env.layers().len(), stereo, opts)?;
     let storage = format.storage(opts.write.precision);
     if format.is_cube_container() {

@@ -274,7 +274,7 @@ fn forget_pending(tmp: &Path) {
 
 /// The file `path` names once symbolic links are followed (at most 40 of them, as Linux
 /// does); `path` itself when it is no link, or a loop.
-fn write_through(path: &Path) -> PathBuf {
+pub(crate) fn write_through(path: &Path) -> PathBuf {
     let mut p = path.to_path_buf();
     for _ in 0..40 {
         let is_link = std::fs::symlink_metadata(&p)

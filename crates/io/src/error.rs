@@ -33,6 +33,15 @@ impl Error {
             source: None,
         }
     }
+    /// The system's fault (a folder that cannot be written, a full disk).
+    pub fn system(path: &Path, problem: String) -> Error {
+        Error {
+            path: path.to_path_buf(),
+            fault: Fault::System,
+            problem,
+            source: None,
+        }
+    }
     /// The system's fault, from an I/O error. A missing input file is the input's fault.
     pub fn io(path: &Path, e: std::io::Error) -> Error {
         let problem = match e.kind() {

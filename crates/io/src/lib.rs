@@ -26,6 +26,7 @@ mod atomic;
 mod babylon_env;
 mod bounds;
 mod dds_io;
+mod destination;
 mod error;
 mod exr_io;
 mod exr_zip;
@@ -45,6 +46,7 @@ pub use apng::write_apng;
 pub use atomic::{atomic_write, interrupted, keep_folder, made_folder, write_together};
 pub use babylon_env::{read_babylon_env, write_babylon_env, BabylonEnv};
 pub use dds_io::write_dds;
+pub use destination::{check_writable, file_system, free_bytes, output_folder, Folders};
 pub use error::{Error, Fault};
 pub use gltf_ibl::{read_gltf_ibl, write_gltf_ibl, GltfIbl};
 pub use ktx1_io::{filament_sh_text, write_ktx1};
@@ -198,7 +200,42 @@ impl Format {
             _ => Storage::Texels(Encoding::Rgba16F),
         }
     }
+    /// The largest side of a picture (of a cube face, for KTX2 and DDS) a file of this
+    /// format holds: a JPEG's 16-bit fields; for the GPU containers [`MAX_CUBE_FACE`]; the
+    /// others' fields are 32-bit (mirrorball's reading bounds, [`Limits`], are tighter).
+    pub fn max_side(self) -> u64 {
+        match self {
+            Format::Jpeg => u16::MAX as u64,
+            Format::Ktx2 | Format::Dds => MAX_CUBE_FACE as u64,
+            Format::Exr | Format::Hdr | Format::Png | Format::Webp => u32::MAX as u64,
+        }
+    }
+
+    /// About how many bytes `texels` texels of `channels` channels take in a file of this
+    /// format at `precision` (the format's default when `None`), before compression: an
+    /// upper bound for EXR, PNG and JPEG, about the size for Radiance HDR (four bytes a
+    /// texel), KTX2 and DDS (four channels). For the room an output needs on disk.
+    pub fn bytes_estimate(self, texels: u64, channels: u64, precision: Option<Precision>) -> u64 {
+        let per_channel = match precision {
+            Some(Precision::Float) => 4,
+            Some(Precision::Half | Precision::U16) => 2,
+            Some(Precision::U8) => 1,
+            None if matches!(self, Format::Png | Format::Jpeg | Format::Webp) => 1,
+            None => 2,
+        };
+        let per_texel = match self {
+            Format::Hdr => 4,
+            Format::Jpeg => 3,
+            Format::Ktx2 | Format::Dds => 4 * per_channel,
+            _ => channels * per_channel,
+        };
+        texels.saturating_mul(per_texel)
+    }
 }
+
+/// The largest cube face written into a GPU container: what Direct3D 11 and 12 take
+/// (`D3D11_REQ_TEXTURECUBE_DIMENSION`), and what Vulkan and OpenGL devices commonly take.
+pub const MAX_CUBE_FACE: u32 = 16384;
 
 /// Bounds checked against a file's declared size before anything is allocated.
 #[derive(Clone, Copy, Debug)]
@@ -448,8 +485,22 @@ pub fn write_cube(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Re
 /// assert!(mirrorball_io::same_file(&a, &dir.path().join(".").join("a.exr")));
 /// assert!(!mirrorball_io::same_file(&a, &dir.path().join("b.exr")));
 /// ```
+///
+/// On Unix the files' metadata is compared, so that neither is opened: opening a FIFO
+/// waits for a writer, and a command's plan reads nothing.
 pub fn same_file(a: &Path, b: &Path) -> bool {
-    same_file::is_same_file(a, b).unwrap_or(false)
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (std::fs::metadata(a), std::fs::metadata(b)) {
+            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        same_file::is_same_file(a, b).unwrap_or(false)
+    }
 }
 
 fn unknown_ext() -> String {

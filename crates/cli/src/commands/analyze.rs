@@ -40,12 +40,14 @@ fn plan(a: &AnalyzeArgs) -> Result<Plan, CliError> {
             .collect::<Result<Vec<_>, _>>()?
     };
     let sizing = match (a.size, a.texel_budget) {
-        (Some(n), _) if n == 0 || n > MAX_SIZE => {
-            return Err(CliError::request(format!(
-                "--size {n} is outside 1..={MAX_SIZE}"
-            )))
-        }
-        (Some(n), _) => Sizing::Size(n),
+        (Some(n), _) => Sizing::Size(
+            crate::size::Bound {
+                min: 1,
+                max: MAX_SIZE,
+                why: "an 8192² disk map is 67 M texels, about a minute to measure".into(),
+            }
+            .check("--size", n)?,
+        ),
         (None, Some(b)) if b == 0 || b > MAX_BUDGET => {
             return Err(CliError::request(format!(
                 "--texel-budget {b} is outside 1..={MAX_BUDGET}"
@@ -61,6 +63,11 @@ fn plan(a: &AnalyzeArgs) -> Result<Plan, CliError> {
             out.display()
         )));
     }
+    let mut files = crate::guard::Files::new();
+    files
+        .making(mirrorball_io::Folders::MakeAll)
+        .output("--out", out.join("index.html"));
+    files.check()?;
     Ok(Plan {
         projections,
         sizing,

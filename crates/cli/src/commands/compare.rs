@@ -26,6 +26,9 @@ pub fn run(a: CompareArgs) -> Result<(), CliError> {
         .map(ProjSpec::parse)
         .transpose()
         .map_err(|e| bad("--test-from", e))?;
+    // A difference picture that cannot be written is said after the score, which is
+    // worth having without it; one that would overwrite an input is refused now.
+    let mut unwritable = None;
     if let Some(d) = &a.diff {
         if !matches!(
             Format::from_path(std::path::Path::new(d)),
@@ -40,7 +43,8 @@ pub fn run(a: CompareArgs) -> Result<(), CliError> {
             .input_arg("the reference", &a.reference)
             .input_arg("the test map", &a.test)
             .output("--diff", d);
-        files.check()?;
+        files.distinct()?;
+        unwritable = files.writable().err();
     }
     let limits = mirrorball_io::Limits::default();
     let mut r = load::load(&a.reference, from.as_ref(), None, &limits)?;
@@ -70,7 +74,8 @@ pub fn run(a: CompareArgs) -> Result<(), CliError> {
     let psnr = log_psnr_where(&r.env, &test, covers).expect("same shape");
     let (diff, both_sr, worst) = differences(&r.env, &test, &covers);
     let total_sr = r.env.projection().covered_solid_angle();
-    if let Some(d) = &a.diff {
+    let diff_path = a.diff.as_ref().filter(|_| unwritable.is_none());
+    if let Some(d) = diff_path {
         write_diff(&diff, d, worst)?;
     }
     if a.json {
@@ -86,13 +91,13 @@ pub fn run(a: CompareArgs) -> Result<(), CliError> {
             "projection": r.env.projection().name(),
             "width": r.env.width(),
             "height": r.env.height(),
-            "diff": a.diff,
+            "diff": diff_path,
         });
         println!(
             "{}",
             serde_json::to_string_pretty(&v).expect("serialisable")
         );
-        return Ok(());
+        return unwritable.map_or(Ok(()), Err);
     }
     let over = if (both_sr - 4.0 * std::f64::consts::PI).abs() < 1e-6 {
         "over the whole sphere".to_string()
@@ -110,10 +115,10 @@ pub fn run(a: CompareArgs) -> Result<(), CliError> {
             " (test map converted to the reference's projection and size)"
         }
     );
-    if let Some(d) = &a.diff {
+    if let Some(d) = diff_path {
         println!("wrote {d}");
     }
-    Ok(())
+    unwritable.map_or(Ok(()), Err)
 }
 
 /// Per texel of `reference`, `|ln(1 + r) − ln(1 + t)|` per colour channel (0 where `keep`

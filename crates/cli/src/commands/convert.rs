@@ -13,7 +13,7 @@ use mirrorball_core::{
     resample, Axis, AxisMap, EnvMap, Image, Layout, Projection, ProjectionKind, Remap,
     ResampleOptions, Resampler, Rotation, Stereo, WorldProjection,
 };
-use mirrorball_io::{ExrCompression, Format, OutputSet, Precision, WriteOptions};
+use mirrorball_io::{ExrCompression, Folders, Format, OutputSet, Precision, WriteOptions};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -33,6 +33,9 @@ pub(crate) struct Plan {
     pub(crate) in_stereo: Option<Stereo>,
     /// `--stereo`: how the output picture holds its eyes.
     pub(crate) stereo: Stereo,
+    /// The input and output files, checked ([`Plan::new`]); their room on disk is checked
+    /// once the output's size is known ([`Plan::check_room`]).
+    pub(crate) files: Files,
     /// The output's container.
     pub(crate) format: Format,
     /// `--exposure`, for the advice when an output cannot hold a value.
@@ -51,8 +54,18 @@ fn parse_compression(c: &str) -> Result<ExrCompression, CliError> {
 }
 
 impl Plan {
-    /// The plan of `a`, its output's folder as `folder` says (one file's must exist).
-    pub(crate) fn new(a: &ConvertArgs, folder: save::Folder) -> Result<Plan, CliError> {
+    /// The plan of `a`, its output written to files: each checked writable, its folders
+    /// made as `folders` says (one file's must exist; a sequence makes its own).
+    pub(crate) fn new(a: &ConvertArgs, folders: Folders) -> Result<Plan, CliError> {
+        let mut plan = Plan::unwritten(a)?;
+        plan.files.making(folders);
+        plan.files.writable()?;
+        Ok(plan)
+    }
+
+    /// The plan of `a` whose output goes elsewhere (a pipe: `a.output` only names the
+    /// container its frames are packed as), so no folder of it is checked.
+    pub(crate) fn unwritten(a: &ConvertArgs) -> Result<Plan, CliError> {
         let input = InputPlan::new(&a.input_args)?;
         let to = ProjSpec::parse(&a.to).map_err(|e| bad("--to", e))?;
         let layout = a
@@ -61,14 +74,7 @@ impl Plan {
             .map(str::parse::<Layout>)
             .transpose()
             .map_err(|e| bad("--layout", e))?;
-        if let Some(s) = a.size {
-            if s == 0 || s > 32768 {
-                return Err(CliError::request(format!(
-                    "--size: {s} is outside 1..=32768"
-                )));
-            }
-        }
-        let format = save::check(&a.output, to.kind, layout, folder)?;
+        let format = save::check(&a.output, to.kind, layout)?;
         let precision = parse_precision(a.precision.as_deref())?;
         match (format, precision) {
             (Format::Png, Some(Precision::Half | Precision::Float))
@@ -129,6 +135,11 @@ impl Plan {
         let in_stereo = stereo_flag("--in-stereo", a.in_stereo.as_deref())?;
         let stereo = stereo_flag("--stereo", a.stereo.as_deref())?.unwrap_or_default();
         save::check_stereo(&a.output, layers, stereo, &save)?;
+        let dst = to.build(None).map_err(|e| bad("--to", e))?;
+        let size = a
+            .size
+            .map(|s| save::size_bound(&a.output, dst, &save, stereo).check("--size", s))
+            .transpose()?;
         let mut files = Files::new();
         files.input_arg("the input", &a.input);
         match save::layer_files(&a.output, layers, &save) {
@@ -139,11 +150,11 @@ impl Plan {
                 files.output("the output", &a.output);
             }
         }
-        files.check()?;
+        files.distinct()?;
         Ok(Plan {
             input,
             to,
-            size: a.size,
+            size,
             save,
             resample: ResampleOptions {
                 rotation,
@@ -154,6 +165,7 @@ impl Plan {
             orient,
             in_stereo,
             stereo,
+            files,
             format,
             exposure: a.exposure,
             quiet: a.quiet,
@@ -172,6 +184,24 @@ impl Plan {
         }
     }
 
+    /// Refuses the job when the output's file system lacks room for a map of `layers`
+    /// layers `w`×`h` of `channels` channels (`eyes` of them in one picture), with its mips
+    /// when asked.
+    pub(crate) fn check_room(
+        &self,
+        (w, h): (u32, u32),
+        layers: usize,
+        eyes: usize,
+        channels: usize,
+    ) -> Result<(), CliError> {
+        let texels = w as u64 * h as u64 * layers as u64 * eyes as u64;
+        let texels = if self.save.mips { texels * 4 / 3 } else { texels };
+        let bytes = self
+            .format
+            .bytes_estimate(texels, channels as u64, self.save.write.precision);
+        self.files.room(bytes)
+    }
+
     /// Whether either side is said to be a stereo pair (a pair a file records, read with
     /// neither flag, gives its left eye: a `2d` output).
     pub(crate) fn is_stereo(&self) -> bool {
@@ -184,7 +214,13 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     if let Some(done) = super::frames::route(&a) {
         return done;
     }
-    let mut plan = Plan::new(&a, save::Folder::Exists)?;
+    let mut plan = Plan::new(&a, Folders::Exist)?;
+    // The room on disk now when --size gives the output's size (four channels at most),
+    // else once the source is read.
+    if let Some(size) = plan.size {
+        let dst = plan.to.build(None).map_err(|e| bad("--to", e))?;
+        plan.check_room(dst.layer_extent(size), dst.layer_count(), plan.stereo.eyes(), 4)?;
+    }
     if plan.is_stereo() {
         return convert_pair(&a, &plan);
     }
@@ -210,6 +246,9 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
         .size
         .unwrap_or_else(|| save::default_size(&src.env, dst.kind()));
     let (w, h) = dst.layer_extent(size);
+    if plan.size.is_none() {
+        plan.check_room((w, h), dst.layer_count(), 1, src.env.channels())?;
+    }
     let rows = h as u64 * dst.layer_count() as u64;
     // Turning a cube into an engine's axes moves texels between faces: the whole map first.
     let layer_files = save::layer_files(&a.output, dst.layer_count(), &plan.save)
@@ -400,6 +439,9 @@ fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
         .size
         .unwrap_or_else(|| save::default_size(left, dst.kind()));
     let (w, h) = dst.layer_extent(size);
+    if plan.size.is_none() {
+        plan.check_room((w, h), dst.layer_count(), plan.stereo.eyes(), left.channels())?;
+    }
     let c = left.channels() as u64;
     let texels = |w: u32, h: u32, n: usize| w as u64 * h as u64 * n as u64;
     let out_eyes = plan.stereo.eyes();

@@ -67,14 +67,61 @@ fn edge(kind: ProjectionKind, size: u32) -> u32 {
     }
 }
 
+/// The demo's sizes: at least 8 (the smallest maps stay maps), at most what every file it
+/// writes holds and mirrorball reads back (each projection's EXR, the cube's KTX2 and DDS).
+fn size_bound() -> crate::size::Bound {
+    let smallest = crate::size::Bound {
+        min: 8,
+        max: u32::MAX,
+        why: String::new(),
+    };
+    ProjectionKind::ALL.iter().fold(smallest, |b, &kind| {
+        let p = kind.default_projection();
+        let layout = mirrorball_core::Layout::default_for(kind);
+        let picture = |s: u32| {
+            let (w, h) = p.layer_extent(edge(kind, s));
+            let (pw, ph) = layout.extent(p.layer_count(), w, h);
+            (pw as u64, ph as u64)
+        };
+        let name = format!("{}.exr", kind.name());
+        let b = b.and(crate::size::pictures(mirrorball_io::Format::Exr, &name, picture));
+        match kind {
+            ProjectionKind::Cube => b.and(crate::size::pictures(
+                mirrorball_io::Format::Ktx2,
+                "cube.ktx2's face",
+                |s| (edge(kind, s) as u64, edge(kind, s) as u64),
+            )),
+            _ => b,
+        }
+    })
+}
+
+/// About how many bytes the demo writes at `size`: every projection as a half-float EXR
+/// and an 8-bit PNG, uncompressed, the cube twice more with its mips as RGBA16F (KTX2 and
+/// DDS), the source and the sheet.
+fn output_bytes(size: u32) -> u64 {
+    let texels = |p: mirrorball_core::Projection, s: u32| {
+        let (w, h) = p.layer_extent(s);
+        w as u64 * h as u64 * p.layer_count() as u64
+    };
+    let maps: u64 = ProjectionKind::ALL
+        .iter()
+        .map(|&k| texels(k.default_projection(), edge(k, size)) * (6 + 3))
+        .sum();
+    let cube = ProjectionKind::Cube.default_projection();
+    let chains = 2 * texels(cube, edge(ProjectionKind::Cube, size)) * 8 * 4 / 3;
+    maps + chains + CITY_EXR.len() as u64 + 5 * SHEET_CELL as u64 * SHEET_CELL as u64 * 4 * 3
+}
+
 pub fn run(a: DemoArgs) -> Result<(), CliError> {
-    if a.size < 8 || a.size > 16384 {
-        return Err(CliError::request(format!(
-            "--size {} is outside 8..=16384",
-            a.size
-        )));
-    }
+    let size = size_bound().check("--size", a.size)?;
     let dir = Path::new(&a.out);
+    let mut files = crate::guard::Files::new();
+    files
+        .making(mirrorball_io::Folders::MakeAll)
+        .output("--out", dir.join("index.html"));
+    files.check()?;
+    files.room(output_bytes(size))?;
     std::fs::create_dir_all(dir).map_err(|e| {
         CliError::system(format!("{}: cannot create the folder: {e}", dir.display()))
     })?;
@@ -112,7 +159,7 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         |done| -> Result<(), CliError> {
             for kind in ProjectionKind::ALL {
                 let proj = kind.default_projection();
-                let size = edge(kind, a.size);
+                let size = edge(kind, size);
                 let t = Instant::now();
                 let out = resample(&src, proj, size, &opts);
                 let secs = t.elapsed().as_secs_f64();

@@ -8,6 +8,7 @@ mod commands;
 mod frames;
 mod hostile;
 mod names;
+mod outputs;
 mod prefilter;
 mod production;
 mod quality;

@@ -73,8 +73,15 @@ impl Plan {
             // Zstandard level 3, KTX-Software's default, where the engine reads it.
             (None, false) => takes_zstd.then_some(3),
         };
+        // A cube face: the GPU containers' limit (what mirrorball_bake::MAX_SIZE is).
+        let size = crate::size::pictures(
+            mirrorball_io::Format::Ktx2,
+            "a baked cube face",
+            |s| (s as u64, s as u64),
+        )
+        .check("--size", a.size)?;
         let opts = BakeOptions {
-            size: a.size,
+            size,
             encoding,
             effort,
             zstd,
@@ -88,14 +95,16 @@ impl Plan {
                 return Err(CliError::request(format!(
                     "--mapping lists {} roughness values but the chain of {} has {n} levels",
                     r.len(),
-                    a.size
+                    size
                 )));
             }
         }
         let dir = PathBuf::from(out);
         check_dir(&dir)?;
         let mut files = Files::new();
-        files.input_arg("the input", source);
+        files
+            .making(mirrorball_io::Folders::MakeOne)
+            .input_arg("the input", source);
         for name in engine
             .file_names(&bake.opts)
             .into_iter()
@@ -111,6 +120,7 @@ impl Plan {
             files.output("a baked file", path);
         }
         files.check()?;
+        files.room(file_bytes(&bake))?;
         if a.samples == 0 || a.samples > 65536 {
             return Err(CliError::request(format!(
                 "--samples: {} is outside 1..=65536",
@@ -131,7 +141,8 @@ impl Plan {
     }
 }
 
-/// The output folder: a folder or nothing yet, in a folder that exists.
+/// The output folder: a folder or nothing yet (that it can be made, in a folder that
+/// exists and can be written, is checked with its files: `guard::Files`).
 fn check_dir(dir: &Path) -> Result<(), CliError> {
     if dir.exists() && !dir.is_dir() {
         return Err(CliError::request(format!(
@@ -139,14 +150,14 @@ fn check_dir(dir: &Path) -> Result<(), CliError> {
             dir.display()
         )));
     }
-    if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
-        if !parent.is_dir() {
-            return Err(CliError::request(format!(
-                "{}: the folder {} does not exist (bake makes OUT-DIR, not its parents)",
-                dir.display(),
-                parent.display()
-            )));
-        }
-    }
     Ok(())
+}
+
+/// About how many bytes the bake's files take: each cube of the chain and the diffuse cube
+/// in the encoding (twice over, for engines that also write the faces or a skybox).
+fn file_bytes(bake: &Bake) -> u64 {
+    let encoding = bake.encoding();
+    let cube = |f: u32| 6 * encoding.image_bytes(f, f) as u64;
+    let chain: u64 = bake.spec.levels.iter().map(|&(f, _)| cube(f)).sum();
+    2 * (chain + bake.spec.diffuse_face.map_or(0, cube))
 }

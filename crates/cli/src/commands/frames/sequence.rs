@@ -157,7 +157,10 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         // A pipe's frames are packed pictures: checked as an EXR of the same layout.
         Output::Pipe(_) => "frame.exr".into(),
     };
-    let mut plan = Plan::new(&probe, save::Folder::Made)?;
+    let mut plan = match output {
+        Output::Pipe(_) => Plan::unwritten(&probe)?,
+        _ => Plan::new(&probe, mirrorball_io::Folders::MakeOne)?,
+    };
     // `--for`'s engine axes: frames are made by one planned `Remap`, so a cube output takes
     // them as the rotation they are (its texel centres map to texel centres).
     if !plan.orient.is_identity() {

@@ -42,6 +42,9 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
     let t0 = Instant::now();
     let (env, energy) = read(&plan)?;
     let shape = chain_shape(&plan, &env)?;
+    if plan.size.is_none() {
+        plan.check_room(shape.size)?;
+    }
     let lobes = lobes(&plan, shape.levels);
     check_memory(&plan, &shape, &env)?;
 

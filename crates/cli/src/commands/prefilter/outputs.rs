@@ -38,20 +38,6 @@ pub(super) fn level_path(out: &str, i: usize) -> String {
         .to_string()
 }
 
-/// `p`'s folder exists (`what` names the flag in the message).
-pub(super) fn check_parent(p: &Path, what: &str) -> Result<(), CliError> {
-    if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(CliError::request(format!(
-                "{what} {}: the folder {} does not exist",
-                p.display(),
-                dir.display()
-            )));
-        }
-    }
-    Ok(())
-}
-
 /// The chain: one cube container, or each level's file(s). Returns the files written and
 /// what their storage could not hold, each level a part of the report.
 pub(super) fn write_chain(

@@ -3,7 +3,7 @@
 //! (SH JSON, preview, BRDF table), and every file read or written, checked before any file
 //! is read.
 
-use super::outputs::{beside, check_parent, level_path};
+use super::outputs::{beside, level_path};
 use crate::choice::parse_flag;
 use crate::commands::convert::parse_precision;
 use crate::commands::{parse_layout, InputPlan};
@@ -12,7 +12,7 @@ use crate::guard::Files;
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::PrefilterArgs;
-use mirrorball_core::{Layout, WorldProjection};
+use mirrorball_core::{Layout, Stereo, WorldProjection};
 use mirrorball_filter::sh::Window;
 use mirrorball_filter::IrradianceMethod;
 use mirrorball_filter::{Compression, LobeKind, PrefilterOptions, RoughnessMapping};
@@ -56,14 +56,22 @@ impl Plan {
         let layout = parse_layout("--layout", a.layout.as_deref())?;
         let format = output_format(a, &to, layout)?;
         let precision = output_precision(a, format)?;
-        check_sizes(a, format)?;
+        let save = SaveOptions {
+            layout,
+            write: WriteOptions {
+                precision,
+                ..Default::default()
+            },
+            mips: false,
+            keep_invalid: input.keep_invalid,
+        };
+        let size = check_sizes(a, format, &to, &save)?;
         let mapping = parse_mapping(a)?;
         let exponents = parse_exponents(a, kind)?;
         let compression = parse_compression(a)?;
         let window = parse_window(a)?;
         let irradiance = parse_flag::<IrradianceMethod>("--irradiance", &a.irradiance)?;
         let opts = prefilter_options(a)?;
-        let keep_invalid = input.keep_invalid;
         let plan = Plan {
             input,
             source: a.input.clone(),
@@ -71,7 +79,7 @@ impl Plan {
             kind,
             to,
             format,
-            size: a.size,
+            size,
             levels: a.levels,
             mapping,
             exponents,
@@ -84,20 +92,15 @@ impl Plan {
             preview_exposure: a.preview_exposure,
             lut_path: None,
             lut_size: a.lut_size,
-            save: SaveOptions {
-                layout,
-                write: WriteOptions {
-                    precision,
-                    ..Default::default()
-                },
-                mips: false,
-                keep_invalid,
-            },
+            save,
             opts,
             quiet: a.quiet,
         };
         let plan = plan.with_side_outputs(a)?;
         plan.files()?.check()?;
+        if let Some(size) = plan.size {
+            plan.check_room(size)?;
+        }
         Ok(plan)
     }
 
@@ -121,10 +124,6 @@ impl Plan {
                     p.display()
                 )));
             }
-            check_parent(p, "--preview")?;
-        }
-        if let Some(p) = &self.sh_path {
-            check_parent(p, "--sh")?;
         }
         self.lut_path = a.lut.clone().map(PathBuf::from);
         if let Some(p) = &self.lut_path {
@@ -134,7 +133,6 @@ impl Plan {
                     p.display()
                 )));
             }
-            check_parent(p, "--lut")?;
         }
         if a.lut_size == 0 || a.lut_size > 4096 {
             return Err(CliError::request(format!(
@@ -143,6 +141,25 @@ impl Plan {
             )));
         }
         Ok(self)
+    }
+
+    /// Refuses the job when the outputs' file system lacks room for a chain from level 0 at
+    /// `size` (at most four channels), the preview and the BRDF table.
+    pub fn check_room(&self, size: u32) -> Result<(), CliError> {
+        let out = self.to.build(None).map_err(|e| bad("--to", e))?;
+        let (w, h) = out.layer_extent(size);
+        let chain = w as u64 * h as u64 * out.layer_count() as u64 * 4 / 3;
+        let lut = self.lut_path.as_ref().map_or(0, |_| {
+            Format::Exr.bytes_estimate(self.lut_size as u64 * self.lut_size as u64, 3, None)
+        });
+        let preview = self.preview_path.as_ref().map_or(0, |_| {
+            Format::Png.bytes_estimate(chain, 3, None)
+        });
+        let bytes = self
+            .format
+            .bytes_estimate(chain, 4, self.save.write.precision)
+            .saturating_add(lut + preview);
+        self.files()?.room(bytes)
     }
 
     /// Every file read and written: the input, the container or every level the chain may
@@ -183,6 +200,15 @@ impl Plan {
     }
 }
 
+/// The output as one file: the cube container, or level 0's file of flat outputs.
+fn output_probe(a: &PrefilterArgs) -> String {
+    if Format::from_path(Path::new(&a.output)).is_some_and(|f| f.is_cube_container()) {
+        a.output.clone()
+    } else {
+        level_path(&a.output, 0)
+    }
+}
+
 /// The output's format (flat outputs are checked with the name of level 0): not JPEG,
 /// prefiltered radiance being HDR.
 fn output_format(
@@ -190,12 +216,7 @@ fn output_format(
     to: &ProjSpec,
     layout: Option<Layout>,
 ) -> Result<Format, CliError> {
-    let probe = if Format::from_path(Path::new(&a.output)).is_some_and(|f| f.is_cube_container()) {
-        a.output.clone()
-    } else {
-        level_path(&a.output, 0)
-    };
-    let format = save::check(&probe, to.kind, layout, save::Folder::Exists)?;
+    let format = save::check(&output_probe(a), to.kind, layout)?;
     if format == Format::Jpeg {
         return Err(CliError::request(format!(
             "{}: prefiltered radiance is HDR; write .exr, .hdr, .ktx2 or .dds (PNG for previews)",
@@ -217,14 +238,23 @@ fn output_precision(a: &PrefilterArgs, format: Format) -> Result<Option<Precisio
     Ok(precision)
 }
 
-/// `--size` (a power of two for a cube container's chain) and `--levels`.
-fn check_sizes(a: &PrefilterArgs, format: Format) -> Result<(), CliError> {
-    if let Some(s) = a.size {
-        if s == 0 || s > 8192 {
-            return Err(CliError::request(format!(
-                "--size: {s} is outside 1..=8192"
-            )));
+/// `--size` (within what level 0's file holds; a power of two for a cube container's
+/// chain) and `--levels`.
+fn check_sizes(
+    a: &PrefilterArgs,
+    format: Format,
+    to: &ProjSpec,
+    save: &SaveOptions,
+) -> Result<Option<u32>, CliError> {
+    let size = match a.size {
+        Some(s) => {
+            let out = to.build(None).map_err(|e| bad("--to", e))?;
+            let level0 = output_probe(a);
+            Some(save::size_bound(&level0, out, save, Stereo::Mono).check("--size", s)?)
         }
+        None => None,
+    };
+    if let Some(s) = size {
         if format.is_cube_container() && !s.is_power_of_two() && a.levels != Some(1) {
             return Err(CliError::request(format!(
                 "--size {s}: a cube map's mip chain halves exactly only from a power of two"
@@ -238,7 +268,7 @@ fn check_sizes(a: &PrefilterArgs, format: Format) -> Result<(), CliError> {
             )));
         }
     }
-    Ok(())
+    Ok(size)
 }
 
 /// `--exponents` (Phong only): non-negative numbers, `inf` or `mirror` for a mirror.

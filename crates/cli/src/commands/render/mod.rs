@@ -26,7 +26,9 @@ use std::time::Instant;
 
 pub fn run(a: RenderArgs) -> Result<(), CliError> {
     let plan = RenderPlan::new(&a)?;
-    output::files(&plan).check()?;
+    let files = output::files(&plan);
+    files.check()?;
+    files.room(output::bytes(&plan))?;
     let scene = load_scene(&plan)?;
     let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangles.len()).sum();
     let started = Instant::now();

@@ -93,6 +93,23 @@ pub(super) fn files(plan: &RenderPlan) -> Files {
     f
 }
 
+/// About how many bytes the render writes: each frame (four channels, before compression),
+/// its diagnostic channels (four RGB `f32` EXRs) and diagram, and the animated PNG.
+pub(super) fn bytes(plan: &RenderPlan) -> u64 {
+    let pixels = plan.camera.width as u64 * plan.camera.height as u64;
+    let mut frame = plan.format.bytes_estimate(pixels, 4, None);
+    if plan.aovs {
+        frame += 4 * Format::Exr.bytes_estimate(pixels, 3, Some(Precision::Float));
+    }
+    if plan.diagnostics {
+        frame += Format::Png.bytes_estimate(1024 * 1024, 4, None);
+    }
+    if plan.animated() {
+        frame += Format::Png.bytes_estimate(pixels, 4, None);
+    }
+    frame.saturating_mul(plan.frames as u64)
+}
+
 /// A frame's colour in the output's format: for PNG and JPEG exposed and tone-mapped, for
 /// EXR and HDR linear times 2^exposure; JPEG and HDR without alpha.
 fn write_colour(path: &Path, img: &Image, plan: &RenderPlan) -> Result<(), CliError> {

@@ -10,7 +10,7 @@ use crate::error::CliError;
 use crate::spec::{bad, parse_dir, ProjSpec};
 use crate::RenderArgs;
 use mirrorball_core::glam::{Mat4, Vec3};
-use mirrorball_core::{Choice, UnknownName};
+use mirrorball_core::{Choice, UnknownName, WorldProjection};
 use mirrorball_io::Format;
 use mirrorball_render::mesh::MAX_TRIANGLES;
 use mirrorball_render::tone::Tone;
@@ -91,18 +91,34 @@ fn parse_colour(option: &str, s: &str) -> Result<[f32; 3], CliError> {
     Ok(v.to_array())
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), CliError> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| bad("--size", format!("'{s}' is not WIDTHxHEIGHT")))?;
-    let p = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&n| (1..=16384).contains(&n))
-            .ok_or_else(|| bad("--size", format!("'{s}': each side must be 1..=16384")))
-    };
-    Ok((p(w)?, p(h)?))
+/// The sides an image written to `output` as `format` may have (the size rule:
+/// `crate::size`).
+pub(super) fn side_bound(output: &Path, format: Format) -> crate::size::Bound {
+    let what = output.display().to_string();
+    crate::size::pictures(format, &what, |n| (n as u64, 1))
+}
+
+/// `--size WIDTHxHEIGHT` of an image written as `format`: each side within what the
+/// container holds and mirrorball reads back, as the size rule says (`crate::size`), and
+/// the picture within mirrorball's reading bound.
+fn parse_size(s: &str, output: &Path, format: Format) -> Result<(u32, u32), CliError> {
+    let not_a_size = || bad("--size", format!("'{s}' is not WIDTHxHEIGHT"));
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(not_a_size)?;
+    let (w, h) = (
+        crate::size::parse(w).map_err(|_| not_a_size())?,
+        crate::size::parse(h).map_err(|_| not_a_size())?,
+    );
+    let side = side_bound(output, format);
+    let check = |v: i64| side.check("--size", v).map_err(|_| side.refusal("--size", s));
+    let (w, h) = (check(w)?, check(h)?);
+    let most = mirrorball_io::Limits::default().max_texels;
+    if w as u64 * h as u64 > most {
+        return Err(bad(
+            "--size",
+            format!("'{s}' is {} pixels; mirrorball reads pictures of at most {most}", w as u64 * h as u64),
+        ));
+    }
+    Ok((w, h))
 }
 
 /// A built-in's name (at `level`, or its default tessellation) or a mesh file's path.
@@ -205,14 +221,19 @@ fn flag_env_as(a: &RenderArgs) -> Result<Option<(ProjSpec, u32)>, CliError> {
         return Ok(None);
     };
     let spec = ProjSpec::parse(s).map_err(|e| bad("--env-as", e))?;
-    let size = a.env_size.unwrap_or(512);
-    if !(1..=8192).contains(&size) {
-        return Err(bad("--env-size", format!("{size} is outside 1..=8192")));
-    }
+    let p = spec.build(None).map_err(|e| bad("--env-as", e))?;
+    // Held in memory, not written: within what a map mirrorball reads may be (its layers,
+    // each as an EXR picture).
+    let bound = crate::size::pictures(Format::Exr, "the --env-as map's layer", |n| {
+        let (w, h) = p.layer_extent(n);
+        (w as u64, h as u64)
+    });
+    let size = bound.check("--env-size", a.env_size.unwrap_or(512))?;
     Ok(Some((spec, size)))
 }
 
-/// `--output`: its format (one render writes) and its folder (which must exist).
+/// `--output`: its format (one render writes); its folder is checked with every output's
+/// (`output::files`).
 fn flag_output(a: &RenderArgs) -> Result<(PathBuf, Format), CliError> {
     let output = PathBuf::from(&a.output);
     let format = Format::from_path(&output).ok_or_else(|| {
@@ -229,14 +250,6 @@ fn flag_output(a: &RenderArgs) -> Result<(PathBuf, Format), CliError> {
             "--output",
             format!("'{}': render writes .png, .jpg, .exr or .hdr", a.output),
         ));
-    }
-    if let Some(parent) = output.parent().filter(|p| !p.as_os_str().is_empty()) {
-        if !parent.is_dir() {
-            return Err(CliError::request(format!(
-                "--output: the folder '{}' does not exist",
-                parent.display()
-            )));
-        }
     }
     Ok((output, format))
 }
@@ -292,14 +305,14 @@ impl RenderPlan {
             .parse::<Tone>()
             .map_err(|e| bad("--tone", e.to_string()))?;
         let material = flag_material(a)?;
-        let size = parse_size(&a.size)?;
+        let (output, format) = flag_output(a)?;
+        let size = parse_size(&a.size, &output, format)?;
         if !(1..=16).contains(&a.ss) {
             return Err(bad("--ss", format!("{} is outside 1..=16", a.ss)));
         }
         let camera = flag_camera(a, size)?;
         let objects = vec![flag_object(a, material)?];
         let env_as = flag_env_as(a)?;
-        let (output, format) = flag_output(a)?;
         if !(1..=3600).contains(&a.turntable) {
             return Err(bad(
                 "--turntable",

@@ -201,7 +201,8 @@ impl<'a> Scene<'a> {
         let sf = &self.file;
         self.apply_meshes(plan)?;
         if let Some(c) = &sf.camera {
-            plan.camera = self.camera(c, &plan.camera)?;
+            let side = super::plan::side_bound(&plan.output, plan.format);
+            plan.camera = self.camera(c, &plan.camera, &side)?;
         }
         if let Some(e) = &sf.environment {
             self.apply_environment(e, plan)?;
@@ -279,7 +280,12 @@ impl<'a> Scene<'a> {
 
     /// The file's camera, with `flags`' lens, clipping distances and size where it gives
     /// none.
-    fn camera(&self, c: &CameraEntry, flags: &Camera) -> Result<Camera, CliError> {
+    fn camera(
+        &self,
+        c: &CameraEntry,
+        flags: &Camera,
+        side: &crate::size::Bound,
+    ) -> Result<Camera, CliError> {
         let lens = match (c.ortho_half_height, c.fov) {
             (Some(h), _) => CameraLens::Orthographic { half_height: h },
             (None, Some(f)) => CameraLens::Perspective { fov_y_deg: f },
@@ -296,9 +302,10 @@ impl<'a> Scene<'a> {
             height: c.height.unwrap_or(flags.height),
         };
         // The bounds of --size.
-        for (key, side) in [("width", c.width), ("height", c.height)] {
-            if let Some(n) = side.filter(|n| !(1..=16384).contains(n)) {
-                return Err(self.error(format!("camera.{key} {n} is outside 1..=16384")));
+        for (key, n) in [("width", c.width), ("height", c.height)] {
+            if let Some(n) = n {
+                side.check(&format!("camera.{key}"), n as i64)
+                    .map_err(|e| self.error(e.message))?;
             }
         }
         camera
