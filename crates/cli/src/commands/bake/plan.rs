@@ -80,6 +80,8 @@ impl Plan {
             zstd,
             mapping,
             source: source.clone(),
+            background_size: a.background_size,
+            overwrite: a.overwrite,
         };
         let bake = Bake::new(engine, opts).map_err(|e| CliError::new(e.fault, e.message))?;
         if let Some(RoughnessMapping::Custom(r)) = &bake.opts.mapping {
@@ -96,11 +98,7 @@ impl Plan {
         check_dir(&dir)?;
         let mut files = Files::new();
         files.input_arg("the input", source);
-        for name in engine
-            .file_names(&bake.opts)
-            .into_iter()
-            .chain([mirrorball_bake::README.to_string()])
-        {
+        for name in bake.file_names() {
             let path = dir.join(&name);
             if path.is_dir() {
                 return Err(CliError::request(format!(
@@ -111,6 +109,7 @@ impl Plan {
             files.output("a baked file", path);
         }
         files.check()?;
+        bake.check_folder(&dir)?;
         if a.samples == 0 || a.samples > 65536 {
             return Err(CliError::request(format!(
                 "--samples: {} is outside 1..=65536",

@@ -52,6 +52,7 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
 
     let t2 = Instant::now();
     let mut written = outputs::write_chain(&plan, &chain)?;
+    outputs::record_side_files(&plan.side_files())?;
     if let Some(p) = &plan.sh_path {
         let described = Described {
             chain: &chain,
