@@ -59,6 +59,7 @@ pub(crate) fn describe() -> Description {
         convention: "Babylon samples at (x, y, -z) of mirrorball's world, left- or right-handed scene (@babylonjs/core 9.35 Materials/materialHelper.functions.js:778, Shaders/ShadersInclude/pbrBlockReflection.js:39); PNG rows upside down (Misc/environmentTextureTools.pure.js:358, invertY)",
         rule: "lod = log2(width*(r^2 + 0.0005))*0.8 (pbrIBLFunctions.js:5, pbrHelperFunctions.js:9, pbrBlockReflection.js:95): level i at alpha = 2^(i/0.8)/width, level 0 a mirror (hdrFiltering.js:85)",
         diffuse: "the manifest's spherical polynomial, from SH as Babylon makes it (Maths/sphericalPolynomial.pure.js:40, 375)",
+        background: None,
     }
 }
 
@@ -69,6 +70,7 @@ pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
     ChainSpec {
         levels: mip_levels(size, |i, _| level_roughness(i, size, LOD_GENERATION_SCALE)),
         diffuse_face: None,
+        background_face: None,
     }
 }
 

@@ -36,6 +36,10 @@
 //!   loader where the GPU has no BC formats (`src/ktx2.rs:250`, "Format not supported by
 //!   this GPU": most phones, and WebGL2 without `EXT_texture_compression_bptc`).
 //!
+//! - **Sky.** `Skybox` takes any cube image (`skybox.wesl:80` samples it at level 0): the
+//!   source resampled into a cube of its own size ([`crate::ChainSpec::background_face`]),
+//!   mirrored in z like the others, in the same encoding.
+//!
 //! Zstandard supercompression (`opts.zstd`) is read by Bevy's default 3D features
 //! (`zstd_rust`).
 
@@ -48,6 +52,8 @@ use std::path::{Path, PathBuf};
 pub(crate) const SPECULAR_FILE: &str = "specular.ktx2";
 /// The diffuse cube's file name.
 pub(crate) const DIFFUSE_FILE: &str = "diffuse.ktx2";
+/// The sky's file name.
+pub(crate) const SKYBOX_FILE: &str = "skybox.ktx2";
 /// The diffuse cube's face edge.
 const DIFFUSE_FACE: u32 = 32;
 /// The encoding a Bevy bake gets unless asked otherwise.
@@ -58,12 +64,13 @@ fn roughness_of_level(i: usize, n: usize) -> f64 {
     i as f64 / (n.max(2) - 1) as f64
 }
 
-/// The levels Bevy takes: the full chain of `opts.size` at [`roughness_of_level`], and the
-/// 32×32 diffuse cube.
+/// The levels Bevy takes: the full chain of `opts.size` at [`roughness_of_level`], the
+/// 32×32 diffuse cube and the sky.
 pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
     ChainSpec {
         levels: mip_levels(opts.size, roughness_of_level),
         diffuse_face: Some(DIFFUSE_FACE),
+        background_face: Some(opts.background_face()),
     }
 }
 
@@ -98,11 +105,11 @@ pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
             opts.size
         ));
     }
-    if encoding.is_block_compressed() && opts.size < 4 {
+    let smallest = opts.size.min(opts.background_face());
+    if encoding.is_block_compressed() && smallest < 4 {
         return Err(format!(
-            "{} needs faces of at least 4×4 (one block), not {}",
+            "{} needs faces of at least 4×4 (one block), not {smallest}",
             encoding.label(),
-            opts.size
         ));
     }
     Ok(())
@@ -117,7 +124,7 @@ pub(crate) fn orientation() -> AxisMap {
 /// What Bevy takes.
 pub(crate) fn describe() -> Description {
     Description {
-        files: "specular.ktx2, diffuse.ktx2 (EnvironmentMapLight)",
+        files: "specular.ktx2, diffuse.ktx2 (EnvironmentMapLight), skybox.ktx2 (Skybox)",
         containers: "KTX2 cubes with mips",
         encodings: &[
             DEFAULT_ENCODING,
@@ -130,16 +137,21 @@ pub(crate) fn describe() -> Description {
         convention: "Bevy samples cubes at (x, y, -z) (bevy_pbr/src/light_probe/environment_map.wesl:92, skybox.wesl:80, bevy 0.20): both cubes are mirrored in z",
         rule: "mip = perceptual roughness x (levels - 1) (environment_map.wesl:242, environment_map.rs:314): level m of L at m/(L-1), down to 1x1",
         diffuse: "diffuse.ktx2: E/pi, 32x32, one level (environment_map.wesl:380-383)",
+        background: Some("skybox.ktx2, the source as a cube, one level, mirrored in z (Skybox, skybox.wesl:80)"),
     }
 }
 
 /// The files written, for the checks before any work.
 pub(crate) fn file_names() -> Vec<String> {
-    vec![SPECULAR_FILE.into(), DIFFUSE_FILE.into()]
+    vec![
+        SPECULAR_FILE.into(),
+        DIFFUSE_FILE.into(),
+        SKYBOX_FILE.into(),
+    ]
 }
 
-/// Writes Bevy's files into `dir`: [`SPECULAR_FILE`] and [`DIFFUSE_FILE`], from lighting
-/// already in Bevy's axes ([`orientation`]).
+/// Writes Bevy's files into `dir`: [`SPECULAR_FILE`], [`DIFFUSE_FILE`] and [`SKYBOX_FILE`],
+/// from lighting already in Bevy's axes ([`orientation`]).
 pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
     check(opts).map_err(|e| Error::request(dir, e))?;
     let n = l.specular.len();
@@ -155,10 +167,12 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
             ));
         }
     }
-    let Some(diffuse) = &l.diffuse else {
+    let (Some(diffuse), Some(sky)) = (&l.diffuse, &l.background) else {
         return Err(Error::request(
             dir,
-            "Bevy needs a diffuse cube; this lighting has none".into(),
+            "Bevy needs a diffuse and a background cube; this lighting lacks one: make it \
+             from Engine::Bevy.chain_spec"
+                .into(),
         ));
     };
     let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
@@ -189,13 +203,19 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
         &[diffuse.layers().to_vec()],
         &how("Lambertian irradiance / pi, z mirrored"),
     )?;
-    Ok(vec![specular_path, diffuse_path])
+    let sky_path = dir.join(SKYBOX_FILE);
+    write_ktx2(
+        &sky_path,
+        &[sky.layers().to_vec()],
+        &how("the source as a cube, z mirrored"),
+    )?;
+    Ok(vec![specular_path, diffuse_path, sky_path])
 }
 
 /// The note's body: what the files hold and a few lines of Bevy to load them.
-pub(crate) fn readme(opts: &BakeOptions) -> String {
+pub(crate) fn readme(opts: &BakeOptions, spec: &ChainSpec) -> String {
     let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
-    let levels = chain_spec(opts).levels.len();
+    let levels = spec.levels.len();
     let zstd = match opts.zstd {
         Some(z) => format!(", Zstandard level {z} (Bevy's `zstd_rust` or `zstd_c` feature)"),
         None => String::new(),
@@ -206,9 +226,10 @@ pub(crate) fn readme(opts: &BakeOptions) -> String {
          - `{SPECULAR_FILE}`: {size}² faces, {levels} levels down to 1×1, level m GGX-filtered at\n  \
            perceptual roughness m/{last} (Bevy picks level roughness × (levels − 1)).\n\
          - `{DIFFUSE_FILE}`: {DIFFUSE_FACE}² faces, the irradiance divided by π (Bevy multiplies by\n  \
-           the diffuse colour only).\n\n\
-         Both are mirrored in z, as Bevy samples cubes at (x, y, −z); the specular cube's first\n\
-         level also serves as a `Skybox`. Put them under `assets/` and:\n\n\
+           the diffuse colour only).\n\
+         - `{SKYBOX_FILE}`: {sky}² faces, one level, the source itself for the `Skybox`.\n\n\
+         All three are mirrored in z, as Bevy samples cubes at (x, y, −z). Put them under\n\
+         `assets/` and:\n\n\
          ```rust\n\
          commands.spawn((\n    \
              Camera3d::default(),\n    \
@@ -220,7 +241,7 @@ pub(crate) fn readme(opts: &BakeOptions) -> String {
                  ..default()\n    \
              }},\n    \
              Skybox {{\n        \
-                 image: Some(asset_server.load(\"{SPECULAR_FILE}\")),\n        \
+                 image: Some(asset_server.load(\"{SKYBOX_FILE}\")),\n        \
                  brightness: 1.0,\n        \
                  ..default()\n    \
              }},\n\
@@ -229,6 +250,7 @@ pub(crate) fn readme(opts: &BakeOptions) -> String {
         enc = encoding.label(),
         size = opts.size,
         last = levels.max(2) - 1,
+        sky = spec.background_face.unwrap_or(opts.size),
     )
 }
 
@@ -276,6 +298,11 @@ mod tests {
         assert_eq!(spec.levels[9], (1, 1.0));
         assert_eq!(spec.levels[3], (64, 3.0 / 9.0));
         assert_eq!(spec.diffuse_face, Some(32));
+        assert_eq!(
+            spec.background_face,
+            Some(512),
+            "level 0's until the source says"
+        );
     }
 
     #[test]

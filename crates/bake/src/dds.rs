@@ -18,9 +18,7 @@
 //! Unreal: `ComputeReflectionCaptureMipFromRoughness` (ReflectionEnvironmentShared.ush):
 //! `RoughnessMapping::Ue4`.
 
-use crate::{
-    chain_by, cube_write, faces, names, BakeOptions, ChainSpec, Description, Engine, Lighting,
-};
+use crate::{chain_by, cube_write, faces, BakeOptions, ChainSpec, Description, Engine, Lighting};
 use mirrorball_core::{Axis, AxisMap};
 use mirrorball_filter::RoughnessMapping;
 use mirrorball_io::{Encoding, Error};
@@ -55,6 +53,7 @@ pub(crate) fn chain_spec(engine: Engine, opts: &BakeOptions) -> ChainSpec {
     ChainSpec {
         levels: chain_by(opts, &mapping(engine, n)),
         diffuse_face: Some(DIFFUSE_FACE),
+        background_face: None,
     }
 }
 
@@ -68,24 +67,26 @@ const ENCODINGS: &[Encoding] = &[
 pub(crate) fn describe(engine: Engine) -> Description {
     match engine {
         Engine::Unity => Description {
-            files: "NAME_specular.dds (GGX chain to 1x1), NAME_diffuse.dds (irradiance/pi, 32²)",
+            files: "specular.dds (GGX chain to 1x1), diffuse.dds (irradiance/pi, 32²)",
             containers: "DDS (DX10 header)",
             encodings: ENCODINGS,
             zstd: false,
             convention: "left-handed, +Y up, +Z forward: z mirrored, (x, y, -z)",
             rule: "mip = 6 * r * (1.7 - 0.7 r) (ImageBasedLighting.hlsl \
                    PerceptualRoughnessToMipmapLevel; levels past 6 hold r = 1)",
-            diffuse: "NAME_diffuse.dds sampled at the normal (Unity makes its own SH from a probe)",
+            diffuse: "diffuse.dds sampled at the normal (Unity makes its own SH from a probe)",
+            background: None,
         },
         _ => Description {
-            files: "NAME_specular.dds (GGX chain to 1x1), NAME_diffuse.dds (irradiance/pi, 32²)",
+            files: "specular.dds (GGX chain to 1x1), diffuse.dds (irradiance/pi, 32²)",
             containers: "DDS (DX10 header)",
             encodings: ENCODINGS,
             zstd: false,
             convention: "left-handed, Z up, X forward, Y right: (y, z, -x)",
             rule: "mip = levels - 2 + 1.2 log2(r) (ReflectionEnvironmentShared.ush \
                    ComputeReflectionCaptureMipFromRoughness)",
-            diffuse: "NAME_diffuse.dds sampled at the normal (a Sky Light makes its own SH)",
+            diffuse: "diffuse.dds sampled at the normal (a Sky Light makes its own SH)",
+            background: None,
         },
     }
 }
@@ -100,13 +101,14 @@ pub(crate) fn orientation(engine: Engine) -> AxisMap {
     }
 }
 
-/// `NAME_specular.dds`, `NAME_diffuse.dds`.
-pub(crate) fn file_names(opts: &BakeOptions) -> Vec<String> {
-    let stem = opts.stem();
-    vec![
-        format!("{stem}_specular.dds"),
-        format!("{stem}_diffuse.dds"),
-    ]
+/// The specular chain's file.
+const SPECULAR: &str = "specular.dds";
+/// The diffuse cube's file.
+const DIFFUSE: &str = "diffuse.dds";
+
+/// `specular.dds`, `diffuse.dds`.
+pub(crate) fn file_names() -> Vec<String> {
+    vec![SPECULAR.into(), DIFFUSE.into()]
 }
 
 pub(crate) fn write(
@@ -115,12 +117,11 @@ pub(crate) fn write(
     dir: &Path,
     opts: &BakeOptions,
 ) -> Result<Vec<PathBuf>, Error> {
-    let names = file_names(opts);
-    let specular = dir.join(&names[0]);
+    let specular = dir.join(SPECULAR);
     mirrorball_io::write_dds(&specular, &faces(&l.specular), &cube_write(opts, vec![]))?;
     let mut files = vec![specular];
     if let Some(d) = &l.diffuse {
-        let diffuse = dir.join(&names[1]);
+        let diffuse = dir.join(DIFFUSE);
         mirrorball_io::write_dds(
             &diffuse,
             &faces(std::slice::from_ref(d)),
@@ -131,23 +132,31 @@ pub(crate) fn write(
     Ok(files)
 }
 
-pub(crate) fn readme(engine: Engine, _opts: &BakeOptions, files: &[PathBuf]) -> String {
-    let n = names(files);
-    let (specular, diffuse) = (&n[0], n.get(1).map_or("", |s| s.as_str()));
+/// The note's body: where to put the files and the lines that load them.
+pub(crate) fn readme(engine: Engine) -> String {
     match engine {
         Engine::Unity => format!(
             "## Loading it\n\n\
-             Put `{specular}` and `{diffuse}` under Assets/. In the texture importer: Texture \
-             Shape Cube, Mapping Auto, Convolution Type None (the mips are already \
-             convolved), sRGB off. The faces are already in Unity's left-handed world.\n\n\
+             Put `{SPECULAR}` and `{DIFFUSE}` under `Assets/Resources/` (any folder of that \
+             name). In the texture importer: Texture Shape Cube, Mapping Auto, Convolution \
+             Type None (the mips are already convolved), sRGB off. The faces are already in \
+             Unity's left-handed world.\n\n\
              ```csharp\n\
+             // The assets the two files became: Resources.Load takes the name without its extension.\n\
+             Cubemap specularCubemap = Resources.Load<Cubemap>(\"specular\"); // {SPECULAR}\n\
+             Cubemap diffuseCubemap = Resources.Load<Cubemap>(\"diffuse\");   // {DIFFUSE}\n\
              var probe = GetComponent<ReflectionProbe>();\n\
              probe.mode = UnityEngine.Rendering.ReflectionProbeMode.Custom;\n\
-             probe.customBakedTexture = specularCubemap; // {specular}\n\
+             probe.customBakedTexture = specularCubemap;\n\
              // or, for the sky: RenderSettings.defaultReflectionMode = DefaultReflectionMode.Custom;\n\
              //                  RenderSettings.customReflectionTexture = specularCubemap;\n\
+             // or, for a shader of your own (below):\n\
+             material.SetTexture(\"_Specular\", specularCubemap);\n\
+             material.SetTexture(\"_Diffuse\", diffuseCubemap);\n\
              ```\n\n\
              ```hlsl\n\
+             TEXTURECUBE(_Specular); SAMPLER(sampler_Specular); // {SPECULAR}\n\
+             TEXTURECUBE(_Diffuse);  SAMPLER(sampler_Diffuse);  // {DIFFUSE}\n\
              half mip = PerceptualRoughnessToMipmapLevel(perceptualRoughness); // 6 r (1.7 - 0.7 r)\n\
              half3 spec = SAMPLE_TEXTURECUBE_LOD(_Specular, sampler_Specular, reflectDir, mip).rgb;\n\
              half3 diff = SAMPLE_TEXTURECUBE(_Diffuse, sampler_Diffuse, normalWS).rgb; // E/pi\n\
@@ -155,13 +164,17 @@ pub(crate) fn readme(engine: Engine, _opts: &BakeOptions, files: &[PathBuf]) -> 
         ),
         _ => format!(
             "## Loading it\n\n\
-             Import `{specular}` and `{diffuse}` in the Content Browser (Import, or drag them \
-             in): each becomes a TextureCube; set Compression Settings HDR Compressed (BC6H) \
-             or HDR and keep its mips. The faces are already in Unreal's Z-up world.\n\n\
+             Import `{SPECULAR}` and `{DIFFUSE}` into the Content folder (Import, or drag them \
+             in): each becomes a TextureCube asset of the same name; set Compression Settings \
+             HDR Compressed (BC6H) or HDR and keep its mips. The faces are already in \
+             Unreal's Z-up world.\n\n\
              ```cpp\n\
+             // The asset the import of {SPECULAR} made, at Content/specular.\n\
+             UTextureCube* SpecularCube = LoadObject<UTextureCube>(nullptr, TEXT(\"/Game/specular.specular\"));\n\
+             // SkyLight: the level's ASkyLight.\n\
              USkyLightComponent* Sky = SkyLight->GetLightComponent();\n\
              Sky->SourceType = ESkyLightSourceType::SLS_SpecifiedCubemap;\n\
-             Sky->SetCubemap(SpecularCube); // {specular}\n\
+             Sky->SetCubemap(SpecularCube);\n\
              Sky->RecaptureSky();\n\
              ```\n\n\
              A Sky Light filters the cubemap again; a material that reads the chain as it is \

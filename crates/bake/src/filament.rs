@@ -1,5 +1,6 @@
-//! Lighting for Filament, as `cmgen --deploy` writes it: `NAME_ibl.ktx` (the specular chain,
-//! KTX1, the SH under the key `sh`), `NAME_skybox.ktx` (the sharp level) and `sh.txt`.
+//! Lighting for Filament, as `cmgen --deploy` writes it, less the source's name in front
+//! (the folder is the bake's): `ibl.ktx` (the specular chain, KTX1, the SH under the key
+//! `sh`), `skybox.ktx` (the source as a cube, at the background's size) and `sh.txt`.
 //!
 //! - **Axes.** Filament's world is mirrorball's (right-handed, +Y up) and its shaders look
 //!   the cube up with the world reflected vector, unflipped: `textureLod(sampler0_iblSpecular,
@@ -23,7 +24,7 @@
 //!   Kᵢ times mirrorball's E/π coefficient ([`prescaled`]).
 
 use crate::{
-    chain_by, cube_write, faces, names, write_text, BakeOptions, ChainSpec, Description, Lighting,
+    chain_by, cube_write, faces, write_text, BakeOptions, ChainSpec, Description, Lighting,
 };
 use mirrorball_core::AxisMap;
 use mirrorball_filter::sh::{self, Sh9};
@@ -31,17 +32,25 @@ use mirrorball_filter::RoughnessMapping;
 use mirrorball_io::{Encoding, Error};
 use std::path::{Path, PathBuf};
 
-/// The full chain at Filament's roughness rule; diffuse light is SH only.
+/// The specular chain's file.
+const IBL: &str = "ibl.ktx";
+/// The sky's file.
+const SKYBOX: &str = "skybox.ktx";
+/// The SH as text.
+const SH_TXT: &str = "sh.txt";
+
+/// The full chain at Filament's roughness rule; diffuse light is SH only; the skybox.
 pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
     ChainSpec {
         levels: chain_by(opts, &RoughnessMapping::Filament),
         diffuse_face: None,
+        background_face: Some(opts.background_face()),
     }
 }
 
 pub(crate) fn describe() -> Description {
     Description {
-        files: "NAME_ibl.ktx (GGX chain to 1x1, SH under the key sh), NAME_skybox.ktx, sh.txt",
+        files: "ibl.ktx (GGX chain to 1x1, SH under the key sh), skybox.ktx, sh.txt",
         containers: "KTX1 (Filament's Ktx1Reader)",
         encodings: &[Encoding::B10G11R11, Encoding::Rgba16F, Encoding::Rgba32F],
         zstd: false,
@@ -51,6 +60,7 @@ pub(crate) fn describe() -> Description {
             "lod = (levels - 1) * r * (2 - r) (surface_light_indirect.fs perceptualRoughnessToLod)",
         diffuse: "SH9 pre-scaled as cmgen --deploy writes it (CubemapSH.cpp \
                   computeIrradianceSH3Bands), in sh.txt and the ibl file's sh key",
+        background: Some("skybox.ktx, the source as a cube, one level (Skybox::Builder)"),
     }
 }
 
@@ -90,20 +100,21 @@ pub(crate) fn sh_txt(sh: &[[f64; 3]; 9]) -> String {
     out
 }
 
-/// `NAME_ibl.ktx`, `NAME_skybox.ktx`, `sh.txt`, as cmgen names them.
-pub(crate) fn file_names(opts: &BakeOptions) -> Vec<String> {
-    let stem = opts.stem();
-    vec![
-        format!("{stem}_ibl.ktx"),
-        format!("{stem}_skybox.ktx"),
-        "sh.txt".into(),
-    ]
+/// `ibl.ktx`, `skybox.ktx`, `sh.txt`: cmgen's names without the source's in front.
+pub(crate) fn file_names() -> Vec<String> {
+    [IBL, SKYBOX, SH_TXT].map(String::from).to_vec()
 }
 
 pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    let [ibl, skybox, txt] = <[String; 3]>::try_from(file_names(opts))
-        .expect("three files")
-        .map(|n| dir.join(n));
+    let [ibl, skybox, txt] = [IBL, SKYBOX, SH_TXT].map(|n| dir.join(n));
+    let Some(sky) = &l.background else {
+        return Err(Error::request(
+            dir,
+            "Filament's skybox is the background; this lighting has none: make it from \
+             Engine::Filament.chain_spec"
+                .into(),
+        ));
+    };
     let sh = prescaled(&l.sh9);
     let sh32: Vec<[f32; 3]> = sh.iter().map(|c| c.map(|v| v as f32)).collect();
     let with_sh = cube_write(
@@ -111,27 +122,38 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
         vec![("sh".into(), mirrorball_io::filament_sh_text(&sh32))],
     );
     mirrorball_io::write_ktx1(&ibl, &faces(&l.specular), &with_sh)?;
-    mirrorball_io::write_ktx1(&skybox, &faces(&l.specular[..1]), &cube_write(opts, vec![]))?;
+    mirrorball_io::write_ktx1(
+        &skybox,
+        &faces(std::slice::from_ref(sky)),
+        &cube_write(opts, vec![]),
+    )?;
     write_text(&txt, &sh_txt(&sh))?;
     Ok(vec![ibl, skybox, txt])
 }
 
-pub(crate) fn readme(_opts: &BakeOptions, files: &[PathBuf]) -> String {
-    let n = names(files);
-    let (ibl, skybox) = (&n[0], &n[1]);
+pub(crate) fn readme(spec: &ChainSpec) -> String {
+    let sky = spec.background_face.unwrap_or(spec.levels[0].0);
     format!(
         "## Loading it\n\n\
-         As the files `cmgen --deploy` writes: `{ibl}` the specular cube with its mip chain \
-         (the SH under the key `sh`), `{skybox}` the sharp cube for the sky, `sh.txt` the \
-         nine pre-scaled irradiance coefficients.\n\n\
+         As the files `cmgen --deploy` writes (without the source's name in front): `{IBL}` \
+         the specular cube with its mip chain (the SH under the key `sh`), `{SKYBOX}` the \
+         source itself for the sky ({sky}² faces), `{SH_TXT}` the nine pre-scaled irradiance \
+         coefficients.\n\n\
          ```cpp\n\
          #include <ktxreader/Ktx1Reader.h>\n\
+         #include <fstream>\n\
+         #include <vector>\n\
          using namespace filament;\n\
-         auto* iblBundle = new image::Ktx1Bundle(iblData, iblSize);\n\
+         auto read = [](const char* name) {{\n\
+         \x20   std::ifstream in(name, std::ios::binary);\n\
+         \x20   return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {{}});\n\
+         }};\n\
+         std::vector<uint8_t> iblData = read(\"{IBL}\"), skyData = read(\"{SKYBOX}\");\n\
+         auto* iblBundle = new image::Ktx1Bundle(iblData.data(), iblData.size());\n\
          math::float3 sh[9];\n\
          iblBundle->getSphericalHarmonics(sh);\n\
          Texture* ibl = ktxreader::Ktx1Reader::createTexture(engine, iblBundle, false);\n\
-         auto* skyBundle = new image::Ktx1Bundle(skyData, skySize);\n\
+         auto* skyBundle = new image::Ktx1Bundle(skyData.data(), skyData.size());\n\
          Texture* sky = ktxreader::Ktx1Reader::createTexture(engine, skyBundle, false);\n\
          IndirectLight* light = IndirectLight::Builder()\n\
          \x20       .reflections(ibl)\n\

@@ -62,6 +62,7 @@ pub(crate) fn describe() -> Description {
         convention: "as Babylon's .env, whose loader is the extension's one implementation (EXT_lights_image_based.pure.js:82-105): samples at (x, y, -z); a right-handed scene sees it the right way round",
         rule: "lodGenerationScale = (N-1)/log2(size): level i at alpha = 2^(i/scale)/size, roughness 1 at the last level (16x16)",
         diffuse: "irradianceCoefficients: 9x3 SH of the irradiance E in Babylon's basis",
+        background: None,
     }
 }
 
@@ -106,6 +107,7 @@ pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
             .map(|i| ((size >> i).max(1), level_roughness(i, size, scale)))
             .collect(),
         diffuse_face: None,
+        background_face: None,
     }
 }
 
@@ -136,10 +138,14 @@ pub(crate) fn readme(opts: &BakeOptions) -> String {
          ```js\n\
          scene.useRightHandedSystem = true;\n\
          await BABYLON.SceneLoader.AppendAsync(\"./\", \"{FILE}\", scene); // @babylonjs/loaders\n\
+         // The loader made the light scene.environmentTexture but left it marked gamma-encoded,\n\
+         // so its shader would darken the light to radiance^2.2: the file's RGBD is linear.\n\
+         scene.environmentTexture.gammaSpace = false;\n\
          ```\n\n\
-         Babylon's loader leaves the light's texture marked gamma-encoded (`gammaSpace` \
-         true), so its shader darkens the light to radiance^2.2; the file's RGBD is linear, \
-         as the extension says.\n",
+         Babylon.js's glTF loader (`EXT_lights_image_based.pure.js`) leaves the RawCubeTexture \
+         it makes at its default `gammaSpace` (true), though the extension says a \
+         four-channel PNG is linear RGBD; the line above undoes that (the texture marks the \
+         materials that use it for an update).\n",
         size = opts.size,
         low = opts.size >> (n - 1),
         last = (n - 1).max(1),

@@ -24,6 +24,7 @@ pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
     ChainSpec {
         levels: chain_by(opts, &RoughnessMapping::Linear),
         diffuse_face: Some(DIFFUSE_FACE),
+        background_face: None,
     }
 }
 
@@ -46,6 +47,7 @@ pub(crate) fn describe() -> Description {
                      (right-handed, +Y up, -Z ahead); nothing turned",
         rule: "level = roughness * (levels - 1) (or --mapping's)",
         diffuse: "diffuse.ktx2 sampled at the normal; sh.json's irradiance_over_pi",
+        background: None,
     }
 }
 
@@ -54,7 +56,7 @@ pub(crate) fn orientation() -> AxisMap {
     AxisMap::IDENTITY
 }
 
-pub(crate) fn file_names(_opts: &BakeOptions) -> Vec<String> {
+pub(crate) fn file_names() -> Vec<String> {
     [SPECULAR, DIFFUSE, SH].map(String::from).to_vec()
 }
 
@@ -104,7 +106,7 @@ fn sh_document(l: &Lighting, opts: &BakeOptions, files: &[PathBuf]) -> String {
     serde_json::to_string_pretty(&doc).expect("JSON values serialise")
 }
 
-pub(crate) fn readme(opts: &BakeOptions, _files: &[PathBuf]) -> String {
+pub(crate) fn readme(opts: &BakeOptions) -> String {
     let mapping = opts.mapping.clone().unwrap_or(RoughnessMapping::Linear);
     format!(
         "## Loading it\n\n\

@@ -11,6 +11,18 @@
 //! permutation); [`Bake::write`] writes the engine's files and a README.md into a folder,
 //! all landing together. Each engine's rules (files, encodings, convention, roughness-to-mip
 //! rule: [`Engine::describe`]) have one home, its module.
+//!
+//! **The folder is the bake's.** Every engine's files have fixed names (none carries the
+//! source's name: [`Engine::file_names`]). A bake records what it wrote in the folder
+//! ([`mirrorball_io::Owned`], `.mirrorball-files`): it replaces only files a bake (or
+//! another mirrorball command) wrote there, refuses any other before any work
+//! ([`Bake::check_folder`], unless [`BakeOptions::overwrite`]), and once its files are in
+//! place removes those of the bake it replaced that it did not write again.
+//!
+//! **The background** (Bevy's `Skybox`, Filament's skybox, three's `scene.background`) is
+//! the source itself as a cube, not a level of the chain: its face edge is
+//! [`BakeOptions::background_size`], else the source's resolution decides
+//! ([`Bake::fit`], [`background_face_for`]).
 #![warn(missing_docs)]
 
 mod babylon;
@@ -21,7 +33,7 @@ mod gltf;
 mod ktx2;
 mod three;
 
-use mirrorball_core::{AxisMap, Choice, EnvMap, Fault, ProjectionKind};
+use mirrorball_core::{AxisMap, Choice, EnvMap, Fault, ProjectionKind, ResampleOptions};
 use mirrorball_filter::sh::{self, Sh9};
 use mirrorball_filter::{Lobe, PrefilterOptions, Prefilterer, RoughnessMapping};
 use mirrorball_io::{CubeWrite, Effort, Encoding};
@@ -114,20 +126,24 @@ pub const ENGINES: [Engine; 8] = [
 
 /// What an engine's lighting is made of, before any of it is made: the specular levels
 /// (each a cube face edge and a GGX perceptual roughness, in the order the engine stores
-/// them) and the diffuse (irradiance) cube's face edge, if the engine takes one.
+/// them), the diffuse (irradiance) cube's face edge, if the engine takes one, and the
+/// background cube's, if it takes one.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChainSpec {
     /// `(face edge, perceptual roughness)` of each specular level.
     pub levels: Vec<(u32, f64)>,
     /// The diffuse cube's face edge, or `None` when the engine's diffuse light is SH only.
     pub diffuse_face: Option<u32>,
+    /// The background cube's face edge (the source resampled, not filtered), or `None` when
+    /// the engine's files hold no background.
+    pub background_face: Option<u32>,
 }
 
 /// What an engine takes and how it reads it, for people (`--for list`, the README) and for
 /// the checks of a request: each engine's module says it once.
 #[derive(Clone, Debug)]
 pub struct Description {
-    /// The files written, for people (`NAME` is the source's file stem).
+    /// The files written, for people.
     pub files: &'static str,
     /// The containers.
     pub containers: &'static str,
@@ -142,6 +158,9 @@ pub struct Description {
     pub rule: &'static str,
     /// What lights diffuse surfaces.
     pub diffuse: &'static str,
+    /// The file that holds the background (the source as a cube, at the background size),
+    /// if the engine takes one.
+    pub background: Option<&'static str>,
 }
 
 /// How a bake is asked for, beyond the engine: the specular chain's level-0 face edge, the
@@ -160,6 +179,11 @@ pub struct BakeOptions {
     pub mapping: Option<RoughnessMapping>,
     /// The source file's name, recorded in notes and metadata.
     pub source: String,
+    /// The background cube's face edge (a power of two), or `None` for the one the
+    /// source's resolution gives ([`background_face_for`], settled by [`Bake::fit`]).
+    pub background_size: Option<u32>,
+    /// Replace files in the folder that no mirrorball run wrote (else they are refused).
+    pub overwrite: bool,
 }
 
 impl Default for BakeOptions {
@@ -171,6 +195,8 @@ impl Default for BakeOptions {
             zstd: None,
             mapping: None,
             source: String::new(),
+            background_size: None,
+            overwrite: false,
         }
     }
 }
@@ -183,21 +209,30 @@ impl BakeOptions {
             .unwrap_or_default()
     }
 
-    /// The source's file stem, for file names (`NAME_ibl.ktx`): `environment` when it has
-    /// none.
-    pub fn stem(&self) -> String {
-        Path::new(&self.source)
-            .file_stem()
-            .map(|s| s.to_string_lossy().replace("{face}", ""))
-            .map(|s| s.trim_matches(['_', '-', '.']).to_string())
-            .filter(|s| !s.is_empty())
-            .unwrap_or_else(|| "environment".into())
+    /// The background's face edge until the source is known: `background_size`, else
+    /// level 0's ([`Bake::fit`] then puts the source's in its place).
+    pub(crate) fn background_face(&self) -> u32 {
+        self.background_size.unwrap_or(self.size)
     }
 }
 
-/// Largest level-0 face edge a bake takes: the largest cube face GPUs take
-/// ([`mirrorball_io::MAX_CUBE_FACE`]).
+/// Largest level-0 (and background) face edge a bake takes: the largest cube face GPUs
+/// take ([`mirrorball_io::MAX_CUBE_FACE`]).
 pub const MAX_SIZE: u32 = mirrorball_io::MAX_CUBE_FACE;
+
+/// The background's face edges chosen from a source's resolution: at least this …
+pub const MIN_BACKGROUND: u32 = 16;
+/// … and at most this (an 8K lat-long's texel density; each doubling is four times the
+/// bytes an engine keeps in memory for the sky).
+pub const MAX_BACKGROUND: u32 = 2048;
+
+/// The background cube's face edge for `env`: the power of two that keeps its texels per
+/// steradian ([`EnvMap::natural_size`]), within [`MIN_BACKGROUND`]`..=`[`MAX_BACKGROUND`].
+/// An 8192×4096 lat-long gives 2048², a 2048×1024 one 512².
+pub fn background_face_for(env: &EnvMap) -> u32 {
+    env.natural_size(ProjectionKind::Cube)
+        .clamp(MIN_BACKGROUND, MAX_BACKGROUND)
+}
 
 /// Prefiltered lighting, cube faces in OpenGL order and orientation: in mirrorball's world
 /// axes as [`Lighting::from_env`] makes it, in the engine's once [`Lighting::oriented`]
@@ -211,13 +246,16 @@ pub struct Lighting {
     /// The irradiance cube, divided by π (the radiance a white Lambertian surface reflects),
     /// level 0 only; `None` when the spec asked for none.
     pub diffuse: Option<EnvMap>,
+    /// The background: the source resampled into a cube (antialiased, not prefiltered);
+    /// `None` when the spec asked for none.
+    pub background: Option<EnvMap>,
     /// The radiance's SH9 (orthonormal real basis, world axes: `mirrorball_filter::sh`).
     pub sh9: Sh9,
 }
 
 impl Lighting {
     /// Prefilters `env` (any projection, sanitized) into `spec`'s levels, the diffuse cube
-    /// from the exact Lambert integral, and the SH9.
+    /// from the exact Lambert integral, and the SH9; resamples it into the background cube.
     pub fn from_env(env: &EnvMap, spec: &ChainSpec, opts: PrefilterOptions) -> Lighting {
         let cube = ProjectionKind::Cube.default_projection();
         let lobes: Vec<Lobe> = spec
@@ -244,10 +282,14 @@ impl Lighting {
         let diffuse = spec
             .diffuse_face
             .map(|face| pre.render_extent(&Lobe::Lambert, cube, face, face));
+        let background = spec
+            .background_face
+            .map(|face| mirrorball_core::resample(env, cube, face, &ResampleOptions::default()));
         Lighting {
             specular,
             roughness: spec.levels.iter().map(|&(_, r)| r).collect(),
             diffuse,
+            background,
             sh9: sh::project(env),
         }
     }
@@ -263,6 +305,7 @@ impl Lighting {
             specular: self.specular.into_iter().map(turn).collect(),
             roughness: self.roughness,
             diffuse: self.diffuse.map(turn),
+            background: self.background.map(turn),
             sh9: self.sh9.transformed(map),
         }
     }
@@ -323,30 +366,33 @@ impl Engine {
         }
     }
 
-    /// The names of the files a bake writes into its folder, besides `README.md`, for the
-    /// checks before any work.
+    /// The files a bake writes into its folder, besides `README.md`, relative to it (`/`
+    /// between folders), for the checks before any work. One rule for every engine: the
+    /// folder is the bake's, so the names are the engine's own, never the source's (only
+    /// how many there are may depend on `opts`: glTF's images per level).
     pub fn file_names(self, opts: &BakeOptions) -> Vec<String> {
         match self {
             Engine::Bevy => bevy::file_names(),
             Engine::Three => three::file_names(),
             Engine::Babylon => vec![babylon::FILE.to_string()],
             Engine::Gltf => gltf::file_names(opts),
-            Engine::Filament => filament::file_names(opts),
-            Engine::Unity | Engine::Unreal => dds::file_names(opts),
-            Engine::Ktx2 => ktx2::file_names(opts),
+            Engine::Filament => filament::file_names(),
+            Engine::Unity | Engine::Unreal => dds::file_names(),
+            Engine::Ktx2 => ktx2::file_names(),
         }
     }
 
-    /// How to load the files in the engine's own code: the README's body.
-    fn readme(self, opts: &BakeOptions, files: &[PathBuf]) -> String {
+    /// How to load the files in the engine's own code: the README's body, naming only
+    /// the files [`Engine::file_names`] lists, by their paths in the folder.
+    fn readme(self, opts: &BakeOptions, spec: &ChainSpec) -> String {
         match self {
-            Engine::Bevy => bevy::readme(opts),
-            Engine::Three => three::readme(opts),
+            Engine::Bevy => bevy::readme(opts, spec),
+            Engine::Three => three::readme(opts, spec),
             Engine::Babylon => babylon::readme(opts),
             Engine::Gltf => gltf::readme(opts),
-            Engine::Filament => filament::readme(opts, files),
-            Engine::Unity | Engine::Unreal => dds::readme(self, opts, files),
-            Engine::Ktx2 => ktx2::readme(opts, files),
+            Engine::Filament => filament::readme(spec),
+            Engine::Unity | Engine::Unreal => dds::readme(self),
+            Engine::Ktx2 => ktx2::readme(opts),
         }
     }
 }
@@ -410,7 +456,8 @@ pub struct Bake {
 
 impl Bake {
     /// Checks the request against the engine: a writer for it in this build, the size (a
-    /// power of two, `1..=MAX_SIZE`), an encoding its loader takes, supercompression only
+    /// power of two, `1..=MAX_SIZE`), a background size only for an engine that takes a
+    /// background (a power of two too), an encoding its loader takes, supercompression only
     /// where it reads it.
     pub fn new(engine: Engine, mut opts: BakeOptions) -> Result<Bake, Error> {
         let d = engine.describe();
@@ -419,6 +466,9 @@ impl Bake {
             return Err(Error::request(format!(
                 "size {s}: a cube's mip chain halves exactly only from a power of two; give one of 1, 2, 4 … {MAX_SIZE}"
             )));
+        }
+        if let Some(b) = opts.background_size {
+            check_background_size(engine, b)?;
         }
         let encoding = opts.encoding_for(engine);
         if !d.encodings.contains(&encoding) {
@@ -465,6 +515,16 @@ impl Bake {
         Ok(())
     }
 
+    /// Settles what the source decides, once it is read: the background's face edge, when
+    /// none was asked for ([`background_face_for`]).
+    pub fn fit(&mut self, env: &EnvMap) {
+        if self.opts.background_size.is_none() {
+            if let Some(face) = self.spec.background_face.as_mut() {
+                *face = background_face_for(env);
+            }
+        }
+    }
+
     /// Rows the prefilter makes, for a progress bar fed by [`PrefilterOptions::progress`].
     pub fn rows(&self) -> u64 {
         let specular: u64 = self.spec.levels.iter().map(|&(f, _)| 6 * f as u64).sum();
@@ -476,6 +536,7 @@ impl Bake {
         let sq = |f: u32| 6 * f as u64 * f as u64;
         self.spec.levels.iter().map(|&(f, _)| sq(f)).sum::<u64>()
             + self.spec.diffuse_face.map_or(0, sq)
+            + self.spec.background_face.map_or(0, sq)
     }
 
     /// The lighting, prefiltered from `env` (sanitized, checked) and turned into the
@@ -484,24 +545,59 @@ impl Bake {
         Lighting::from_env(env, &self.spec, opts).oriented(&self.engine.orientation())
     }
 
-    /// Writes the engine's files and `README.md` into `dir` (made if missing), all landing
-    /// together: on an error (or an interrupt) none is left and old files stay as they were,
-    /// and a folder made for them is removed again.
-    /// `lighting` is in the engine's axes ([`Bake::lighting`]). Returns the files written.
+    /// Every file the bake writes into its folder, relative to it: the engine's and
+    /// `README.md`.
+    pub fn file_names(&self) -> Vec<String> {
+        let mut names = self.engine.file_names(&self.opts);
+        names.push(README.to_string());
+        names
+    }
+
+    /// Refuses, before any work, to replace a file in `dir` that no mirrorball run wrote
+    /// (its record, [`mirrorball_io::Owned`], does not list it), unless
+    /// [`BakeOptions::overwrite`]: the message names the file. A folder that does not
+    /// exist yet holds none.
+    pub fn check_folder(&self, dir: &Path) -> Result<(), Error> {
+        let owned = mirrorball_io::Owned::read(dir)?;
+        Ok(owned.check(&self.file_names(), self.opts.overwrite)?)
+    }
+
+    /// [`Bake::write_into`], returning the files written.
     pub fn write(&self, lighting: &Lighting, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+        self.write_into(lighting, dir).map(|w| w.files)
+    }
+
+    /// Writes the engine's files and `README.md` into `dir` (made if missing), with the
+    /// folder's record of them, all landing together: on an error (or an interrupt) none is
+    /// left and old files stay as they were, and a folder made for them is removed again.
+    /// First refuses as [`Bake::check_folder`] does; once the files are in place, removes
+    /// the files of the bake this one replaces that it did not write again.
+    /// `lighting` is in the engine's axes ([`Bake::lighting`]).
+    pub fn write_into(&self, lighting: &Lighting, dir: &Path) -> Result<Written, Error> {
+        let mut owned = mirrorball_io::Owned::read(dir)?;
+        owned.check(&self.file_names(), self.opts.overwrite)?;
         let made = make_dir(dir)?;
         if made {
             mirrorball_io::made_folder(dir);
         }
         let result = mirrorball_io::write_together(|| {
             let files = write_engine(self.engine, lighting, dir, &self.opts)?;
-            write_text(&dir.join(README), &self.readme(&files))
+            write_text(&dir.join(README), &self.readme(dir, &files))?;
+            let mut names = relative(dir, &files);
+            names.push(README.to_string());
+            let stale = owned.replace(WRITER, &names);
+            owned.write()?;
+            Ok(stale)
         });
         if made {
             mirrorball_io::keep_folder(dir);
         }
         match result {
-            Ok(((), files)) => Ok(files),
+            Ok((stale, mut files)) => {
+                files.retain(|f| f.file_name() != Some(mirrorball_io::RECORD.as_ref()));
+                let removed = owned.remove(&stale);
+                Ok(Written { files, removed })
+            }
             Err(e) => {
                 if made {
                     let _ = std::fs::remove_dir(dir);
@@ -512,9 +608,16 @@ impl Bake {
     }
 
     /// The README: what was baked, each file, the engine's rules, and how to load it.
-    fn readme(&self, files: &[PathBuf]) -> String {
+    fn readme(&self, dir: &Path, files: &[PathBuf]) -> String {
         let d = self.engine.describe();
-        let names: Vec<String> = names(files).iter().map(|n| format!("`{n}`")).collect();
+        let names: Vec<String> = relative(dir, files)
+            .iter()
+            .map(|n| format!("`{n}`"))
+            .collect();
+        let background = match (d.background, self.spec.background_face) {
+            (Some(what), Some(face)) => format!("- Background: {what}, {face}² faces\n"),
+            _ => String::new(),
+        };
         format!(
             "# Image-based lighting for {engine}\n\n\
              Baked by mirrorball {version} from `{source}`: a {size}² GGX chain of {levels} levels, \
@@ -522,7 +625,7 @@ impl Bake {
              - Files: {names}\n\
              - Convention: {convention}\n\
              - Roughness to level: {rule}\n\
-             - Diffuse: {diffuse}\n\n{body}",
+             - Diffuse: {diffuse}\n{background}\n{body}",
             engine = self.engine,
             version = env!("CARGO_PKG_VERSION"),
             source = self.opts.source,
@@ -532,10 +635,59 @@ impl Bake {
             names = names.join(", "),
             convention = d.convention,
             rule = d.rule,
-            diffuse = d.diffuse.replace("NAME", &self.opts.stem()),
-            body = self.engine.readme(&self.opts, files),
+            diffuse = d.diffuse,
+            body = self.engine.readme(&self.opts, &self.spec),
         )
     }
+}
+
+/// Who a bake's files are recorded as written by, in the folder's record.
+const WRITER: &str = "bake";
+
+/// What [`Bake::write_into`] did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Written {
+    /// The files written (the engine's, then `README.md`), in place.
+    pub files: Vec<PathBuf>,
+    /// The files of the bake this one replaced that it did not write again, removed.
+    pub removed: Vec<PathBuf>,
+}
+
+/// Refuses a background size that is not a power of two in `1..=MAX_SIZE`, or any for an
+/// engine whose files hold no background.
+fn check_background_size(engine: Engine, b: u32) -> Result<(), Error> {
+    if engine.describe().background.is_none() {
+        let takers: Vec<String> = ENGINES
+            .iter()
+            .filter(|e| e.describe().background.is_some())
+            .map(|e| e.to_string())
+            .collect();
+        return Err(Error::request(format!(
+            "background size {b}: {engine}'s files hold no background (those of {} do)",
+            takers.join(", ")
+        )));
+    }
+    if b == 0 || b > MAX_SIZE || !b.is_power_of_two() {
+        return Err(Error::request(format!(
+            "background size {b}: give a power of two, 1, 2, 4 … {MAX_SIZE}"
+        )));
+    }
+    Ok(())
+}
+
+/// `files` (inside `dir`) relative to `dir`, `/` between folders.
+fn relative(dir: &Path, files: &[PathBuf]) -> Vec<String> {
+    files
+        .iter()
+        .map(|f| {
+            let rel = f.strip_prefix(dir).unwrap_or(f);
+            let parts: Vec<String> = rel
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                .collect();
+            parts.join("/")
+        })
+        .collect()
 }
 
 /// Makes `dir` (and its parents) when missing; `true` when it made the folder itself.
@@ -579,7 +731,7 @@ pub fn list() -> String {
             None => String::new(),
         };
         out += &format!(
-            "{e}\n  files:       {}\n  containers:  {}{}\n  encodings:   {encodings}\n  convention:  {}\n  cube turn:   the engine's direction (x, y, z) shows mirrorball's {}\n  roughness:   {}\n  diffuse:     {}\n",
+            "{e}\n  files:       {}\n  containers:  {}{}\n  encodings:   {encodings}\n  convention:  {}\n  cube turn:   the engine's direction (x, y, z) shows mirrorball's {}\n  roughness:   {}\n  diffuse:     {}\n  background:  {}\n",
             d.files,
             d.containers,
             if d.zstd { ", Zstandard supercompression" } else { "" },
@@ -587,6 +739,7 @@ pub fn list() -> String {
             e.orientation(),
             d.rule,
             d.diffuse,
+            d.background.unwrap_or("none written"),
         );
     }
     out

@@ -77,7 +77,8 @@ pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
 }
 
 /// three's PMREM levels: faces `size >> lod` for `lod` in `0..=log2(size) − LOD_MIN`, each at
-/// [`lod_to_roughness`]; no diffuse cube (three takes diffuse light from the last level).
+/// [`lod_to_roughness`]; no diffuse cube (three takes diffuse light from the last level);
+/// the plain cube at the background's size.
 pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
     let max_lod = opts.size.max(1).ilog2().saturating_sub(LOD_MIN);
     ChainSpec {
@@ -85,6 +86,7 @@ pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
             .map(|lod| ((opts.size >> lod).max(1), lod_to_roughness(lod, max_lod)))
             .collect(),
         diffuse_face: None,
+        background_face: Some(opts.background_face()),
     }
 }
 
@@ -104,6 +106,7 @@ pub(crate) fn describe() -> Description {
         convention: "three looks CubeTextures up at (-x, y, z) (src/renderers/webgl/WebGLMaterials.js 248-252, WebGLBackground.js 144-148, r187): both files are mirrored in x",
         rule: "three's PMREM: faces size>>lod down to 8x8, level lod at roughness 1 - sqrt(1 - lod/maxLod) (PMREMGenerator.js 236-240), read at mip maxLod*r(2-r) (envmap_common_pars_fragment.glsl.js 12-18)",
         diffuse: "the PMREM's last, roughness-1 level times pi (envmap_physical_pars_fragment.glsl.js 4-19)",
+        background: Some("cube/ (six RGBE faces: px nx py ny pz nz), the source as a cube, mirrored in x (scene.background)"),
     }
 }
 
@@ -114,8 +117,8 @@ pub(crate) fn file_names() -> Vec<String> {
         .collect()
 }
 
-/// Writes three's files into `dir`: `pmrem.dds` and `cube/{px,nx,py,ny,pz,nz}.hdr`, from
-/// lighting already in three's axes ([`orientation`]).
+/// Writes three's files into `dir`: `pmrem.dds` and `cube/{px,nx,py,ny,pz,nz}.hdr` (the
+/// background), from lighting already in three's axes ([`orientation`]).
 pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
     let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
     let levels: Vec<Vec<Image>> = l.specular.iter().map(|m| m.layers().to_vec()).collect();
@@ -131,9 +134,17 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
     )?;
     let mut files = vec![pmrem];
 
+    let Some(background) = &l.background else {
+        return Err(Error::request(
+            dir,
+            "three's plain cube is the background; this lighting has none: make it from \
+             Engine::Three.chain_spec"
+                .into(),
+        ));
+    };
     let cube = dir.join(CUBE_DIR);
     std::fs::create_dir_all(&cube).map_err(|e| Error::io(&cube, e))?;
-    for (face, name) in levels[0].iter().zip(CUBE_FACES) {
+    for (face, name) in background.layers().iter().zip(CUBE_FACES) {
         let path = cube.join(name);
         mirrorball_io::write_image(&path, face, &WriteOptions::default())?;
         files.push(path);
@@ -142,9 +153,13 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
 }
 
 /// The note's body: what each file is and the lines of three.js that load it.
-pub(crate) fn readme(opts: &BakeOptions) -> String {
+pub(crate) fn readme(opts: &BakeOptions, spec: &ChainSpec) -> String {
     let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
-    let levels: Vec<String> = chain_spec(opts)
+    let faces: Vec<String> = CUBE_FACES
+        .iter()
+        .map(|f| format!("'{CUBE_DIR}/{f}'"))
+        .collect();
+    let levels: Vec<String> = spec
         .levels
         .iter()
         .enumerate()
@@ -160,8 +175,8 @@ In three.js (r187):
   (`PMREMGenerator.lodToRoughness`), the roughness three's shaders read it at
   (mip = maxLod · r(2 − r)); the last level is three's diffuse light.
   Levels (lod: face, roughness): {levels}.
-- `{CUBE_DIR}/px.hdr … nz.hdr`: the plain cube (RGBE), for `scene.background` and for
-  materials three filters itself.
+- `{CUBE_DIR}/`: the plain cube (RGBE), {sky}² faces of the source itself, for
+  `scene.background` and for materials three filters itself.
 
 Both are mirrored left to right for three's cube lookup at (−x, y, z), so three shows
 them the right way round: do not flip them again.
@@ -181,8 +196,8 @@ pmrem.needsUpdate = true;
 scene.environment = pmrem; // or material.envMap = pmrem (MeshStandardMaterial)
 
 // The background (or envMap of MeshBasicMaterial/MeshPhongMaterial).
-scene.background = await new HDRCubeTextureLoader().setPath('{CUBE_DIR}/')
-  .loadAsync(['px.hdr', 'nx.hdr', 'py.hdr', 'ny.hdr', 'pz.hdr', 'nz.hdr']);
+scene.background = await new HDRCubeTextureLoader()
+  .loadAsync([{faces}]);
 // A blurred background reads the PMREM: scene.background = pmrem; scene.backgroundBlurriness = 0.5;
 ```
 
@@ -191,5 +206,7 @@ PMREM from it (`PMREMGenerator`).
 "#,
         label = encoding.label(),
         levels = levels.join(", "),
+        sky = spec.background_face.unwrap_or(opts.size),
+        faces = faces.join(", "),
     )
 }

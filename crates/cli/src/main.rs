@@ -452,6 +452,10 @@ pub struct PrefilterArgs {
     /// Edge of the BRDF table.
     #[arg(long, default_value_t = 128)]
     lut_size: u32,
+    /// Replace a side file (SH JSON, preview, BRDF table) that no mirrorball run wrote
+    /// (else prefilter refuses it; its own from an earlier run it replaces).
+    #[arg(long)]
+    overwrite: bool,
     /// Layout of flat outputs of multi-layer projections.
     #[arg(long, value_name = "LAYOUT", value_parser = names::<Layout>())]
     layout: Option<String>,
@@ -478,6 +482,14 @@ pub struct BakeArgs {
     /// Face edge of the specular chain's level 0, a power of two.
     #[arg(long, default_value_t = 256, value_parser = size::parse, allow_hyphen_values = true)]
     size: i64,
+    /// Face edge of the sky background (bevy, three, filament), a power of two; default:
+    /// the source's resolution (the edge that keeps its texels per steradian, 16 to 2048).
+    #[arg(long, value_name = "EDGE")]
+    background_size: Option<u32>,
+    /// Replace files in OUT-DIR that no mirrorball run wrote (else bake refuses them; the
+    /// files of an earlier bake there are replaced, or removed when not written again).
+    #[arg(long)]
+    overwrite: bool,
     /// Texel encoding (default: the engine's; `bake --for list` shows which it takes).
     #[arg(long, value_parser = names::<mirrorball_io::Encoding>())]
     encoding: Option<String>,
@@ -584,6 +596,13 @@ fn main() -> ExitCode {
             .collect();
     }
     budget::set_max(cli.max_memory);
+    let quiet = matches.subcommand().is_some_and(|(_, m)| {
+        m.try_get_one::<bool>("quiet")
+            .ok()
+            .flatten()
+            .copied()
+            .unwrap_or(false)
+    });
     let result: Result<(), CliError> = match cli.command {
         Command::Convert(a) => commands::convert::run(a),
         Command::Info(a) => commands::info::run(a),
@@ -595,6 +614,14 @@ fn main() -> ExitCode {
         Command::Render(a) => commands::render::run(*a),
         Command::Studio(a) => commands::studio::run(a),
     };
+    if !quiet {
+        for f in mirrorball_io::removed_leftovers() {
+            eprintln!(
+                "mirrorball: removed {}, left by a mirrorball run that was killed (its process no longer runs)",
+                f.display()
+            );
+        }
+    }
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -336,19 +336,9 @@ pub fn per_layer_write(
     }
 }
 
-/// The natural default edge for a conversion from `src` to `kind`: the power of two nearest
-/// (in ratio) to the edge that keeps the source's texels per steradian, so that cube faces
-/// are 256, 512, 1024 … and lat-longs 2:1 (1024×512, 4096×2048 …), as engines and
-/// users expect.
+/// The natural default edge for a conversion from `src` to `kind`
+/// ([`EnvMap::natural_size`]: the power of two that keeps the source's texels per
+/// steradian).
 pub fn default_size(src: &EnvMap, kind: ProjectionKind) -> u32 {
-    // Texels per steradian of the source, spread evenly.
-    let n_src = src.width() as f64 * src.height() as f64 * src.layers().len() as f64;
-    let per_sr = n_src / src.projection().covered_solid_angle();
-    let dst = kind.default_projection();
-    let (w1, h1) = dst.layer_extent(1024);
-    let texels_1024 = w1 as f64 * h1 as f64 * dst.layer_count() as f64;
-    let want = per_sr * dst.covered_solid_angle();
-    let size = 1024.0 * (want / texels_1024).sqrt();
-    let log2 = size.max(1.0).log2().round().clamp(0.0, 14.0);
-    1 << log2 as u32
+    src.natural_size(kind)
 }

@@ -126,6 +126,24 @@ impl EnvMap {
         EnvMap { projection, layers }
     }
 
+    /// The natural edge (`size`, as [`WorldProjection::layer_extent`] takes it) of this map
+    /// in projection `kind`: the power of two nearest (in ratio) to the edge that keeps this
+    /// map's texels per steradian, so that cube faces are 256, 512, 1024 … and lat-longs
+    /// 2:1 (1024×512, 4096×2048 …), as engines and users expect. An 8192×4096 lat-long
+    /// gives 2048² cube faces.
+    pub fn natural_size(&self, kind: crate::ProjectionKind) -> u32 {
+        // Texels per steradian of the source, spread evenly.
+        let n_src = self.width() as f64 * self.height() as f64 * self.layers.len() as f64;
+        let per_sr = n_src / self.projection.covered_solid_angle();
+        let dst = kind.default_projection();
+        let (w1, h1) = dst.layer_extent(1024);
+        let texels_1024 = w1 as f64 * h1 as f64 * dst.layer_count() as f64;
+        let want = per_sr * dst.covered_solid_angle();
+        let size = 1024.0 * (want / texels_1024).sqrt();
+        let log2 = size.max(1.0).log2().round().clamp(0.0, 14.0);
+        1 << log2 as u32
+    }
+
     /// The projection.
     pub fn projection(&self) -> &Projection {
         &self.projection

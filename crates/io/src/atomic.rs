@@ -10,12 +10,13 @@
 //!   beside their destinations and land as one set when it ends, or not at all.
 //! - An output that is a symbolic link is written through (the file it points to is
 //!   replaced, the link kept), as `cp` does.
-//! - A temporary file is named `.NAME.PID.tmp`; a later run that writes `NAME` removes the
-//!   ones a killed run (SIGKILL, power loss) left, once their process is gone.
+//! - A temporary file is named `.NAME.PID.tmp`; the first write of a run into a folder
+//!   removes every file of that pattern there whose process is gone (a run killed by
+//!   SIGKILL, a power loss), whatever it was to become; [`removed_leftovers`] says which.
 
 use crate::Error;
 use std::cell::RefCell;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -31,11 +32,10 @@ static FOLDERS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 /// Held shared while files are renamed into place, exclusively by [`interrupted`].
 static COMMITS: RwLock<()> = RwLock::new(());
-/// A folder's leftover temporary files of dead processes, by the base name of the file
-/// they were meant to become.
-type Leftovers = HashMap<String, Vec<PathBuf>>;
-/// Per folder already looked at, its [`Leftovers`].
-static LEFTOVERS: Mutex<Option<HashMap<PathBuf, Leftovers>>> = Mutex::new(None);
+/// The folders already cleared of dead processes' temporary files ([`remove_leftovers`]).
+static CLEARED: Mutex<Option<HashSet<PathBuf>>> = Mutex::new(None);
+/// The dead processes' temporary files removed, until [`removed_leftovers`] takes them.
+static REMOVED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 thread_local! {
     /// While [`write_together`] runs on this thread: the files it has staged.
@@ -328,29 +328,52 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
-/// Removes the temporary files a dead process left for `path`. Each folder is listed once
-/// per process.
+/// The first time this process writes into `path`'s folder: removes every temporary file
+/// there (the pattern `.NAME.PID.tmp`, a plain file) whose process no longer runs on this
+/// machine, and notes it for [`removed_leftovers`]. Nothing else is touched: not a file of
+/// another pattern, not one of a live process (nor of this one).
 fn remove_leftovers(path: &Path) {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let base = temp_base(path);
-    let mut cache = LEFTOVERS.lock().unwrap_or_else(|e| e.into_inner());
-    let by_dir = cache.get_or_insert_with(HashMap::new);
-    let found = by_dir
-        .entry(dir.clone())
-        .or_insert_with(|| leftovers_in(&dir));
-    if let Some(files) = found.remove(&base) {
-        for f in files {
-            let _ = std::fs::remove_file(f);
+    {
+        let mut cleared = CLEARED.lock().unwrap_or_else(|e| e.into_inner());
+        if !cleared.get_or_insert_with(HashSet::new).insert(dir.clone()) {
+            return;
         }
     }
+    let removed: Vec<PathBuf> = leftovers_in(&dir)
+        .into_iter()
+        .filter(|f| std::fs::remove_file(f).is_ok())
+        .collect();
+    REMOVED
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .extend(removed);
 }
 
-/// The temporary files in `dir` whose process is gone, by their base name.
-fn leftovers_in(dir: &Path) -> Leftovers {
-    let mut out = Leftovers::new();
+/// The temporary files of processes that no longer run that this process has removed so
+/// far (each once), for the caller to say so.
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// // A process id no machine hands out (above Linux's limit of 2^22).
+/// let left = dir.path().join(".sky.exr.4999999.tmp");
+/// std::fs::write(&left, b"half").unwrap();
+/// mirrorball_io::atomic_write(&dir.path().join("note.txt"), |_| Ok(())).unwrap();
+/// if cfg!(target_os = "linux") {
+///     assert!(!left.exists());
+///     assert!(mirrorball_io::removed_leftovers().contains(&left));
+/// }
+/// ```
+pub fn removed_leftovers() -> Vec<PathBuf> {
+    std::mem::take(&mut *REMOVED.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// The temporary files in `dir` whose process is gone.
+fn leftovers_in(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return out;
     };
@@ -358,17 +381,20 @@ fn leftovers_in(dir: &Path) -> Leftovers {
     for e in entries.flatten() {
         let name = e.file_name();
         let Some(name) = name.to_str() else { continue };
-        let Some((base, pid)) = parse_temp_name(name) else {
+        let Some((_, pid)) = parse_temp_name(name) else {
             continue;
         };
         if pid == std::process::id() || alive.contains(&pid) {
+            continue;
+        }
+        if !e.file_type().is_ok_and(|t| t.is_file()) {
             continue;
         }
         if process_alive(pid) {
             alive.insert(pid);
             continue;
         }
-        out.entry(base.to_string()).or_default().push(e.path());
+        out.push(e.path());
     }
     out
 }

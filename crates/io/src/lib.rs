@@ -38,12 +38,15 @@ mod ldr_io;
 mod meta_text;
 pub mod openexr;
 mod output;
+mod owned;
 mod pipe_size;
 mod rgba_png;
 
 pub use alloc::HugePages;
 pub use apng::write_apng;
-pub use atomic::{atomic_write, interrupted, keep_folder, made_folder, write_together};
+pub use atomic::{
+    atomic_write, interrupted, keep_folder, made_folder, removed_leftovers, write_together,
+};
 pub use babylon_env::{read_babylon_env, write_babylon_env, BabylonEnv};
 pub use dds_io::write_dds;
 pub use destination::{check_writable, file_system, free_bytes, output_folder, Folders};
@@ -54,6 +57,7 @@ pub use ktx2_io::{write_ktx2, CubeWrite};
 pub use ldr_io::{lut16 as srgb16_to_linear, lut8 as srgb8_to_linear};
 pub use mirrorball_encode::{Clipped, Effort, Encoding, Range, Storage};
 pub use output::OutputSet;
+pub use owned::{Owned, RECORD};
 pub use pipe_size::{widen_pipe, PIPE_BYTES};
 pub use rgba_png::Rgba8Face;
 

@@ -30,8 +30,8 @@ pub fn texel_dir(face: usize, x: u32, y: u32, n: u32) -> DVec3 {
         .unwrap()
 }
 
-/// Bakes the direction-coded map for `engine` into `dir`: the bake, the float lighting (in
-/// the engine's axes) and the files written.
+/// Bakes the direction-coded map (256 wide) for `engine` into `dir` as `mirrorball bake`
+/// does: the bake, the float lighting (in the engine's axes) and the files written.
 pub fn bake(
     engine: Engine,
     size: u32,
@@ -44,9 +44,10 @@ pub fn bake(
         source: "coded.exr".into(),
         ..Default::default()
     };
-    let bake = Bake::new(engine, opts).unwrap();
+    let mut bake = Bake::new(engine, opts).unwrap();
     let env = direction_coded(256);
     bake.check(&env).unwrap();
+    bake.fit(&env);
     let lighting = bake.lighting(&env, Default::default());
     let files = bake.write(&lighting, dir).unwrap();
     (bake, lighting, files)

@@ -111,10 +111,7 @@ fn filament_files_read_back_by_an_independent_reader() {
     let size = 16;
     let (baked, lighting, files) = bake(Engine::Filament, size, None, dir.path());
     let names = crate::common::names(&files);
-    assert_eq!(
-        names,
-        ["coded_ibl.ktx", "coded_skybox.ktx", "sh.txt", "README.md"]
-    );
+    assert_eq!(names, ["ibl.ktx", "skybox.ktx", "sh.txt", "README.md"]);
 
     // The default encoding, as cmgen writes it and Filament's Ktx1Reader reads it.
     let bytes = std::fs::read(&files[0]).unwrap();
@@ -181,11 +178,14 @@ fn filament_files_read_back_by_an_independent_reader() {
         let lod = 4.0 * r * (2.0 - r); // perceptualRoughnessToLod, iblRoughnessOneLevel = 4
         assert!((lod - m as f64).abs() < 1e-12, "level {m}: r = {r}");
     }
+    // The sky: the source itself at its own resolution (a 256-wide lat-long: 64²), not
+    // the chain's level 0.
     let skybox = std::fs::read(&files[1]).unwrap();
     let sky = ktx::Ktx::new(&skybox[..]);
+    assert_eq!(baked.spec.background_face, Some(64));
     assert_eq!(
         (sky.mipmap_levels(), sky.pixel_width(), sky.faces()),
-        (1, size, 6)
+        (1, 64, 6)
     );
 
     // sh.txt and the ibl file's `sh` key: cmgen's pre-scaled irradiance SH of the map.

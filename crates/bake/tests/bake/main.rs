@@ -6,4 +6,5 @@ mod common;
 mod dds;
 mod filament;
 mod flow;
+mod folder;
 mod ktx2;

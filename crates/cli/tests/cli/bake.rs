@@ -57,7 +57,7 @@ fn every_engine_bakes_end_to_end() {
             ..Default::default()
         };
         let mut want = engine.file_names(&opts);
-        want.push("README.md".into());
+        want.extend(["README.md".into(), mirrorball_io::RECORD.into()]);
         want.sort();
         let made: Vec<String> = files(&out)
             .into_iter()
@@ -226,8 +226,9 @@ fn a_failed_write_leaves_nothing() {
     let src = input(dir.path(), "sky.exr", false);
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
-    // The last file written through a link into a folder that does not exist: the cubes
-    // before it are written beside their names, then the set is dropped.
+    // The last file written through a link into a folder that does not exist (the bake
+    // told to replace it): the cubes before it are written beside their names, then the
+    // set is dropped.
     std::os::unix::fs::symlink(dir.path().join("gone/sh.json"), out.join("sh.json")).unwrap();
     let o = run(&[
         "bake",
@@ -237,6 +238,7 @@ fn a_failed_write_leaves_nothing() {
         out.to_str().unwrap(),
         "--size",
         "16",
+        "--overwrite",
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("sh.json"), "{}", stderr(&o));
@@ -330,5 +332,230 @@ fn convert_for_an_engine_turns_the_map_its_way() {
         stderr(&o).contains("--for: unknown 'maya'"),
         "{}",
         stderr(&o)
+    );
+}
+
+/// `bake` of `src` for `engine` into `out` at size 16, with `extra` flags.
+fn bake_into(src: &Path, engine: Engine, out: &Path, extra: &[&str]) -> std::process::Output {
+    let engine = engine.to_string();
+    let mut args = vec![
+        "bake",
+        src.to_str().unwrap(),
+        "--for",
+        &engine,
+        out.to_str().unwrap(),
+        "--size",
+        "16",
+    ];
+    args.extend(extra);
+    run(&args)
+}
+
+/// What a bake for `engine` leaves in its folder: its files, the README, the record, and
+/// a folder entry for each of its folders (as `files` lists them).
+fn bake_listing(engine: Engine) -> Vec<String> {
+    let mut want: Vec<String> = engine
+        .file_names(&BakeOptions {
+            size: 16,
+            ..Default::default()
+        })
+        .into_iter()
+        .chain(["README.md".into(), mirrorball_io::RECORD.into()])
+        .collect();
+    let folders: Vec<String> = want
+        .iter()
+        .filter_map(|f| f.split_once('/').map(|(d, _)| format!("{d}/")))
+        .collect();
+    want.extend(folders);
+    want.sort();
+    want.dedup();
+    want
+}
+
+#[test]
+fn every_engine_refuses_files_no_bake_wrote_unless_told() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = input(dir.path(), "sky.exr", false);
+    for engine in ENGINES {
+        let out = dir.path().join(format!("{engine}"));
+        std::fs::create_dir(&out).unwrap();
+        std::fs::write(out.join("README.md"), "my notes").unwrap();
+        std::fs::write(out.join("notes.txt"), "mine").unwrap();
+        // The user's README, then a file of the engine's own name the user made: each
+        // refused by name before any work, nothing written, exit 2.
+        let own = engine.file_names(&BakeOptions::default())[0].clone();
+        for (made, named) in [(None, "README.md"), (Some(&own), own.as_str())] {
+            if let Some(f) = made {
+                let p = out.join(f);
+                std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+                std::fs::write(&p, "mine too").unwrap();
+            }
+            let before = files(&out);
+            let o = bake_into(&src, engine, &out, &[]);
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(2), "{engine}: {e}");
+            assert!(
+                e.contains(&out.join(named).display().to_string()) && e.contains("--overwrite"),
+                "{engine}: {e}"
+            );
+            assert!(
+                !e.contains("prefilter"),
+                "{engine}: refused before any work: {e}"
+            );
+            assert_eq!(files(&out), before, "{engine}");
+        }
+        // Told to: they are replaced, the other file is left alone; a bake again is its own.
+        let o = bake_into(&src, engine, &out, &["--overwrite", "-q"]);
+        assert!(o.status.success(), "{engine}: {}", stderr(&o));
+        assert_ne!(std::fs::read(out.join("README.md")).unwrap(), b"my notes");
+        assert_ne!(std::fs::read(out.join(&own)).unwrap(), b"mine too");
+        assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
+        let o = bake_into(&src, engine, &out, &["-q"]);
+        assert!(o.status.success(), "{engine} again: {}", stderr(&o));
+        let mut want = bake_listing(engine);
+        want.push("notes.txt".into());
+        want.sort();
+        assert_eq!(files(&out), want, "{engine}");
+    }
+}
+
+#[test]
+fn a_bake_for_another_engine_removes_the_earlier_bakes_files_and_no_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = input(dir.path(), "sky.exr", false);
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    // Every engine after the one before it, round to the first again.
+    let mut before: Option<Engine> = None;
+    for engine in ENGINES.into_iter().chain([ENGINES[0]]) {
+        let o = bake_into(&src, engine, &out, &[]);
+        let said = stderr(&o);
+        assert!(o.status.success(), "{engine} after {before:?}: {said}");
+        let mut want = bake_listing(engine);
+        want.push("notes.txt".into());
+        want.sort();
+        assert_eq!(files(&out), want, "{engine} after {before:?}");
+        let record = std::fs::read_to_string(out.join(mirrorball_io::RECORD)).unwrap();
+        let listed: Vec<&str> = record
+            .lines()
+            .filter_map(|l| l.strip_prefix("bake\t"))
+            .collect();
+        let mut own = engine.file_names(&BakeOptions {
+            size: 16,
+            ..Default::default()
+        });
+        own.push("README.md".into());
+        assert_eq!(listed, own, "{engine}");
+        if let Some(b) = before {
+            let opts = BakeOptions::default();
+            let stale: Vec<String> = b
+                .file_names(&opts)
+                .into_iter()
+                .filter(|f| !engine.file_names(&opts).contains(f))
+                .collect();
+            for f in &stale {
+                assert!(
+                    said.contains(&out.join(f).display().to_string()),
+                    "{engine} after {b}: {f} not said removed: {said}"
+                );
+            }
+            assert_eq!(said.contains("removed"), !stale.is_empty(), "{said}");
+        }
+        before = Some(engine);
+    }
+    assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
+}
+
+/// A direction-coded lat-long EXR `width` wide.
+fn wide_input(dir: &Path, width: u32) -> PathBuf {
+    let env = mirrorball_bake::direction_coded(width);
+    let path = dir.join(format!("sky{width}.exr"));
+    mirrorball_io::write_image(&path, &env.layers()[0], &Default::default()).unwrap();
+    path
+}
+
+/// The face edge of the background an engine's bake wrote in `out`.
+fn background_edge(engine: Engine, out: &Path) -> u32 {
+    let read = |f: &str| {
+        mirrorball_io::read(&out.join(f), &mirrorball_io::Limits::default())
+            .unwrap()
+            .layers[0]
+            .width()
+    };
+    match engine {
+        Engine::Bevy => read("skybox.ktx2"),
+        Engine::Three => read("cube/px.hdr"),
+        // KTX1's pixelWidth (after the identifier and six u32s).
+        Engine::Filament => {
+            let b = std::fs::read(out.join("skybox.ktx")).unwrap();
+            u32::from_le_bytes(b[36..40].try_into().unwrap())
+        }
+        _ => unreachable!("{engine} writes no background"),
+    }
+}
+
+#[test]
+fn the_background_has_the_sources_resolution_or_the_size_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    // 512×256: 131072 texels, as six faces of 148² hold: 128², the nearest power of two.
+    let src = wide_input(dir.path(), 512);
+    let takers: Vec<Engine> = ENGINES
+        .into_iter()
+        .filter(|e| e.describe().background.is_some())
+        .collect();
+    assert_eq!(takers, [Engine::Bevy, Engine::Three, Engine::Filament]);
+    for engine in ENGINES {
+        let out = dir.path().join(format!("{engine}"));
+        let o = bake_into(&src, engine, &out, &[]);
+        let said = stderr(&o);
+        assert!(o.status.success(), "{engine}: {said}");
+        if !takers.contains(&engine) {
+            assert!(!said.contains("background"), "{engine}: {said}");
+            refused(
+                dir.path(),
+                &[
+                    "bake",
+                    src.to_str().unwrap(),
+                    "--for",
+                    &engine.to_string(),
+                    out.to_str().unwrap(),
+                    "--background-size",
+                    "64",
+                ],
+                "no background",
+            );
+            continue;
+        }
+        assert!(said.contains("16², background 128²"), "{engine}: {said}");
+        assert_eq!(background_edge(engine, &out), 128, "{engine}");
+        let readme = std::fs::read_to_string(out.join("README.md")).unwrap();
+        assert!(readme.contains("128²"), "{engine}: {readme}");
+        ok(&[
+            "bake",
+            src.to_str().unwrap(),
+            "--for",
+            &engine.to_string(),
+            out.to_str().unwrap(),
+            "--size",
+            "16",
+            "--background-size",
+            "32",
+            "-q",
+        ]);
+        assert_eq!(background_edge(engine, &out), 32, "{engine}");
+    }
+    refused(
+        dir.path(),
+        &[
+            "bake",
+            src.to_str().unwrap(),
+            "--for",
+            "bevy",
+            dir.path().join("x").to_str().unwrap(),
+            "--background-size",
+            "100",
+        ],
+        "background size 100: give a power of two",
     );
 }

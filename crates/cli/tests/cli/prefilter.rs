@@ -231,3 +231,63 @@ fn bad_requests_fail_before_work() {
     }
     assert!(files(dir.path()).is_empty(), "{:?}", files(dir.path()));
 }
+
+/// The side files (SH JSON, preview, BRDF table) replace only files a mirrorball run wrote:
+/// a user's file of the same name is refused by name before any work (exit 2, nothing
+/// written) unless `--overwrite`, and prefilter's own are replaced again without asking.
+#[test]
+fn side_files_replace_only_what_mirrorball_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let src = asset("sky.exr");
+    let out = d.join("sky.ktx2");
+    let lut = d.join("brdf.png");
+    let prefilter = |extra: &[&str]| {
+        let mut args = vec![
+            "prefilter",
+            src.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--size",
+            "8",
+            "--lut",
+            lut.to_str().unwrap(),
+            "--lut-size",
+            "8",
+            "-q",
+        ];
+        args.extend(extra);
+        run(&args)
+    };
+    for side in ["sky.sh.json", "sky_preview.png", "brdf.png"] {
+        std::fs::write(d.join(side), "mine").unwrap();
+        let before = files(d);
+        let o = prefilter(&[]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{side}: {e}");
+        assert!(
+            e.contains(&d.join(side).display().to_string()) && e.contains("--overwrite"),
+            "{side}: {e}"
+        );
+        assert_eq!(files(d), before, "{side}: nothing written");
+        std::fs::remove_file(d.join(side)).unwrap();
+    }
+    std::fs::write(d.join("sky.sh.json"), "mine").unwrap();
+    std::fs::write(d.join("notes.txt"), "mine").unwrap();
+    let o = prefilter(&["--overwrite"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_ne!(std::fs::read(d.join("sky.sh.json")).unwrap(), b"mine");
+    let o = prefilter(&[]);
+    assert!(o.status.success(), "its own again: {}", stderr(&o));
+    assert_eq!(
+        files(d),
+        [
+            mirrorball_io::RECORD,
+            "brdf.png",
+            "notes.txt",
+            "sky.ktx2",
+            "sky.sh.json",
+            "sky_preview.png"
+        ]
+    );
+    assert_eq!(std::fs::read(d.join("notes.txt")).unwrap(), b"mine");
+}

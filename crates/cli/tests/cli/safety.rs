@@ -237,15 +237,93 @@ fn an_interrupted_run_leaves_nothing_half_written() {
         files(d)
     );
 
-    // A killed run's temporary files are removed by the next run that writes those files.
+    // A killed run's temporary files stay; the next run that writes anything into the
+    // folder removes them and says which.
     assert_eq!(interrupt(d, &big, "-KILL"), 128 + 9);
-    assert!(files(d).iter().any(|f| f.ends_with(".tmp")));
-    small_set(d);
+    let left: Vec<String> = files(d)
+        .into_iter()
+        .filter(|f| f.ends_with(".tmp"))
+        .collect();
+    assert!(!left.is_empty());
+    let said = ok(&[
+        "convert",
+        d.join("s.exr").to_str().unwrap(),
+        d.join("other.hdr").to_str().unwrap(),
+        "--to",
+        "latlong",
+        "--size",
+        "16",
+    ]);
+    for f in &left {
+        assert!(
+            said.contains(&format!("removed {}", d.join(f).display())),
+            "{f}: {said}"
+        );
+    }
     assert!(
         !files(d).iter().any(|f| f.ends_with(".tmp")),
         "{:?}",
         files(d)
     );
+}
+
+/// Only mirrorball's own temporary files (`.NAME.PID.tmp`, a plain file) of processes that
+/// no longer run are removed, from any folder a run writes into, and the run says so;
+/// nothing else is touched, and a quiet run removes them without a word.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_run_removes_only_the_temporary_files_of_dead_processes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::copy(asset("city.exr"), d.join("s.exr")).unwrap();
+    let out = d.join("out");
+    std::fs::create_dir(&out).unwrap();
+    // A process that has ended, and one that runs (this test's).
+    let mut gone = std::process::Command::new("true").spawn().unwrap();
+    gone.wait().unwrap();
+    let (dead, live) = (gone.id(), std::process::id());
+    let dead_tmp = format!(".x.exr.{dead}.tmp");
+    let kept = [
+        format!(".y.png.{live}.tmp"),
+        format!("x.exr.{dead}.tmp"),
+        format!(".x.exr.{dead}.tmp.bak"),
+        ".x.exr.tmp".to_string(),
+        format!(".x.exr.{dead}a.tmp"),
+    ];
+    for f in kept.iter().chain([&dead_tmp]) {
+        std::fs::write(out.join(f), b"half").unwrap();
+    }
+    std::fs::create_dir(out.join(format!(".dir.{dead}.tmp"))).unwrap();
+    let before = files(&out);
+    let convert = |name: &str, quiet: bool| {
+        let o = out.join(name);
+        let mut args = vec!["convert", "s.exr", o.to_str().unwrap(), "--to", "latlong"];
+        args.extend(["--size", "16"]);
+        if quiet {
+            args.push("-q");
+        }
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_mirrorball"))
+            .current_dir(d)
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let said = convert("a.exr", false);
+    let want = format!("removed {}", out.join(&dead_tmp).display());
+    assert!(said.contains(&want), "{said}");
+    assert_eq!(said.matches("removed").count(), 1, "{said}");
+    let mut now = before.clone();
+    now.retain(|f| *f != dead_tmp);
+    now.push("a.exr".into());
+    now.sort();
+    assert_eq!(files(&out), now);
+    // Nothing more to remove; and a quiet run removes them without a word.
+    assert!(!convert("b.exr", false).contains("removed"));
+    std::fs::write(out.join(&dead_tmp), b"half").unwrap();
+    assert_eq!(convert("c.exr", true), "");
+    assert!(!out.join(&dead_tmp).exists());
 }
 
 #[cfg(unix)]

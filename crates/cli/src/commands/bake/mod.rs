@@ -44,6 +44,7 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
     let t0 = Instant::now();
     let env = load::read_prepared(&plan.source, &plan.input, plan.quiet)?;
     plan.bake.check(&env)?;
+    plan.bake.fit(&env);
     let size = plan.bake.opts.size;
     let face = size.clamp(256, 4096) as u64;
     // The cubes made, and their copy in the engine's axes.
@@ -66,12 +67,20 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
         say(line);
     }
     let t2 = Instant::now();
-    let files = with_spinner("writing", plan.quiet, || {
-        plan.bake.write(&lighting, &plan.dir)
+    let written = with_spinner("writing", plan.quiet, || {
+        plan.bake.write_into(&lighting, &plan.dir)
     })?;
-    let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+    let names: Vec<String> = written
+        .files
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let background = match plan.bake.spec.background_face {
+        Some(f) => format!(", background {f}²"),
+        None => String::new(),
+    };
     say(format!(
-        "wrote {} for {}: {} levels from {size}², {} (read {:.2}s, prefilter {:.2}s, write {:.2}s)",
+        "wrote {} for {}: {} levels from {size}²{background}, {} (read {:.2}s, prefilter {:.2}s, write {:.2}s)",
         names.join(", "),
         plan.bake.engine,
         plan.bake.spec.levels.len(),
@@ -80,6 +89,19 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
         (t2 - t1).as_secs_f64(),
         t2.elapsed().as_secs_f64()
     ));
+    if !written.removed.is_empty() {
+        let gone: Vec<String> = written
+            .removed
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        say(format!(
+            "removed {} file(s) of the earlier bake in {} that this one does not write: {}",
+            gone.len(),
+            plan.dir.display(),
+            gone.join(", ")
+        ));
+    }
     Ok(())
 }
 

@@ -87,6 +87,8 @@ impl Plan {
             zstd,
             mapping,
             source: source.clone(),
+            background_size: a.background_size,
+            overwrite: a.overwrite,
         };
         let bake = Bake::new(engine, opts).map_err(|e| CliError::new(e.fault, e.message))?;
         if let Some(RoughnessMapping::Custom(r)) = &bake.opts.mapping {
@@ -105,11 +107,7 @@ impl Plan {
         files
             .making(mirrorball_io::Folders::MakeOne)
             .input_arg("the input", source);
-        for name in engine
-            .file_names(&bake.opts)
-            .into_iter()
-            .chain([mirrorball_bake::README.to_string()])
-        {
+        for name in bake.file_names() {
             let path = dir.join(&name);
             if path.is_dir() {
                 return Err(CliError::request(format!(
@@ -121,6 +119,7 @@ impl Plan {
         }
         files.check()?;
         files.room(file_bytes(&bake))?;
+        bake.check_folder(&dir)?;
         if a.samples == 0 || a.samples > 65536 {
             return Err(CliError::request(format!(
                 "--samples: {} is outside 1..=65536",

@@ -55,6 +55,7 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
 
     let t2 = Instant::now();
     let (mut written, report) = outputs::write_chain(&plan, &chain)?;
+    outputs::record_side_files(&plan.side_files())?;
     let keep: Vec<String> = crate::fit::precision_advice(report.storage)
         .into_iter()
         .collect();

@@ -38,6 +38,53 @@ pub(super) fn level_path(out: &str, i: usize) -> String {
         .to_string()
 }
 
+/// Who the side files are recorded as written by, in their folders' records.
+const WRITER: &str = "prefilter";
+
+/// `paths` by folder: each folder (`.` for a bare name) and the names in it.
+fn by_folder(paths: &[&Path]) -> Vec<(PathBuf, Vec<String>)> {
+    let mut out: Vec<(PathBuf, Vec<String>)> = Vec::new();
+    for p in paths {
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let Some(name) = p.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+            continue;
+        };
+        match out.iter_mut().find(|(d, _)| *d == dir) {
+            Some((_, names)) => names.push(name),
+            None => out.push((dir, vec![name])),
+        }
+    }
+    out
+}
+
+/// Refuses, before any work, to replace a side file (SH JSON, preview, BRDF table) that
+/// no mirrorball run wrote (its folder's record, `mirrorball_io::Owned`, does not list
+/// it), unless `overwrite`: the message names the file.
+pub(super) fn check_side_files(paths: &[&Path], overwrite: bool) -> Result<(), CliError> {
+    for (dir, names) in by_folder(paths) {
+        mirrorball_io::Owned::read(&dir)?.check(&names, overwrite)?;
+    }
+    Ok(())
+}
+
+/// Records the side files in their folders' records, just before they are written: a run
+/// stopped between the two leaves a record naming a file that is not there, which costs
+/// nothing, where the other order would leave a file of ours that the next run refuses.
+pub(super) fn record_side_files(paths: &[&Path]) -> Result<(), CliError> {
+    for (dir, names) in by_folder(paths) {
+        let mut owned = mirrorball_io::Owned::read(&dir)?;
+        if names.iter().all(|n| owned.owns(n)) {
+            continue;
+        }
+        owned.add(WRITER, &names);
+        owned.write()?;
+    }
+    Ok(())
+}
+
 /// The chain: one cube container, or each level's file(s). Returns the files written and
 /// what their storage could not hold, each level a part of the report.
 pub(super) fn write_chain(

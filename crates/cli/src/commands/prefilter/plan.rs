@@ -3,7 +3,7 @@
 //! (SH JSON, preview, BRDF table), and every file read or written, checked before any file
 //! is read.
 
-use super::outputs::{beside, level_path};
+use super::outputs::{beside, check_side_files, level_path};
 use crate::choice::parse_flag;
 use crate::commands::convert::parse_precision;
 use crate::commands::{parse_layout, InputPlan};
@@ -101,6 +101,7 @@ impl Plan {
         if let Some(size) = plan.size {
             plan.check_room(size)?;
         }
+        check_side_files(&plan.side_files(), a.overwrite)?;
         Ok(plan)
     }
 
@@ -160,6 +161,16 @@ impl Plan {
             .bytes_estimate(chain, 4, self.save.write.precision)
             .saturating_add(lut + preview);
         self.files()?.room(bytes)
+    }
+
+    /// The side outputs that will be written: the SH JSON, the preview sheet, the BRDF
+    /// table.
+    pub fn side_files(&self) -> Vec<&Path> {
+        [&self.sh_path, &self.preview_path, &self.lut_path]
+            .into_iter()
+            .flatten()
+            .map(PathBuf::as_path)
+            .collect()
     }
 
     /// Every file read and written: the input, the container or every level the chain may
