@@ -215,7 +215,8 @@ pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<
 /// The note's body: what the files hold and a few lines of Bevy to load them.
 pub(crate) fn readme(opts: &BakeOptions, spec: &ChainSpec) -> String {
     let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
-    let levels = spec.levels.len();
+    let level_count = spec.levels.len();
+    let levels = mirrorball_core::count(level_count as u64, "level");
     let zstd = match opts.zstd {
         Some(z) => format!(", Zstandard level {z} (Bevy's `zstd_rust` or `zstd_c` feature)"),
         None => String::new(),
@@ -223,7 +224,7 @@ pub(crate) fn readme(opts: &BakeOptions, spec: &ChainSpec) -> String {
     format!(
         "## Loading it\n\n\
          For Bevy's `EnvironmentMapLight`, {enc}{zstd}:\n\n\
-         - `{SPECULAR_FILE}`: {size}² faces, {levels} levels down to 1×1, level m GGX-filtered at\n  \
+         - `{SPECULAR_FILE}`: {size}² faces, {levels} down to 1×1, level m GGX-filtered at\n  \
            perceptual roughness m/{last} (Bevy picks level roughness × (levels − 1)).\n\
          - `{DIFFUSE_FILE}`: {DIFFUSE_FACE}² faces, the irradiance divided by π (Bevy multiplies by\n  \
            the diffuse colour only).\n\
@@ -249,7 +250,7 @@ pub(crate) fn readme(opts: &BakeOptions, spec: &ChainSpec) -> String {
          ```\n",
         enc = encoding.label(),
         size = opts.size,
-        last = levels.max(2) - 1,
+        last = level_count.max(2) - 1,
         sky = spec.background_face.unwrap_or(opts.size),
     )
 }

@@ -620,7 +620,7 @@ impl Bake {
         };
         format!(
             "# Image-based lighting for {engine}\n\n\
-             Baked by mirrorball {version} from `{source}`: a {size}² GGX chain of {levels} levels, \
+             Baked by mirrorball {version} from `{source}`: a {size}² GGX chain of {levels}, \
              {encoding}.\n\n\
              - Files: {names}\n\
              - Convention: {convention}\n\
@@ -630,7 +630,7 @@ impl Bake {
             version = env!("CARGO_PKG_VERSION"),
             source = self.opts.source,
             size = self.opts.size,
-            levels = self.spec.levels.len(),
+            levels = mirrorball_core::count(self.spec.levels.len() as u64, "level"),
             encoding = self.encoding().label(),
             names = names.join(", "),
             convention = d.convention,

@@ -112,11 +112,12 @@ pub struct ConvertArgs {
         hide_default_value = true
     )]
     output: String,
-    /// Output projection, `NAME[:key=value…]` (see --from).
+    /// Output projection, `NAME[:key=value…]` (see --from). Default, for one file: the
+    /// input's projection, at the input's size unless --size (to change only the container
+    /// or the layout); sequences, pipes and manifests need it.
     #[arg(
         long,
         value_name = "PROJECTION",
-        required_unless_present = "manifest",
         default_value = "",
         hide_default_value = true
     )]
@@ -167,9 +168,9 @@ pub struct ConvertArgs {
     /// Texel precision: half, float (EXR/KTX2/DDS) or 8, 16 (PNG).
     #[arg(long, value_parser = names::<Precision>())]
     precision: Option<String>,
-    /// EXR compression.
-    #[arg(long, default_value = "zip", value_parser = names::<ExrCompression>())]
-    compression: String,
+    /// EXR compression (default zip; .exr outputs only).
+    #[arg(long, value_parser = names::<ExrCompression>())]
+    compression: Option<String>,
     /// Write the full mip chain (KTX2/DDS).
     #[arg(long)]
     mips: bool,
@@ -534,7 +535,10 @@ fn on_interrupt_clean_up() {
                 _ => "hung up",
             };
             // A new line: a progress bar may be on this one.
-            eprintln!("\nmirrorball: {what}; removed {removed} unfinished file(s), nothing half-written left");
+            eprintln!(
+                "\nmirrorball: {what}; removed {}, nothing half-written left",
+                mirrorball_core::count(removed as u64, "unfinished file")
+            );
             std::process::exit(128 + sig);
         }
     });

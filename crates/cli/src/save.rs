@@ -3,12 +3,13 @@
 
 use crate::error::CliError;
 use crate::fit::{self, Report};
+use mirrorball_core::Choice;
 use crate::load::{layer_names, FACE};
 use mirrorball_core::{
     EnvMap, Image, Layout, Projection, ProjectionKind, Stereo, WorldProjection,
 };
 use mirrorball_filter::MipChain;
-use mirrorball_io::{Format, MapInfo, OutputSet, WriteOptions};
+use mirrorball_io::{Format, MapInfo, OutputSet, Precision, WriteOptions};
 use std::path::{Path, PathBuf};
 
 /// What to write.
@@ -43,20 +44,82 @@ pub fn default_layout(layers: usize) -> Layout {
     }
 }
 
-/// Checks that `out` can hold a map of `kind` before any work starts (its folder is
-/// `guard::Files`' to check).
-pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<Format, CliError> {
+/// The flags that only some containers take, and which: the one table their refusals are
+/// made from ([`check_flags`]). `--precision` takes its values from
+/// [`Format::precisions`].
+const CONTAINER_FLAGS: &[(&str, fn(Format) -> bool)] = &[
+    ("--compression", |f| f == Format::Exr),
+    ("--mips", Format::is_cube_container),
+    ("--layout", |f| !f.is_cube_container()),
+    ("--tone", |f| matches!(f, Format::Png | Format::Jpeg)),
+];
+
+/// The output's container, from `out`'s extension: one mirrorball writes (its folder is
+/// `guard::Files`' to check). What the container alone decides, checked before anything is read.
+pub fn check_container(out: &str) -> Result<Format, CliError> {
     let path = Path::new(out);
+    let written: Vec<&str> = Format::ALL
+        .iter()
+        .filter(|f| f.is_written())
+        .map(|f| f.extension())
+        .collect();
     let format = Format::from_path(path).ok_or_else(|| {
         CliError::request(format!(
-            "{out}: unknown output extension (use .exr .hdr .png .jpg .ktx2 .dds)"
+            "{out}: unknown output extension (use {})",
+            written.join(" ")
         ))
     })?;
-    if format == Format::Webp {
+    if !format.is_written() {
         return Err(CliError::request(format!(
-            "{out}: WebP is read-only here; write .png"
+            "{out}: {} is read-only here; write .png",
+            format.name()
         )));
     }
+    Ok(format)
+}
+
+/// Refuses a container flag `out`'s container does not take (`given`: the flags given,
+/// as [`CONTAINER_FLAGS`] names them), and a `precision` it does not write: each names the
+/// flag, the container and the containers (or values) that take it.
+pub fn check_flags(
+    out: &str,
+    format: Format,
+    given: &[&str],
+    precision: Option<Precision>,
+) -> Result<(), CliError> {
+    let container = format!("{} ({})", format.extension(), format.name());
+    for (flag, takes) in CONTAINER_FLAGS {
+        if given.contains(flag) && !takes(format) {
+            let which: Vec<&str> = Format::ALL
+                .iter()
+                .filter(|f| f.is_written() && takes(**f))
+                .map(|f| f.extension())
+                .collect();
+            return Err(CliError::request(format!(
+                "{out}: {flag} applies to {} outputs, not {container}",
+                which.join(" ")
+            )));
+        }
+    }
+    match (precision, format.precisions()) {
+        (Some(p), takes) if !takes.contains(&p) => {
+            let takes: Vec<&str> = takes.iter().map(|p| p.name()).collect();
+            Err(CliError::request(format!(
+                "{out}: --precision {} does not apply to {container}, which {}",
+                p.name(),
+                match takes.len() {
+                    0 => "has one precision of its own".to_string(),
+                    _ => format!("takes {}", takes.join(" or ")),
+                }
+            )))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Checks that `out` can hold a map of `kind` before any work starts.
+pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<Format, CliError> {
+    let format = check_container(out)?;
     if format.is_cube_container() && kind != ProjectionKind::Cube {
         return Err(CliError::request(format!(
             "{out}: KTX2 and DDS files are sampled by GPUs as OpenGL/Direct3D cube maps, so they hold --to cube only (not {kind})"
@@ -76,7 +139,8 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
     if let Some(l) = layout {
         if !l.fits(layers) {
             return Err(CliError::request(format!(
-                "--layout {l} needs six faces; a {kind} map has {layers} layer(s)"
+                "--layout {l} needs six faces; a {kind} map has {}",
+                mirrorball_core::count(layers as u64, "layer")
             )));
         }
         if l != Layout::Separate && out.contains(FACE) {
@@ -242,7 +306,8 @@ pub fn pack_eyes(eyes: &[EnvMap], stereo: Stereo, layout: Layout) -> Result<Imag
         .collect::<Option<Vec<Image>>>()
         .ok_or_else(|| {
             CliError::request(format!(
-                "layout {layout} does not fit a map of {n} layer(s)"
+                "layout {layout} does not fit a map of {}",
+                mirrorball_core::count(n as u64, "layer")
             ))
         })?;
     stereo.join(pictures).ok_or_else(|| {

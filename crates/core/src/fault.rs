@@ -25,3 +25,37 @@ impl Fault {
         }
     }
 }
+
+/// Why a path named as an input cannot be read as a file, with whose fault it is, from what
+/// `std::fs::metadata(path)` returned (core does no I/O: the caller looks): not there (the
+/// input's), a directory (the input's), a file of 0 bytes (the input's, called empty, not
+/// truncated), or the system's reason (permissions, a folder in the path that is a file).
+/// `None` for a regular file with bytes in it, and for anything else that is there (a
+/// pipe or a device: its length says nothing). Every reader of input files (images,
+/// meshes, scenes, manifests) asks it first, so each says these the same way.
+///
+/// ```
+/// use mirrorball_core::{input_file_problem, Fault};
+/// let dir = std::env::temp_dir();
+/// let (fault, problem) = input_file_problem(&std::fs::metadata(&dir)).unwrap();
+/// assert_eq!((fault, problem.as_str()), (Fault::Input, "is a directory, not a file"));
+/// let none = std::fs::metadata(dir.join("no-such-file-here.exr"));
+/// assert_eq!(input_file_problem(&none).unwrap().1, "no such file");
+/// ```
+pub fn input_file_problem(
+    meta: &std::io::Result<std::fs::Metadata>,
+) -> Option<(Fault, String)> {
+    use std::io::ErrorKind;
+    match meta {
+        Err(e) => Some(match e.kind() {
+            ErrorKind::NotFound => (Fault::Input, "no such file".to_string()),
+            ErrorKind::PermissionDenied => (Fault::System, "permission denied".to_string()),
+            k => (Fault::of_io(k), e.to_string()),
+        }),
+        Ok(m) if m.is_dir() => Some((Fault::Input, "is a directory, not a file".to_string())),
+        Ok(m) if m.is_file() && m.len() == 0 => {
+            Some((Fault::Input, "the file is empty (0 bytes)".to_string()))
+        }
+        Ok(_) => None,
+    }
+}

@@ -31,14 +31,14 @@ mod remap;
 mod resample;
 
 pub use axis_map::AxisMap;
-pub use choice::{Choice, UnknownName};
+pub use choice::{count, Choice, UnknownName};
 pub use codes::{Codes, CodesError};
 pub use envmap::{
     bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, bilinear_mix,
     bilinear_taps, count_invalid, sample_texels, sanitize_layer, CornerLanes, EnvMap, EnvMapError,
     Stats,
 };
-pub use fault::Fault;
+pub use fault::{input_file_problem, Fault};
 pub use image::Image;
 pub use layout::{guess, CellGrid, CubeCells, Guess, Layout, Stereo};
 pub use projection::{

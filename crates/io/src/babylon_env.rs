@@ -94,6 +94,7 @@ pub fn write_babylon_env(path: &Path, env: &BabylonEnv) -> Result<(), Error> {
 /// a version above 2, a level count other than `log2(width) + 1`, images outside the file)
 /// and images that are not RGBA 8-bit PNGs of their level's size.
 pub fn read_babylon_env(path: &Path) -> Result<BabylonEnv, Error> {
+    Error::check_input(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let bad = |p: String| Error::input(path, p);
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {

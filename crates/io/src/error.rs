@@ -60,6 +60,19 @@ impl Error {
             source: Some(e),
         }
     }
+    /// Refuses `path` as an input before any reader opens it: missing, a directory, or
+    /// empty, each said so ([`mirrorball_core::input_file_problem`]).
+    pub fn check_input(path: &Path) -> Result<(), Error> {
+        match mirrorball_core::input_file_problem(&std::fs::metadata(path)) {
+            None => Ok(()),
+            Some((fault, problem)) => Err(Error {
+                path: path.to_path_buf(),
+                fault,
+                problem,
+                source: None,
+            }),
+        }
+    }
     /// Whose fault it is.
     pub fn fault(&self) -> Fault {
         self.fault

@@ -113,6 +113,7 @@ pub fn write_gltf_ibl(path: &Path, ibl: &GltfIbl) -> Result<Vec<PathBuf>, Error>
 
 /// Reads the light the default scene of the glTF file `path` references, with its images.
 pub fn read_gltf_ibl(path: &Path) -> Result<GltfIbl, Error> {
+    Error::check_input(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let bad = |p: String| Error::input(path, p);
     let gltf: Value = serde_json::from_slice(&bytes).map_err(|e| bad(format!("JSON: {e}")))?;
@@ -185,6 +186,7 @@ pub fn read_gltf_ibl(path: &Path) -> Result<GltfIbl, Error> {
                     ))
                 })?;
             let file = dir.join(uri);
+            Error::check_input(&file)?;
             let png = std::fs::read(&file).map_err(|e| Error::io(&file, e))?;
             let what = format!("level {level} face {f}");
             out.push(rgba_png::decode(

@@ -323,7 +323,7 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
     let (vk_format, type_size) = vk_format(encoding);
     let supercompressed = how.zstd.is_some();
 
-    let dfd = data_format_descriptor(encoding, supercompressed);
+    let dfd = data_format_descriptor(encoding);
     let writer = format!("mirrorball {}", env!("CARGO_PKG_VERSION"));
     // Sorted by key, as the specification requires (code-point order: "KTX…" before
     // "mirrorball:…").
@@ -458,7 +458,9 @@ type Sample = (u32, u32, u32, u32, u32);
 /// version 2, the colour model (RGBSDA, or BC6H = 133), BT.709 primaries, linear transfer
 /// (every encoding here is linear or decoded by the shader), straight alpha, the texel block
 /// dimensions minus one (3, 3, 0, 0 for BC6H's 4×4 blocks), bytesPlane0 = the block's bytes
-/// (0 when supercompressed: the validator requires "unsized" planes then), and the samples:
+/// (supercompressed or not: KTX 2.0.4, "DFD for Supercompressed Data", has the descriptor
+/// keep the pre-deflation images' bytesPlane[0-7], where earlier revisions asked for 0;
+/// `ktx validate` warns 6030 on a 0), and the samples:
 ///
 /// - float channels: the FLOAT qualifier (and SIGNED when signed), sampleLower/Upper the
 ///   bits of −1.0 (or 0.0 when unsigned) and 1.0;
@@ -466,7 +468,7 @@ type Sample = (u32, u32, u32, u32, u32);
 ///   exponent at bit 27 with the EXPONENT qualifier (lower 15, upper 31);
 /// - R8G8B8A8_UNORM: 8 bits a channel, lower 0, upper 255;
 /// - BC6H: one 128-bit sample of channel 0 (BC6H colour).
-pub(crate) fn data_format_descriptor(encoding: Encoding, supercompressed: bool) -> Vec<u8> {
+pub(crate) fn data_format_descriptor(encoding: Encoding) -> Vec<u8> {
     const MODEL_RGBSDA: u8 = 1;
     const MODEL_BC6H: u8 = 133;
     const EXPONENT: u32 = 0x20;
@@ -525,9 +527,7 @@ pub(crate) fn data_format_descriptor(encoding: Encoding, supercompressed: bool) 
     out.extend_from_slice(&[model, 1, 1, 0]); // model, BT709, LINEAR, straight alpha
     out.extend_from_slice(&dims); // texelBlockDimension0..3 (stored minus 1)
     let mut planes = [0u8; 8];
-    if !supercompressed {
-        planes[0] = encoding.block_bytes() as u8;
-    }
+    planes[0] = encoding.block_bytes() as u8;
     out.extend_from_slice(&planes); // bytesPlane0..7
     for (offset, bits, channel, lower, upper) in samples {
         let word = offset | (bits - 1) << 16 | channel << 24;
@@ -698,8 +698,9 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         let held = if zstd { raw } else { len };
         if held != want {
             return Err(invalid(format!(
-                "mip level {p} holds {held} bytes{}; {faces} face(s) of {w}×{h} {} need {want}",
+                "mip level {p} holds {held} bytes{}; {} of {w}×{h} {} need {want}",
                 if zstd { " uncompressed" } else { "" },
+                mirrorball_core::count(u64::from(faces), "face"),
                 format.name()
             )));
         }

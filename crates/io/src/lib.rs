@@ -235,6 +235,60 @@ impl Format {
         };
         texels.saturating_mul(per_texel)
     }
+
+    /// Every format, in the order messages list them.
+    pub const ALL: [Format; 7] = [
+        Format::Exr,
+        Format::Hdr,
+        Format::Png,
+        Format::Jpeg,
+        Format::Webp,
+        Format::Ktx2,
+        Format::Dds,
+    ];
+
+    /// The usual extension, with its dot: `.exr`.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Exr => ".exr",
+            Format::Hdr => ".hdr",
+            Format::Png => ".png",
+            Format::Jpeg => ".jpg",
+            Format::Webp => ".webp",
+            Format::Ktx2 => ".ktx2",
+            Format::Dds => ".dds",
+        }
+    }
+
+    /// The container's name for people: `OpenEXR`, `Radiance HDR`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Exr => "OpenEXR",
+            Format::Hdr => "Radiance HDR",
+            Format::Png => "PNG",
+            Format::Jpeg => "JPEG",
+            Format::Webp => "WebP",
+            Format::Ktx2 => "KTX2",
+            Format::Dds => "DDS",
+        }
+    }
+
+    /// Whether mirrorball writes it (WebP it only reads).
+    pub fn is_written(self) -> bool {
+        self != Format::Webp
+    }
+
+    /// The precisions its writer takes, its default first: half or float for OpenEXR, KTX2
+    /// and DDS, 8 or 16 bits for PNG, 8 for JPEG; none to choose for Radiance HDR (always
+    /// RGBE) and WebP (not written).
+    pub fn precisions(self) -> &'static [Precision] {
+        match self {
+            Format::Exr | Format::Ktx2 | Format::Dds => &[Precision::Half, Precision::Float],
+            Format::Png => &[Precision::U8, Precision::U16],
+            Format::Jpeg => &[Precision::U8],
+            Format::Hdr | Format::Webp => &[],
+        }
+    }
 }
 
 /// The largest cube face written into a GPU container: what Direct3D 11 and 12 take
@@ -401,8 +455,9 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     Ok(loaded)
 }
 
-/// [`read`]'s reader for `path`'s format.
+/// [`read`]'s reader for `path`'s format, once `path` is a file with bytes in it.
 fn read_format(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+    Error::check_input(path)?;
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
     match format {
         Format::Exr => exr_io::read(path, limits),

@@ -139,11 +139,11 @@ pub fn render_fisheye(
         up: right.cross(fwd),
         forward: fwd,
     };
-    let fish = mirrorball_core::Fisheye::new(frame, lens, fov_deg).ok_or_else(|| {
-        RenderError::request(format!(
-            "a {lens:?} lens cannot cover a {fov_deg}° field of view"
-        ))
-    })?;
+    lens.fov_range()
+        .check("the fisheye's fov", fov_deg)
+        .map_err(|e| RenderError::request(format!("{e} (the {} lens)", lens.name())))?;
+    let fish = mirrorball_core::Fisheye::new(frame, lens, fov_deg)
+        .ok_or_else(|| RenderError::request(format!("fov={fov_deg}: no {} fisheye", lens.name())))?;
     let cube = capture_cube(scene, eye, face, None, settings)?;
     let out = mirrorball_core::resample(
         &cube,

@@ -50,12 +50,12 @@ impl MeshError {
 
 /// Whose fault it is that a parser could not open `path` or a file it refers to (glTF
 /// buffers): the main file's own failure to open ([`Fault::of_io`]: missing is the
-/// input's fault, unreadable the system's); when it opens, the fault is in what it refers
-/// to, the input's.
-fn open_fault(path: &Path) -> Fault {
+/// input's fault, unreadable the system's), with the system's reason; when it opens, the
+/// fault is in what it refers to, the input's (and no reason).
+fn open_failure(path: &Path) -> (Fault, Option<String>) {
     match std::fs::File::open(path) {
-        Err(e) => Fault::of_io(e.kind()),
-        Ok(_) => Fault::Input,
+        Err(e) => (Fault::of_io(e.kind()), Some(e.to_string())),
+        Ok(_) => (Fault::Input, None),
     }
 }
 
@@ -73,11 +73,17 @@ fn open_fault(path: &Path) -> Fault {
 /// // The file has no normals: they are made, facing the side the triangle winds
 /// // counter-clockwise around (+Z).
 /// assert!((mesh.normals[0] - glam::Vec3::Z).length() < 1e-6);
-/// // A file that is not there is the input's fault.
+/// // A file that is not there is the input's fault, and the message says so with its path.
 /// let err = load_mesh(std::path::Path::new("no/such/mesh.obj")).unwrap_err();
 /// assert_eq!(err.fault(), Fault::Input);
+/// assert_eq!(err.to_string(), "no/such/mesh.obj: no such file");
 /// ```
 pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
+    // Missing, a directory or empty: said so before a parser sees it.
+    if let Some((fault, problem)) = mirrorball_core::input_file_problem(&std::fs::metadata(path))
+    {
+        return Err(MeshError::new(path, fault, problem));
+    }
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -152,7 +158,7 @@ fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
             )
         } else {
             let fault = match e {
-                gltf::Error::Io(_) => open_fault(path),
+                gltf::Error::Io(_) => open_failure(path).0,
                 _ => Fault::Input,
             };
             MeshError::new(path, fault, msg)
@@ -230,11 +236,12 @@ fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
     let (models, _mtl) = tobj::load_obj(path, &opts).map_err(|e| {
         // tobj keeps no I/O error kind. Its read error is, on a file that opened, a line
         // that is not UTF-8: the content, as is every other error.
-        let fault = match e {
-            tobj::LoadError::OpenFileFailed => open_fault(path),
-            _ => Fault::Input,
-        };
-        MeshError::new(path, fault, e.to_string())
+        match (&e, open_failure(path)) {
+            (tobj::LoadError::OpenFileFailed, (fault, Some(why))) => {
+                MeshError::new(path, fault, format!("cannot open the file: {why}"))
+            }
+            _ => MeshError::input(path, e.to_string()),
+        }
     })?;
     let mut out = Mesh::default();
     for m in models {

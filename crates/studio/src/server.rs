@@ -5,7 +5,7 @@
 //! | `GET /` | the page (`?view=viewport`: the viewport alone, at the camera's size) |
 //! | `GET /web/NAME` | the page's scripts and shaders, embedded in the binary |
 //! | `GET /api/state` | what is loaded, as JSON ([`State::describe`]) |
-//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float&mips=0\|1` | the environment's texels, with its mip chain for `mips=1` ([`texture`]) |
+//! | `GET /api/environment?projection=native\|SPEC&size=N&precision=half\|float&mips=0\|1&limit=N` | the environment's texels, with its mip chain for `mips=1` ([`texture`]); resampled smaller where its padded atlas would be over `limit` texels on a side (the page's GPU's `MAX_TEXTURE_SIZE`), the header's `fitted` saying so |
 //! | `GET /api/mesh/I?tessellation=N` | object `I` in world space ([`geometry`]); a built-in tessellated `N` (`state::MAX_TRIANGLES` at most) |
 //! | `GET /api/grid?projection=SPEC&n=N` | directions with the core's texture coordinates ([`grid`]) |
 //! | `POST /api/directions?projection=native\|SPEC` | the core's direction of each `(u, v, layer)` of the body, in the map `/api/environment` sends for the same `projection` ([`grid::directions`]) |
@@ -15,7 +15,7 @@
 //! | `GET /api/export?what=map\|chain&format=EXT&projection=…&size=N` | a file to download, written by the [`Host`]: the map (as loaded, or converted as `/api/environment` converts it) or the last prefiltered chain |
 //! | `POST /api/upload?name=FILE` | a file to read (the body, at most the upload limit): a scene, an environment or a mesh; a scene may name the files held for it |
 //! | `POST /api/upload?name=FILE&alongside=1` | a file held, unread, for the scene uploaded next (the files picked or dropped with it; all of them together at most the upload limit); any other upload lets them go |
-//! | `POST /api/object?name=scene\|BUILTIN\|BUNDLED&tessellation=N` | shows one object in place of the scene's (a built-in, or a mesh the [`Host`] bundles), or the scene's own again |
+//! | `POST /api/object?name=scene\|BUILTIN\|BUNDLED\|OPENED&tessellation=N` | shows one object in place of the scene's (a built-in, a mesh the [`Host`] bundles, or the mesh file opened last), or the scene's own again |
 
 use crate::guard::Guard;
 use crate::state::{gpu_kind, ObjectChoice, State};
@@ -254,6 +254,8 @@ struct EnvQuery {
     size: Option<u32>,
     precision: Option<String>,
     mips: Option<String>,
+    /// The largest texture edge the page's GPU takes (`GL_MAX_TEXTURE_SIZE`).
+    limit: Option<u32>,
 }
 
 async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -> Response {
@@ -303,10 +305,14 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
                 ),
             ));
         }
+        let (map, fitted) = match q.limit {
+            Some(limit) => fit(&app, map, limit, mips)?,
+            None => (map, None),
+        };
         Ok(if mips {
-            texture::encode_mips(&map, precision)
+            texture::encode_mips(&map, precision, fitted)
         } else {
-            texture::encode(&map, precision)
+            texture::encode(&map, precision, fitted)
         })
     });
     match work.await {
@@ -314,6 +320,32 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
         Ok(Err((s, m))) => bad(s, m),
         Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
     }
+}
+
+/// `map` as a GPU whose textures are at most `limit` texels on a side takes it: itself
+/// when its padded atlas (with the chain, for `mips`) fits, else resampled by the core
+/// (antialiased, as `convert` shrinks) to the largest size of its projection whose atlas
+/// fits, with what was done for the page to say.
+fn fit(
+    app: &App,
+    map: Arc<EnvMap>,
+    limit: u32,
+    mips: bool,
+) -> Result<(Arc<EnvMap>, Option<texture::Fitted>), (StatusCode, String)> {
+    let from = (map.width(), map.height());
+    let (aw, ah) = texture::atlas_extent(from, mips);
+    if aw <= limit && ah <= limit {
+        return Ok((map, None));
+    }
+    let size = texture::fitting_size(map.projection(), map.width(), limit, mips).ok_or_else(|| {
+        (
+            StatusCode::BAD_REQUEST,
+            format!("limit: no {} map fits textures of {limit} texels", map.projection().name()),
+        )
+    })?;
+    let spec = map.projection().to_string();
+    let fitted = convert(app, &map, &spec, Some(size))?;
+    Ok((fitted, Some(texture::Fitted { from, limit })))
 }
 
 /// `map` in the projection `spec` at `size` (default: the core's resolution match), the
@@ -725,8 +757,11 @@ async fn object(Shared(app): Shared<AppState>, Query(q): Query<ObjectQuery>) -> 
         );
     };
     let bundled = app.host.bundled_meshes();
+    let opened = app.state.lock().expect("state").opened_object() == Some(name.as_str());
     let choice = if name == "scene" {
         ObjectChoice::Scene
+    } else if opened {
+        ObjectChoice::Opened
     } else if let Some(b) = Builtin::from_name(&name) {
         let max = b.max_tessellation(crate::state::MAX_TRIANGLES);
         let level = q
@@ -746,19 +781,17 @@ async fn object(Shared(app): Shared<AppState>, Query(q): Query<ObjectQuery>) -> 
         match read {
             Ok((name, Ok(mesh))) => ObjectChoice::Mesh {
                 name,
-                mesh: Box::new(mesh),
+                mesh: std::sync::Arc::new(mesh),
             },
             Ok((_, Err(m))) => return bad(StatusCode::INTERNAL_SERVER_ERROR, m),
             Err(e) => return bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
         }
     } else {
-        let known: Vec<&str> = (["scene"].into_iter())
-            .chain(Builtin::ALL.iter().map(|b| b.name()))
-            .chain(bundled.iter().copied())
-            .collect();
+        let s = app.state.lock().expect("state");
+        let known = s.object_choices().join(", ");
         return bad(
             StatusCode::BAD_REQUEST,
-            format!("object: unknown '{name}' (known: {})", known.join(", ")),
+            format!("object: unknown '{name}' (known: {known})"),
         );
     };
     let mut s = app.state.lock().expect("state");

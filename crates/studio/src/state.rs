@@ -50,7 +50,9 @@ pub enum ObjectChoice {
     /// One built-in at the origin, at a tessellation.
     Builtin(Builtin, u32),
     /// One mesh (a file uploaded, or one the embedding program bundles), called `name`.
-    Mesh { name: String, mesh: Box<Mesh> },
+    Mesh { name: String, mesh: Arc<Mesh> },
+    /// The mesh file opened last ([`State::base_object`]) again, else the scene's own.
+    Opened,
 }
 
 /// The scene's own objects, kept while another is shown: the objects, their built-ins and
@@ -74,6 +76,9 @@ pub struct State {
     shown: Option<(String, SceneObjects)>,
     /// The meshes the embedding program bundles ([`crate::Host::bundled_meshes`]).
     pub bundled: &'static [&'static str],
+    /// The mesh file opened last (named on the command line, picked or dropped) since the
+    /// scene was: what a link that names no object shows ([`State::base_object`]).
+    opened: Option<(String, Arc<Mesh>)>,
 }
 
 /// The most triangles the page may ask a built-in to be tessellated into.
@@ -90,6 +95,7 @@ impl State {
             generation: 1,
             shown: None,
             bundled: &[],
+            opened: None,
         }
     }
 
@@ -101,8 +107,11 @@ impl State {
             Opened::Scene(v) => {
                 self.view = *v;
                 self.shown = None;
+                self.opened = None;
             }
             Opened::Mesh { name, mesh } => {
+                let mesh: Arc<Mesh> = Arc::from(mesh);
+                self.opened = Some((name.clone(), mesh.clone()));
                 self.show_object(ObjectChoice::Mesh { name, mesh });
                 return;
             }
@@ -148,8 +157,18 @@ impl State {
             Some((_, k)) => k,
             None => kept(),
         };
+        let choice = match choice {
+            ObjectChoice::Opened => match &self.opened {
+                Some((name, mesh)) => ObjectChoice::Mesh {
+                    name: name.clone(),
+                    mesh: mesh.clone(),
+                },
+                None => ObjectChoice::Scene,
+            },
+            c => c,
+        };
         let (name, object, builtin, source) = match choice {
-            ObjectChoice::Scene => {
+            ObjectChoice::Opened | ObjectChoice::Scene => {
                 v.scene.objects = kept.objects;
                 v.builtins = kept.builtins;
                 v.source = kept.source;
@@ -175,7 +194,7 @@ impl State {
             ObjectChoice::Mesh { name, mesh } => {
                 let object = Object {
                     model: mesh.normalizing_transform(),
-                    mesh: Arc::from(mesh),
+                    mesh,
                     material: Material::mirror(),
                 };
                 (name, object, None, None)
@@ -193,6 +212,18 @@ impl State {
         self.shown.as_ref().map(|(n, _)| n.as_str())
     }
 
+    /// What a link that names no object shows: the mesh file opened last, or `scene` (the
+    /// scene's own objects). An object another link or the menu chose is not kept: a link
+    /// decides the whole view.
+    pub fn base_object(&self) -> &str {
+        self.opened.as_ref().map_or("scene", |(n, _)| n.as_str())
+    }
+
+    /// The name of the mesh file opened last, if any ([`ObjectChoice::Opened`]).
+    pub fn opened_object(&self) -> Option<&str> {
+        self.opened.as_ref().map(|(n, _)| n.as_str())
+    }
+
     /// Records a message for the page, kept until something loads or is shown.
     pub fn error(&mut self, message: String) {
         self.errors.push(message);
@@ -202,16 +233,27 @@ impl State {
         self.generation += 1;
     }
 
+    /// What `POST /api/object` may show: `scene`, the built-ins, the bundled meshes and
+    /// the mesh file opened last.
+    pub fn object_choices(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = (["scene"].into_iter())
+            .chain(Builtin::ALL.iter().map(|b| b.name()))
+            .chain(self.bundled.iter().copied())
+            .collect();
+        if let Some(n) = self.opened_object().filter(|n| !names.contains(n)) {
+            names.push(n);
+        }
+        names
+    }
+
     /// The page's description of everything loaded.
     pub fn describe(&self) -> Value {
         json!({
             "generation": self.generation,
             "scene": describe_scene(&self.view),
             "object": self.shown_object(),
-            "objectChoices": (["scene"].into_iter())
-                .chain(Builtin::ALL.iter().map(|b| b.name()))
-                .chain(self.bundled.iter().copied())
-                .collect::<Vec<_>>(),
+            "baseObject": self.base_object(),
+            "objectChoices": self.object_choices(),
             "errors": self.errors,
         })
     }

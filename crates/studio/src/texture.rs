@@ -18,7 +18,7 @@
 //! IEEE half floats; atlas texels no level covers are zero.
 
 use crate::state::describe_map;
-use mirrorball_core::{Choice, EnvMap, WorldProjection};
+use mirrorball_core::{Choice, EnvMap, Projection, WorldProjection};
 use mirrorball_filter::{MipChain, MipFilter};
 
 /// How texels are sent.
@@ -41,15 +41,63 @@ mirrorball_core::choice_traits!(Precision);
 /// The padding on each side, in texels.
 pub const PAD: u32 = 1;
 
+/// How a map was made to fit the page's GPU: its size before, and the largest texture
+/// edge the page said the GPU takes (`GL_MAX_TEXTURE_SIZE`). Sent as the header's
+/// `fitted` (`{"from": [w, h], "limit": N}`), for the page to say.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fitted {
+    pub from: (u32, u32),
+    pub limit: u32,
+}
+
 /// `map`'s layers padded, RGBA, as the payload described above (one level).
-pub fn encode(map: &EnvMap, precision: Precision) -> Vec<u8> {
-    encode_levels(std::slice::from_ref(map), precision)
+pub fn encode(map: &EnvMap, precision: Precision, fitted: Option<Fitted>) -> Vec<u8> {
+    encode_levels(std::slice::from_ref(map), precision, fitted)
 }
 
 /// `map` and its mip chain (`MipChain::build`, box filter: what `mirrorball render`'s
 /// footprint samplers read) as the payload described above.
-pub fn encode_mips(map: &EnvMap, precision: Precision) -> Vec<u8> {
-    encode_levels(MipChain::build(map, MipFilter::Box).levels(), precision)
+pub fn encode_mips(map: &EnvMap, precision: Precision, fitted: Option<Fitted>) -> Vec<u8> {
+    encode_levels(MipChain::build(map, MipFilter::Box).levels(), precision, fitted)
+}
+
+/// The atlas's width and height for a `w`×`h` level 0, alone or with its chain (`mips`:
+/// each level half the one before, rounded down, at least 1, down to 1×1, as
+/// `MipChain::build` makes them).
+pub fn atlas_extent((w, h): (u32, u32), mips: bool) -> (u32, u32) {
+    let mut sizes = vec![(w, h)];
+    while let Some(&(a, b)) = sizes.last().filter(|_| mips) {
+        if a == 1 && b == 1 {
+            break;
+        }
+        sizes.push(((a / 2).max(1), (b / 2).max(1)));
+    }
+    let (_, aw, ah) = atlas(&sizes);
+    (aw, ah)
+}
+
+/// The largest size (`layer_extent`'s parameter) of `p` at most `size` whose atlas, alone
+/// or with its chain, is at most `limit` texels wide and high; `None` when not even size
+/// 1's is.
+pub fn fitting_size(p: &Projection, size: u32, limit: u32, mips: bool) -> Option<u32> {
+    let fits = |s: u32| {
+        let (aw, ah) = atlas_extent(p.layer_extent(s), mips);
+        aw <= limit && ah <= limit
+    };
+    if !fits(1) {
+        return None;
+    }
+    // The atlas grows with the size: the largest that fits, by bisection.
+    let (mut lo, mut hi) = (1, size.max(1));
+    while lo < hi {
+        let mid = lo + (hi - lo).div_ceil(2);
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid - 1;
+        }
+    }
+    Some(lo)
 }
 
 /// Where each level's padded block lies in the atlas: `[x, y, width, height]` (top-left
@@ -69,7 +117,7 @@ pub fn atlas(levels: &[(u32, u32)]) -> (Vec<[u32; 4]>, u32, u32) {
 }
 
 /// `levels` (level 0 first, one projection) padded into one atlas per layer.
-fn encode_levels(levels: &[EnvMap], precision: Precision) -> Vec<u8> {
+fn encode_levels(levels: &[EnvMap], precision: Precision, fitted: Option<Fitted>) -> Vec<u8> {
     let map = &levels[0];
     let sizes: Vec<(u32, u32)> = levels.iter().map(|l| (l.width(), l.height())).collect();
     let (rects, aw, ah) = atlas(&sizes);
@@ -79,6 +127,9 @@ fn encode_levels(levels: &[EnvMap], precision: Precision) -> Vec<u8> {
     header["texelHeight"] = ah.into();
     header["precision"] = precision.name().into();
     header["levels"] = rects.iter().map(|r| r.to_vec()).collect::<Vec<_>>().into();
+    if let Some(f) = fitted {
+        header["fitted"] = serde_json::json!({"from": [f.from.0, f.from.1], "limit": f.limit});
+    }
     let mut json = header.to_string().into_bytes();
     while !json.len().is_multiple_of(4) {
         json.push(b' ');
@@ -220,7 +271,7 @@ mod tests {
     fn every_levels_padded_read_is_the_cores_read_of_that_level() {
         for kind in ProjectionKind::ALL {
             let map = indexed(kind, 16);
-            let (size, rects, data) = decode(&encode_mips(&map, Precision::Float));
+            let (size, rects, data) = decode(&encode_mips(&map, Precision::Float, None));
             let chain = MipChain::build(&map, MipFilter::Box);
             assert_eq!(rects.len(), chain.len(), "{kind:?}");
             assert_eq!(data.len(), map.layers().len() * size.0 * size.1 * 4);
@@ -264,7 +315,7 @@ mod tests {
         // Texels that name themselves: a tap taken from the wrong texel shows.
         for kind in ProjectionKind::ALL {
             let map = indexed(kind, 8);
-            let (size, rects, data) = decode(&encode(&map, Precision::Float));
+            let (size, rects, data) = decode(&encode(&map, Precision::Float, None));
             assert_eq!(rects.len(), 1);
             assert_eq!(data.len(), map.layers().len() * size.0 * size.1 * 4);
             let p: Projection = *map.projection();

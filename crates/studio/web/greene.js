@@ -268,10 +268,8 @@ export function attach(studio) {
     const source = view.env;
     // None while the viewport loads another (or the scene has none): the last one stays.
     if (!source) return Promise.resolve();
-    let q = `projection=${encodeURIComponent(view.projection)}&precision=float&mips=0`;
-    if (view.size) q += `&size=${view.size}`;
     const promise = (async () => {
-      const parsed = G.parseTexture(await (await G.api(`/api/environment?${q}`)).arrayBuffer());
+      const parsed = G.parseTexture(await (await G.api(`/api/environment?${studio.environmentQuery(false)}`)).arrayBuffer());
       await programsFor(parsed.header);
       if (envLoading?.source !== source) return;
       if (env) gl.deleteTexture(env.texture);

@@ -596,8 +596,8 @@ export function attach(studio) {
     p.set('paraboloid', view.paraboloid);
     if (view.tessellation) p.set('tessellation', String(view.tessellation));
     else p.delete('tessellation');
-    if (view.state?.object) p.set('object', view.state.object);
-    else p.delete('object');
+    // Always named, `scene` too: a link decides the object whatever the server shows.
+    p.set('object', view.state?.object ?? 'scene');
     if (view.attach) p.set('attach', view.attach);
     else p.delete('attach');
     p.set('twin', view.twin ? '1' : '0');

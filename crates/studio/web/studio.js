@@ -11,8 +11,11 @@
 // to the eye whatever the scene says; `twin=1` draws the same view with the map attached the
 // other way beside the viewport (Zimmons' figure 18, view dependence); `panblur=DEG` blurs
 // the background as a camera panning that far since the last frame (Greene §9, as `render
-// --pan-blur DEG`; viewport.frag `sweep`). `window.studio` is the
-// page's handle for tests and later views (simulator, overlays) to plug into.
+// --pan-blur DEG`; viewport.frag `sweep`). The GPU's limits are read here (MAX_TEXTURE_SIZE,
+// MAX_CUBE_MAP_TEXTURE_SIZE) and the server sends a map that fits them, resampled by the
+// core where it would not (said on the page); `max-texture=N` lowers the first, to see what
+// a smaller GPU shows. `window.studio` is the page's handle for tests and later views
+// (simulator, overlays) to plug into.
 
 const params = new URLSearchParams(location.search);
 const token = params.get('token') || '';
@@ -34,6 +37,40 @@ const gl = canvas.getContext('webgl2', {
   premultipliedAlpha: false,
   preserveDrawingBuffer: true,
 });
+
+/**
+ * The GPU's limits: the largest edge of a 2D or array texture (the environment's layers,
+ * each padded, its mip chain in an atlas beside level 0) and of a cube map's face (the
+ * prefiltered lighting, Greene's capture); `max-texture=N` in the link lowers the first.
+ */
+const limits = (() => {
+  if (!gl) return { texture: 0, cube: 0 };
+  const texture = gl.getParameter(gl.MAX_TEXTURE_SIZE);
+  const asked = Number(params.get('max-texture'));
+  return {
+    texture: Number.isInteger(asked) && asked > 0 ? Math.min(asked, texture) : texture,
+    cube: gl.getParameter(gl.MAX_CUBE_MAP_TEXTURE_SIZE),
+  };
+})();
+
+/** The query `/api/environment` is asked with for the view (`mips` for mode 4's chain). */
+function environmentQuery(mips) {
+  let q = `projection=${encodeURIComponent(view.projection)}&precision=float&mips=${mips ? 1 : 0}&limit=${limits.texture}`;
+  if (view.size) q += `&size=${view.size}`;
+  return q;
+}
+
+/** What the page says of a map the server resampled to fit the GPU (the header's `fitted`). */
+function fittedNote(h) {
+  const f = h.fitted;
+  if (!f) return null;
+  return (
+    `the map is ${f.from[0]}×${f.from[1]}, more than this GPU's textures hold (${f.limit} texels on a side` +
+    `${f.limit < gl.getParameter(gl.MAX_TEXTURE_SIZE) ? ', as the link asks' : ', MAX_TEXTURE_SIZE'}; ` +
+    `each layer is padded by a texel${h.levels.length > 1 ? ' and its mip chain laid beside it' : ''}): ` +
+    `the viewport draws it resampled on the server to ${h.width}×${h.height} (antialiased, as mirrorball convert shrinks)`
+  );
+}
 
 const view = {
   state: null,
@@ -58,7 +95,10 @@ const view = {
   lightingPending: null,
   // The chain's level-0 face edge (`lightsize`: a power of two, 8 to 512; the server says
   // what it refuses).
-  lightSize: Number(params.get('lightsize') || 128),
+  // (At most the GPU's cube face: MAX_CUBE_MAP_TEXTURE_SIZE.)
+  lightSize: Math.min(Number(params.get('lightsize') || 128), limits.cube || Infinity),
+  // What the page says of the environment as the GPU takes it (`fittedNote`).
+  envNote: null,
   lightingGeneration: -1,
   meshes: [], // { vao, count }
   programs: new Map(),
@@ -85,7 +125,12 @@ const linkNotes = [];
 let exportNote = null;
 
 function report(error) {
-  const notes = [...linkNotes, ...(exportNote ? [exportNote] : []), ...(view.state?.scene?.notes || [])];
+  const notes = [
+    ...linkNotes,
+    ...(view.envNote ? [view.envNote] : []),
+    ...(exportNote ? [exportNote] : []),
+    ...(view.state?.scene?.notes || []),
+  ];
   const errors = view.state?.errors || [];
   const message = error ? String(error.message || error) : null;
   show([
@@ -245,12 +290,12 @@ async function loadMeshes() {
 async function loadEnvironment() {
   if (view.env) for (const t of [view.env.texture, ...(view.env.halves || [])]) gl.deleteTexture(t);
   view.env = null;
+  view.envNote = null;
   if (!view.state.scene.environment) return;
   // Mode 4 reads the mip chain (texture.rs `encode_mips`).
   const mips = view.mode === 4;
-  let q = `projection=${encodeURIComponent(view.projection)}&precision=float&mips=${mips ? 1 : 0}`;
-  if (view.size) q += `&size=${view.size}`;
-  const parsed = G.parseTexture(await (await G.api(`/api/environment?${q}`)).arrayBuffer());
+  const parsed = G.parseTexture(await (await G.api(`/api/environment?${environmentQuery(mips)}`)).arrayBuffer());
+  view.envNote = fittedNote(parsed.header);
   const halves = parsed.header.projection === 'paraboloid' ? G.paraboloidTextures(gl, parsed) : null;
   view.env = { header: parsed.header, texture: G.environmentTexture(gl, parsed), halves };
 }
@@ -556,6 +601,7 @@ document.getElementById('mode').addEventListener('change', async (e) => {
   if (view.mode === 4 && view.env && view.env.header.levels.length === 1 && view.env.header.width * view.env.header.height > 1) {
     try {
       await loadEnvironment();
+      report();
     } catch (err) {
       report(err);
     }
@@ -769,14 +815,15 @@ document.addEventListener('keydown', (e) => {
 
 const ready = (async () => {
   if (!gl) throw new Error('this browser has no WebGL2');
-  // A link names the object it showed: shown again (the server's objects are the page's).
+  // A link decides the object: the one it names, else what was opened (the scene's own
+  // objects, or the mesh file opened last), never what an earlier link or the menu chose
+  // (the server keeps that for every page).
   const asked = params.get('object');
-  if (asked) {
-    const st = await (await G.api('/api/state')).json();
-    if ((st.object ?? 'scene') !== asked) {
-      if (st.objectChoices.includes(asked)) await G.api(`/api/object?name=${encodeURIComponent(asked)}`, { method: 'POST' });
-      else linkNotes.push(`the link showed the object ${asked}, which is not here: open its file again`);
-    }
+  const st = await (await G.api('/api/state')).json();
+  const want = asked ?? st.baseObject;
+  if ((st.object ?? 'scene') !== want) {
+    if (st.objectChoices.includes(want)) await G.api(`/api/object?name=${encodeURIComponent(want)}`, { method: 'POST' });
+    else linkNotes.push(`the link showed the object ${want}, which is not here: open its file again`);
   }
   await loadState();
   await redraw();
@@ -785,7 +832,7 @@ const ready = (async () => {
 ready.catch(report);
 
 afterDraw.push(drawTwin);
-const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting, sceneFile, sceneFlags, twin, attachNow, chooseObject };
+const handle = { ready, redraw, pixels, view, gl, G, P, draw, camera, afterDraw, canvas, embed, program, ensureLighting, sceneFile, sceneFlags, twin, attachNow, chooseObject, limits, environmentQuery };
 // The simulator panel and the view state in the URL (sim.js); `ready` waits for both.
 const sim = await import(`./sim.js?token=${encodeURIComponent(token)}`);
 handle.sim = sim.attach(handle);

@@ -140,8 +140,8 @@ pub fn run(a: AnalyzeArgs) -> Result<(), CliError> {
             );
         }
         eprintln!(
-            "wrote {} files in {:.2}s: open {}",
-            written.len(),
+            "wrote {} in {:.2}s: open {}",
+            mirrorball_core::count(written.len() as u64, "file"),
             t0.elapsed().as_secs_f64(),
             index.display()
         );

@@ -49,8 +49,22 @@ pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
         .transpose()
 }
 
-fn parse_compression(c: &str) -> Result<ExrCompression, CliError> {
-    crate::choice::parse_flag("--compression", c)
+fn parse_compression(c: Option<&str>) -> Result<ExrCompression, CliError> {
+    c.map(|c| crate::choice::parse_flag("--compression", c))
+        .transpose()
+        .map(Option::unwrap_or_default)
+}
+
+/// The container flags `a` gives, as [`save::check_flags`] names them.
+fn container_flags(a: &ConvertArgs) -> Vec<&'static str> {
+    [
+        ("--compression", a.compression.is_some()),
+        ("--mips", a.mips),
+        ("--layout", a.layout.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(flag, given)| given.then_some(flag))
+    .collect()
 }
 
 impl Plan {
@@ -67,6 +81,12 @@ impl Plan {
     /// container its frames are packed as), so no folder of it is checked.
     pub(crate) fn unwritten(a: &ConvertArgs) -> Result<Plan, CliError> {
         let input = InputPlan::new(&a.input_args)?;
+        if a.to.is_empty() {
+            return Err(CliError::request(
+                "--to: a sequence, a pipe or a manifest's job needs the output's projection \
+                 (only a conversion of one file keeps its input's)",
+            ));
+        }
         let to = ProjSpec::parse(&a.to).map_err(|e| bad("--to", e))?;
         let layout = a
             .layout
@@ -74,30 +94,10 @@ impl Plan {
             .map(str::parse::<Layout>)
             .transpose()
             .map_err(|e| bad("--layout", e))?;
-        let format = save::check(&a.output, to.kind, layout)?;
         let precision = parse_precision(a.precision.as_deref())?;
-        match (format, precision) {
-            (Format::Png, Some(Precision::Half | Precision::Float))
-            | (Format::Jpeg, Some(Precision::Half | Precision::Float | Precision::U16)) => {
-                return Err(CliError::request(format!(
-                    "{}: --precision {} does not fit this container (PNG: 8 or 16; JPEG: 8)",
-                    a.output,
-                    a.precision.as_deref().unwrap_or_default()
-                )))
-            }
-            (Format::Exr | Format::Ktx2 | Format::Dds, Some(Precision::U8 | Precision::U16)) => {
-                return Err(CliError::request(format!(
-                    "{}: 8/16-bit integers are for PNG; use half or float",
-                    a.output
-                )))
-            }
-            _ => {}
-        }
-        if a.mips && !format.is_cube_container() {
-            return Err(CliError::request(
-                "--mips applies to .ktx2 and .dds outputs",
-            ));
-        }
+        let format = save::check_container(&a.output)?;
+        save::check_flags(&a.output, format, &container_flags(a), precision)?;
+        save::check(&a.output, to.kind, layout)?;
         let mut rotation = Rotation::from_euler_deg(a.yaw, a.pitch, a.roll);
         for f in &a.flip {
             let axis = crate::choice::parse_flag::<Axis>("--flip", f)?;
@@ -116,7 +116,7 @@ impl Plan {
         }
         let write = WriteOptions {
             precision,
-            exr_compression: parse_compression(&a.compression)?,
+            exr_compression: parse_compression(a.compression.as_deref())?,
             jpeg_quality: 92,
             declared: None,
         };
@@ -127,11 +127,6 @@ impl Plan {
             keep_invalid: input.keep_invalid,
         };
         let layers = to.build(None).map_err(|e| bad("--to", e))?.layer_count();
-        let stereo_flag = |flag: &str, given: Option<&str>| {
-            given
-                .map(|m| crate::choice::parse_flag::<Stereo>(flag, m))
-                .transpose()
-        };
         let in_stereo = stereo_flag("--in-stereo", a.in_stereo.as_deref())?;
         let stereo = stereo_flag("--stereo", a.stereo.as_deref())?.unwrap_or_default();
         save::check_stereo(&a.output, layers, stereo, &save)?;
@@ -209,29 +204,73 @@ impl Plan {
     }
 }
 
+/// Reads `a`'s input as `input` says: both eyes a stereo conversion needs
+/// (`load::load_eyes`), else one map (`load::load`).
+fn read(
+    a: &ConvertArgs,
+    input: &InputPlan,
+    (in_stereo, stereo): (Option<Stereo>, Stereo),
+) -> Result<load::Source, CliError> {
+    let limits = mirrorball_io::Limits::default();
+    let (from, layout) = (input.from.as_ref(), input.layout);
+    if in_stereo.is_some_and(|s| s != Stereo::Mono) || stereo != Stereo::Mono {
+        load::load_eyes(&a.input, from, layout, (in_stereo, stereo), &limits)
+    } else {
+        load::load(&a.input, from, layout, &limits)
+    }
+}
+
+/// The plan and the source read. Without `--to` the input's projection is kept (and its
+/// size, unless `--size`), so the input is read first; what the output's container alone
+/// decides is checked before that.
+fn plan_and_read(mut a: ConvertArgs) -> Result<(ConvertArgs, Plan, load::Source), CliError> {
+    if !a.to.is_empty() {
+        let plan = Plan::new(&a, Folders::Exist)?;
+        // The room on disk now when --size gives the output's size (four channels at
+        // most), else once the source is read.
+        if let Some(size) = plan.size {
+            let dst = plan.to.build(None).map_err(|e| bad("--to", e))?;
+            plan.check_room(dst.layer_extent(size), dst.layer_count(), plan.stereo.eyes(), 4)?;
+        }
+        let src = read(&a, &plan.input, (plan.in_stereo, plan.stereo))?;
+        return Ok((a, plan, src));
+    }
+    // Only the container changes: the output is checked as one file before the input is
+    // read, the plan made once the input tells its projection.
+    let precision = parse_precision(a.precision.as_deref())?;
+    let format = save::check_container(&a.output)?;
+    save::check_flags(&a.output, format, &container_flags(&a), precision)?;
+    let mut files = Files::new();
+    files
+        .input_arg("the input", &a.input)
+        .output("the output", &a.output);
+    files.check()?;
+    let input = InputPlan::new(&a.input_args)?;
+    let in_stereo = stereo_flag("--in-stereo", a.in_stereo.as_deref())?;
+    let stereo = stereo_flag("--stereo", a.stereo.as_deref())?.unwrap_or_default();
+    let src = read(&a, &input, (in_stereo, stereo))?;
+    a.to = src.env.projection().to_string();
+    let plan = Plan::new(&a, Folders::Exist)?;
+    Ok((a, plan, src))
+}
+
+/// A stereo flag's mode, if given.
+fn stereo_flag(flag: &str, given: Option<&str>) -> Result<Option<Stereo>, CliError> {
+    given
+        .map(|m| crate::choice::parse_flag::<Stereo>(flag, m))
+        .transpose()
+}
+
 pub fn run(a: ConvertArgs) -> Result<(), CliError> {
     // Sequences, pipes and manifests (`frames/`).
     if let Some(done) = super::frames::route(&a) {
         return done;
     }
-    let mut plan = Plan::new(&a, Folders::Exist)?;
-    // The room on disk now when --size gives the output's size (four channels at most),
-    // else once the source is read.
-    if let Some(size) = plan.size {
-        let dst = plan.to.build(None).map_err(|e| bad("--to", e))?;
-        plan.check_room(dst.layer_extent(size), dst.layer_count(), plan.stereo.eyes(), 4)?;
-    }
-    if plan.is_stereo() {
-        return convert_pair(&a, &plan);
-    }
     let t0 = Instant::now();
-    let limits = mirrorball_io::Limits::default();
-    let mut src = load::load(
-        &a.input,
-        plan.input.from.as_ref(),
-        plan.input.layout,
-        &limits,
-    )?;
+    let (a, mut plan, mut src) = plan_and_read(a)?;
+    if plan.is_stereo() {
+        return convert_pair(&a, &plan, src, t0);
+    }
     let say = |s: String| {
         if !a.quiet {
             eprintln!("{s}");
@@ -415,16 +454,12 @@ fn convert_layers(
 /// eyes it needs read (`Stereo::eyes_read`), one `Remap` planned from the left eye's shape
 /// and applied to each, each output eye made from its `Stereo::source_eye`, the eyes packed
 /// and joined into one picture.
-fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
-    let t0 = Instant::now();
-    let limits = mirrorball_io::Limits::default();
-    let mut src = load::load_eyes(
-        &a.input,
-        plan.input.from.as_ref(),
-        plan.input.layout,
-        (plan.in_stereo, plan.stereo),
-        &limits,
-    )?;
+fn convert_pair(
+    a: &ConvertArgs,
+    plan: &Plan,
+    mut src: load::Source,
+    t0: Instant,
+) -> Result<(), CliError> {
     let in_stereo = src.stereo;
     for line in src.prepare(&a.input, plan.input.keep_invalid) {
         if !a.quiet {
@@ -455,10 +490,10 @@ fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
     );
     budget::check(
         &format!(
-            "{} {w}x{h}x{}, {} eye(s)",
+            "{} {w}x{h}x{}, {}",
             dst.name(),
             dst.layer_count(),
-            out_eyes
+            mirrorball_core::count(out_eyes as u64, "eye")
         ),
         budget::f32_texels(
             texels(left.width(), left.height(), left.layers().len()) * eyes.len() as u64,
@@ -506,12 +541,12 @@ fn convert_pair(a: &ConvertArgs, plan: &Plan) -> Result<(), CliError> {
     if !a.quiet {
         let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
         eprintln!(
-            "wrote {}: {} {w}x{h}{} per eye, {} ({} eye(s) read; read {:.2}s, convert {:.2}s, write {:.2}s)",
+            "wrote {}: {} {w}x{h}{} per eye, {} ({} read; read {:.2}s, convert {:.2}s, write {:.2}s)",
             names.join(", "),
             dst.name(),
             times(dst.layer_count()),
             plan.stereo,
-            eyes_read,
+            mirrorball_core::count(eyes_read as u64, "eye"),
             t_read.as_secs_f64(),
             t_conv.as_secs_f64(),
             (t1.elapsed() - t_conv).as_secs_f64()

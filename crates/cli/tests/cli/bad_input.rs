@@ -152,7 +152,7 @@ fn bad_requests_fail_before_any_work() {
             "fisheye:fov=400:lens=stereographic",
         ],
         // Names as the user spells them, not Rust's debug form ("Stereographic").
-        &["the stereographic fisheye lens covers at most"],
+        &["--to: fisheye, stereographic lens: fov must be in (0°, 359.99964°]; fov=400 was given"],
     );
     fails(
         &["convert", s, &o("a.exr"), "--to", "cube", "--size", "0"],

@@ -15,7 +15,7 @@
 //! 16-point Gauss–Legendre, which leaves errors near 1e-13.
 
 use super::quadrature::gauss_legendre;
-use super::{texel_range, WorldProjection};
+use super::{texel_range, Range, WorldProjection};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -141,6 +141,15 @@ impl Lens {
             Lens::Stereographic => PI * (1.0 - 1e-6),
             Lens::Orthographic => FRAC_PI_2,
         }
+    }
+
+    /// The whole fields of view the lens covers, in degrees: `(0°, 2·max_half_fov]` (a
+    /// stereographic lens stops just short of 360°, where the antipode would lie at
+    /// infinity). [`Fisheye::new`] checks with it; messages print it.
+    pub fn fov_range(self) -> Range {
+        Range::above(0.0)
+            .to(2.0 * self.max_half_fov().to_degrees())
+            .unit("°")
     }
 }
 
@@ -564,8 +573,11 @@ impl Default for Fisheye {
 
 impl Fisheye {
     /// A fisheye with total field of view `fov_deg` (the rim is `fov/2` from the axis), or
-    /// `None` if the lens cannot reach that angle.
+    /// `None` outside the lens's [`Lens::fov_range`].
     pub fn new(frame: Frame, lens: Lens, fov_deg: f64) -> Option<Fisheye> {
+        if !lens.fov_range().contains(fov_deg) {
+            return None;
+        }
         RadialMap::new(frame, lens, 0.5 * fov_deg.to_radians()).map(|map| Fisheye { map })
     }
     /// The underlying disk map.

@@ -13,7 +13,7 @@
 //! `(H/w)·(sin φ_top − sin φ_bottom)`, and the density is `2H·d(sin φ)/db`.
 
 use super::latlong::dir_from_lon_lat;
-use super::{DirRun, WorldProjection};
+use super::{DirRun, Range, WorldProjection};
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
 
@@ -51,14 +51,23 @@ pub struct Cylinder {
 }
 
 impl Cylinder {
-    /// A cylinder with fields of view in degrees: `0 < hfov ≤ 360`, and `0 < vfov < 180`
-    /// for the central rule (which never reaches the poles), `≤ 180` for the others.
+    /// The horizontal fields of view, in degrees: `(0°, 360°]`.
+    pub const HFOV: Range = Range::above(0.0).to(360.0).unit("°");
+
+    /// The vertical fields of view of `rule`, in degrees: `(0°, 180°)` for the central rule
+    /// (which never reaches the poles), `(0°, 180°]` for the others.
+    pub fn vfov_range(rule: CylinderRule) -> Range {
+        let r = Range::above(0.0).unit("°");
+        match rule {
+            CylinderRule::Central => r.below(180.0),
+            _ => r.to(180.0),
+        }
+    }
+
+    /// A cylinder with fields of view in degrees, in [`Cylinder::HFOV`] and
+    /// [`Cylinder::vfov_range`].
     pub fn new(rule: CylinderRule, hfov_deg: f64, vfov_deg: f64) -> Option<Cylinder> {
-        let v_ok = match rule {
-            CylinderRule::Central => vfov_deg < 180.0,
-            _ => vfov_deg <= 180.0,
-        };
-        if !(hfov_deg > 0.0 && hfov_deg <= 360.0 && vfov_deg > 0.0 && v_ok) {
+        if !(Cylinder::HFOV.contains(hfov_deg) && Cylinder::vfov_range(rule).contains(vfov_deg)) {
             return None;
         }
         let (hfov, vfov) = (hfov_deg.to_radians(), vfov_deg.to_radians());

@@ -54,7 +54,7 @@
 
 use super::azimuthal::{ab_to_dir_of, dir_to_ab_of, edge_integral_of};
 use super::quadrature::gauss_legendre;
-use super::{texel_range, Frame, Lens, Projection, RadialMap, WorldProjection};
+use super::{texel_range, Frame, Lens, Projection, RadialMap, Range, WorldProjection};
 use crate::Image;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -68,6 +68,26 @@ pub enum LensModel {
     /// OpenCV's fisheye polynomial `θ_d = θ(1 + k₁θ² + k₂θ⁴ + k₃θ⁶ + k₄θ⁸)`, `[k₁, k₂, k₃, k₄]`
     /// (all zero: equidistant), normalised to `ρ = θ_d(θ)/θ_d(fov/2)`.
     Polynomial([f64; 4]),
+}
+
+impl LensModel {
+    /// The whole fields of view the model covers, in degrees: a standard lens's
+    /// [`Lens::fov_range`], the polynomial's `(0°, 360°]` (a lens sees at most the whole
+    /// sphere).
+    pub fn fov_range(self) -> Range {
+        match self {
+            LensModel::Standard(l) => l.fov_range(),
+            LensModel::Polynomial(_) => Range::above(0.0).to(360.0).unit("°"),
+        }
+    }
+
+    /// The model's name for messages: a lens's name, or `polynomial`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LensModel::Standard(l) => l.name(),
+            LensModel::Polynomial(_) => "polynomial",
+        }
+    }
 }
 
 /// One lens of a [`DualFisheye`]: where its image circle lies in the picture and how it
@@ -336,8 +356,9 @@ impl DualFisheye {
         let frames = [rig, rig.turned_around()];
         let mut optics = Vec::with_capacity(2);
         for (i, (lens, frame)) in lenses.iter().zip(frames).enumerate() {
-            optics
-                .push(Self::optic(lens, frame).map_err(|e| format!("{} lens: {e}", lens_name(i)))?);
+            optics.push(Self::optic(lens, frame).map_err(|e| {
+                format!("{} lens ({}): {e}", lens_name(i), lens.model.name())
+            })?);
         }
         let (a, b) = (&lenses[0], &lenses[1]);
         let gap = (a.centre - b.centre).length() - (a.radius + b.radius);
@@ -357,17 +378,7 @@ impl DualFisheye {
 
     /// One lens's disk, looking along `frame` before its roll; or what is wrong with it.
     fn optic(lens: &FisheyeLens, frame: Frame) -> Result<Optic, String> {
-        let fov = lens.fov_deg;
-        if !fov.is_finite() || fov <= 0.0 {
-            return Err(format!(
-                "fov={fov} is not a field of view (degrees, over 0)"
-            ));
-        }
-        if fov > 360.0 {
-            return Err(format!(
-                "fov={fov} is over 360° (a lens sees at most the whole sphere)"
-            ));
-        }
+        let fov = lens.model.fov_range().check("fov", lens.fov_deg)?;
         let (c, r) = (lens.centre, lens.radius);
         if !(c.x.is_finite() && c.y.is_finite() && lens.roll_deg.is_finite()) {
             return Err(format!(
@@ -402,13 +413,7 @@ impl DualFisheye {
         match lens.model {
             LensModel::Standard(l) => RadialMap::new(rolled, l, theta_max)
                 .map(Optic::Radial)
-                .ok_or_else(|| {
-                    format!(
-                        "the {} lens covers at most {:.0}° (fov={fov} asked)",
-                        l.name(),
-                        2.0 * l.max_half_fov().to_degrees()
-                    )
-                }),
+                .ok_or_else(|| format!("fov={fov}: outside the {} lens's reach", l.name())),
             LensModel::Polynomial(k) => {
                 if k.iter().any(|v| !v.is_finite()) {
                     return Err(format!("k={k:?}: the coefficients must be finite"));
@@ -1125,7 +1130,7 @@ mod tests {
             ..f
         });
         assert!(
-            e.contains("front lens") && e.contains("fov=400") && e.contains("over 360"),
+            e.contains("front lens") && e.contains("fov=400") && e.contains("(0°, 360°]"),
             "{e}"
         );
         assert!(try_front(FisheyeLens { fov_deg: 0.0, ..f }).contains("fov=0"));
@@ -1156,6 +1161,9 @@ mod tests {
             model: LensModel::Standard(Lens::Orthographic),
             ..f
         });
-        assert!(e.contains("orthographic"), "{e}");
+        assert!(
+            e.contains("front lens (orthographic): fov must be in (0°, 180°]; fov=200 was given"),
+            "{e}"
+        );
     }
 }

@@ -2,7 +2,7 @@
 //! Hoffman 1984, Greene 1986 §6).
 
 use super::fastmath;
-use super::{texel_range, DirRun, Lookup, WorldProjection};
+use super::{texel_range, DirRun, Lookup, Range, WorldProjection};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -175,9 +175,13 @@ impl Default for Mercator {
 }
 
 impl Mercator {
-    /// A Mercator map covering latitudes up to `max_lat_deg` degrees (0 < limit < 90).
+    /// The latitude limits, in degrees: `(0°, 90°)` (the poles lie at infinity).
+    pub const MAX_LAT: Range = Range::above(0.0).below(90.0).unit("°");
+
+    /// A Mercator map covering latitudes up to `max_lat_deg` degrees, in
+    /// [`Mercator::MAX_LAT`].
     pub fn new(max_lat_deg: f64) -> Option<Mercator> {
-        if !(max_lat_deg > 0.0 && max_lat_deg < 90.0) {
+        if !Mercator::MAX_LAT.contains(max_lat_deg) {
             return None;
         }
         let max_lat = max_lat_deg.to_radians();

@@ -24,6 +24,7 @@ mod octahedral;
 mod perspective;
 mod pseudo;
 pub mod quadrature;
+mod range;
 mod spec;
 
 pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap, SphereMap};
@@ -36,7 +37,8 @@ pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
 pub use perspective::View;
 pub use pseudo::{Hammer, Sinusoidal};
-pub use spec::{parse_dir, ProjectionSpec};
+pub use range::Range;
+pub use spec::{parse_dir, Bounded, ProjectionSpec};
 
 use crate::{Choice, Image, UnknownName};
 use glam::{DVec2, DVec3};

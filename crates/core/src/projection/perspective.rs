@@ -24,7 +24,7 @@
 
 use super::cube::cube_area;
 use super::quadrature::gauss_legendre;
-use super::{texel_range, Frame, WorldProjection};
+use super::{texel_range, Frame, Range, WorldProjection};
 use glam::{DMat3, DVec2, DVec3};
 
 /// A rectilinear or Pannini view (see the module documentation).
@@ -66,6 +66,18 @@ impl View {
         View::new(true, d, [hfov, vfov, yaw, pitch, roll])
     }
 
+    /// The vertical fields of view, in degrees: `(0°, 180°)`.
+    pub const VFOV: Range = Range::above(0.0).below(180.0).unit("°");
+
+    /// Pannini's distances: `[0, ∞)` (0 is the rectilinear view).
+    pub const DISTANCE: Range = Range::from(0.0);
+
+    /// The horizontal fields of view, in degrees, a view with Pannini distance `d` draws
+    /// (`(0°, 180°)` for the rectilinear view, `d = 0`): below [`View::max_hfov_deg`].
+    pub fn hfov_range(d: f64) -> Range {
+        Range::above(0.0).below(View::max_hfov_deg(d)).unit("°")
+    }
+
     /// The widest horizontal field of view, in degrees, Pannini's `d` draws one to one
     /// (`X` grows with φ while `1 + d cos φ > 0` and `d + cos φ > 0`).
     pub fn max_hfov_deg(d: f64) -> f64 {
@@ -75,10 +87,10 @@ impl View {
 
     fn new(pannini: bool, d: f64, angles: [f64; 5]) -> Option<View> {
         let [hfov, vfov, yaw, pitch, roll] = angles;
-        if !(d.is_finite() && d >= 0.0 && angles.iter().all(|a| a.is_finite())) {
+        if !(d.is_finite() && View::DISTANCE.contains(d) && angles.iter().all(|a| a.is_finite())) {
             return None;
         }
-        if !(hfov > 0.0 && hfov < View::max_hfov_deg(d) && vfov > 0.0 && vfov < 180.0) {
+        if !(View::hfov_range(d).contains(hfov) && View::VFOV.contains(vfov)) {
             return None;
         }
         let half = 0.5 * hfov.to_radians();

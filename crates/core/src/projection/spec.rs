@@ -28,7 +28,8 @@
 
 use super::{
     AngularMap, Cylinder, CylinderRule, DualFisheye, DualParaboloid, Fisheye, FisheyeLens, Frame,
-    Lens, LensModel, Mercator, Projection, ProjectionKind, SphereMap, UnknownProjection, View,
+    Lens, LensModel, Mercator, Projection, ProjectionKind, Range, SphereMap, UnknownProjection,
+    View,
 };
 use crate::Choice;
 use glam::DVec3;
@@ -263,117 +264,182 @@ impl ProjectionSpec {
         }
     }
 
-    /// The projection. For Mercator without `max-lat`, `extent` (an input picture's size)
-    /// fixes the limit from the aspect ratio.
-    pub fn build(&self, extent: Option<(u32, u32)>) -> Result<Projection, String> {
-        let frame = match (self.look, self.up) {
-            (Some(d), Some(up)) => Frame::looking_along_up(d, up)
-                .ok_or("the up direction must not be along the look direction")?,
+    /// Every bounded number key of this spec's kind, with the value given (if any) and the
+    /// interval it must lie in, which may depend on the other keys (a fisheye's lens,
+    /// Pannini's `d`, a cylinder's rule, a dual fisheye lens's model). [`ProjectionSpec::build`]
+    /// checks each given value against it before anything else, so every range message
+    /// comes from here: `fisheye, equidistant lens: fov must be in (0°, 360°]; fov=-90 was
+    /// given`.
+    pub fn ranges(&self) -> Vec<Bounded> {
+        let one = |scope: String, key: &'static str, given: Option<f64>, range: Range| Bounded {
+            scope,
+            key,
+            given,
+            range,
+        };
+        let name = self.kind.name().to_string();
+        match self.kind {
+            ProjectionKind::Fisheye => {
+                let lens = self.lens.unwrap_or(Lens::Equidistant);
+                let scope = format!("{name}, {} lens", lens.name());
+                vec![one(scope, "fov", self.fov, lens.fov_range())]
+            }
+            ProjectionKind::Mercator => vec![one(name, "max-lat", self.max_lat, Mercator::MAX_LAT)],
+            ProjectionKind::Cylindrical
+            | ProjectionKind::CylindricalEqualArea
+            | ProjectionKind::HalfEquirect => vec![
+                one(name.clone(), "hfov", self.hfov, Cylinder::HFOV),
+                one(
+                    name,
+                    "vfov",
+                    self.vfov,
+                    Cylinder::vfov_range(self.cylinder_rule()),
+                ),
+            ],
+            ProjectionKind::Perspective => vec![
+                one(name.clone(), "hfov", self.hfov, View::hfov_range(0.0)),
+                one(name, "vfov", self.vfov, View::VFOV),
+            ],
+            ProjectionKind::Pannini => {
+                let d = self.distance.unwrap_or(1.0);
+                vec![
+                    one(name.clone(), "d", self.distance, View::DISTANCE),
+                    one(format!("{name}, d={d}"), "hfov", self.hfov, View::hfov_range(d)),
+                    one(name, "vfov", self.vfov, View::VFOV),
+                ]
+            }
+            ProjectionKind::DualFisheye => {
+                let models = self.lens_models().unwrap_or([FisheyeLens::FRONT.model; 2]);
+                (0..2)
+                    .map(|i| {
+                        let (lens, own) = (["front", "back"][i], self.lenses[i].fov);
+                        let key = match (own, i) {
+                            (None, _) => "fov",
+                            (Some(_), 0) => "front-fov",
+                            _ => "back-fov",
+                        };
+                        let scope = format!("{name}, {lens} lens ({})", models[i].name());
+                        one(scope, key, own.or(self.fov), models[i].fov_range())
+                    })
+                    .collect()
+            }
+            _ => Vec::new(),
+        }
+    }
+
+    /// The cylinder rule of a cylinder kind (half-equirect's is equidistant).
+    fn cylinder_rule(&self) -> CylinderRule {
+        match self.kind {
+            ProjectionKind::Cylindrical => CylinderRule::Central,
+            ProjectionKind::CylindricalEqualArea => CylinderRule::EqualArea,
+            _ => CylinderRule::Equidistant,
+        }
+    }
+
+    /// Each dual fisheye lens's model: its own `-k` or `-lens`, else the shared `k` or
+    /// `lens`, else equidistant; refused when one lens is given both.
+    fn lens_models(&self) -> Result<[LensModel; 2], String> {
+        let mut models = [FisheyeLens::FRONT.model, FisheyeLens::BACK.model];
+        for (i, (m, ls)) in models.iter_mut().zip(&self.lenses).enumerate() {
+            let name = ["front", "back"][i];
+            if ls.lens.is_some() && ls.k.is_some() {
+                return Err(format!(
+                    "dual-fisheye: {name}-lens and {name}-k both given: a lens has one model"
+                ));
+            }
+            *m = match (ls.k, ls.lens, self.k, self.lens) {
+                (Some(k), ..) => LensModel::Polynomial(k),
+                (None, Some(lens), ..) => LensModel::Standard(lens),
+                (None, None, Some(_), Some(_)) => {
+                    return Err("dual-fisheye: lens and k both given: a lens has one \
+                                model (per lens: front-lens, back-k, ...)"
+                        .into())
+                }
+                (None, None, Some(k), None) => LensModel::Polynomial(k),
+                (None, None, None, Some(lens)) => LensModel::Standard(lens),
+                (None, None, None, None) => *m,
+            };
+        }
+        Ok(models)
+    }
+
+    /// The frame `look` and `up` give (the default frame without them).
+    fn frame(&self) -> Result<Frame, String> {
+        const ALONG: &str = "the up direction must not be along the look direction";
+        Ok(match (self.look, self.up) {
+            (Some(d), Some(up)) => Frame::looking_along_up(d, up).ok_or(ALONG)?,
             (Some(d), None) => {
                 Frame::looking_along(d).ok_or("the look direction must be non-zero")?
             }
-            (None, Some(up)) => Frame::looking_along_up(Frame::default().forward, up)
-                .ok_or("the up direction must not be along the look direction")?,
+            (None, Some(up)) => Frame::looking_along_up(Frame::default().forward, up).ok_or(ALONG)?,
             (None, None) => Frame::default(),
-        };
+        })
+    }
+
+    /// The projection. For Mercator without `max-lat`, `extent` (an input picture's size)
+    /// fixes the limit from the aspect ratio. Each number given is checked against its
+    /// interval first ([`ProjectionSpec::ranges`]).
+    pub fn build(&self, extent: Option<(u32, u32)>) -> Result<Projection, String> {
+        for b in self.ranges() {
+            if let Some(v) = b.given {
+                b.range
+                    .check(b.key, v)
+                    .map_err(|e| format!("{}: {e}", b.scope))?;
+            }
+        }
+        let frame = self.frame()?;
+        // Past the ranges, a constructor refuses nothing more: its check is the range's.
+        let inside = || format!("{self}: parameters outside their ranges");
         Ok(match self.kind {
             ProjectionKind::Sphere => SphereMap::new(frame).into(),
             ProjectionKind::Angular => AngularMap::new(frame).into(),
             ProjectionKind::Paraboloid => DualParaboloid::new(frame).into(),
             ProjectionKind::Fisheye => {
                 let lens = self.lens.unwrap_or(Lens::Equidistant);
-                let fov = self.fov.unwrap_or(180.0);
-                Fisheye::new(frame, lens, fov)
-                    .ok_or_else(|| {
-                        format!(
-                            "the {} fisheye lens covers at most {:.0}° (fov={fov} asked)",
-                            lens.name(),
-                            2.0 * lens.max_half_fov().to_degrees()
-                        )
-                    })?
+                Fisheye::new(frame, lens, self.fov.unwrap_or(180.0))
+                    .ok_or_else(inside)?
                     .into()
             }
             ProjectionKind::Mercator => match (self.max_lat, extent) {
-                (Some(l), _) => Mercator::new(l)
-                    .ok_or_else(|| format!("max-lat must be between 0 and 90 degrees, not {l}"))?
-                    .into(),
+                (Some(l), _) => Mercator::new(l).ok_or_else(inside)?.into(),
                 (None, Some((w, h))) => Mercator::from_extent(w, h).ok_or("empty picture")?.into(),
                 (None, None) => Mercator::default().into(),
             },
             ProjectionKind::Cylindrical
             | ProjectionKind::CylindricalEqualArea
             | ProjectionKind::HalfEquirect => {
-                let (rule, h, v, vmax) = match self.kind {
-                    ProjectionKind::Cylindrical => (CylinderRule::Central, 360.0, 90.0, "< 180"),
-                    ProjectionKind::CylindricalEqualArea => {
-                        (CylinderRule::EqualArea, 360.0, 180.0, "≤ 180")
-                    }
-                    _ => (CylinderRule::Equidistant, 180.0, 180.0, "≤ 180"),
+                let rule = self.cylinder_rule();
+                let (h, v) = match rule {
+                    CylinderRule::Central => (360.0, 90.0),
+                    CylinderRule::EqualArea => (360.0, 180.0),
+                    CylinderRule::Equidistant => (180.0, 180.0),
                 };
                 let (h, v) = (self.hfov.unwrap_or(h), self.vfov.unwrap_or(v));
-                Projection::Cylinder(Cylinder::new(rule, h, v).ok_or_else(|| {
-                    format!(
-                        "{}: hfov must be in (0, 360] degrees and vfov in (0, 180) or \
-                         (0, 180] ({vmax} here), not hfov={h}, vfov={v}",
-                        self.kind.name()
-                    )
-                })?)
+                Projection::Cylinder(Cylinder::new(rule, h, v).ok_or_else(inside)?)
             }
             ProjectionKind::Perspective | ProjectionKind::Pannini => {
                 let pannini = self.kind == ProjectionKind::Pannini;
-                let d = if pannini {
-                    self.distance.unwrap_or(1.0)
-                } else {
-                    0.0
-                };
                 let (h, v) = (
                     self.hfov.unwrap_or(if pannini { 120.0 } else { 90.0 }),
                     self.vfov.unwrap_or(90.0),
                 );
                 let [yaw, pitch, roll] = self.aim.map(|a| a.unwrap_or(0.0));
-                if d.is_nan() || d < 0.0 {
-                    return Err(format!("pannini: d must be 0 or more, not {d}"));
-                }
                 let view = if pannini {
-                    View::pannini(d, h, v, yaw, pitch, roll)
+                    View::pannini(self.distance.unwrap_or(1.0), h, v, yaw, pitch, roll)
                 } else {
                     View::perspective(h, v, yaw, pitch, roll)
                 };
-                Projection::View(view.ok_or_else(|| {
-                    format!(
-                        "{}: hfov must be in (0, {}) degrees and vfov in (0, 180), not \
-                         hfov={h}, vfov={v}",
-                        self.kind.name(),
-                        Num(View::max_hfov_deg(d))
-                    )
-                })?)
+                Projection::View(view.ok_or_else(inside)?)
             }
             ProjectionKind::DualFisheye => {
-                let defaults = [FisheyeLens::FRONT, FisheyeLens::BACK];
-                let mut lenses = defaults;
-                for (i, (l, ls)) in lenses.iter_mut().zip(&self.lenses).enumerate() {
-                    let name = ["front", "back"][i];
+                let models = self.lens_models()?;
+                let mut lenses = [FisheyeLens::FRONT, FisheyeLens::BACK];
+                for ((l, ls), model) in lenses.iter_mut().zip(&self.lenses).zip(models) {
                     if let Some([cx, cy, r, roll]) = ls.place {
                         (l.centre, l.radius, l.roll_deg) = (glam::DVec2::new(cx, cy), r, roll);
                     }
                     l.fov_deg = ls.fov.or(self.fov).unwrap_or(l.fov_deg);
-                    if ls.lens.is_some() && ls.k.is_some() {
-                        return Err(format!(
-                            "dual-fisheye: {name}-lens and {name}-k both given: a lens has one model"
-                        ));
-                    }
-                    l.model = match (ls.k, ls.lens, self.k, self.lens) {
-                        (Some(k), ..) => LensModel::Polynomial(k),
-                        (None, Some(lens), ..) => LensModel::Standard(lens),
-                        (None, None, Some(_), Some(_)) => {
-                            return Err("dual-fisheye: lens and k both given: a lens has one \
-                                        model (per lens: front-lens, back-k, ...)"
-                                .into())
-                        }
-                        (None, None, Some(k), None) => LensModel::Polynomial(k),
-                        (None, None, None, Some(lens)) => LensModel::Standard(lens),
-                        (None, None, None, None) => l.model,
-                    };
+                    l.model = model;
                 }
                 DualFisheye::new(frame, lenses[0], lenses[1])
                     .map_err(|e| format!("dual-fisheye: {e}"))?
@@ -382,6 +448,20 @@ impl ProjectionSpec {
             k => k.default_projection(),
         })
     }
+}
+
+/// One bounded number key of a spec ([`ProjectionSpec::ranges`]): where it applies, its
+/// name, the value given and the interval it must lie in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bounded {
+    /// What the interval belongs to, for messages: `fisheye, orthographic lens`.
+    pub scope: String,
+    /// The key: `fov`, `max-lat`, `hfov`, …
+    pub key: &'static str,
+    /// The value given, if any.
+    pub given: Option<f64>,
+    /// The interval.
+    pub range: Range,
 }
 
 impl Projection {
@@ -705,8 +785,14 @@ mod tests {
         assert_eq!(back.to_string(), p.to_string());
         // Bad input: the key and the problem.
         for (bad, says) in [
-            ("dfisheye:fov=400", "fov=400 is over 360"),
-            ("dfisheye:front-fov=-5", "front lens: fov=-5"),
+            (
+                "dfisheye:fov=400",
+                "front lens (equidistant): fov must be in (0°, 360°]; fov=400 was given",
+            ),
+            (
+                "dfisheye:front-fov=-5",
+                "front lens (equidistant): front-fov must be in (0°, 360°]; front-fov=-5",
+            ),
             ("dfisheye:fov=nan", "'nan' is not a number"),
             ("dfisheye:front=1.5,0.5,0", "radius 0 must be over 0"),
             ("dfisheye:back=5,0.5,0.5", "outside the 2×1 picture"),
@@ -717,13 +803,60 @@ mod tests {
             ("dfisheye:lens=equisolid:k=0.1", "lens and k both given"),
             (
                 "dfisheye:fov=200:lens=orthographic",
-                "orthographic lens covers at most 180",
+                "front lens (orthographic): fov must be in (0°, 180°]",
             ),
             ("fisheye:k=0.1", "does not apply"),
         ] {
             let e = ProjectionSpec::parse(bad).unwrap_err();
             assert!(e.contains(says), "{bad}: {e}");
         }
+    }
+
+    /// Every bounded key of every kind, given a value outside its interval, is refused
+    /// with the interval and the value (the message [`ProjectionSpec::ranges`] makes), and
+    /// a value inside is taken.
+    #[test]
+    fn every_range_message_names_the_interval_and_the_value() {
+        let mut checked = 0;
+        for kind in ProjectionKind::ALL {
+            let ranges = ProjectionSpec::of(kind).ranges();
+            // A key shared by both dual fisheye lenses is checked for the front one first.
+            for (i, b) in ranges.iter().enumerate() {
+                if ranges[..i].iter().any(|a| a.key == b.key) {
+                    continue;
+                }
+                let tries = [-1e9, -90.0, 0.0, b.range.hi(), b.range.hi() + 1.0, 1e9];
+                for v in tries.into_iter().filter(|v| v.is_finite()) {
+                    let text = format!("{}:{}={v}", kind.name(), b.key);
+                    let got = ProjectionSpec::parse(&text);
+                    if b.range.contains(v) {
+                        assert!(got.is_ok(), "{text}: {got:?}");
+                        continue;
+                    }
+                    let e = got.unwrap_err();
+                    let want = format!(
+                        "{}: {} must be in {}; {}={v} was given",
+                        b.scope, b.key, b.range, b.key
+                    );
+                    assert_eq!(e, want, "{text}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked >= 30, "{checked} refusals checked");
+        // The issue's cases, word for word.
+        assert_eq!(
+            ProjectionSpec::parse("fisheye:fov=-90").unwrap_err(),
+            "fisheye, equidistant lens: fov must be in (0°, 360°]; fov=-90 was given"
+        );
+        assert_eq!(
+            ProjectionSpec::parse("fisheye:lens=orthographic:fov=200").unwrap_err(),
+            "fisheye, orthographic lens: fov must be in (0°, 180°]; fov=200 was given"
+        );
+        assert_eq!(
+            ProjectionSpec::parse("pannini:d=2:hfov=250").unwrap_err(),
+            "pannini, d=2: hfov must be in (0°, 240°); hfov=250 was given"
+        );
     }
 
     fn frame_up_angular() -> AngularMap {

@@ -80,10 +80,10 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
         None => String::new(),
     };
     say(format!(
-        "wrote {} for {}: {} levels from {size}²{background}, {} (read {:.2}s, prefilter {:.2}s, write {:.2}s)",
+        "wrote {} for {}: {} from {size}²{background}, {} (read {:.2}s, prefilter {:.2}s, write {:.2}s)",
         names.join(", "),
         plan.bake.engine,
-        plan.bake.spec.levels.len(),
+        mirrorball_core::count(plan.bake.spec.levels.len() as u64, "level"),
         plan.bake.encoding().label(),
         (t1 - t0).as_secs_f64(),
         (t2 - t1).as_secs_f64(),

@@ -67,6 +67,12 @@ impl Plan {
             }
         }
         let takes_zstd = engine.describe().zstd;
+        if a.no_zstd && !takes_zstd {
+            return Err(CliError::request(format!(
+                "--no-zstd: {engine} loads no Zstandard-supercompressed file ({}), so there is none to turn off",
+                engine.describe().containers
+            )));
+        }
         let zstd = match (a.zstd, a.no_zstd) {
             (Some(l), _) => Some(l),
             (None, true) => None,
@@ -95,9 +101,10 @@ impl Plan {
             let n = bake.spec.levels.len();
             if r.len() != n {
                 return Err(CliError::request(format!(
-                    "--mapping lists {} roughness values but the chain of {} has {n} levels",
-                    r.len(),
-                    size
+                    "--mapping lists {} but the chain of {} has {}",
+                    mirrorball_core::count(r.len() as u64, "roughness value"),
+                    size,
+                    mirrorball_core::count(n as u64, "level")
                 )));
             }
         }

@@ -245,6 +245,8 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         )));
     }
     let shard = a.frames.shard.as_deref().map(Shard::parse).transpose()?;
+    mirrorball_io::Error::check_input(std::path::Path::new(name))
+        .map_err(|e| CliError::from(e).context("--manifest"))?;
     let text = std::fs::read_to_string(name)
         .map_err(|e| CliError::request(format!("--manifest {name}: {e}")))?;
     let csv = match std::path::Path::new(name)
@@ -309,8 +311,8 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
     }
     if failed > 0 {
         return Err(CliError::input(format!(
-            "{failed} of {} job(s) failed",
-            range.len()
+            "{failed} of {} failed",
+            mirrorball_core::count(range.len() as u64, "job")
         )));
     }
     Ok(())

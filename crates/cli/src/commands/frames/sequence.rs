@@ -121,9 +121,9 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         let fmt = out_fmt.ok_or_else(|| {
             CliError::request("output -: raw frames need --pix-fmt (or --out-pix-fmt): rgb24, rgb48le, rgbf32le, gbrpf32le")
         })?;
-        if a.precision.is_some() || a.mips {
+        if a.precision.is_some() || a.mips || a.compression.is_some() {
             return Err(CliError::request(
-                "output -: raw frames carry --pix-fmt's precision and no mips; leave out --precision and --mips",
+                "output -: raw frames carry --pix-fmt's precision, no mips and no compression; leave out --precision, --mips and --compression",
             ));
         }
         Output::Pipe(fmt)

@@ -16,7 +16,7 @@ use crate::progress::with_progress;
 use crate::save;
 use crate::spec::bad;
 use crate::PrefilterArgs;
-use mirrorball_core::{EnvMap, Projection, ProjectionKind, WorldProjection};
+use mirrorball_core::{count, EnvMap, Projection, ProjectionKind, WorldProjection};
 use mirrorball_filter::mip::level_count;
 use mirrorball_filter::sh;
 use mirrorball_filter::{
@@ -84,10 +84,10 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
     say(
         &plan,
         format!(
-            "wrote {}: {} {} level(s) [{}] (read {:.2}s, prefilter {:.2}s, write {:.2}s)",
+            "wrote {}: {} {} [{}] (read {:.2}s, prefilter {:.2}s, write {:.2}s)",
             written.join(", "),
             shape.projection.name(),
-            chain.len(),
+            count(chain.len() as u64, "level"),
             outputs::levels_detail(&chain, &lobes),
             (t1 - t0).as_secs_f64(),
             t_filter.as_secs_f64(),
@@ -146,15 +146,17 @@ fn chain_shape(plan: &Plan, env: &EnvMap) -> Result<Chain, CliError> {
     let full = level_count(w0, h0);
     let levels = plan.levels.unwrap_or(full).min(full);
     let listed = match (&plan.mapping, &plan.exponents) {
-        (_, Some(e)) => Some(("--exponents", "exponents", e.len())),
+        (_, Some(e)) => Some(("--exponents", "exponent", e.len())),
         (RoughnessMapping::Custom(r), None) if plan.kind != LobeKind::Lambert => {
-            Some(("--mapping", "roughness values", r.len()))
+            Some(("--mapping", "roughness value", r.len()))
         }
         _ => None,
     };
     if let Some((flag, what, n)) = listed.filter(|&(_, _, n)| n != levels) {
         return Err(CliError::request(format!(
-            "{flag} lists {n} {what} but the chain has {levels} levels ({w0}x{h0} down to {}); give {levels}, or --levels {n}",
+            "{flag} lists {} but the chain has {} ({w0}x{h0} down to {}); give {levels}, or --levels {n}",
+            count(n as u64, what),
+            count(levels as u64, "level"),
             if plan.levels.is_some() { "--levels" } else { "1x1" }
         )));
     }

@@ -237,15 +237,11 @@ fn output_format(
     Ok(format)
 }
 
-/// `--precision`: integers only in PNG.
+/// `--precision` and `--layout`, where the container takes them ([`save::check_flags`]).
 fn output_precision(a: &PrefilterArgs, format: Format) -> Result<Option<Precision>, CliError> {
     let precision = parse_precision(a.precision.as_deref())?;
-    if matches!(precision, Some(Precision::U8 | Precision::U16)) && format != Format::Png {
-        return Err(CliError::request(format!(
-            "{}: 8/16-bit integers are for PNG; use half or float",
-            a.output
-        )));
-    }
+    let given: &[&str] = if a.layout.is_some() { &["--layout"] } else { &[] };
+    save::check_flags(&a.output, format, given, precision)?;
     Ok(precision)
 }
 

@@ -46,13 +46,14 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     if !plan.quiet {
         let (w, h) = (plan.camera.width, plan.camera.height);
         eprintln!(
-            "{frames} frame(s) {w}x{h}, {triangles} triangles, mode {}, {}x{} samples per pixel: {:.3} s ({:.1} frames/s)",
+            "{} {w}x{h}, {}, mode {}, {}x{} samples per pixel: {:.3} s ({:.1} frames/s)",
+            mirrorball_core::count(u64::from(plan.frames), "frame"),
+            mirrorball_core::count(triangles as u64, "triangle"),
             plan.settings.indexing.name(),
             plan.settings.supersample,
             plan.settings.supersample,
             secs,
             plan.frames as f64 / secs.max(1e-9),
-            frames = plan.frames,
         );
     }
     Ok(())

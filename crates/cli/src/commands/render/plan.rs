@@ -251,6 +251,13 @@ fn flag_output(a: &RenderArgs) -> Result<(PathBuf, Format), CliError> {
             format!("'{}': render writes .png, .jpg, .exr or .hdr", a.output),
         ));
     }
+    // A tone curve is for the 8-bit containers; a linear .exr/.hdr takes none.
+    let given: &[&str] = if a.given.iter().any(|g| g == "tone") {
+        &["--tone"]
+    } else {
+        &[]
+    };
+    crate::save::check_flags(&a.output, format, given, None)?;
     Ok((output, format))
 }
 
@@ -263,16 +270,9 @@ fn flag_fisheye(a: &RenderArgs) -> Result<Option<(mirrorball_core::Lens, f64)>, 
         .fisheye_lens
         .parse::<mirrorball_core::Lens>()
         .map_err(|e| bad("--fisheye-lens", e.to_string()))?;
-    if !(fov.is_finite() && fov > 0.0 && fov.to_radians() / 2.0 <= lens.max_half_fov()) {
-        return Err(bad(
-            "--fisheye",
-            format!(
-                "a {} lens covers (0°, {:.0}°], not {fov}°",
-                a.fisheye_lens,
-                2.0 * lens.max_half_fov().to_degrees()
-            ),
-        ));
-    }
+    lens.fov_range()
+        .check("--fisheye", fov)
+        .map_err(|e| CliError::request(format!("{e} (the {} lens)", lens.name())))?;
     if a.aovs || a.diagnostics {
         return Err(CliError::request(
             "--fisheye: the diagnostic channels and diagram are made for the cube views, not the fisheye; drop --aovs/--diagnostics",

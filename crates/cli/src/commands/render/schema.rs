@@ -142,18 +142,21 @@ impl<'a> Scene<'a> {
     /// Reads and parses `path`, TOML by its extension, else JSON.
     fn read(path: &'a Path) -> Result<Scene<'a>, CliError> {
         let name = path.display();
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            // A picture's name where the scene goes is the output given without -o.
-            let hint = if mirrorball_io::Format::from_path(path).is_some() {
-                " (the picture to write is given with -o/--output)"
-            } else {
-                ""
-            };
+        // A picture's name where the scene goes is the output given without -o.
+        let hint = if mirrorball_io::Format::from_path(path).is_some() {
+            " (the picture to write is given with -o/--output)"
+        } else {
+            ""
+        };
+        let cannot = |fault, why: &dyn std::fmt::Display| {
             CliError::new(
-                Fault::of_io(e.kind()),
-                format!("{name}: cannot read the scene file: {e}{hint}"),
+                fault,
+                format!("{name}: cannot read the scene file: {why}{hint}"),
             )
-        })?;
+        };
+        // Missing, a directory or empty: said so, as every input file is.
+        mirrorball_io::Error::check_input(path).map_err(|e| cannot(e.fault(), &e.problem()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| cannot(Fault::of_io(e.kind()), &e))?;
         let file: SceneFile = if is_toml(path) {
             toml::from_str(&text)
                 .map_err(|e| CliError::input(format!("{name}: not a valid TOML scene: {e}")))?
