@@ -6,5 +6,6 @@ mod hostile;
 mod imf_envmap;
 mod mutate;
 mod openexr;
+mod panorama;
 mod quality;
 mod records;
