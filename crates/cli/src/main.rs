@@ -68,6 +68,9 @@ enum Command {
     /// The viewport in a browser: a local web server (127.0.0.1, a token in the printed URL)
     /// drawing a scene or an environment with WebGL2 as `render` draws it.
     Studio(commands::studio::StudioArgs),
+    /// Add, replace or remove the 360° metadata of an MP4/MOV without re-encoding: Spherical
+    /// Video V2 (st3d, sv3d), optionally V1's XML; `info FILE.mp4` shows what a video has.
+    Tag(commands::tag::TagArgs),
 }
 
 /// How to read an input file.
@@ -617,6 +620,7 @@ fn main() -> ExitCode {
         Command::Analyze(a) => commands::analyze::run(a),
         Command::Render(a) => commands::render::run(*a),
         Command::Studio(a) => commands::studio::run(a),
+        Command::Tag(a) => commands::tag::run(a),
     };
     if !quiet {
         for f in mirrorball_io::removed_leftovers() {

@@ -169,7 +169,7 @@ impl CubeCells {
     }
 
     /// The top-left texel of cell `i`'s face, for faces of `n` texels.
-    fn origin(&self, i: usize, n: u32) -> (u32, u32) {
+    pub fn origin(&self, i: usize, n: u32) -> (u32, u32) {
         let (c, _) = self.grid.dims();
         let (col, row) = (i as u32 % c, i as u32 / c);
         if self.eac_pad {
@@ -182,7 +182,7 @@ impl CubeCells {
     /// The face coordinates `(s, t)` shown at cell coordinates `(c, d)` of cell `i`, as
     /// doubled integers (`2x + 1 − n` for texel `x` of `n`) or as reals: a signed
     /// permutation (see the type's documentation).
-    fn face_coords<T: Copy + std::ops::Neg<Output = T>>(&self, i: usize, c: T, d: T) -> (T, T) {
+    pub fn face_coords<T: Copy + std::ops::Neg<Output = T>>(&self, i: usize, c: T, d: T) -> (T, T) {
         let (c, d) = match self.turns[i] & 3 {
             0 => (c, d),
             1 => (d, -c),

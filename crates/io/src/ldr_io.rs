@@ -175,7 +175,8 @@ fn jpeg_is_complete(bytes: &[u8]) -> bool {
 /// Writes `image` as PNG (8-bit, or 16-bit with [`Precision::U16`]) or JPEG (8-bit,
 /// quality [`WriteOptions::jpeg_quality`], 92 when 0; alpha dropped), encoding linear light
 /// to sRGB with clamping to [0, 1] and rounding to nearest. Alpha is stored linearly. A PNG
-/// records [`WriteOptions::declared`] in `tEXt` chunks, a JPEG in a comment segment.
+/// records [`WriteOptions::declared`] in `tEXt` chunks, a JPEG in a comment segment; a
+/// lat-long or VR180 picture also gets GPano XMP (PNG `iTXt`, JPEG `APP1`).
 /// Written to a temporary file that the returned [`Staged`] renames into place.
 pub fn write(
     path: &Path,
@@ -240,7 +241,10 @@ pub fn write(
         let (projection, layout) = info.texts();
         let mut pairs = vec![(crate::PROJECTION_KEY, projection)];
         pairs.extend(layout.map(|l| (crate::LAYOUT_KEY, l)));
-        let jpeg = crate::meta_text::with_jpeg_comment(jpeg, &pairs);
+        let mut jpeg = crate::meta_text::with_jpeg_comment(jpeg, &pairs);
+        if let Some(xmp) = panorama_xmp(info, w, h) {
+            jpeg = crate::meta_text::with_jpeg_xmp(jpeg, &xmp);
+        }
         return stage(path, |out| {
             std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
         });
@@ -279,12 +283,22 @@ pub fn write(
         if let Some(l) = layout {
             chunks.extend(crate::meta_text::text_chunk(crate::LAYOUT_KEY, &l));
         }
+        if let Some(xmp) = panorama_xmp(info, w, h) {
+            let key = mirrorball_spherical::gpano::PNG_KEYWORD;
+            chunks.extend(crate::meta_text::itxt_chunk(key, &xmp));
+        }
     }
     stage(path, |out| {
         PngEncoder::new(crate::meta_text::WithText::new(out, chunks))
             .write_image(&bytes, w, h, color)
             .map_err(|e| encode_error(path, "PNG", e))
     })
+}
+
+/// The GPano XMP packet of a lat-long or VR180 picture of `w`×`h` texels (none for other
+/// projections and for stereo pairs): 360° viewers show such photos as panoramas.
+fn panorama_xmp(info: &crate::MapInfo, w: u32, h: u32) -> Option<String> {
+    mirrorball_spherical::gpano::for_picture(&info.projection, info.layout, info.stereo, w, h)
 }
 
 // ---------------------------------------------------------------------------------------

@@ -4,6 +4,7 @@
 //! ITU T.81 §B.2.4.5) of `key=value` lines, written after `SOI` and the JFIF `APP0` segment
 //! and read back from before the first scan.
 
+use mirrorball_spherical::crc32;
 use std::io::{self, Read, Seek, SeekFrom, Write};
 
 /// Bytes before the first chunk after `IHDR`: the 8-byte signature and the 25-byte `IHDR`
@@ -26,21 +27,18 @@ pub(crate) fn text_chunk(keyword: &str, text: &str) -> Vec<u8> {
     chunk
 }
 
-/// CRC-32 as PNG computes it (ISO 3309, reflected polynomial 0xEDB88320), over the chunk
-/// type and data.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = 0xFFFF_FFFFu32;
-    for &b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            crc = if crc & 1 != 0 {
-                (crc >> 1) ^ 0xEDB8_8320
-            } else {
-                crc >> 1
-            };
-        }
-    }
-    !crc
+/// An uncompressed `iTXt` chunk (§11.3.3.4): `keyword NUL 0 0 NUL NUL text`, no language
+/// tag or translated keyword, the text UTF-8. An XMP packet goes in one keyed
+/// `XML:com.adobe.xmp` (XMP Specification Part 3, §1.1.5).
+pub(crate) fn itxt_chunk(keyword: &str, text: &str) -> Vec<u8> {
+    let mut body = b"iTXt".to_vec();
+    body.extend_from_slice(keyword.as_bytes());
+    body.extend_from_slice(&[0, 0, 0, 0, 0]);
+    body.extend_from_slice(text.as_bytes());
+    let mut chunk = ((body.len() - 4) as u32).to_be_bytes().to_vec();
+    chunk.extend_from_slice(&body);
+    chunk.extend_from_slice(&crc32(&body).to_be_bytes());
+    chunk
 }
 
 /// A writer that passes a PNG stream through, putting `chunks` in right after `IHDR`.
@@ -143,23 +141,39 @@ const COM: u8 = 0xFE;
 const SOS: u8 = 0xDA;
 const EOI: u8 = 0xD9;
 
+/// JPEG's application segment 1, which holds Exif and XMP.
+const APP1: u8 = 0xE1;
+
 /// `jpeg` (a whole file) with a comment segment holding `pairs` as `key=value` lines, put
 /// after `SOI` and, when there is one, the `APP0` segment (JFIF wants `APP0` first).
 pub(crate) fn with_jpeg_comment(jpeg: Vec<u8>, pairs: &[(&str, String)]) -> Vec<u8> {
     let text: Vec<String> = pairs.iter().map(|(k, v)| format!("{k}={v}")).collect();
-    let text = text.join("\n");
-    if text.is_empty() || text.len() > 65533 || jpeg.len() < 2 || jpeg[..2] != [0xFF, SOI] {
+    with_jpeg_segment(jpeg, COM, text.join("\n").as_bytes())
+}
+
+/// `jpeg` with an `APP1` segment holding the XMP packet `xmp` after the XMP signature
+/// (XMP Specification Part 3, §1.1.3), put where [`with_jpeg_comment`] puts its segment.
+pub(crate) fn with_jpeg_xmp(jpeg: Vec<u8>, xmp: &str) -> Vec<u8> {
+    let mut body = mirrorball_spherical::gpano::JPEG_SIGNATURE.to_vec();
+    body.extend_from_slice(xmp.as_bytes());
+    with_jpeg_segment(jpeg, APP1, &body)
+}
+
+/// `jpeg` with a segment of `marker` holding `body` after `SOI` and any `APP0`; unchanged
+/// when `body` is empty or longer than a segment holds.
+fn with_jpeg_segment(jpeg: Vec<u8>, marker: u8, body: &[u8]) -> Vec<u8> {
+    if body.is_empty() || body.len() > 65533 || jpeg.len() < 2 || jpeg[..2] != [0xFF, SOI] {
         return jpeg;
     }
     let mut at = 2;
     if jpeg.len() >= 6 && jpeg[2] == 0xFF && jpeg[3] == APP0 {
         at = (4 + usize::from(u16::from_be_bytes([jpeg[4], jpeg[5]]))).min(jpeg.len());
     }
-    let mut out = Vec::with_capacity(jpeg.len() + text.len() + 4);
+    let mut out = Vec::with_capacity(jpeg.len() + body.len() + 4);
     out.extend_from_slice(&jpeg[..at]);
-    out.extend_from_slice(&[0xFF, COM]);
-    out.extend_from_slice(&((text.len() + 2) as u16).to_be_bytes());
-    out.extend_from_slice(text.as_bytes());
+    out.extend_from_slice(&[0xFF, marker]);
+    out.extend_from_slice(&((body.len() + 2) as u16).to_be_bytes());
+    out.extend_from_slice(body);
     out.extend_from_slice(&jpeg[at..]);
     out
 }
@@ -168,6 +182,21 @@ pub(crate) fn with_jpeg_comment(jpeg: Vec<u8>, pairs: &[(&str, String)]) -> Vec<
 /// are skipped). A malformed stream ends the walk: the decoder reports it.
 pub(crate) fn jpeg_comments(jpeg: &[u8]) -> Vec<(String, String)> {
     let mut pairs = Vec::new();
+    for body in jpeg_segments(jpeg, COM) {
+        let text = String::from_utf8_lossy(body);
+        for line in text.lines() {
+            if let Some((k, v)) = line.split_once('=') {
+                pairs.push((k.to_string(), v.to_string()));
+            }
+        }
+    }
+    pairs
+}
+
+/// The bodies of a JPEG's segments of `marker` before its first scan. A malformed stream
+/// ends the walk.
+fn jpeg_segments(jpeg: &[u8], want: u8) -> Vec<&[u8]> {
+    let mut out = Vec::new();
     let mut i = 2;
     while i + 4 <= jpeg.len() && jpeg[i] == 0xFF {
         let marker = jpeg[i + 1];
@@ -182,17 +211,37 @@ pub(crate) fn jpeg_comments(jpeg: &[u8]) -> Vec<(String, String)> {
         let Some(body) = jpeg.get(i + 4..i + 2 + len).filter(|_| len >= 2) else {
             break;
         };
-        if marker == COM {
-            let text = String::from_utf8_lossy(body);
-            for line in text.lines() {
-                if let Some((k, v)) = line.split_once('=') {
-                    pairs.push((k.to_string(), v.to_string()));
-                }
-            }
+        if marker == want {
+            out.push(body);
         }
         i += 2 + len;
     }
-    pairs
+    out
+}
+
+/// The XMP packet of a PNG (an `iTXt` chunk keyed `XML:com.adobe.xmp`) or a JPEG (an `APP1`
+/// segment after the XMP signature), if the file has one; other files have none.
+pub fn read_xmp(path: &std::path::Path) -> Result<Option<String>, crate::Error> {
+    use mirrorball_spherical::gpano::{JPEG_SIGNATURE, PNG_KEYWORD};
+    let err = |e| crate::Error::io(path, e);
+    let mut file = io::BufReader::new(std::fs::File::open(path).map_err(err)?);
+    let mut magic = [0u8; 2];
+    let n = file.read(&mut magic).map_err(err)?;
+    file.seek(SeekFrom::Start(0)).map_err(err)?;
+    if magic[..n] == [0xFF, SOI] {
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes).map_err(err)?;
+        let xmp = jpeg_segments(&bytes, APP1)
+            .into_iter()
+            .find_map(|b| b.strip_prefix(JPEG_SIGNATURE))
+            .map(|b| String::from_utf8_lossy(b).into_owned());
+        return Ok(xmp);
+    }
+    let texts = read_texts(&mut file).map_err(err)?;
+    Ok(texts
+        .into_iter()
+        .find(|(k, _)| k == PNG_KEYWORD)
+        .map(|(_, v)| v))
 }
 
 #[cfg(test)]

@@ -6,6 +6,9 @@ use crate::{load, InfoArgs};
 use mirrorball_core::WorldProjection;
 
 pub fn run(a: InfoArgs) -> Result<(), CliError> {
+    if super::tag::is_movie(&a.input) {
+        return super::tag::info(&a.input, a.json);
+    }
     let input = InputPlan::new(&a.input_args)?;
     let src = load::load(
         &a.input,
@@ -16,6 +19,7 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
     let env = &src.env;
     let s = env.stats();
     let p = env.projection();
+    let panorama = super::tag::photo_panorama(&a.input, env.width(), env.height())?;
     if a.json {
         let v = serde_json::json!({
             "file": a.input,
@@ -35,6 +39,7 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
             "nan_values": s.nan,
             "inf_values": s.inf,
             "negative_values": s.negative,
+            "panorama": panorama,
         });
         println!(
             "{}",
@@ -45,6 +50,9 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
     println!("file:        {}", a.input);
     println!("container:   {}", src.description);
     println!("projection:  {} ({})", p.name(), src.decided);
+    if let Some(pano) = &panorama {
+        println!("panorama:    {pano}");
+    }
     println!(
         "size:        {}x{}{}, {} channels",
         env.width(),

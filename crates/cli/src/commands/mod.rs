@@ -9,6 +9,7 @@ pub mod info;
 pub mod prefilter;
 pub mod render;
 pub mod studio;
+pub mod tag;
 
 use crate::error::CliError;
 use crate::spec::{bad, ProjSpec};

@@ -6,6 +6,7 @@ mod hostile;
 mod imf_envmap;
 mod mutate;
 mod openexr;
+mod panorama;
 mod quality;
 mod ranges;
 mod records;
