@@ -3,11 +3,9 @@
 
 use crate::error::CliError;
 use crate::fit::{self, Report};
-use mirrorball_core::Choice;
 use crate::load::{layer_names, FACE};
-use mirrorball_core::{
-    EnvMap, Image, Layout, Projection, ProjectionKind, Stereo, WorldProjection,
-};
+use mirrorball_core::Choice;
+use mirrorball_core::{EnvMap, Image, Layout, Projection, ProjectionKind, Stereo, WorldProjection};
 use mirrorball_filter::MipChain;
 use mirrorball_io::{Format, MapInfo, OutputSet, Precision, WriteOptions};
 use std::path::{Path, PathBuf};

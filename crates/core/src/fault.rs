@@ -42,9 +42,7 @@ impl Fault {
 /// let none = std::fs::metadata(dir.join("no-such-file-here.exr"));
 /// assert_eq!(input_file_problem(&none).unwrap().1, "no such file");
 /// ```
-pub fn input_file_problem(
-    meta: &std::io::Result<std::fs::Metadata>,
-) -> Option<(Fault, String)> {
+pub fn input_file_problem(meta: &std::io::Result<std::fs::Metadata>) -> Option<(Fault, String)> {
     use std::io::ErrorKind;
     match meta {
         Err(e) => Some(match e.kind() {

@@ -57,10 +57,7 @@ fn nearest_existing(dir: &Path) -> (PathBuf, Vec<PathBuf>) {
 /// error names `path`; a missing or unwritable folder is also named.
 pub fn check_writable(path: &Path, folders: Folders) -> Result<(), Error> {
     if path.is_dir() {
-        return Err(Error::request(
-            path,
-            "is a folder; give a file name".into(),
-        ));
+        return Err(Error::request(path, "is a folder; give a file name".into()));
     }
     let dir = output_folder(path);
     let (existing, missing) = nearest_existing(&dir);

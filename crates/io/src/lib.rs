@@ -370,7 +370,7 @@ impl mirrorball_core::Choice for ExrCompression {
 mirrorball_core::choice_traits!(ExrCompression);
 
 /// How to write a file.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct WriteOptions {
     /// Texel precision; `None` picks the format's natural one (half for EXR/KTX2/DDS, 8-bit
     /// for PNG/JPEG; Radiance HDR is always RGBE).

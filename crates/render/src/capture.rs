@@ -142,8 +142,9 @@ pub fn render_fisheye(
     lens.fov_range()
         .check("the fisheye's fov", fov_deg)
         .map_err(|e| RenderError::request(format!("{e} (the {} lens)", lens.name())))?;
-    let fish = mirrorball_core::Fisheye::new(frame, lens, fov_deg)
-        .ok_or_else(|| RenderError::request(format!("fov={fov_deg}: no {} fisheye", lens.name())))?;
+    let fish = mirrorball_core::Fisheye::new(frame, lens, fov_deg).ok_or_else(|| {
+        RenderError::request(format!("fov={fov_deg}: no {} fisheye", lens.name()))
+    })?;
     let cube = capture_cube(scene, eye, face, None, settings)?;
     let out = mirrorball_core::resample(
         &cube,

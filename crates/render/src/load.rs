@@ -80,8 +80,7 @@ fn open_failure(path: &Path) -> (Fault, Option<String>) {
 /// ```
 pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
     // Missing, a directory or empty: said so before a parser sees it.
-    if let Some((fault, problem)) = mirrorball_core::input_file_problem(&std::fs::metadata(path))
-    {
+    if let Some((fault, problem)) = mirrorball_core::input_file_problem(&std::fs::metadata(path)) {
         return Err(MeshError::new(path, fault, problem));
     }
     let ext = path

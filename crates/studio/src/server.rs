@@ -337,12 +337,16 @@ fn fit(
     if aw <= limit && ah <= limit {
         return Ok((map, None));
     }
-    let size = texture::fitting_size(map.projection(), map.width(), limit, mips).ok_or_else(|| {
-        (
-            StatusCode::BAD_REQUEST,
-            format!("limit: no {} map fits textures of {limit} texels", map.projection().name()),
-        )
-    })?;
+    let size =
+        texture::fitting_size(map.projection(), map.width(), limit, mips).ok_or_else(|| {
+            (
+                StatusCode::BAD_REQUEST,
+                format!(
+                    "limit: no {} map fits textures of {limit} texels",
+                    map.projection().name()
+                ),
+            )
+        })?;
     let spec = map.projection().to_string();
     let fitted = convert(app, &map, &spec, Some(size))?;
     Ok((fitted, Some(texture::Fitted { from, limit })))

@@ -58,7 +58,11 @@ pub fn encode(map: &EnvMap, precision: Precision, fitted: Option<Fitted>) -> Vec
 /// `map` and its mip chain (`MipChain::build`, box filter: what `mirrorball render`'s
 /// footprint samplers read) as the payload described above.
 pub fn encode_mips(map: &EnvMap, precision: Precision, fitted: Option<Fitted>) -> Vec<u8> {
-    encode_levels(MipChain::build(map, MipFilter::Box).levels(), precision, fitted)
+    encode_levels(
+        MipChain::build(map, MipFilter::Box).levels(),
+        precision,
+        fitted,
+    )
 }
 
 /// The atlas's width and height for a `w`×`h` level 0, alone or with its chain (`mips`:

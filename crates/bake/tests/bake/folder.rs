@@ -4,8 +4,8 @@
 
 use crate::common::{bake, direction_coded};
 use mirrorball_bake::{
-    background_face_for, Bake, BakeOptions, Engine, Lighting, ENGINES, MAX_BACKGROUND,
-    MIN_BACKGROUND, README,
+    background_face_for, Bake, BakeOptions, Lighting, ENGINES, MAX_BACKGROUND, MIN_BACKGROUND,
+    README,
 };
 use mirrorball_core::{EnvMap, Image, ProjectionKind};
 use std::collections::BTreeSet;

@@ -190,7 +190,11 @@ impl Plan {
         channels: usize,
     ) -> Result<(), CliError> {
         let texels = w as u64 * h as u64 * layers as u64 * eyes as u64;
-        let texels = if self.save.mips { texels * 4 / 3 } else { texels };
+        let texels = if self.save.mips {
+            texels * 4 / 3
+        } else {
+            texels
+        };
         let bytes = self
             .format
             .bytes_estimate(texels, channels as u64, self.save.write.precision);
@@ -230,7 +234,12 @@ fn plan_and_read(mut a: ConvertArgs) -> Result<(ConvertArgs, Plan, load::Source)
         // most), else once the source is read.
         if let Some(size) = plan.size {
             let dst = plan.to.build(None).map_err(|e| bad("--to", e))?;
-            plan.check_room(dst.layer_extent(size), dst.layer_count(), plan.stereo.eyes(), 4)?;
+            plan.check_room(
+                dst.layer_extent(size),
+                dst.layer_count(),
+                plan.stereo.eyes(),
+                4,
+            )?;
         }
         let src = read(&a, &plan.input, (plan.in_stereo, plan.stereo))?;
         return Ok((a, plan, src));
@@ -475,7 +484,12 @@ fn convert_pair(
         .unwrap_or_else(|| save::default_size(left, dst.kind()));
     let (w, h) = dst.layer_extent(size);
     if plan.size.is_none() {
-        plan.check_room((w, h), dst.layer_count(), plan.stereo.eyes(), left.channels())?;
+        plan.check_room(
+            (w, h),
+            dst.layer_count(),
+            plan.stereo.eyes(),
+            left.channels(),
+        )?;
     }
     let c = left.channels() as u64;
     let texels = |w: u32, h: u32, n: usize| w as u64 * h as u64 * n as u64;

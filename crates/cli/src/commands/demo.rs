@@ -84,7 +84,11 @@ fn size_bound() -> crate::size::Bound {
             (pw as u64, ph as u64)
         };
         let name = format!("{}.exr", kind.name());
-        let b = b.and(crate::size::pictures(mirrorball_io::Format::Exr, &name, picture));
+        let b = b.and(crate::size::pictures(
+            mirrorball_io::Format::Exr,
+            &name,
+            picture,
+        ));
         match kind {
             ProjectionKind::Cube => b.and(crate::size::pictures(
                 mirrorball_io::Format::Ktx2,

@@ -127,13 +127,55 @@ const COMMANDS: &[&[&str]] = &[
     &["convert", "in/%03d.exr", "{o}%03d.exr", "--to", "cube"],
     &["convert", "in.exr", "{o}.ktx2", "--to", "cube", "--mips"],
     &["prefilter", "in.exr", "{o}.ktx2", "--lobe", "ggx"],
-    &["prefilter", "in.exr", "{o}.exr", "--lobe", "ggx", "--to", "latlong"],
-    &["prefilter", "in.exr", "p.ktx2", "--lobe", "ggx", "--sh", "{o}.json"],
-    &["prefilter", "in.exr", "p.ktx2", "--lobe", "ggx", "--preview", "{o}.png"],
-    &["prefilter", "in.exr", "p.ktx2", "--lobe", "ggx", "--lut", "{o}.exr"],
+    &[
+        "prefilter",
+        "in.exr",
+        "{o}.exr",
+        "--lobe",
+        "ggx",
+        "--to",
+        "latlong",
+    ],
+    &[
+        "prefilter",
+        "in.exr",
+        "p.ktx2",
+        "--lobe",
+        "ggx",
+        "--sh",
+        "{o}.json",
+    ],
+    &[
+        "prefilter",
+        "in.exr",
+        "p.ktx2",
+        "--lobe",
+        "ggx",
+        "--preview",
+        "{o}.png",
+    ],
+    &[
+        "prefilter",
+        "in.exr",
+        "p.ktx2",
+        "--lobe",
+        "ggx",
+        "--lut",
+        "{o}.exr",
+    ],
     &["bake", "in.exr", "--for", "ktx2", "{o}"],
-    &["render", "--env", "in.exr", "-o", "{o}.png", "--size", "64x48"],
-    &["render", "--env", "in.exr", "-o", "{o}.exr", "--turntable", "2"],
+    &[
+        "render", "--env", "in.exr", "-o", "{o}.png", "--size", "64x48",
+    ],
+    &[
+        "render",
+        "--env",
+        "in.exr",
+        "-o",
+        "{o}.exr",
+        "--turntable",
+        "2",
+    ],
     &["demo", "--out", "{o}", "--size", "64"],
     &["analyze", "--out", "{o}", "--size", "16"],
 ];
@@ -159,9 +201,11 @@ fn target(case: Case, args: &[&str]) -> Option<(String, String, &'static str)> {
         }
         Case::MissingInReadOnly => ("ro/new/out".into(), "ro/new".into(), "does not exist"),
         // Where bake's README.md, demo's and analyze's page go is a folder.
-        Case::Folder if args[0] == "bake" => {
-            ("taken".into(), "taken/README.md".into(), "a folder is where")
-        }
+        Case::Folder if args[0] == "bake" => (
+            "taken".into(),
+            "taken/README.md".into(),
+            "a folder is where",
+        ),
         Case::Folder if folder => ("report".into(), "report/index.html".into(), "is a folder"),
         Case::Folder if o.contains('%') || o.contains("{face}") => return None,
         Case::Folder => ("taken".into(), file("taken"), "is a folder"),

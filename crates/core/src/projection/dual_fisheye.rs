@@ -356,9 +356,10 @@ impl DualFisheye {
         let frames = [rig, rig.turned_around()];
         let mut optics = Vec::with_capacity(2);
         for (i, (lens, frame)) in lenses.iter().zip(frames).enumerate() {
-            optics.push(Self::optic(lens, frame).map_err(|e| {
-                format!("{} lens ({}): {e}", lens_name(i), lens.model.name())
-            })?);
+            optics.push(
+                Self::optic(lens, frame)
+                    .map_err(|e| format!("{} lens ({}): {e}", lens_name(i), lens.model.name()))?,
+            );
         }
         let (a, b) = (&lenses[0], &lenses[1]);
         let gap = (a.centre - b.centre).length() - (a.radius + b.radius);

@@ -304,7 +304,12 @@ impl ProjectionSpec {
                 let d = self.distance.unwrap_or(1.0);
                 vec![
                     one(name.clone(), "d", self.distance, View::DISTANCE),
-                    one(format!("{name}, d={d}"), "hfov", self.hfov, View::hfov_range(d)),
+                    one(
+                        format!("{name}, d={d}"),
+                        "hfov",
+                        self.hfov,
+                        View::hfov_range(d),
+                    ),
                     one(name, "vfov", self.vfov, View::VFOV),
                 ]
             }
@@ -371,7 +376,9 @@ impl ProjectionSpec {
             (Some(d), None) => {
                 Frame::looking_along(d).ok_or("the look direction must be non-zero")?
             }
-            (None, Some(up)) => Frame::looking_along_up(Frame::default().forward, up).ok_or(ALONG)?,
+            (None, Some(up)) => {
+                Frame::looking_along_up(Frame::default().forward, up).ok_or(ALONG)?
+            }
             (None, None) => Frame::default(),
         })
     }

@@ -286,7 +286,11 @@ fn validate_ktx2(bytes: &[u8], encoding: Encoding) -> Vec<Vec<u8>> {
     // KTX 2.0.4 keeps the pre-deflation bytesPlanes when supercompressed (6030 warns on 0).
     let mut planes = [0u8; 8];
     planes[0] = x.block;
-    assert_eq!(d[20..28], planes, "bytesPlane (6022; 6030 when supercompressed)");
+    assert_eq!(
+        d[20..28],
+        planes,
+        "bytesPlane (6022; 6030 when supercompressed)"
+    );
     for (i, want) in x.samples.iter().enumerate() {
         let s = &d[28 + 16 * i..44 + 16 * i];
         let word = u32_at(s, 0);

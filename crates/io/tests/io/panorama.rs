@@ -99,8 +99,14 @@ fn other_projections_pairs_and_unrecorded_pictures_carry_none() {
     let dir = tempfile::tempdir().unwrap();
     for ext in ["png", "jpg"] {
         let cases = [
-            (Some(options(ProjectionKind::Sphere, Stereo::Mono, None)), (16, 16)),
-            (Some(options(ProjectionKind::LatLong, Stereo::SideBySide, None)), (64, 16)),
+            (
+                Some(options(ProjectionKind::Sphere, Stereo::Mono, None)),
+                (16, 16),
+            ),
+            (
+                Some(options(ProjectionKind::LatLong, Stereo::SideBySide, None)),
+                (64, 16),
+            ),
             (None, (64, 32)),
         ];
         for (i, (opts, (w, h))) in cases.into_iter().enumerate() {

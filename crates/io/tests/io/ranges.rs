@@ -22,7 +22,11 @@ fn sunny(storage: Storage) -> Image {
             img.set(x, y, &max.map(|m| m / 2.0));
         }
     }
-    img.set(5, 5, &max.map(|m| if m < f32::MAX / 4.0 { 4.0 * m } else { m }));
+    img.set(
+        5,
+        5,
+        &max.map(|m| if m < f32::MAX / 4.0 { 4.0 * m } else { m }),
+    );
     img
 }
 
@@ -53,14 +57,20 @@ fn check(path: &Path, storage: Storage, layers: &[Image]) {
         for k in 0..3 {
             let want = src.get(x, x)[k].min(max[k]);
             let g = got.get(x, x)[k];
-            assert!((g - want).abs() <= want * tol, "{what}: texel {x}, {g} for {want}");
+            assert!(
+                (g - want).abs() <= want * tol,
+                "{what}: texel {x}, {g} for {want}"
+            );
         }
     }
 }
 
 /// The flat formats' writers, each with every precision it takes.
 const FLAT: &[(&str, &[Option<Precision>])] = &[
-    ("exr", &[None, Some(Precision::Half), Some(Precision::Float)]),
+    (
+        "exr",
+        &[None, Some(Precision::Half), Some(Precision::Float)],
+    ),
     ("hdr", &[None]),
     ("png", &[None, Some(Precision::U8), Some(Precision::U16)]),
     ("jpg", &[None, Some(Precision::U8)]),
@@ -117,6 +127,9 @@ fn every_storage_is_written_within_its_range_by_every_writer() {
         check(&path, storage, &levels[0]);
     }
     for s in Storage::all() {
-        assert!(seen.contains(&s), "{s:?} is written by no writer tested here");
+        assert!(
+            seen.contains(&s),
+            "{s:?} is written by no writer tested here"
+        );
     }
 }

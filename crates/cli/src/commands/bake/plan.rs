@@ -80,11 +80,9 @@ impl Plan {
             (None, false) => takes_zstd.then_some(3),
         };
         // A cube face: the GPU containers' limit (what mirrorball_bake::MAX_SIZE is).
-        let size = crate::size::pictures(
-            mirrorball_io::Format::Ktx2,
-            "a baked cube face",
-            |s| (s as u64, s as u64),
-        )
+        let size = crate::size::pictures(mirrorball_io::Format::Ktx2, "a baked cube face", |s| {
+            (s as u64, s as u64)
+        })
         .check("--size", a.size)?;
         let opts = BakeOptions {
             size,

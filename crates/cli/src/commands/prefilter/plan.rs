@@ -153,9 +153,10 @@ impl Plan {
         let lut = self.lut_path.as_ref().map_or(0, |_| {
             Format::Exr.bytes_estimate(self.lut_size as u64 * self.lut_size as u64, 3, None)
         });
-        let preview = self.preview_path.as_ref().map_or(0, |_| {
-            Format::Png.bytes_estimate(chain, 3, None)
-        });
+        let preview = self
+            .preview_path
+            .as_ref()
+            .map_or(0, |_| Format::Png.bytes_estimate(chain, 3, None));
         let bytes = self
             .format
             .bytes_estimate(chain, 4, self.save.write.precision)
@@ -240,7 +241,11 @@ fn output_format(
 /// `--precision` and `--layout`, where the container takes them ([`save::check_flags`]).
 fn output_precision(a: &PrefilterArgs, format: Format) -> Result<Option<Precision>, CliError> {
     let precision = parse_precision(a.precision.as_deref())?;
-    let given: &[&str] = if a.layout.is_some() { &["--layout"] } else { &[] };
+    let given: &[&str] = if a.layout.is_some() {
+        &["--layout"]
+    } else {
+        &[]
+    };
     save::check_flags(&a.output, format, given, precision)?;
     Ok(precision)
 }

@@ -109,13 +109,19 @@ fn parse_size(s: &str, output: &Path, format: Format) -> Result<(u32, u32), CliE
         crate::size::parse(h).map_err(|_| not_a_size())?,
     );
     let side = side_bound(output, format);
-    let check = |v: i64| side.check("--size", v).map_err(|_| side.refusal("--size", s));
+    let check = |v: i64| {
+        side.check("--size", v)
+            .map_err(|_| side.refusal("--size", s))
+    };
     let (w, h) = (check(w)?, check(h)?);
     let most = mirrorball_io::Limits::default().max_texels;
     if w as u64 * h as u64 > most {
         return Err(bad(
             "--size",
-            format!("'{s}' is {} pixels; mirrorball reads pictures of at most {most}", w as u64 * h as u64),
+            format!(
+                "'{s}' is {} pixels; mirrorball reads pictures of at most {most}",
+                w as u64 * h as u64
+            ),
         ));
     }
     Ok((w, h))
