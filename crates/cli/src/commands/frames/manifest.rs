@@ -19,6 +19,7 @@
 
 use super::log::{Log, Status};
 use super::pattern::Pattern;
+use super::record::{self, Verdict};
 use super::shard::Shard;
 use crate::error::CliError;
 use crate::spec::ProjSpec;
@@ -28,7 +29,7 @@ use mirrorball_core::WorldProjection;
 use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::ffi::OsString;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// One line of a manifest.
@@ -278,17 +279,32 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         to_stderr: false,
     };
     let (mut done, mut skipped, mut failed) = (0, 0, 0);
+    let (mut unknown, mut again) = (0u64, 0u64);
+    let mut made = record::Made::default();
     for k in range.clone() {
         let (job, args) = (&jobs[k], parsed[k].clone());
         let fields = json!({"job": k, "line": job.line, "input": job.input, "output": job.output});
         let t = Instant::now();
-        if !a.frames.overwrite && outputs(&args).is_some_and(|o| o.iter().all(|p| p.exists())) {
-            skipped += 1;
-            log.line(fields, Status::Skipped, t.elapsed(), None);
-            continue;
+        // A job of one conversion is recorded as a sequence's frame is (`record.rs`).
+        let outs = outputs(&args);
+        let stamp = record::stamp(&record::settings(&args), Path::new(&args.input));
+        if let Some(o) = outs.as_ref().filter(|o| o.iter().all(|p| p.exists())) {
+            match made.verdict(&o[0], stamp) {
+                _ if a.frames.overwrite => {}
+                Verdict::Other => again += 1,
+                v => {
+                    skipped += 1;
+                    unknown += u64::from(v == Verdict::Unknown);
+                    log.line(fields, Status::Skipped, t.elapsed(), None);
+                    continue;
+                }
+            }
         }
         match super::super::convert::run(args) {
             Ok(()) => {
+                if let Some(o) = &outs {
+                    record::note(&o[0], stamp)?;
+                }
                 done += 1;
                 log.line(fields, Status::Done, t.elapsed(), None);
             }
@@ -302,6 +318,9 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         }
     }
     if !a.quiet {
+        for line in record::kept_lines("job", skipped, unknown, again) {
+            eprintln!("{line}");
+        }
         eprintln!(
             "jobs {}..{} of {}: {done} done, {skipped} skipped (outputs exist), {failed} failed",
             range.start,

@@ -15,6 +15,7 @@ mod packing;
 mod pattern;
 mod pipe;
 mod pipeline;
+mod record;
 mod sequence;
 mod shard;
 

@@ -12,6 +12,7 @@ use super::packing::{Packing, Picture};
 use super::pattern::{Frame, Pattern, Printf};
 use super::pipe::{self, PixFmt};
 use super::pipeline::{self, Eyes, Meta, FRAMES_IN_FLIGHT};
+use super::record::{self, Verdict};
 use super::shard::Shard;
 use crate::commands::convert::{times, Plan};
 use crate::error::CliError;
@@ -196,7 +197,9 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         save::layer_files(&s, dst.layer_count(), &plan.save)
             .unwrap_or_else(|| vec![path.to_path_buf()])
     };
-    let mut skipped = 0u64;
+    let settings = record::settings(a);
+    let mut made = record::Made::default();
+    let (mut skipped, mut unknown, mut again) = (0u64, 0u64, 0u64);
     let input = match input {
         Input::Files(frames) => {
             let mut dirs = std::collections::HashMap::new();
@@ -222,21 +225,29 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
                     )));
                 }
                 if !f.overwrite && !outs.is_empty() && outs.iter().all(|o| o.exists()) {
-                    skipped += 1;
-                    log.line(
-                        json!({"frame": fr.number, "input": fr.path, "output": outs[0]}),
-                        Status::Skipped,
-                        Default::default(),
-                        None,
-                    );
-                    continue;
+                    let verdict = made.verdict(&outs[0], record::stamp(&settings, &fr.path));
+                    if verdict == Verdict::Other {
+                        again += 1;
+                    } else {
+                        skipped += 1;
+                        unknown += u64::from(verdict == Verdict::Unknown);
+                        log.line(
+                            json!({"frame": fr.number, "input": fr.path, "output": outs[0]}),
+                            Status::Skipped,
+                            Default::default(),
+                            None,
+                        );
+                        continue;
+                    }
                 }
                 todo.push(fr);
             }
-            if todo.is_empty() {
-                if !a.quiet {
-                    eprintln!("every output exists already ({skipped} frame(s) skipped; --overwrite converts them again)");
+            if !a.quiet {
+                for line in record::kept_lines("frame", skipped, unknown, again) {
+                    eprintln!("{line}");
                 }
+            }
+            if todo.is_empty() {
                 return Ok(());
             }
             Input::Files(todo)
@@ -685,6 +696,7 @@ fn convert_frames(
             None => packing.encode_rows(fmt, rows, bytes),
         };
     let t_plan = t0.elapsed();
+    let settings = record::settings(a);
 
     let fresh = || -> Eyes {
         (0..plan.stereo.eyes())
@@ -724,8 +736,10 @@ fn convert_frames(
                 pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
                 "-".into()
             }
-            (Output::Files(p), _) => save_frame(eyes, &p.path(m.number), plan)?,
-            (Output::File(s), _) => save_frame(eyes, Path::new(s), plan)?,
+            (Output::Files(p), _) => {
+                save_frame(eyes, &p.path(m.number), plan, &m.input, &settings)?
+            }
+            (Output::File(s), _) => save_frame(eyes, Path::new(s), plan, &m.input, &settings)?,
             _ => unreachable!("a pipe has its format"),
         };
         logged(m, out, t);
@@ -820,10 +834,20 @@ fn convert_frames(
     result
 }
 
-/// Writes one frame's file(s) through io's atomic writes; the name for the log.
-fn save_frame(eyes: &[EnvMap], path: &Path, plan: &Plan) -> Result<String, CliError> {
+/// Writes one frame's file(s) through io's atomic writes and records how it was made (from
+/// `input` with `settings`: `record.rs`); the name for the log.
+fn save_frame(
+    eyes: &[EnvMap],
+    path: &Path,
+    plan: &Plan,
+    input: &str,
+    settings: &str,
+) -> Result<String, CliError> {
     let s = path.to_string_lossy().into_owned();
     let saved = save::save_eyes(eyes, plan.stereo, &s, &plan.save)?;
     plan.say_clipped(&s, &saved.report);
+    if let Some(first) = saved.files.first() {
+        record::note(first, record::stamp(settings, Path::new(input)))?;
+    }
     Ok(s)
 }
