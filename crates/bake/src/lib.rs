@@ -39,6 +39,7 @@ use mirrorball_filter::{Lobe, PrefilterOptions, Prefilterer, RoughnessMapping};
 use mirrorball_io::{CubeWrite, Effort, Encoding};
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
 
 /// Why a bake cannot be done or failed, and whose fault it is.
 #[derive(Debug)]
@@ -257,6 +258,7 @@ impl Lighting {
     /// Prefilters `env` (any projection, sanitized) into `spec`'s levels, the diffuse cube
     /// from the exact Lambert integral, and the SH9; resamples it into the background cube.
     pub fn from_env(env: &EnvMap, spec: &ChainSpec, opts: PrefilterOptions) -> Lighting {
+        let progress = opts.progress.clone();
         let cube = ProjectionKind::Cube.default_projection();
         let lobes: Vec<Lobe> = spec
             .levels
@@ -282,9 +284,13 @@ impl Lighting {
         let diffuse = spec
             .diffuse_face
             .map(|face| pre.render_extent(&Lobe::Lambert, cube, face, face));
-        let background = spec
-            .background_face
-            .map(|face| mirrorball_core::resample(env, cube, face, &ResampleOptions::default()));
+        let background = spec.background_face.map(|face| {
+            let sky = mirrorball_core::resample(env, cube, face, &ResampleOptions::default());
+            if let Some(p) = &progress {
+                p.fetch_add(mirrorball_filter::cube_work(env, face), Ordering::Relaxed);
+            }
+            sky
+        });
         Lighting {
             specular,
             roughness: spec.levels.iter().map(|&(_, r)| r).collect(),
@@ -525,10 +531,38 @@ impl Bake {
         }
     }
 
-    /// Rows the prefilter makes, for a progress bar fed by [`PrefilterOptions::progress`].
-    pub fn rows(&self) -> u64 {
-        let specular: u64 = self.spec.levels.iter().map(|&(f, _)| 6 * f as u64).sum();
-        specular + self.spec.diffuse_face.map_or(0, |f| 6 * f as u64)
+    /// The work of [`Bake::lighting`] from `env` with `opts`, in the units its
+    /// [`PrefilterOptions::progress`] counts (`mirrorball_filter::work`): the prefilter and
+    /// the sky's cube.
+    pub fn lighting_work(&self, env: &EnvMap, opts: &PrefilterOptions) -> u64 {
+        let cube = ProjectionKind::Cube.default_projection();
+        let mut outputs: Vec<(Lobe, mirrorball_core::Projection, u32, u32)> = self
+            .spec
+            .levels
+            .iter()
+            .map(|&(face, roughness)| (Lobe::Ggx { roughness }, cube, face, face))
+            .collect();
+        if let Some(face) = self.spec.diffuse_face {
+            outputs.push((Lobe::Lambert, cube, face, face));
+        }
+        mirrorball_filter::work(env, &outputs, opts)
+            + self
+                .spec
+                .background_face
+                .map_or(0, |face| mirrorball_filter::cube_work(env, face))
+    }
+
+    /// About the work of [`Bake::write_into`], in `mirrorball_core::work`'s units (what the
+    /// encoders and container writers count there): every cube encoded in the bake's
+    /// encoding, and supercompressed when asked.
+    pub fn write_work(&self) -> u64 {
+        let texels = self.texels();
+        let encoding = self.encoding();
+        let zstd = self.opts.zstd.map_or(0, |_| {
+            let bytes = encoding.image_bytes(1024, 1024) as u64 * texels / (1024 * 1024);
+            mirrorball_io::zstd_work(bytes)
+        });
+        encoding.work(texels) + zstd
     }
 
     /// Texels of every cube made (four `f32` channels each), for the memory estimate.

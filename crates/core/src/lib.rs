@@ -29,6 +29,7 @@ pub mod par;
 pub mod projection;
 mod remap;
 mod resample;
+pub mod work;
 
 pub use axis_map::AxisMap;
 pub use choice::{count, Choice, UnknownName};

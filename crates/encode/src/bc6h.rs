@@ -108,6 +108,7 @@ pub fn encode_unsigned(image: &Image, effort: Effort, out: &mut Vec<u8>) {
                     stride: 4 * bw as u32 * 8,
                 };
                 intel_tex_2::bc6h::compress_blocks_into(&settings, &surface, row);
+                mirrorball_core::work::add(Encoding::Bc6hUnsigned.work(16 * bw as u64));
             },
         );
 }
@@ -130,6 +131,7 @@ pub fn encode_signed(image: &Image, out: &mut Vec<u8>) {
             }
             block.copy_from_slice(&encode_signed_block(&texels));
         });
+    mirrorball_core::work::add(Encoding::Bc6hSigned.work(16 * (bw * bh) as u64));
 }
 
 /// Interpolation weights of 4-bit indices (×1/64).

@@ -157,6 +157,18 @@ impl Encoding {
         Ok(())
     }
 
+    /// The work of encoding `texels` texels, in [`mirrorball_core::work`]'s units: what
+    /// [`Encoding::encode_with`] adds to its counter (measured with `cargo bench -p
+    /// mirrorball-io --bench encode`, `Effort::Basic` for unsigned BC6H).
+    pub fn work(self, texels: u64) -> u64 {
+        let per_texel = match self {
+            Encoding::Bc6hUnsigned => 900,
+            Encoding::Bc6hSigned => 700,
+            _ => 4,
+        };
+        texels * per_texel
+    }
+
     /// Encodes `image` (RGB or RGBA, linear) into `out`, replacing its contents with
     /// [`Encoding::image_bytes`] bytes: texels in rows, top row first, or 4×4 blocks in rows.
     /// Values are written as [`Range::fit`] of the encoding's range makes them: a finite
@@ -200,6 +212,7 @@ impl Encoding {
                 Encoding::Bc6hUnsigned | Encoding::Bc6hSigned => unreachable!("handled above"),
             }
         }
+        mirrorball_core::work::add(self.work(image.width() as u64 * image.height() as u64));
     }
 
     /// Decodes one `width`×`height` image of [`Encoding::image_bytes`] bytes into linear

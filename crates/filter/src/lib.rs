@@ -85,7 +85,7 @@ pub use brdf_lut::{BrdfLut, Visibility};
 pub use irradiance::IrradianceMethod;
 pub use lobe::{Lobe, LobeKind};
 pub use mip::{MipChain, MipFilter};
-pub use prefilter::{chain_lobes, chain_rows, PrefilterOptions, Prefilterer};
+pub use prefilter::{chain_lobes, chain_work, cube_work, work, PrefilterOptions, Prefilterer};
 pub use reference::BruteForce;
 pub use robust::{compress, Compression, EnergyReport};
 pub use sampler::{Filter, Footprint, Sampler};

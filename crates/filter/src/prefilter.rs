@@ -55,7 +55,8 @@ pub struct PrefilterOptions {
     /// Opening criterion κ of the point-source cluster tree: a cluster is summed as one point
     /// when it is smaller than κ times its distance from the lobe axis (default 0.1).
     pub bright_opening: f64,
-    /// Counts finished output rows, for progress bars.
+    /// Counts the work done, for progress bars, in the units [`work`] estimates: each
+    /// preparation once it is made, each output row as it is finished.
     pub progress: Option<Arc<AtomicU64>>,
 }
 
@@ -159,6 +160,7 @@ impl Prefilterer {
 
     fn with_face(src: &EnvMap, face: u32, opts: PrefilterOptions) -> Prefilterer {
         let cube = working_cube(src, face);
+        count(&opts, cost::working_cube(src, face));
         Prefilterer {
             cube,
             full: OnceLock::new(),
@@ -192,7 +194,9 @@ impl Prefilterer {
             } else {
                 None
             };
-            (seamless_pyramid(&body), bright)
+            let made = (seamless_pyramid(&body), bright);
+            count(&self.opts, cost::pyramid(self.cube.width()));
+            made
         })
     }
 
@@ -211,12 +215,19 @@ impl Prefilterer {
         if let Some((body, None)) = self.split.get() {
             return body; // nothing was split off: the body is the whole map
         }
-        self.full.get_or_init(|| seamless_pyramid(&self.cube))
+        self.full.get_or_init(|| {
+            let made = seamless_pyramid(&self.cube);
+            count(&self.opts, cost::pyramid(self.cube.width()));
+            made
+        })
     }
 
     fn moments(&self) -> &MomentPyramid {
-        self.moments
-            .get_or_init(|| MomentPyramid::new(self.cube.layers()))
+        self.moments.get_or_init(|| {
+            let made = MomentPyramid::new(self.cube.layers());
+            count(&self.opts, cost::moments(self.cube.width()));
+            made
+        })
     }
 
     fn evaluator(&self, lobe: &Lobe) -> Eval<'_> {
@@ -291,11 +302,7 @@ impl Prefilterer {
 
     /// The map of `lobe` in projection `out` with `w×h` layers.
     pub fn render_extent(&self, lobe: &Lobe, out: Projection, w: u32, h: u32) -> EnvMap {
-        if lobe.is_mirror()
-            && out.kind() == mirrorball_core::ProjectionKind::Cube
-            && w == h
-            && w == self.cube.width()
-        {
+        if is_copy(lobe, &out, w, h, self.cube.width()) {
             // A mirror at the working cube's own resolution: the cube itself.
             let layers = self
                 .cube
@@ -303,12 +310,11 @@ impl Prefilterer {
                 .iter()
                 .map(|l| l.with_channels(self.channels))
                 .collect();
-            if let Some(p) = &self.opts.progress {
-                p.fetch_add(6 * h as u64, Ordering::Relaxed);
-            }
+            count(&self.opts, 6 * cost::COPY * w as u64 * h as u64);
             return EnvMap::new(out, layers).expect("a cube");
         }
         let e = self.evaluator(lobe);
+        let row_cost = w as u64 * cost::texel(lobe, &self.opts);
         let c = self.channels;
         let layers = out.layer_count();
         let (wu, hu) = (w as usize, h as usize);
@@ -346,9 +352,7 @@ impl Prefilterer {
                         o[3] = 1.0;
                     }
                 }
-                if let Some(p) = &self.opts.progress {
-                    p.fetch_add(1, Ordering::Relaxed);
-                }
+                count(&self.opts, row_cost);
             },
         );
         let images: Vec<Image> = buf
@@ -379,13 +383,132 @@ fn chain_outputs(lobes: &[Lobe], out: Projection, size: u32) -> Vec<(Lobe, Proje
         .collect()
 }
 
-/// Rows a [`Prefilterer::render_chain`] call will report through
-/// [`PrefilterOptions::progress`].
-pub fn chain_rows(out: &Projection, size: u32, levels: usize) -> u64 {
-    let (_, h0) = out.layer_extent(size.max(1));
-    (0..levels)
-        .map(|i| (h0 >> i).max(1) as u64 * out.layer_count() as u64)
-        .sum()
+/// Whether rendering `lobe` into `out` at `w`×`h` is the working cube (of face `face`)
+/// itself: a mirror cube at its resolution.
+fn is_copy(lobe: &Lobe, out: &Projection, w: u32, h: u32, face: u32) -> bool {
+    lobe.is_mirror() && out.kind() == mirrorball_core::ProjectionKind::Cube && w == h && w == face
+}
+
+/// Adds `units` of work done to the options' progress counter, if any.
+fn count(opts: &PrefilterOptions, units: u64) {
+    if let Some(p) = &opts.progress {
+        p.fetch_add(units, Ordering::Relaxed);
+    }
+}
+
+/// The work of preparing `src` for `outputs` ([`Prefilterer::for_outputs`]) and rendering
+/// each of them ([`Prefilterer::render_extent`]), in the units
+/// [`PrefilterOptions::progress`] counts: the total a progress bar runs to.
+pub fn work(
+    src: &EnvMap,
+    outputs: &[(Lobe, Projection, u32, u32)],
+    opts: &PrefilterOptions,
+) -> u64 {
+    let need = outputs
+        .iter()
+        .map(|(lobe, out, w, h)| needed_face(lobe, out, *w, *h))
+        .max();
+    let face = working_face(src, opts.cube_size, need, opts.max_cube_size);
+    let uses = |f: &dyn Fn(&Lobe) -> bool| outputs.iter().any(|(l, ..)| f(l));
+    let fis = |l: &Lobe| !l.is_mirror() && *l != Lobe::Lambert;
+    let mut units = cost::working_cube(src, face);
+    if uses(&fis) {
+        units += cost::pyramid(face);
+    }
+    if outputs
+        .iter()
+        .any(|(l, o, w, h)| l.is_mirror() && !is_copy(l, o, *w, *h, face))
+    {
+        units += cost::pyramid(face);
+    }
+    if uses(&|l| *l == Lobe::Lambert) {
+        units += cost::moments(face);
+    }
+    for (lobe, out, w, h) in outputs {
+        let texels = *w as u64 * *h as u64 * out.layer_count() as u64;
+        units += texels
+            * match is_copy(lobe, out, *w, *h, face) {
+                true => cost::COPY,
+                false => cost::texel(lobe, opts),
+            };
+    }
+    units
+}
+
+/// The work of resampling `src` into a cube of face `face` (as the working cube is made),
+/// in [`work`]'s units: for whoever makes such a cube beside the prefilter (a bake's sky).
+pub fn cube_work(src: &EnvMap, face: u32) -> u64 {
+    cost::working_cube(src, face)
+}
+
+/// [`work`] for a chain ([`Prefilterer::for_chain`] and
+/// [`Prefilterer::render_chain`]): `lobes[i]` at level `i`.
+pub fn chain_work(
+    src: &EnvMap,
+    lobes: &[Lobe],
+    out: Projection,
+    size: u32,
+    opts: &PrefilterOptions,
+) -> u64 {
+    work(src, &chain_outputs(lobes, out, size), opts)
+}
+
+/// What each step of prefiltering costs, in units of about a nanosecond of one core
+/// (measured on the release build: `cargo run --release -p mirrorball-filter --example
+/// costs`), so that a progress bar fed by [`PrefilterOptions::progress`] moves at an even
+/// pace and its time left holds from the start. Only the ratios matter.
+mod cost {
+    use super::{sample_count, Lobe, PrefilterOptions};
+    use mirrorball_core::EnvMap;
+
+    /// A working cube texel copied into a mirror output.
+    pub const COPY: u64 = 1;
+    /// A mirror lookup (one trilinear fetch of the pyramid).
+    const MIRROR: u64 = 40;
+    /// One importance sample of a glossy lobe (a pyramid fetch and its weight).
+    const SAMPLE: u64 = 25;
+    /// The point sources' walk per glossy output texel.
+    const BRIGHT: u64 = 600;
+    /// An irradiance texel from the moment hierarchy.
+    const LAMBERT: u64 = 2500;
+    /// Resampling per source texel read and per working cube texel made.
+    const RESAMPLE_SRC: u64 = 20;
+    const RESAMPLE_OUT: u64 = 120;
+    /// A pyramid (with the bright split) per working cube texel.
+    const PYRAMID: u64 = 60;
+    /// The moment hierarchy per working cube texel.
+    const MOMENTS: u64 = 200;
+
+    fn cube_texels(face: u32) -> u64 {
+        6 * face as u64 * face as u64
+    }
+
+    /// Making the working cube of face `face` from `src`.
+    pub fn working_cube(src: &EnvMap, face: u32) -> u64 {
+        let src_texels = src.width() as u64 * src.height() as u64 * src.layers().len() as u64;
+        src_texels * RESAMPLE_SRC + cube_texels(face) * RESAMPLE_OUT
+    }
+
+    /// A pyramid of the working cube of face `face`.
+    pub fn pyramid(face: u32) -> u64 {
+        cube_texels(face) * PYRAMID
+    }
+
+    /// The moment hierarchy of the working cube of face `face`.
+    pub fn moments(face: u32) -> u64 {
+        cube_texels(face) * MOMENTS
+    }
+
+    /// One output texel of `lobe`.
+    pub fn texel(lobe: &Lobe, opts: &PrefilterOptions) -> u64 {
+        if lobe.is_mirror() {
+            MIRROR
+        } else if *lobe == Lobe::Lambert {
+            LAMBERT
+        } else {
+            sample_count(opts.samples, lobe) as u64 * SAMPLE + BRIGHT
+        }
+    }
 }
 
 /// The lobes of an `levels`-level chain: GGX with `mapping`'s roughness per level; Phong

@@ -151,6 +151,12 @@ pub struct CubeWrite {
     pub metadata: Vec<(String, String)>,
 }
 
+/// The work of supercompressing `bytes` bytes with Zstandard at the levels bakes use (3 by
+/// default), in [`mirrorball_core::work`]'s units: what [`write_ktx2`] counts for it.
+pub fn zstd_work(bytes: u64) -> u64 {
+    bytes * 3
+}
+
 /// Refuses what `write` cannot encode, before any work: everything [`Encoding::check`]
 /// refuses (negative values as unsigned BC6H), in any face of any level.
 pub(crate) fn check_encodable(
@@ -362,7 +368,12 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
         None => Vec::new(),
         Some(z) => (0..level_count)
             .into_par_iter()
-            .map(|p| zstd::bulk::compress(&encode_level(p), z))
+            .map(|p| {
+                let level = encode_level(p);
+                let packed = zstd::bulk::compress(&level, z);
+                mirrorball_core::work::add(zstd_work(level.len() as u64));
+                packed
+            })
             .collect::<Result<_, _>>()
             .map_err(|e| Error::io(path, e))?,
     };

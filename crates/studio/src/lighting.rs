@@ -24,7 +24,7 @@
 
 use mirrorball_core::{EnvMap, ProjectionKind};
 use mirrorball_filter::{
-    chain_lobes, chain_rows, sh, LobeKind, PrefilterOptions, Prefilterer, RoughnessMapping, Sh9,
+    chain_lobes, chain_work, sh, LobeKind, PrefilterOptions, Prefilterer, RoughnessMapping, Sh9,
 };
 use serde_json::json;
 use std::sync::atomic::AtomicU64;
@@ -73,10 +73,12 @@ pub fn request(
     }
 }
 
-/// The number of rows [`prefilter`] reports through `progress` for level-0 edge `size`.
-pub fn rows(size: u32) -> u64 {
+/// The work [`prefilter`] reports through `progress` for `map` at level-0 edge `size`
+/// (`mirrorball_filter::chain_work`'s units).
+pub fn work(map: &EnvMap, size: u32, mapping: &RoughnessMapping) -> u64 {
     let cube = ProjectionKind::Cube.default_projection();
-    chain_rows(&cube, size, levels(size))
+    let lobes = chain_lobes(LobeKind::Ggx, mapping, levels(size));
+    chain_work(map, &lobes, cube, size, &PrefilterOptions::default())
 }
 
 /// The levels of a full chain from edge `size` down to 1.
@@ -85,7 +87,7 @@ pub fn levels(size: u32) -> usize {
 }
 
 /// Prefilters `map` (any projection) to a GGX cube chain of level-0 edge `size` and the
-/// irradiance's SH9, counting finished rows in `progress`.
+/// irradiance's SH9, counting the work done in `progress` ([`work`]).
 pub fn prefilter(
     map: &EnvMap,
     size: u32,

@@ -416,7 +416,8 @@ async fn lighting_of(Shared(app): Shared<AppState>, Query(q): Query<LightingQuer
         );
     }
     p.done.store(0, Ordering::SeqCst);
-    p.total.store(lighting::rows(size), Ordering::SeqCst);
+    p.total
+        .store(lighting::work(&map, size, &mapping), Ordering::SeqCst);
     let done = p.done.clone();
     let work = tokio::task::spawn_blocking(move || {
         let l = lighting::prefilter(&map, size, mapping, done);

@@ -12,7 +12,7 @@ use crate::budget;
 use crate::error::CliError;
 use crate::fit;
 use crate::load;
-use crate::progress::{with_progress, with_spinner};
+use crate::progress::with_work_progress;
 use crate::BakeArgs;
 use mirrorball_core::Choice;
 use plan::{BakePlan, Plan};
@@ -36,8 +36,9 @@ impl From<mirrorball_bake::Error> for CliError {
 }
 
 fn bake(mut plan: BakePlan) -> Result<(), CliError> {
+    let quiet = plan.quiet;
     let say = |s: String| {
-        if !plan.quiet {
+        if !quiet {
             eprintln!("{s}");
         }
     };
@@ -55,21 +56,24 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
         2 * plan.bake.texels(),
         "a smaller --size",
     )?;
+    // One bar over the prefilter and the writing, each weighted by its work (the
+    // prefilter's units and the writers' are the same: about a nanosecond of one core).
+    let work = plan.bake.lighting_work(&env, &plan.prefilter) + plan.bake.write_work();
     let t1 = Instant::now();
-    let mut lighting = with_progress("prefilter", plan.bake.rows(), plan.quiet, |counter| {
+    let (report, written, t2) = with_work_progress("baking", work, quiet, |counter| {
         plan.prefilter.progress = Some(counter);
-        plan.bake.lighting(&env, plan.prefilter.clone())
+        let mut lighting = plan.bake.lighting(&env, plan.prefilter.clone());
+        drop(env);
+        let report = measure(&mut lighting, &plan);
+        let t2 = Instant::now();
+        let written = plan.bake.write_into(&lighting, &plan.dir);
+        (report, written, t2)
     });
-    drop(env);
-    let report = measure(&mut lighting, &plan);
     let dir = format!("{}/", plan.dir.display());
     if let Some(line) = report.line(&dir, &keep_advice(&plan, &report)) {
         say(line);
     }
-    let t2 = Instant::now();
-    let written = with_spinner("writing", plan.quiet, || {
-        plan.bake.write_into(&lighting, &plan.dir)
-    })?;
+    let written = written?;
     let names: Vec<String> = written
         .files
         .iter()

@@ -200,7 +200,7 @@ fn check_memory(plan: &Plan, shape: &Chain, env: &EnvMap) -> Result<(), CliError
     )
 }
 
-/// The chain, with a progress bar in rows. Lambert renders level 0 only: one irradiance
+/// The chain, with a progress bar. Lambert renders level 0 only: one irradiance
 /// map, the further levels its solid-angle-weighted box mips (the irradiance is smooth, and
 /// engines read any level). The working cube is made as fine as the levels rendered need
 /// (no finer than the source), unless --cube-size says otherwise.
@@ -212,14 +212,17 @@ fn prefilter(
     sh9: &sh::Sh9,
 ) -> Vec<EnvMap> {
     let (out, size, levels) = (shape.projection, shape.size, shape.levels);
-    let rendered = if plan.kind == LobeKind::Lambert {
-        1
-    } else {
-        levels
+    // The work the bar runs to, in the prefilterer's units (none for SH irradiance, which
+    // takes no time worth a bar).
+    let work = match (plan.kind, plan.irradiance) {
+        (LobeKind::Lambert, IrradianceMethod::Sh) => 0,
+        (LobeKind::Lambert, IrradianceMethod::Exact) => {
+            mirrorball_filter::chain_work(env, &[Lobe::Lambert], out, size, &plan.opts)
+        }
+        _ => mirrorball_filter::chain_work(env, lobes, out, size, &plan.opts),
     };
-    let rows = mirrorball_filter::chain_rows(&out, size, rendered);
     let quiet = plan.quiet;
-    with_progress("prefilter", rows, quiet, |counter| {
+    with_progress("prefilter", work, quiet, |counter| {
         plan.opts.progress = Some(counter);
         let opts = plan.opts.clone();
         match (plan.kind, plan.irradiance) {
