@@ -128,20 +128,26 @@ mod tests {
         let l = pictures(Format::Exr, "a latlong .exr", |s| (s as u64, s as u64 / 2));
         assert_eq!(l.max, 23170, "{l:?}");
         assert!(l.why.contains("268435456"), "{}", l.why);
-        // A JPEG's sides are 16-bit: an hstrip of faces 10923 is 65538 wide.
-        let j = pictures(Format::Jpeg, "a cube .jpg", |s| (6 * s as u64, s as u64));
-        assert_eq!(j.max, 10922, "{j:?}");
-        for v in [-5i64, 0, 10923] {
+        // A JPEG's sides are 16-bit: a thin strip twice as wide as the size is 65536 wide
+        // at 32768, long before its texels reach the reader's bound (an hstrip cube of
+        // 6688² faces reaches that bound first).
+        let c = pictures(Format::Jpeg, "a cube .jpg", |s| (6 * s as u64, s as u64));
+        assert_eq!(c.max, 6688, "{c:?}");
+        let j = pictures(Format::Jpeg, "a strip .jpg", |s| {
+            (2 * s as u64, s as u64 / 16)
+        });
+        assert_eq!(j.max, 32767, "{j:?}");
+        for v in [-5i64, 0, 32768] {
             let e = j.check("--size", v).unwrap_err();
             assert_eq!(e.fault, mirrorball_core::Fault::Request);
             assert!(
                 e.message
-                    == format!("--size {v}: outside 1..=10922 (a cube .jpg: a JPEG's sides are 16-bit, at most 65535 texels a side)"),
+                    == format!("--size {v}: outside 1..=32767 (a strip .jpg: a JPEG's sides are 16-bit, at most 65535 texels a side)"),
                 "{}",
                 e.message
             );
         }
-        assert_eq!(j.check("--size", 10922).unwrap(), 10922);
+        assert_eq!(j.check("--size", 32767).unwrap(), 32767);
         assert!(parse("12x").unwrap_err().contains("whole number"));
         assert_eq!(parse("-5"), Ok(-5));
     }

@@ -79,25 +79,28 @@ fn open_failure(path: &Path) -> (Fault, Option<String>) {
 /// assert_eq!(err.to_string(), "no/such/mesh.obj: no such file");
 /// ```
 pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
-    // Missing, a directory or empty: said so before a parser sees it.
-    if let Some((fault, problem)) = mirrorball_core::input_file_problem(&std::fs::metadata(path)) {
-        return Err(MeshError::new(path, fault, problem));
-    }
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
+    // A format no reader takes is the request's fault, whatever the file; then missing, a
+    // directory or empty: said so before a parser sees it.
+    if !matches!(ext.as_str(), "glb" | "gltf" | "obj") {
+        return Err(MeshError::new(
+            path,
+            Fault::Request,
+            "unknown mesh format (known: .glb .gltf .obj)",
+        ));
+    }
+    if let Some((fault, problem)) = mirrorball_core::input_file_problem(&std::fs::metadata(path)) {
+        return Err(MeshError::new(path, fault, problem));
+    }
     // The parsers are other crates': a panic on malformed data (gltf-json 1.4 indexes the
     // accessors with a POSITION attribute's index before checking it) becomes an error.
     let parse = || match ext.as_str() {
         "glb" | "gltf" => load_gltf(path),
-        "obj" => load_obj(path),
-        _ => Err(MeshError::new(
-            path,
-            Fault::Request,
-            "unknown mesh format (known: .glb .gltf .obj)",
-        )),
+        _ => load_obj(path),
     };
     let mesh =
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse)).unwrap_or_else(|_| {

@@ -106,7 +106,18 @@ fn the_files_of_a_bake_land_together_or_not_at_all() {
     assert!(bake.write(&lighting, &inner).is_err());
     assert_eq!(std::fs::read_dir(&inner).unwrap().count(), 1);
     assert!(bake.write(&lighting, &fresh).is_ok());
-    assert_eq!(std::fs::read_dir(&fresh).unwrap().count(), 4);
+    let mut made: Vec<String> = std::fs::read_dir(&fresh)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    made.sort();
+    let mut want = bake.file_names();
+    want.push(mirrorball_io::RECORD.to_string());
+    want.sort();
+    assert_eq!(
+        made, want,
+        "the engine's files, README.md and the folder's record"
+    );
 }
 
 #[test]

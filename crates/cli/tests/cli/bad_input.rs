@@ -245,7 +245,10 @@ fn dual_fisheye_bad_lenses() {
     let out = dir.path().join("a.exr");
     let o = out.to_str().unwrap();
     for (spec, says) in [
-        ("dfisheye:fov=400", &["fov=400", "over 360"][..]),
+        (
+            "dfisheye:fov=400",
+            &["fov=400", "must be in (0°, 360°]"][..],
+        ),
         ("dfisheye:back-fov=0", &["back lens", "fov=0"]),
         ("dfisheye:fov=nan", &["'nan' is not a number"]),
         (

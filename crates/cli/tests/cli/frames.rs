@@ -3,7 +3,7 @@
 //! with the same frames as PNG files; manifests and shards run every job once, skip what
 //! is done and resume; bad requests are refused before anything is written.
 
-use crate::util::{asset, files, run, stderr, stdout};
+use crate::util::{asset, files, outputs, run, stderr, stdout};
 use mirrorball_io::{read, Limits};
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -78,7 +78,7 @@ fn a_sequence_is_each_frame_converted_alone() {
     let lines = json_lines(&log);
     assert_eq!(lines.len(), 3, "{log}");
     assert!(lines.iter().all(|l| l["status"] == "done"));
-    assert_eq!(files(&o), ["c_000.exr", "c_001.exr", "c_002.exr"]);
+    assert_eq!(outputs(&o), ["c_000.exr", "c_001.exr", "c_002.exr"]);
     for k in 0..3 {
         let single = d.path().join(format!("single_{k}.exr"));
         ok(&[
@@ -153,7 +153,7 @@ fn globs_and_shards_cover_every_frame_once() {
         );
     }
     assert_eq!(seen, [0, 1, 2, 3, 4]);
-    assert_eq!(files(&o), ["0.exr", "1.exr", "2.exr", "3.exr", "4.exr"]);
+    assert_eq!(outputs(&o), ["0.exr", "1.exr", "2.exr", "3.exr", "4.exr"]);
 }
 
 #[test]
@@ -189,7 +189,7 @@ fn an_interrupted_sequence_leaves_whole_frames_and_resumes() {
     };
     let mut child = Command::new(bin()).args(args(&[])).spawn().unwrap();
     let t0 = std::time::Instant::now();
-    while files(&o).iter().filter(|f| !f.starts_with('.')).count() < 2 {
+    while outputs(&o).iter().filter(|f| !f.starts_with('.')).count() < 2 {
         assert!(t0.elapsed().as_secs() < 120, "no frame written");
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
@@ -198,7 +198,7 @@ fn an_interrupted_sequence_leaves_whole_frames_and_resumes() {
         .status();
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130), "exits as interrupted");
-    let left = files(&o);
+    let left = outputs(&o);
     assert!(
         left.iter().all(|f| !f.starts_with('.')),
         "temporary files left: {left:?}"
@@ -220,7 +220,7 @@ fn an_interrupted_sequence_leaves_whole_frames_and_resumes() {
     let skipped = lines.iter().filter(|l| l["status"] == "skipped").count();
     assert_eq!(skipped, left.len());
     assert_eq!(lines.len(), 40);
-    assert_eq!(files(&o).len(), 40);
+    assert_eq!(outputs(&o).len(), 40);
 }
 
 /// Runs `producer | mirrorball args | consumer` and returns mirrorball's output.
@@ -601,7 +601,7 @@ fn bad_frames_requests_are_refused_and_nothing_is_written() {
         let out = run(&a);
         assert_eq!(out.status.code(), Some(code), "{a:?}: {}", stderr(&out));
         assert!(stderr(&out).contains(says), "{a:?}: {}", stderr(&out));
-        assert!(files(&o).is_empty(), "{a:?} wrote {:?}", files(&o));
+        assert!(outputs(&o).is_empty(), "{a:?} wrote {:?}", outputs(&o));
     }
     // A pipe that ends inside a frame: the frames before it are whole, then the error.
     let frame = 32 * 16 * 3;
@@ -636,7 +636,7 @@ fn bad_frames_requests_are_refused_and_nothing_is_written() {
         "{}",
         stderr(&out)
     );
-    assert_eq!(files(&o), ["0.exr", "1.exr"]);
+    assert_eq!(outputs(&o), ["0.exr", "1.exr"]);
 }
 
 #[test]
@@ -754,4 +754,71 @@ fn manifests_run_each_job_once_across_shards_skip_and_report() {
         "{}",
         stderr(&o)
     );
+}
+
+#[test]
+fn a_rerun_skips_only_what_the_same_settings_made() {
+    let d = tempfile::tempdir().unwrap();
+    let (i, o) = (d.path().join("in"), d.path().join("out"));
+    std::fs::create_dir_all(&i).unwrap();
+    frames(&i, 3, 64);
+    let pat_in = i.join("f_%04d.exr");
+    let pat_out = o.join("c_%03d.exr");
+    let convert = |size: &str| {
+        ok(&[
+            "convert",
+            pat_in.to_str().unwrap(),
+            pat_out.to_str().unwrap(),
+            "--to",
+            "cube",
+            "--size",
+            size,
+            "--json",
+        ])
+    };
+    let statuses = |log: &str| -> Vec<String> {
+        json_lines(log)
+            .iter()
+            .map(|l| l["status"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let height = |k: u32| {
+        read(&o.join(format!("c_{k:03}.exr")), &Limits::default())
+            .unwrap()
+            .layers[0]
+            .height()
+    };
+    // The output folder is made; the same request again skips every frame.
+    let (log, _) = convert("16");
+    assert_eq!(statuses(&log), ["done"; 3]);
+    let h16 = height(0);
+    let (log, err) = convert("16");
+    assert_eq!(statuses(&log), ["skipped"; 3]);
+    assert!(
+        err.contains("3 frames skipped: their outputs exist, made with these settings"),
+        "{err}"
+    );
+    // Other settings: every frame again, and said so.
+    let (log, err) = convert("8");
+    assert_eq!(statuses(&log), ["done"; 3], "{err}");
+    assert!(err.contains("3 frames converted again"), "{err}");
+    assert_eq!(height(0), h16 / 2, "made again at the new size");
+    // A newer input frame: that frame alone again.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let one = i.join("f_0001.exr");
+    let bytes = std::fs::read(&one).unwrap();
+    std::fs::write(&one, bytes).unwrap();
+    let (log, err) = convert("8");
+    assert_eq!(statuses(&log), ["skipped", "done", "skipped"], "{err}");
+    assert!(err.contains("1 frame converted again"), "{err}");
+    // An output no record speaks for (another tool's, or an older mirrorball's) is kept,
+    // and said.
+    std::fs::remove_file(o.join(".mirrorball-frames")).unwrap();
+    let (log, err) = convert("16");
+    assert_eq!(statuses(&log), ["skipped"; 3]);
+    assert!(
+        err.contains("3 frames skipped: their outputs exist, with no record of the settings"),
+        "{err}"
+    );
+    assert_eq!(height(2), h16 / 2, "kept");
 }

@@ -199,6 +199,12 @@ fn target(case: Case, args: &[&str]) -> Option<(String, String, &'static str)> {
         Case::MissingInReadOnly if makes_folders => {
             ("ro/new".into(), "ro/new".into(), "permission denied")
         }
+        // A sequence makes its output folder, not the folders above it.
+        Case::MissingInReadOnly if o.contains('%') => (
+            "ro/new/out".into(),
+            "ro/new".into(),
+            "cannot make the folder",
+        ),
         Case::MissingInReadOnly => ("ro/new/out".into(), "ro/new".into(), "does not exist"),
         // Where bake's README.md, demo's and analyze's page go is a folder.
         Case::Folder if args[0] == "bake" => (

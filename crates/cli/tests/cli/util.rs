@@ -36,6 +36,15 @@ pub fn ok(args: &[&str]) -> String {
 
 /// Files in `dir` and its folders (a folder listed as `name/`, then its files as
 /// `name/file`), sorted (to check nothing half-written is left).
+/// [`files`] less the record a sequence keeps of how it made each output
+/// (`.mirrorball-frames`): what the user would call the outputs.
+pub fn outputs(dir: &Path) -> Vec<String> {
+    files(dir)
+        .into_iter()
+        .filter(|f| !f.ends_with(".mirrorball-frames"))
+        .collect()
+}
+
 pub fn files(dir: &Path) -> Vec<String> {
     fn walk(dir: &Path, prefix: &str, v: &mut Vec<String>) {
         for e in std::fs::read_dir(dir).unwrap() {

@@ -407,7 +407,7 @@ fn exr_uncompressed_files_are_byte_for_byte_what_the_exr_crate_writes() {
 }
 
 #[test]
-fn exr_half_clamps_to_the_largest_half_and_float_keeps_values() {
+fn exr_half_clamps_finite_values_to_the_largest_half_and_float_keeps_values() {
     let dir = tempfile::tempdir().unwrap();
     let mut img = Image::new(2, 1, 3);
     img.set(0, 0, &[1.0e6, -1.0e6, 70000.0]);
@@ -416,7 +416,9 @@ fn exr_half_clamps_to_the_largest_half_and_float_keeps_values() {
     write_image(&path, &img, &WriteOptions::default()).unwrap();
     let (back, _) = read_one(&path);
     assert_eq!(back.get(0, 0), &[65504.0, -65504.0, 65504.0]);
-    assert_eq!(back.get(1, 0), &[half(1.0e-3), 65504.0, 0.5]);
+    // Half holds infinities: they stay (the caller decides whether one reaches a writer:
+    // the CLI sets them to 0 unless --keep-invalid).
+    assert_eq!(back.get(1, 0), &[half(1.0e-3), f32::INFINITY, 0.5]);
 
     write_image(&path, &img, &opts(Some(Precision::Float))).unwrap();
     let (back, _) = read_one(&path);
@@ -1443,10 +1445,11 @@ fn exr_zip_blocks_agree_with_the_exr_crate_both_ways() {
                     let values: Vec<f32> = ch.sample_data.values_as_f32().collect();
                     assert_eq!(values.len(), 37 * 45);
                     for (i, v) in values.iter().enumerate() {
-                        // What was written, as half where half was asked for (clamped to
-                        // the largest half, as mirrorball writes it).
+                        // What was written, as half where half was asked for (finite
+                        // values clamped to the largest half, as mirrorball writes them;
+                        // infinities, which half holds, kept).
                         let a = img.data()[i * c + k];
-                        let want = if precision == Precision::Half {
+                        let want = if precision == Precision::Half && a.is_finite() {
                             half(a.clamp(-65504.0, 65504.0))
                         } else {
                             a

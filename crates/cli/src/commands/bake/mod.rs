@@ -100,8 +100,8 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
             .map(|p| p.display().to_string())
             .collect();
         say(format!(
-            "removed {} file(s) of the earlier bake in {} that this one does not write: {}",
-            gone.len(),
+            "removed {} of the earlier bake in {} that this one does not write: {}",
+            mirrorball_core::count(gone.len() as u64, "file"),
             plan.dir.display(),
             gone.join(", ")
         ));

@@ -110,7 +110,7 @@ impl Plan {
         check_dir(&dir)?;
         let mut files = Files::new();
         files
-            .making(mirrorball_io::Folders::MakeOne)
+            .making(mirrorball_io::Folders::MakeAll)
             .input_arg("the input", source);
         for name in bake.file_names() {
             let path = dir.join(&name);
@@ -147,11 +147,21 @@ impl Plan {
 
 /// The output folder: a folder or nothing yet (that it can be made, in a folder that
 /// exists and can be written, is checked with its files: `guard::Files`).
+/// Bake makes OUT-DIR and the folders inside it its files need (three's `cube/`), not the
+/// folders above it: OUT-DIR's parent must exist.
 fn check_dir(dir: &Path) -> Result<(), CliError> {
     if dir.exists() && !dir.is_dir() {
         return Err(CliError::request(format!(
             "{}: OUT-DIR is a file; bake writes a folder of files (give a folder's name)",
             dir.display()
+        )));
+    }
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(p) = parent.filter(|p| !dir.exists() && !p.is_dir()) {
+        return Err(CliError::request(format!(
+            "{}: the folder {} does not exist (bake makes OUT-DIR, not the folders above it)",
+            dir.display(),
+            p.display()
         )));
     }
     Ok(())

@@ -819,7 +819,8 @@ fn convert_frames(
     let secs = t1.elapsed().as_secs_f64();
     if !a.quiet {
         eprintln!(
-            "{n} frame(s) to {} {w}x{h}{} in {secs:.2}s ({:.2} frames/s; planned in {:.2}s){}",
+            "{} to {} {w}x{h}{} in {secs:.2}s ({:.2} frames/s; planned in {:.2}s){}",
+            mirrorball_core::count(n, "frame"),
             dst.name(),
             times(dst.layer_count()),
             n as f64 / secs.max(1e-9),

@@ -154,8 +154,12 @@ impl<'a> Scene<'a> {
                 format!("{name}: cannot read the scene file: {why}{hint}"),
             )
         };
-        // Missing, a directory or empty: said so, as every input file is.
-        mirrorball_io::Error::check_input(path).map_err(|e| cannot(e.fault(), &e.problem()))?;
+        // Missing or a directory: said so, as every input file is. An empty file is a
+        // scene that says nothing, and what it lacks is said once it is planned.
+        let empty = std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.len() == 0);
+        if !empty {
+            mirrorball_io::Error::check_input(path).map_err(|e| cannot(e.fault(), &e.problem()))?;
+        }
         let text = std::fs::read_to_string(path).map_err(|e| cannot(Fault::of_io(e.kind()), &e))?;
         let file: SceneFile = if is_toml(path) {
             toml::from_str(&text)
@@ -310,6 +314,14 @@ impl<'a> Scene<'a> {
                 side.check(&format!("camera.{key}"), n as i64)
                     .map_err(|e| self.error(e.message))?;
             }
+        }
+        let most = mirrorball_io::Limits::default().max_texels;
+        let pixels = camera.width as u64 * camera.height as u64;
+        if pixels > most {
+            return Err(self.error(format!(
+                "camera.width {} × camera.height {}: {pixels} pixels, more than the {most} a picture mirrorball reads back may have",
+                camera.width, camera.height
+            )));
         }
         camera
             .validate()
