@@ -450,7 +450,10 @@ fn a_bake_for_another_engine_removes_the_earlier_bakes_files_and_no_other() {
         own.sort();
         assert_eq!(listed, own, "{engine}");
         if let Some(b) = before {
-            let opts = BakeOptions::default();
+            let opts = BakeOptions {
+                size: 16,
+                ..Default::default()
+            };
             let stale: Vec<String> = b
                 .file_names(&opts)
                 .into_iter()

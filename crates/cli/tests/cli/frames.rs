@@ -115,6 +115,8 @@ fn a_sequence_is_each_frame_converted_alone() {
         "cube",
         "--size",
         "32",
+        "--precision",
+        "float",
         "--json",
     ];
     let status: Vec<String> = json_lines(&ok(&args).0)
@@ -776,11 +778,19 @@ fn a_rerun_skips_only_what_the_same_settings_made() {
             "--json",
         ])
     };
+    // Each frame's status, in frame order (skipped frames are logged first).
     let statuses = |log: &str| -> Vec<String> {
-        json_lines(log)
+        let mut lines: Vec<(u64, String)> = json_lines(log)
             .iter()
-            .map(|l| l["status"].as_str().unwrap().to_string())
-            .collect()
+            .map(|l| {
+                (
+                    l["frame"].as_u64().unwrap(),
+                    l["status"].as_str().unwrap().to_string(),
+                )
+            })
+            .collect();
+        lines.sort();
+        lines.into_iter().map(|(_, s)| s).collect()
     };
     let height = |k: u32| {
         read(&o.join(format!("c_{k:03}.exr")), &Limits::default())

@@ -56,8 +56,14 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
     let t2 = Instant::now();
     let (mut written, report) = outputs::write_chain(&plan, &chain)?;
     outputs::record_side_files(&plan.side_files())?;
+    // Float holds the values; else the source's highlights are tamed first, under the
+    // container's largest value (the energy that removes is reported).
     let keep: Vec<String> = crate::fit::precision_advice(report.storage)
         .into_iter()
+        .chain([format!(
+            "--compress soft:{}",
+            report.storage.range().least_max()
+        )])
         .collect();
     if let Some(line) = report.line(&plan.output, &keep) {
         say(&plan, line);

@@ -96,6 +96,14 @@ impl Plan {
             opts,
             quiet: a.quiet,
         };
+        // The name given is where the chain goes, even when each level is a file of its
+        // own beside it: a folder there is a mistake, said before any work.
+        if Path::new(&a.output).is_dir() {
+            return Err(CliError::request(format!(
+                "{}: is a folder; give a file name (the levels are written beside it as NAME_mipN)",
+                a.output
+            )));
+        }
         let plan = plan.with_side_outputs(a)?;
         plan.files()?.check()?;
         if let Some(size) = plan.size {
