@@ -14,6 +14,9 @@ use std::path::{Path, PathBuf};
 pub struct Files {
     inputs: Vec<(String, PathBuf)>,
     outputs: Vec<(String, PathBuf)>,
+    /// Output names as given, from which the files written are named (prefilter's levels,
+    /// a turntable's frames): none may be a folder.
+    names: Vec<(String, PathBuf)>,
     /// Which folders of the outputs the command makes.
     folders: Folders,
 }
@@ -51,6 +54,13 @@ impl Files {
         self
     }
 
+    /// An output's name as given, when the files written are named from it (`NAME_mip0.exr`,
+    /// `NAME-0000.png`): a folder of that name is refused as a file's would be.
+    pub fn named(&mut self, what: &str, path: impl Into<PathBuf>) -> &mut Files {
+        self.names.push((what.to_string(), path.into()));
+        self
+    }
+
     /// The command makes the outputs' folders as `folders` says (by default none: each
     /// must exist).
     pub fn making(&mut self, folders: Folders) -> &mut Files {
@@ -68,6 +78,12 @@ impl Files {
     /// Refuses an output whose name is a folder, whose folder is missing (beyond what the
     /// command makes) or cannot be written: the message names the output.
     pub fn writable(&self) -> Result<(), CliError> {
+        if let Some((what, name)) = self.names.iter().find(|(_, p)| p.is_dir()) {
+            return Err(CliError::request(format!(
+                "{what} {}: is a folder; give a file name (the files are named from it)",
+                name.display()
+            )));
+        }
         let mut seen = std::collections::HashSet::new();
         for (what, out) in &self.outputs {
             // Each folder once: a chain of levels or faces shares one.

@@ -590,3 +590,74 @@ fn flags_on_the_command_line_win_over_the_scene_file() {
         "{e}"
     );
 }
+
+/// The README's render examples run as written, from the repository's root, each writing
+/// its picture; the trio's is the figure beside it (`docs/img/render-materials.png`).
+#[test]
+fn the_readmes_render_examples_make_the_pictures_beside_them() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let section = readme
+        .split("## Rendering")
+        .nth(1)
+        .and_then(|s| s.split("```sh").nth(1))
+        .and_then(|s| s.split("```").next())
+        .expect("the README's render block");
+    let dir = tempfile::tempdir().unwrap();
+    let mut made = std::collections::HashMap::new();
+    for line in section
+        .lines()
+        .filter(|l| l.starts_with("mirrorball render"))
+    {
+        let command = line.split("  #").next().unwrap();
+        let mut args: Vec<String> = command
+            .split_whitespace()
+            .skip(1)
+            .map(String::from)
+            .collect();
+        let at = args.iter().position(|a| a == "-o").expect("-o") + 1;
+        let name = args[at].clone();
+        let out = dir.path().join(&name);
+        args[at] = out.display().to_string();
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_mirrorball"))
+            .args(&args)
+            .current_dir(&root)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{line}: {}", stderr(&o));
+        assert!(out.exists(), "{line}: no {name}");
+        made.insert(name, out);
+    }
+    assert_eq!(made.len(), 5, "{made:?}");
+    // Pictures as 8-bit sRGB codes, compared: the share of channels more than 2 codes
+    // apart, and the mean difference.
+    let codes = |p: &Path| mirrorball_io::read(p, &Default::default()).unwrap().layers[0].clone();
+    let compare = |ours: &mirrorball_core::Image, fig: &mirrorball_core::Image, x0: u32| {
+        let (mut far, mut sum, mut n) = (0u64, 0f64, 0u64);
+        for y in 0..ours.height() {
+            for x in 0..ours.width() {
+                let (a, b) = (ours.get(x, y), fig.get(x0 + x, y));
+                for c in 0..3 {
+                    let code =
+                        |v: f32| (mirrorball_core::color::linear_to_srgb(v as f64) * 255.0).round();
+                    let d = (code(a[c]) - code(b[c])).abs();
+                    far += u64::from(d > 2.0);
+                    sum += d as f64;
+                    n += 1;
+                }
+            }
+        }
+        (far as f64 / n as f64, sum / n as f64)
+    };
+    let trio = codes(&made["trio.png"]);
+    let figure = codes(&root.join("docs/img/render-materials.png"));
+    assert_eq!(
+        (trio.width(), trio.height()),
+        (figure.width(), figure.height())
+    );
+    let (far, mean) = compare(&trio, &figure, 0);
+    assert!(
+        far < 0.01 && mean < 0.5,
+        "trio: {far} of channels over 2 codes apart, mean {mean}"
+    );
+}

@@ -96,14 +96,6 @@ impl Plan {
             opts,
             quiet: a.quiet,
         };
-        // The name given is where the chain goes, even when each level is a file of its
-        // own beside it: a folder there is a mistake, said before any work.
-        if Path::new(&a.output).is_dir() {
-            return Err(CliError::request(format!(
-                "{}: is a folder; give a file name (the levels are written beside it as NAME_mipN)",
-                a.output
-            )));
-        }
         let plan = plan.with_side_outputs(a)?;
         plan.files()?.check()?;
         if let Some(size) = plan.size {
@@ -190,6 +182,7 @@ impl Plan {
         if self.format.is_cube_container() {
             files.output("the output", &self.output);
         } else {
+            files.named("the output", &self.output);
             let layers = self
                 .to
                 .build(None)

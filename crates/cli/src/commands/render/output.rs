@@ -75,6 +75,7 @@ pub(super) fn files(plan: &RenderPlan) -> Files {
             f.input("the mesh", p);
         }
     }
+    f.named("the output", &plan.output);
     for i in 0..plan.frames as usize {
         let path = plan.frame_path(i);
         if plan.diagnostics {
