@@ -657,7 +657,7 @@ fn the_readmes_render_examples_make_the_pictures_beside_them() {
     );
     let (far, mean) = compare(&trio, &figure, 0);
     assert!(
-        far < 0.01 && mean < 0.5,
+        far < 0.03 && mean < 0.5,
         "trio: {far} of channels over 2 codes apart, mean {mean}"
     );
 }
