@@ -70,6 +70,7 @@ def main() -> int:
     ap.add_argument("--engines", default="bevy,unity")
     ap.add_argument("--bake-size", default="1024")
     ap.add_argument("--no-build", action="store_true")
+    ap.add_argument("--pace", action="store_true", help="print the bar's pace in each tenth")
     args = ap.parse_args()
     if not args.no_build:
         sh(["cargo", "build", "--release", "-p", "mirrorball-cli"], cwd=REPO)
@@ -88,6 +89,14 @@ def main() -> int:
                 if not rows:
                     print(f"{width:>12} {engine:>7}: no bar recorded", file=sys.stderr)
                     continue
+                if args.pace:
+                    # The bar's pace in each tenth of it, in units a second: even when every
+                    # step is weighted by its cost.
+                    marks = [next((t for t, p, n in rows if p >= k / 10 * n), rows[-1][0])
+                             for k in range(11)]
+                    paces = [(rows[0][2] / 10) / max(b - a, 1e-3) / 1e9
+                             for a, b in zip(marks, marks[1:])]
+                    print("   pace (units/ns) per tenth: " + " ".join(f"{p:.2f}" for p in paces))
                 for share in (0.1, 0.2, 0.5):
                     shown, true = eta_at(rows, share)
                     ratio = shown / true if true > 0 else float("nan")

@@ -488,8 +488,8 @@ pub struct BakeArgs {
     size: i64,
     /// Face edge of the sky background (bevy, three, filament), a power of two; default:
     /// the source's resolution (the edge that keeps its texels per steradian, 16 to 2048).
-    #[arg(long, value_name = "EDGE")]
-    background_size: Option<u32>,
+    #[arg(long, value_name = "EDGE", value_parser = size::parse, allow_hyphen_values = true)]
+    background_size: Option<i64>,
     /// Replace files in OUT-DIR that no mirrorball run wrote (else bake refuses them; the
     /// files of an earlier bake there are replaced, or removed when not written again).
     #[arg(long)]

@@ -80,10 +80,14 @@ impl Plan {
             (None, false) => takes_zstd.then_some(3),
         };
         // A cube face: the GPU containers' limit (what mirrorball_bake::MAX_SIZE is).
-        let size = crate::size::pictures(mirrorball_io::Format::Ktx2, "a baked cube face", |s| {
+        let face = crate::size::pictures(mirrorball_io::Format::Ktx2, "a baked cube face", |s| {
             (s as u64, s as u64)
-        })
-        .check("--size", a.size)?;
+        });
+        let size = face.check("--size", a.size)?;
+        let background_size = a
+            .background_size
+            .map(|b| face.check("--background-size", b))
+            .transpose()?;
         let opts = BakeOptions {
             size,
             encoding,
@@ -91,7 +95,7 @@ impl Plan {
             zstd,
             mapping,
             source: source.clone(),
-            background_size: a.background_size,
+            background_size,
             overwrite: a.overwrite,
         };
         let bake = Bake::new(engine, opts).map_err(|e| CliError::new(e.fault, e.message))?;
