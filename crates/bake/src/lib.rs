@@ -39,7 +39,6 @@ use mirrorball_filter::{Lobe, PrefilterOptions, Prefilterer, RoughnessMapping};
 use mirrorball_io::{CubeWrite, Effort, Encoding};
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
 
 /// Why a bake cannot be done or failed, and whose fault it is.
 #[derive(Debug)]
@@ -284,12 +283,15 @@ impl Lighting {
         let diffuse = spec
             .diffuse_face
             .map(|face| pre.render_extent(&Lobe::Lambert, cube, face, face));
+        // The sky's rows counted as they are made, each its share of the cube's work.
         let background = spec.background_face.map(|face| {
-            let sky = mirrorball_core::resample(env, cube, face, &ResampleOptions::default());
-            if let Some(p) = &progress {
-                p.fetch_add(mirrorball_filter::cube_work(env, face), Ordering::Relaxed);
-            }
-            sky
+            let rows = 6 * face as u64;
+            let opts = ResampleOptions {
+                progress: progress.clone(),
+                progress_unit: mirrorball_filter::cube_work(env, face) / rows,
+                ..ResampleOptions::default()
+            };
+            mirrorball_core::resample(env, cube, face, &opts)
         });
         Lighting {
             specular,

@@ -144,6 +144,9 @@ pub struct ResampleOptions {
     pub max_samples: u32,
     /// Counts finished output rows, for progress bars.
     pub progress: Option<Arc<AtomicU64>>,
+    /// What each finished row adds to [`progress`](Self::progress): 1 (rows) by default;
+    /// a bar that counts work in other units gives a row's cost.
+    pub progress_unit: u64,
 }
 
 impl Default for ResampleOptions {
@@ -153,6 +156,7 @@ impl Default for ResampleOptions {
             exposure: 0.0,
             max_samples: 8,
             progress: None,
+            progress_unit: 1,
         }
     }
 }
@@ -1143,15 +1147,15 @@ impl Job {
         first_row: usize,
         side: Option<&SideColumns>,
         out: &mut [f32],
-        progress: Option<&Arc<AtomicU64>>,
+        progress: Option<(&Arc<AtomicU64>, u64)>,
     ) {
         let w = self.w as usize;
         out.par_chunks_mut(w * C).enumerate().for_each_init(
             || (RowScratch::new(w), PointScratch::new()),
             |(s, ps), (k, row)| {
                 self.row::<C>(pyr, s, ps, layer, first_row + k, side, row);
-                if let Some(p) = progress {
-                    p.fetch_add(1, Ordering::Relaxed);
+                if let Some((p, unit)) = progress {
+                    p.fetch_add(unit, Ordering::Relaxed);
                 }
             },
         );
@@ -1237,6 +1241,7 @@ pub struct Resampler<'a> {
     pyramid: Pyramid<'a>,
     channels: usize,
     progress: Option<Arc<AtomicU64>>,
+    progress_unit: u64,
     /// Each layer's [`SideColumns`], where it has them: made once, not once a band.
     sides: Vec<Option<SideColumns>>,
 }
@@ -1266,6 +1271,7 @@ impl<'a> Resampler<'a> {
             pyramid,
             channels: src.channels(),
             progress: opts.progress.clone(),
+            progress_unit: opts.progress_unit,
             sides,
         }
     }
@@ -1340,7 +1346,8 @@ impl<'a> Resampler<'a> {
             "rows_into: {} samples from row {first_row} are not whole rows of a {w}x{h}x{c} layer",
             out.len()
         );
-        let (progress, side) = (self.progress.as_ref(), self.sides[layer].as_ref());
+        let progress = self.progress.as_ref().map(|p| (p, self.progress_unit));
+        let side = self.sides[layer].as_ref();
         let first = first_row as usize;
         match c {
             3 => self

@@ -158,13 +158,14 @@ impl Encoding {
     }
 
     /// The work of encoding `texels` texels, in [`mirrorball_core::work`]'s units: what
-    /// [`Encoding::encode_with`] adds to its counter (measured with `cargo bench -p
-    /// mirrorball-io --bench encode`, `Effort::Basic` for unsigned BC6H).
+    /// [`Encoding::encode_with`] adds to its counter (`Effort::Basic` for unsigned BC6H;
+    /// fitted with the prefilter's costs to the pace `bench/progress_eta.py --pace`
+    /// measures).
     pub fn work(self, texels: u64) -> u64 {
         let per_texel = match self {
-            Encoding::Bc6hUnsigned => 900,
-            Encoding::Bc6hSigned => 700,
-            _ => 4,
+            Encoding::Bc6hUnsigned => 650,
+            Encoding::Bc6hSigned => 500,
+            _ => 10,
         };
         texels * per_texel
     }

@@ -299,17 +299,27 @@ pub(crate) fn working_face(
 
 /// The prefilterers' working map: a cube of `face²` faces with four channels, `src` itself
 /// when it already is one, otherwise an antialiased conversion.
-pub(crate) fn working_cube(src: &EnvMap, face: u32) -> EnvMap {
+///
+/// `progress`, when given, counts each row resampled with `unit` (the prefilter's bar).
+pub(crate) fn working_cube(
+    src: &EnvMap,
+    face: u32,
+    progress: Option<(std::sync::Arc<std::sync::atomic::AtomicU64>, u64)>,
+) -> EnvMap {
     let is_cube = src.projection().kind() == mirrorball_core::ProjectionKind::Cube;
     if is_cube && src.width() == face {
         return with_four_channels(src.clone());
     }
-    let out = resample(
-        src,
-        Projection::Cube(CubeMap),
-        face,
-        &ResampleOptions::default(),
-    );
+    let (progress, progress_unit) = match progress {
+        Some((p, unit)) => (Some(p), unit),
+        None => (None, 1),
+    };
+    let opts = ResampleOptions {
+        progress,
+        progress_unit,
+        ..ResampleOptions::default()
+    };
+    let out = resample(src, Projection::Cube(CubeMap), face, &opts);
     with_four_channels(out)
 }
 

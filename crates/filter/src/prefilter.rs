@@ -159,8 +159,17 @@ impl Prefilterer {
     }
 
     fn with_face(src: &EnvMap, face: u32, opts: PrefilterOptions) -> Prefilterer {
-        let cube = working_cube(src, face);
-        count(&opts, cost::working_cube(src, face));
+        // Counted row by row as it is resampled; a copy (a cube of the face asked for) at
+        // once.
+        let work = cost::working_cube(src, face);
+        let before = opts.progress.as_ref().map(|p| p.load(Ordering::Relaxed));
+        let rows = 6 * face as u64;
+        let cube = working_cube(src, face, opts.progress.clone().map(|p| (p, work / rows)));
+        if let (Some(p), Some(b)) = (&opts.progress, before) {
+            // What the rows did not count (a copy, and the division's remainder).
+            let counted = p.load(Ordering::Relaxed).saturating_sub(b);
+            count(&opts, work.saturating_sub(counted.min(work)));
+        }
         Prefilterer {
             cube,
             full: OnceLock::new(),
@@ -453,10 +462,10 @@ pub fn chain_work(
     work(src, &chain_outputs(lobes, out, size), opts)
 }
 
-/// What each step of prefiltering costs, in units of about a nanosecond of one core
-/// (measured on the release build: `cargo run --release -p mirrorball-filter --example
-/// costs`), so that a progress bar fed by [`PrefilterOptions::progress`] moves at an even
-/// pace and its time left holds from the start. Only the ratios matter.
+/// What each step of prefiltering costs, in units of about a nanosecond of one core, so
+/// that a progress bar fed by [`PrefilterOptions::progress`] moves at an even pace and its
+/// time left holds from the start. Only the ratios matter: they are fitted to the pace
+/// `bench/progress_eta.py --pace` measures on release bakes of 4K and 8K sources.
 mod cost {
     use super::{sample_count, Lobe, PrefilterOptions};
     use mirrorball_core::EnvMap;
@@ -472,8 +481,8 @@ mod cost {
     /// An irradiance texel from the moment hierarchy.
     const LAMBERT: u64 = 2500;
     /// Resampling per source texel read and per working cube texel made.
-    const RESAMPLE_SRC: u64 = 20;
-    const RESAMPLE_OUT: u64 = 120;
+    const RESAMPLE_SRC: u64 = 40;
+    const RESAMPLE_OUT: u64 = 40;
     /// A pyramid (with the bright split) per working cube texel.
     const PYRAMID: u64 = 60;
     /// The moment hierarchy per working cube texel.

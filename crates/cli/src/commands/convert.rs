@@ -156,6 +156,7 @@ impl Plan {
                 exposure: a.exposure,
                 max_samples: a.max_samples.max(1),
                 progress: None,
+                progress_unit: 1,
             },
             orient,
             in_stereo,
