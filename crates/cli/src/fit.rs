@@ -45,7 +45,7 @@ impl Report {
 
     /// Everything measured as one: counts summed, the largest value.
     pub fn sum(&self) -> Clipped {
-        self.parts.iter().fold(Clipped::default(), |a, &b| a.add(b))
+        self.parts.iter().fold(Clipped::default(), |a, &b| a + b)
     }
 
     /// The measured parts of `other` (another file of the same storage, or the next levels)

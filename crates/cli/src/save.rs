@@ -42,10 +42,13 @@ pub fn default_layout(layers: usize) -> Layout {
     }
 }
 
+/// Whether a container takes a flag.
+type TakesFlag = fn(Format) -> bool;
+
 /// The flags that only some containers take, and which: the one table their refusals are
 /// made from ([`check_flags`]). `--precision` takes its values from
 /// [`Format::precisions`].
-const CONTAINER_FLAGS: &[(&str, fn(Format) -> bool)] = &[
+const CONTAINER_FLAGS: &[(&str, TakesFlag)] = &[
     ("--compression", |f| f == Format::Exr),
     ("--mips", Format::is_cube_container),
     ("--layout", |f| !f.is_cube_container()),

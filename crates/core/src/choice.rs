@@ -119,6 +119,23 @@ macro_rules! choice_traits {
     };
 }
 
+/// `n` and the noun for people, singular for one: `1 level`, `0 levels`, `6 faces`. Every
+/// count a message or a summary line prints goes through it.
+///
+/// ```
+/// use mirrorball_core::count;
+/// assert_eq!(count(1, "level"), "1 level");
+/// assert_eq!(count(9, "level"), "9 levels");
+/// assert_eq!(count(0, "file"), "0 files");
+/// ```
+pub fn count(n: u64, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -151,22 +168,5 @@ mod tests {
         for v in Abc::all() {
             assert_eq!(v.name().parse::<Abc>(), Ok(v));
         }
-    }
-}
-
-/// `n` and the noun for people, singular for one: `1 level`, `0 levels`, `6 faces`. Every
-/// count a message or a summary line prints goes through it.
-///
-/// ```
-/// use mirrorball_core::count;
-/// assert_eq!(count(1, "level"), "1 level");
-/// assert_eq!(count(9, "level"), "9 levels");
-/// assert_eq!(count(0, "file"), "0 files");
-/// ```
-pub fn count(n: u64, noun: &str) -> String {
-    if n == 1 {
-        format!("1 {noun}")
-    } else {
-        format!("{n} {noun}s")
     }
 }

@@ -158,7 +158,7 @@ impl Range {
             .par_chunks(w * c)
             .enumerate()
             .map(|(y, row)| self.measure_row(row, c, y as u32, weight))
-            .reduce(Clipped::default, Clipped::add)
+            .reduce(Clipped::default, std::ops::Add::add)
     }
 
     /// [`Range::measure`] of one row `y`.
@@ -174,8 +174,7 @@ impl Range {
                 continue;
             }
             let (mut energy, mut lost, mut over) = (0.0f64, 0.0f64, false);
-            for k in 0..3 {
-                let v = px[k];
+            for (k, &v) in px.iter().enumerate().take(3) {
                 if !v.is_finite() {
                     m.invalid += 1;
                     continue;
@@ -210,13 +209,13 @@ impl Range {
             .layers()
             .iter()
             .map(|l| self.measure(l, None))
-            .fold(Clipped::default(), Clipped::add);
+            .fold(Clipped::default(), std::ops::Add::add);
         if counted.texels == 0 || self.display {
             return counted;
         }
         (0..env.layers().len())
             .map(|layer| self.measure_layer(env, layer))
-            .fold(Clipped::default(), Clipped::add)
+            .fold(Clipped::default(), std::ops::Add::add)
     }
 
     /// Layer `layer` of `env` measured with its texels' solid angles.
@@ -266,9 +265,10 @@ impl Default for Clipped {
     }
 }
 
-impl Clipped {
-    /// Both measurements together (of one map: parts of it, or its layers).
-    pub fn add(self, o: Clipped) -> Clipped {
+/// Both measurements together (of one map: parts of it, or its layers).
+impl std::ops::Add for Clipped {
+    type Output = Clipped;
+    fn add(self, o: Clipped) -> Clipped {
         Clipped {
             texels: self.texels + o.texels,
             largest: self.largest.max(o.largest),
@@ -279,7 +279,9 @@ impl Clipped {
             invalid: self.invalid + o.invalid,
         }
     }
+}
 
+impl Clipped {
     /// The share of the energy clipping removes, `lost / total`, when it was weighted.
     pub fn share(&self) -> Option<f64> {
         (self.weighted && self.total > 0.0).then(|| self.lost / self.total)

@@ -422,7 +422,7 @@ impl LayerFit {
             m = range.measure(img, self.weighted.then_some(&weight as _));
         }
         match report.parts.first_mut() {
-            Some(p) => *p = p.add(m),
+            Some(p) => *p = *p + m,
             None => report.parts.push(m),
         }
     }

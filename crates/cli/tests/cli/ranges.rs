@@ -425,7 +425,7 @@ fn every_engine_bakes_a_sun_without_infinity_and_says_what_it_clips() {
         let keep = if engine.describe().encodings.contains(&Encoding::Rgba32F) {
             "to keep it: --encoding rgba32f".to_string()
         } else {
-            format!("to keep it: darken the source first (mirrorball convert --exposure -")
+            "to keep it: darken the source first (mirrorball convert --exposure -".to_string()
         };
         assert!(said.contains(&keep), "{engine}: {said}");
         let mut read = 0;

@@ -642,7 +642,7 @@ fn the_readmes_render_examples_make_the_pictures_beside_them() {
                         |v: f32| (mirrorball_core::color::linear_to_srgb(v as f64) * 255.0).round();
                     let d = (code(a[c]) - code(b[c])).abs();
                     far += u64::from(d > 2.0);
-                    sum += d as f64;
+                    sum += d;
                     n += 1;
                 }
             }

@@ -54,8 +54,8 @@ fn check(path: &Path, storage: Storage, layers: &[Image]) {
     // Flat files hold the picture as it was written; cube containers its first face.
     let (got, src) = (&back[0], &layers[0]);
     for x in [5, 6] {
-        for k in 0..3 {
-            let want = src.get(x, x)[k].min(max[k]);
+        for (k, &m) in max.iter().enumerate() {
+            let want = src.get(x, x)[k].min(m);
             let g = got.get(x, x)[k];
             assert!(
                 (g - want).abs() <= want * tol,
