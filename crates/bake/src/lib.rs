@@ -139,6 +139,22 @@ pub struct ChainSpec {
     pub background_face: Option<u32>,
 }
 
+impl ChainSpec {
+    /// Every cube the prefilterer renders: `(lobe, projection, width, height)`.
+    fn outputs(&self) -> Vec<(Lobe, mirrorball_core::Projection, u32, u32)> {
+        let cube = ProjectionKind::Cube.default_projection();
+        let mut outputs: Vec<_> = self
+            .levels
+            .iter()
+            .map(|&(face, roughness)| (Lobe::Ggx { roughness }, cube, face, face))
+            .collect();
+        if let Some(face) = self.diffuse_face {
+            outputs.push((Lobe::Lambert, cube, face, face));
+        }
+        outputs
+    }
+}
+
 /// What an engine takes and how it reads it, for people (`--for list`, the README) and for
 /// the checks of a request: each engine's module says it once.
 #[derive(Clone, Debug)]
@@ -263,16 +279,7 @@ impl Lighting {
             .iter()
             .map(|&(_, roughness)| Lobe::Ggx { roughness })
             .collect();
-        let mut outputs: Vec<(Lobe, mirrorball_core::Projection, u32, u32)> = spec
-            .levels
-            .iter()
-            .zip(&lobes)
-            .map(|(&(face, _), lobe)| (*lobe, cube, face, face))
-            .collect();
-        if let Some(face) = spec.diffuse_face {
-            outputs.push((Lobe::Lambert, cube, face, face));
-        }
-        let pre = Prefilterer::for_outputs(env, &outputs, opts);
+        let pre = Prefilterer::for_outputs(env, &spec.outputs(), opts);
         let specular = spec
             .levels
             .iter()
@@ -537,6 +544,35 @@ impl Bake {
         self.spec.levels.iter().map(|&(f, _)| sq(f)).sum::<u64>()
             + self.spec.diffuse_face.map_or(0, sq)
             + self.spec.background_face.map_or(0, sq)
+    }
+
+    /// Bytes [`lighting`](Self::lighting)`(env, opts)` holds at its peak besides `env` and
+    /// the cubes it makes ([`texels`](Self::texels) of `env`'s channels): the prefilterer
+    /// ([`Prefilterer::memory_for_outputs`]) with the background's conversion, made while
+    /// it is held; or, the prefilterer gone, the copy of the largest cube being turned into
+    /// the engine's axes.
+    pub fn memory(&self, env: &EnvMap, opts: &PrefilterOptions) -> u64 {
+        let cube = ProjectionKind::Cube.default_projection();
+        let working = Prefilterer::memory_for_outputs(env, &self.spec.outputs(), opts);
+        let background = self.spec.background_face.map_or(0, |f| {
+            mirrorball_core::resample_memory(env, cube, (f, f), &ResampleOptions::default())
+        });
+        let turned = match self.engine.orientation().is_identity() {
+            true => 0,
+            false => {
+                let largest = self
+                    .spec
+                    .levels
+                    .iter()
+                    .map(|&(f, _)| f)
+                    .chain(self.spec.diffuse_face)
+                    .chain(self.spec.background_face)
+                    .max()
+                    .unwrap_or(0) as u64;
+                6 * largest * largest * env.channels() as u64 * 4
+            }
+        };
+        (working + background).max(turned)
     }
 
     /// The lighting, prefiltered from `env` (sanitized, checked) and turned into the

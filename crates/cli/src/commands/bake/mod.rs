@@ -46,13 +46,11 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
     plan.bake.check(&env)?;
     plan.bake.fit(&env);
     let size = plan.bake.opts.size;
-    let face = size.clamp(256, 4096) as u64;
-    // The cubes made, and their copy in the engine's axes.
     budget::check_prefilter(
-        &format!("baking a {size}² chain (working cube {face}²)"),
+        &format!("baking a {size}² chain"),
         &env,
-        face,
-        2 * plan.bake.texels(),
+        plan.bake.memory(&env, &plan.prefilter),
+        plan.bake.texels(),
         "a smaller --size",
     )?;
     let t1 = Instant::now();
