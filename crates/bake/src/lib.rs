@@ -546,17 +546,24 @@ impl Bake {
             + self.spec.background_face.map_or(0, sq)
     }
 
-    /// Bytes [`lighting`](Self::lighting)`(env, opts)` holds at its peak besides `env` and
-    /// the cubes it makes ([`texels`](Self::texels) of `env`'s channels): the prefilterer
+    /// Bytes a bake of `env` holds at its peak, `env` included: while
+    /// [`lighting`](Self::lighting)`(env, opts)` works, `env`, the cubes made
+    /// ([`texels`](Self::texels), `env`'s channels) and the prefilterer
     /// ([`Prefilterer::memory_for_outputs`]) with the background's conversion, made while
-    /// it is held; or, the prefilterer gone, the copy of the largest cube being turned into
-    /// the engine's axes.
+    /// it is held, or, the prefilterer gone, the copy of the largest cube being turned into
+    /// the engine's axes; while [`write_into`](Self::write_into) writes (`env` dropped by
+    /// then), the cubes, a copy of one file's cubes for its writer and their encoded texels
+    /// (twice with Zstandard: the level and its compressed copy).
     pub fn memory(&self, env: &EnvMap, opts: &PrefilterOptions) -> u64 {
         let cube = ProjectionKind::Cube.default_projection();
+        let c = env.channels() as u64;
+        let source = env.width() as u64 * env.height() as u64 * env.layers().len() as u64 * c * 4;
+        let made = self.texels() * c * 4;
         let working = Prefilterer::memory_for_outputs(env, &self.spec.outputs(), opts);
         let background = self.spec.background_face.map_or(0, |f| {
             mirrorball_core::resample_memory(env, cube, (f, f), &ResampleOptions::default())
         });
+        let sq = |f: u32| 6 * f as u64 * f as u64;
         let turned = match self.engine.orientation().is_identity() {
             true => 0,
             false => {
@@ -568,11 +575,21 @@ impl Bake {
                     .chain(self.spec.diffuse_face)
                     .chain(self.spec.background_face)
                     .max()
-                    .unwrap_or(0) as u64;
-                6 * largest * largest * env.channels() as u64 * 4
+                    .unwrap_or(0);
+                sq(largest) * c * 4
             }
         };
-        (working + background).max(turned)
+        let making = source + made + (working + background).max(turned);
+        let file = self
+            .spec
+            .levels
+            .iter()
+            .map(|&(f, _)| sq(f))
+            .sum::<u64>()
+            .max(self.spec.background_face.map_or(0, sq));
+        let encoded = file * encoded_bytes(self.opts.encoding.unwrap_or_default());
+        let writing = made + file * c * 4 + encoded * if self.opts.zstd.is_some() { 2 } else { 1 };
+        making.max(writing)
     }
 
     /// The lighting, prefiltered from `env` (sanitized, checked) and turned into the
@@ -797,6 +814,16 @@ pub(crate) fn chain_by(opts: &BakeOptions, mapping: &RoughnessMapping) -> Vec<(u
 /// Each level's faces, as the cube writers take them.
 pub(crate) fn faces(levels: &[EnvMap]) -> Vec<Vec<mirrorball_core::Image>> {
     levels.iter().map(|l| l.layers().to_vec()).collect()
+}
+
+/// Bytes of one texel in `encoding`.
+fn encoded_bytes(encoding: Encoding) -> u64 {
+    match encoding {
+        Encoding::Rgba32F => 16,
+        Encoding::Rgba16F => 8,
+        Encoding::Rgb9E5 | Encoding::B10G11R11 | Encoding::Rgbd | Encoding::Rgbm => 4,
+        Encoding::Bc6hUnsigned | Encoding::Bc6hSigned => 1,
+    }
 }
 
 /// How each cube of a bake is written: its encoding, effort and supercompression, recorded

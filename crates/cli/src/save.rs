@@ -386,8 +386,8 @@ pub fn save_eyes(
 /// Bytes [`save_eyes`] makes besides the maps it writes (`eyes` maps, each of `layers`
 /// layers of `w`×`h` texels of `channels` `f32` channels, in projection `kind`): for a
 /// KTX2/DDS cube, the levels copied for the writer (the mip chain first made when
-/// `opts.mips`); for one file, the packed picture (a cross's empty cells included); for
-/// one file a layer, nothing.
+/// `opts.mips`); for one file, the packed picture (a cross's empty cells included; a pair's
+/// eyes packed and then joined) and the encoder's buffers; for one file a layer, nothing.
 pub fn write_bytes(
     out: &str,
     kind: ProjectionKind,
@@ -412,7 +412,19 @@ pub fn write_bytes(
         _ => output_layout(out, layers, opts),
     };
     let (pw, ph) = layout.extent(layers, w, h);
-    pw as u64 * ph as u64 * eyes as u64 * texel
+    let pictures = pw as u64 * ph as u64 * eyes as u64 * texel;
+    let (jw, jh) = match eyes {
+        1 => (pw, ph),
+        _ => Stereo::SideBySide.extent(pw, ph),
+    };
+    let encoder =
+        mirrorball_io::write_buffer_bytes(Path::new(out), (jw, jh, channels), &opts.write);
+    // A pair's eyes are packed, then joined into one picture: both held at once.
+    encoder
+        + match eyes {
+            1 => pictures,
+            _ => 2 * pictures,
+        }
 }
 
 /// The options for one file a layer of a `projection` map: each file records the projection

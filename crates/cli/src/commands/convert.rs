@@ -516,7 +516,12 @@ fn convert_pair(
         (w, h),
         &plan.resample,
     );
-    budget::check(
+    let eye = budget::f32_texels(texels(w, h, dst.layer_count()), c);
+    let plan_bytes = remap.memory_bytes() as u64;
+    // Converting: the eyes read, the conversion's plan and the output eyes (one more while
+    // an eye is turned into an engine's axes). Writing: the plan, the output eyes and the
+    // pictures packed from them.
+    budget::check_convert(
         &format!(
             "{} {w}x{h}x{}, {}",
             dst.name(),
@@ -527,9 +532,18 @@ fn convert_pair(
             texels(left.width(), left.height(), left.layers().len()) * eyes.len() as u64,
             c,
         ),
-        // Each output eye, and the joined picture.
-        2 * budget::f32_texels(texels(w, h, dst.layer_count()) * out_eyes as u64, c)
-            + remap.memory_bytes() as u64,
+        (
+            plan_bytes + if plan.orient.is_identity() { 0 } else { eye },
+            eye * out_eyes as u64,
+            plan_bytes
+                + save::write_bytes(
+                    &a.output,
+                    dst.kind(),
+                    (w, h, dst.layer_count()),
+                    (out_eyes, c as usize),
+                    &plan.save,
+                ),
+        ),
         "a smaller --size",
     )?;
     let t1 = Instant::now();

@@ -46,11 +46,15 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
     plan.bake.check(&env)?;
     plan.bake.fit(&env);
     let size = plan.bake.opts.size;
-    budget::check_prefilter(
+    let held = budget::f32_texels(
+        env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
+        env.channels() as u64,
+    );
+    let peak = plan.bake.memory(&env, &plan.prefilter);
+    budget::check(
         &format!("baking a {size}² chain"),
-        &env,
-        plan.bake.memory(&env, &plan.prefilter),
-        plan.bake.texels(),
+        held,
+        peak.saturating_sub(held),
         "a smaller --size",
     )?;
     let t1 = Instant::now();
