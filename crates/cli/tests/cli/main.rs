@@ -7,7 +7,6 @@ mod batch_docs;
 mod commands;
 mod frames;
 mod hostile;
-mod memory;
 mod names;
 mod outputs;
 mod prefilter;
