@@ -139,6 +139,22 @@ pub struct ChainSpec {
     pub background_face: Option<u32>,
 }
 
+impl ChainSpec {
+    /// Every cube the prefilterer renders: `(lobe, projection, width, height)`.
+    fn outputs(&self) -> Vec<(Lobe, mirrorball_core::Projection, u32, u32)> {
+        let cube = ProjectionKind::Cube.default_projection();
+        let mut outputs: Vec<_> = self
+            .levels
+            .iter()
+            .map(|&(face, roughness)| (Lobe::Ggx { roughness }, cube, face, face))
+            .collect();
+        if let Some(face) = self.diffuse_face {
+            outputs.push((Lobe::Lambert, cube, face, face));
+        }
+        outputs
+    }
+}
+
 /// What an engine takes and how it reads it, for people (`--for list`, the README) and for
 /// the checks of a request: each engine's module says it once.
 #[derive(Clone, Debug)]
@@ -264,16 +280,7 @@ impl Lighting {
             .iter()
             .map(|&(_, roughness)| Lobe::Ggx { roughness })
             .collect();
-        let mut outputs: Vec<(Lobe, mirrorball_core::Projection, u32, u32)> = spec
-            .levels
-            .iter()
-            .zip(&lobes)
-            .map(|(&(face, _), lobe)| (*lobe, cube, face, face))
-            .collect();
-        if let Some(face) = spec.diffuse_face {
-            outputs.push((Lobe::Lambert, cube, face, face));
-        }
-        let pre = Prefilterer::for_outputs(env, &outputs, opts);
+        let pre = Prefilterer::for_outputs(env, &spec.outputs(), opts);
         let specular = spec
             .levels
             .iter()
@@ -575,6 +582,52 @@ impl Bake {
             + self.spec.background_face.map_or(0, sq)
     }
 
+    /// Bytes a bake of `env` holds at its peak, `env` included: while
+    /// [`lighting`](Self::lighting)`(env, opts)` works, `env`, the cubes made
+    /// ([`texels`](Self::texels), `env`'s channels) and the prefilterer
+    /// ([`Prefilterer::memory_for_outputs`]) with the background's conversion, made while
+    /// it is held, or, the prefilterer gone, the copy of the largest cube being turned into
+    /// the engine's axes; while [`write_into`](Self::write_into) writes (`env` dropped by
+    /// then), the cubes, a copy of one file's cubes for its writer and their encoded texels
+    /// (twice with Zstandard: the level and its compressed copy).
+    pub fn memory(&self, env: &EnvMap, opts: &PrefilterOptions) -> u64 {
+        let cube = ProjectionKind::Cube.default_projection();
+        let c = env.channels() as u64;
+        let source = env.width() as u64 * env.height() as u64 * env.layers().len() as u64 * c * 4;
+        let made = self.texels() * c * 4;
+        let working = Prefilterer::memory_for_outputs(env, &self.spec.outputs(), opts);
+        let background = self.spec.background_face.map_or(0, |f| {
+            mirrorball_core::resample_memory(env, cube, (f, f), &ResampleOptions::default())
+        });
+        let sq = |f: u32| 6 * f as u64 * f as u64;
+        let turned = match self.engine.orientation().is_identity() {
+            true => 0,
+            false => {
+                let largest = self
+                    .spec
+                    .levels
+                    .iter()
+                    .map(|&(f, _)| f)
+                    .chain(self.spec.diffuse_face)
+                    .chain(self.spec.background_face)
+                    .max()
+                    .unwrap_or(0);
+                sq(largest) * c * 4
+            }
+        };
+        let making = source + made + (working + background).max(turned);
+        let file = self
+            .spec
+            .levels
+            .iter()
+            .map(|&(f, _)| sq(f))
+            .sum::<u64>()
+            .max(self.spec.background_face.map_or(0, sq));
+        let encoded = file * encoded_bytes(self.opts.encoding.unwrap_or_default());
+        let writing = made + file * c * 4 + encoded * if self.opts.zstd.is_some() { 2 } else { 1 };
+        making.max(writing)
+    }
+
     /// The lighting, prefiltered from `env` (sanitized, checked) and turned into the
     /// engine's axes.
     pub fn lighting(&self, env: &EnvMap, opts: PrefilterOptions) -> Lighting {
@@ -797,6 +850,16 @@ pub(crate) fn chain_by(opts: &BakeOptions, mapping: &RoughnessMapping) -> Vec<(u
 /// Each level's faces, as the cube writers take them.
 pub(crate) fn faces(levels: &[EnvMap]) -> Vec<Vec<mirrorball_core::Image>> {
     levels.iter().map(|l| l.layers().to_vec()).collect()
+}
+
+/// Bytes of one texel in `encoding`.
+fn encoded_bytes(encoding: Encoding) -> u64 {
+    match encoding {
+        Encoding::Rgba32F => 16,
+        Encoding::Rgba16F => 8,
+        Encoding::Rgb9E5 | Encoding::B10G11R11 | Encoding::Rgbd | Encoding::Rgbm => 4,
+        Encoding::Bc6hUnsigned | Encoding::Bc6hSigned => 1,
+    }
 }
 
 /// How each cube of a bake is written: its encoding, effort and supercompression, recorded

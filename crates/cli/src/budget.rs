@@ -26,9 +26,13 @@ fn limit() -> Option<(u64, &'static str)> {
     Some((kb * 1024, "available memory"))
 }
 
+/// What the process holds before any map: its code and libraries, its threads' stacks and
+/// the allocator's own (a conversion of a 512×256 map to 16×8 peaks at 10.5–12.5 MB).
+pub const PROCESS: u64 = 10 << 20;
+
 /// Refuses `what` when it needs more than the limit: `held` bytes it already holds (a
-/// source read into memory) and `more` it will allocate. `hint` says what to change ("a
-/// smaller --size").
+/// source read into memory) and `more` it will allocate at its peak, besides the process
+/// itself ([`PROCESS`]). `hint` says what to change ("a smaller --size").
 pub fn check(what: &str, held: u64, more: u64, hint: &str) -> Result<(), CliError> {
     let Some((max, source)) = limit() else {
         return Ok(());
@@ -37,9 +41,9 @@ pub fn check(what: &str, held: u64, more: u64, hint: &str) -> Result<(), CliErro
     let max = if MAX.get().is_some() {
         max
     } else {
-        max.saturating_add(held)
+        max.saturating_add(held).saturating_add(PROCESS)
     };
-    let bytes = held.saturating_add(more);
+    let bytes = held.saturating_add(more).saturating_add(PROCESS);
     if bytes <= max {
         return Ok(());
     }
@@ -48,6 +52,25 @@ pub fn check(what: &str, held: u64, more: u64, hint: &str) -> Result<(), CliErro
         human(bytes),
         human(max)
     )))
+}
+
+/// Refuses converting `what` when it would not fit: the source (`held`), the conversion's
+/// own (`scratch`: the source's pyramid) and the output (`made`) while converting; then,
+/// the source dropped, the output and what writing it copies (`written`).
+pub fn check_convert(
+    what: &str,
+    held: u64,
+    (scratch, made, written): (u64, u64, u64),
+    hint: &str,
+) -> Result<(), CliError> {
+    let converting = held.saturating_add(scratch).saturating_add(made);
+    let writing = made.saturating_add(written);
+    check(
+        what,
+        held,
+        converting.max(writing).saturating_sub(held),
+        hint,
+    )
 }
 
 /// `bytes` for people: "12.9 GB".
@@ -83,26 +106,26 @@ pub fn parse_bytes(s: &str) -> Result<u64, String> {
     }
 }
 
-/// Refuses prefiltering `what` when it would not fit: the source `env` is held, the working
-/// cube of face `face` (bordered, with its pyramid, twice when bright texels are split off)
-/// is made, and `made` texels of four `f32` channels are the outputs (prefilter's chain, a
-/// bake's cubes).
+/// Refuses prefiltering `what` when it would not fit: the source `env` is held, the
+/// prefilterer holds `working` bytes at its peak (its working cube and pyramids:
+/// `Prefilterer::memory_for_outputs`), and `made` texels of the source's channels are the
+/// outputs (prefilter's chain, a bake's cubes).
 pub fn check_prefilter(
     what: &str,
     env: &mirrorball_core::EnvMap,
-    face: u64,
+    working: u64,
     made: u64,
     hint: &str,
 ) -> Result<(), CliError> {
-    let working = f32_texels(6 * (face + 2) * (face + 2) * 4 / 3, 4) * 2;
+    let c = env.channels() as u64;
     let held = f32_texels(
         env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
-        env.channels() as u64,
+        c,
     );
     check(
         what,
         held,
-        working.saturating_add(f32_texels(made, 4)),
+        working.saturating_add(f32_texels(made, c)),
         hint,
     )
 }

@@ -386,6 +386,50 @@ pub fn save_eyes(
     })
 }
 
+/// Bytes [`save_eyes`] makes besides the maps it writes (`eyes` maps, each of `layers`
+/// layers of `w`×`h` texels of `channels` `f32` channels, in projection `kind`): for a
+/// KTX2/DDS cube, the levels copied for the writer (the mip chain first made when
+/// `opts.mips`); for one file, the packed picture (a cross's empty cells included; a pair's
+/// eyes packed and then joined) and the encoder's buffers; for one file a layer, nothing.
+pub fn write_bytes(
+    out: &str,
+    kind: ProjectionKind,
+    (w, h, layers): (u32, u32, usize),
+    (eyes, channels): (usize, usize),
+    opts: &SaveOptions,
+) -> u64 {
+    let texel = channels as u64 * 4;
+    let map = w as u64 * h as u64 * layers as u64 * texel;
+    let format = Format::from_path(Path::new(out));
+    if format.is_some_and(Format::is_cube_container) {
+        return match opts.mips {
+            true => 2 * map * 4 / 3,
+            false => map,
+        };
+    }
+    if layer_files(out, layers, opts).is_some() {
+        return 0;
+    }
+    let layout = match opts.layout {
+        None if kind == ProjectionKind::Eac && !out.contains(FACE) => Layout::default_for(kind),
+        _ => output_layout(out, layers, opts),
+    };
+    let (pw, ph) = layout.extent(layers, w, h);
+    let pictures = pw as u64 * ph as u64 * eyes as u64 * texel;
+    let (jw, jh) = match eyes {
+        1 => (pw, ph),
+        _ => Stereo::SideBySide.extent(pw, ph),
+    };
+    let encoder =
+        mirrorball_io::write_buffer_bytes(Path::new(out), (jw, jh, channels), &opts.write);
+    // A pair's eyes are packed, then joined into one picture: both held at once.
+    encoder
+        + match eyes {
+            1 => pictures,
+            _ => 2 * pictures,
+        }
+}
+
 /// The options for one file a layer of a `projection` map: each file records the projection
 /// (and the `separate` layout), so that `{face}` reads the set back without `--from`.
 pub fn per_layer_write(

@@ -50,7 +50,9 @@ pub use projection::{
 };
 pub use projection::{DualFisheye, FisheyeLens, LensModel};
 pub use remap::{Remap, RemapError, RemapRows};
-pub use resample::{resample, resample_to_extent, Axis, ResampleOptions, Resampler, Rotation};
+pub use resample::{
+    resample, resample_memory, resample_to_extent, Axis, ResampleOptions, Resampler, Rotation,
+};
 
 pub use glam;
 /// The SIMD lanes the fast variants are written on.

@@ -417,6 +417,37 @@ pub fn resample(src: &EnvMap, dst: Projection, size: u32, opts: &ResampleOptions
     resample_to_extent(src, dst, w, h, opts)
 }
 
+/// Bytes a conversion of `src` into `w`×`h` layers of `dst` holds besides the source and
+/// the output: the source's pyramid, as deep as the conversion needs, each level's images
+/// (the source's channels) and its blocks' four weights. What a memory budget adds to the
+/// source and the output it counts itself.
+pub fn resample_memory(
+    src: &EnvMap,
+    dst: Projection,
+    (w, h): (u32, u32),
+    opts: &ResampleOptions,
+) -> u64 {
+    let job = Job::new(
+        *src.projection(),
+        (src.width(), src.height()),
+        dst,
+        (w, h),
+        opts,
+    );
+    let per_texel = src.channels() as u64 * 4 + 16;
+    let layers = src.layers().len() as u64;
+    let (mut lw, mut lh) = (src.width().max(1), src.height().max(1));
+    let mut bytes = 0u64;
+    for _ in 1..job.levels {
+        if lw == 1 && lh == 1 {
+            break;
+        }
+        (lw, lh) = half_extent(lw, lh);
+        bytes += lw as u64 * lh as u64 * layers * per_texel;
+    }
+    bytes
+}
+
 /// Footprint ratio of an output texel of density `ddens` over the source texels at source
 /// density `sdens` (`area` = output texel area / source texel area in their `uv` units).
 #[inline]

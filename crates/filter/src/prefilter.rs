@@ -158,6 +158,90 @@ impl Prefilterer {
         Prefilterer::for_outputs(src, &chain_outputs(lobes, out, size), opts)
     }
 
+    /// Bytes [`for_outputs`](Self::for_outputs)`(src, outputs, opts)` and the rendering of
+    /// `outputs` hold at their peak besides `src` and the outputs themselves: the working
+    /// cube (four `f32` channels), made from the source through a conversion (its pyramid,
+    /// and the cube once more at the source's channels); then the seamless pyramids the
+    /// lobes read (one of the map's body, made from a copy of the cube, for the rough lobes;
+    /// one of the whole map for mirrors other than the cube itself) and Lambert's moment
+    /// pyramid.
+    pub fn memory_for_outputs(
+        src: &EnvMap,
+        outputs: &[(Lobe, Projection, u32, u32)],
+        opts: &PrefilterOptions,
+    ) -> u64 {
+        let need = outputs
+            .iter()
+            .map(|(lobe, out, w, h)| needed_face(lobe, out, *w, *h))
+            .max();
+        let face = working_face(src, opts.cube_size, need, opts.max_cube_size) as u64;
+        let texel = 16u64;
+        let cube = 6 * face * face * texel;
+        let cube_proj = Projection::Cube(mirrorball_core::CubeMap);
+        let made = match src.projection().kind() == mirrorball_core::ProjectionKind::Cube
+            && src.width() as u64 == face
+        {
+            true => cube,
+            false => {
+                let converted = 6 * face * face * src.channels() as u64 * 4;
+                let pyramid = mirrorball_core::resample_memory(
+                    src,
+                    cube_proj,
+                    (face as u32, face as u32),
+                    &Default::default(),
+                );
+                // The conversion's pyramid goes before the four-channel copy is made.
+                let widened = if src.channels() == 4 { 0 } else { cube };
+                converted + pyramid.max(widened)
+            }
+        };
+        let mut pyramid = 0;
+        let mut s = face;
+        loop {
+            pyramid += 6 * (s + 2) * (s + 2) * texel;
+            if s <= 1 {
+                break;
+            }
+            s /= 2;
+        }
+        let rough = outputs
+            .iter()
+            .any(|(l, ..)| !l.is_mirror() && *l != Lobe::Lambert);
+        let mirror = outputs.iter().any(|(l, out, w, h)| {
+            l.is_mirror()
+                && !(out.kind() == mirrorball_core::ProjectionKind::Cube
+                    && w == h
+                    && *w as u64 == face)
+        });
+        let lambert = outputs.iter().any(|(l, ..)| *l == Lobe::Lambert);
+        let mut working = cube;
+        if rough {
+            // The body's copy lives while its pyramid is made.
+            working += cube + pyramid;
+        }
+        if mirror {
+            working += pyramid;
+        }
+        if lambert {
+            // Face geometry and radiance at level 0, four moments a node below it.
+            working += face * face * texel + cube + cube * 4 / 3;
+        }
+        made.max(working)
+    }
+
+    /// [`memory_for_outputs`](Self::memory_for_outputs) of
+    /// [`for_chain`](Self::for_chain)`(src, lobes, out, size, opts)` and its
+    /// [`render_chain`](Self::render_chain).
+    pub fn memory_for_chain(
+        src: &EnvMap,
+        lobes: &[Lobe],
+        out: Projection,
+        size: u32,
+        opts: &PrefilterOptions,
+    ) -> u64 {
+        Prefilterer::memory_for_outputs(src, &chain_outputs(lobes, out, size), opts)
+    }
+
     fn with_face(src: &EnvMap, face: u32, opts: PrefilterOptions) -> Prefilterer {
         // Counted row by row as it is resampled; a copy (a cube of the face asked for) at
         // once.

@@ -324,6 +324,26 @@ pub fn write(
     }
 }
 
+/// Bytes [`write`] holds besides `image` (`w`×`h`, `c` channels) while it writes it: for
+/// ZIP and ZIPS, a batch of 32 blocks compressed (at most their packed size) and each
+/// thread's packed block; uncompressed, its two line buffers; for the other compressions,
+/// which the `exr` crate writes, as much as the packed picture.
+pub(crate) fn write_buffer_bytes(w: u32, h: u32, c: usize, opts: &WriteOptions) -> u64 {
+    let sample = match opts.precision {
+        Some(Precision::Float) => 4,
+        _ => 2,
+    };
+    let line = w as u64 * c as u64 * sample;
+    let threads = rayon::current_num_threads() as u64;
+    let lines = match opts.exr_compression {
+        ExrCompression::Zip => (32 + threads) * 16,
+        ExrCompression::Zips => 32 + threads,
+        ExrCompression::None => return 2 * line.max(2 << 20),
+        _ => h as u64,
+    };
+    lines.min(h as u64) * line
+}
+
 /// Writes a one-layer image: uncompressed, ZIP and ZIPS blocks made here on all cores (ZIP
 /// compressed with libdeflate, [`crate::exr_zip`]), each block's samples taken straight
 /// from `image` (half samples clamped as `fit` in [`write`] does); the `exr` crate writes

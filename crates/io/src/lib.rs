@@ -482,6 +482,16 @@ pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<()
     )?)
 }
 
+/// Bytes writing a `w`×`h` image of `c` channels to `path` (as [`write_image`] does) holds
+/// besides the image: the encoder's buffers where they grow with the picture (OpenEXR's
+/// batches of compressed blocks); 0 where they do not.
+pub fn write_buffer_bytes(path: &Path, (w, h, c): (u32, u32, usize), opts: &WriteOptions) -> u64 {
+    match Format::from_path(path) {
+        Some(Format::Exr) => exr_io::write_buffer_bytes(w, h, c, opts),
+        _ => 0,
+    }
+}
+
 /// Writes one flat image as [`write_image`] does, to a temporary file beside `path` that
 /// [`Staged::commit`] renames into place (dropped uncommitted, it is removed). `buffers`
 /// are the encoders' buffers, kept from one file to the next.

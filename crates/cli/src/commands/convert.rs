@@ -310,17 +310,31 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
             c,
         );
         let layer = budget::f32_texels(w as u64 * h as u64, c);
-        // One file a layer: one layer in memory, two counted (a margin for the encoders'
-        // buffers). One file: the map, and a packed copy for flat layouts (a third more for
-        // a mip chain).
-        let more = match &layer_files {
-            Some(_) => 2 * layer,
-            None => layer.saturating_mul(dst.layer_count() as u64 * 2),
+        let mut scratch = mirrorball_core::resample_memory(env, dst, (w, h), &plan.resample);
+        let map = layer.saturating_mul(dst.layer_count() as u64);
+        if !plan.orient.is_identity() {
+            // The map turned into an engine's axes is a copy, made once the pyramid is gone.
+            scratch = scratch.max(map);
+        }
+        // One file a layer: a layer being made while the one before is written. One file:
+        // the map, then what writing copies (the packed picture, a cube container's levels).
+        let (made, written) = match &layer_files {
+            Some(_) => (2 * layer, 0),
+            None => (
+                map,
+                save::write_bytes(
+                    &a.output,
+                    dst.kind(),
+                    (w, h, dst.layer_count()),
+                    (1, c as usize),
+                    &plan.save,
+                ),
+            ),
         };
-        budget::check(
+        budget::check_convert(
             &format!("{} {w}x{h}x{}", dst.name(), dst.layer_count()),
             held,
-            more,
+            (scratch, made, written),
             "a smaller --size",
         )?;
     }
@@ -503,7 +517,12 @@ fn convert_pair(
         (w, h),
         &plan.resample,
     );
-    budget::check(
+    let eye = budget::f32_texels(texels(w, h, dst.layer_count()), c);
+    let plan_bytes = remap.memory_bytes() as u64;
+    // Converting: the eyes read, the conversion's plan and the output eyes (one more while
+    // an eye is turned into an engine's axes). Writing: the plan, the output eyes and the
+    // pictures packed from them.
+    budget::check_convert(
         &format!(
             "{} {w}x{h}x{}, {}",
             dst.name(),
@@ -514,9 +533,18 @@ fn convert_pair(
             texels(left.width(), left.height(), left.layers().len()) * eyes.len() as u64,
             c,
         ),
-        // Each output eye, and the joined picture.
-        2 * budget::f32_texels(texels(w, h, dst.layer_count()) * out_eyes as u64, c)
-            + remap.memory_bytes() as u64,
+        (
+            plan_bytes + if plan.orient.is_identity() { 0 } else { eye },
+            eye * out_eyes as u64,
+            plan_bytes
+                + save::write_bytes(
+                    &a.output,
+                    dst.kind(),
+                    (w, h, dst.layer_count()),
+                    (out_eyes, c as usize),
+                    &plan.save,
+                ),
+        ),
         "a smaller --size",
     )?;
     let t1 = Instant::now();

@@ -47,13 +47,15 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
     plan.bake.check(&env)?;
     plan.bake.fit(&env);
     let size = plan.bake.opts.size;
-    let face = size.clamp(256, 4096) as u64;
-    // The cubes made, and their copy in the engine's axes.
-    budget::check_prefilter(
-        &format!("baking a {size}² chain (working cube {face}²)"),
-        &env,
-        face,
-        2 * plan.bake.texels(),
+    let held = budget::f32_texels(
+        env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
+        env.channels() as u64,
+    );
+    let peak = plan.bake.memory(&env, &plan.prefilter);
+    budget::check(
+        &format!("baking a {size}² chain"),
+        held,
+        peak.saturating_sub(held),
         "a smaller --size",
     )?;
     // One bar over the prefilter and the writing, each weighted by its work (the

@@ -518,7 +518,7 @@ fn plan_for_blank(
     h: u32,
 ) -> Option<(Shape, Remap, Option<Picture>)> {
     let frame = budget::f32_texels(w as u64 * h as u64, 3);
-    budget::check("", 0, (FRAMES_IN_FLIGHT + 1) * frame, "").ok()?;
+    budget::check("", 0, FRAMES_IN_FLIGHT * frame, "").ok()?;
     let stereo = plan.in_stereo.unwrap_or_default();
     let (left, _, _) = load::interpret_eyes(
         "-",
@@ -640,19 +640,40 @@ fn convert_frames(
         _ => plan_frames(&shape0, dst, plan, packing),
     };
     let frame_bytes = |env_texels: u64| budget::f32_texels(env_texels, c as u64);
+    let source = frame_bytes(
+        src0.width() as u64
+            * src0.height() as u64
+            * src0.layers().len() as u64
+            * eyes0.len() as u64,
+    );
+    let out_eyes = plan.stereo.eyes();
+    let made = frame_bytes(w as u64 * h as u64 * dst.layer_count() as u64 * out_eyes as u64);
+    // The frame being written is packed into a picture (a file's layout; a pair's eyes
+    // joined for a pipe).
+    let written = match &output {
+        Output::Files(p) => save::write_bytes(
+            &p.path(meta0.number).to_string_lossy(),
+            dst.kind(),
+            (w, h, dst.layer_count()),
+            (out_eyes, c),
+            &plan.save,
+        ),
+        Output::File(f) => save::write_bytes(
+            f,
+            dst.kind(),
+            (w, h, dst.layer_count()),
+            (out_eyes, c),
+            &plan.save,
+        ),
+        Output::Pipe(_) if out_eyes > 1 => 2 * made,
+        Output::Pipe(_) => 0,
+    };
+    // The pipeline's frames in flight, source and output, the plan, and the picture being
+    // written.
     budget::check(
         &format!("frames of {} {w}x{h}x{}", dst.name(), dst.layer_count()),
         0,
-        (FRAMES_IN_FLIGHT + 1)
-            * (frame_bytes(
-                src0.width() as u64
-                    * src0.height() as u64
-                    * src0.layers().len() as u64
-                    * eyes0.len() as u64,
-            ) + 2 * frame_bytes(
-                w as u64 * h as u64 * dst.layer_count() as u64 * plan.stereo.eyes() as u64,
-            ))
-            + remap.memory_bytes() as u64,
+        FRAMES_IN_FLIGHT * (source + made) + remap.memory_bytes() as u64 + written,
         "a smaller --size",
     )?;
     if let (Some((layout, _, fmt)), false) = (&packed, a.quiet) {

@@ -46,7 +46,7 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
         plan.check_room(shape.size)?;
     }
     let lobes = lobes(&plan, shape.levels);
-    check_memory(&plan, &shape, &env)?;
+    check_memory(&plan, &shape, &env, &lobes)?;
 
     let t1 = Instant::now();
     let sh9 = sh::project(&env);
@@ -186,22 +186,29 @@ fn lobes(plan: &Plan, levels: usize) -> Vec<Lobe> {
     }
 }
 
-/// The working cube (bordered, with its pyramid, twice when bright texels are split off)
-/// is about as fine as level 0 needs, at least 256² and at most 4096², unless --cube-size
-/// says; the chain is four channels with its mips; the source is held meanwhile.
-fn check_memory(plan: &Plan, shape: &Chain, env: &EnvMap) -> Result<(), CliError> {
+/// The prefilterer's peak (its working cube and pyramids, as fine as the levels rendered
+/// need), the chain (the source's channels, with its mips) and the source held meanwhile.
+/// Lambert from SH makes no working cube.
+fn check_memory(plan: &Plan, shape: &Chain, env: &EnvMap, lobes: &[Lobe]) -> Result<(), CliError> {
     let (w0, h0) = shape.extent;
-    let out = &shape.projection;
-    let face = plan.opts.cube_size.unwrap_or(shape.size.clamp(256, 4096)) as u64;
+    let out = shape.projection;
+    let working = match (plan.kind, plan.irradiance) {
+        (LobeKind::Lambert, IrradianceMethod::Sh) => 0,
+        (LobeKind::Lambert, IrradianceMethod::Exact) => {
+            Prefilterer::memory_for_chain(env, &[Lobe::Lambert], out, shape.size, &plan.opts)
+        }
+        _ => Prefilterer::memory_for_chain(env, lobes, out, shape.size, &plan.opts),
+    };
+    let chain = w0 as u64 * h0 as u64 * out.layer_count() as u64;
     budget::check_prefilter(
         &format!(
-            "prefiltering into {} {w0}x{h0}x{} (working cube {face}²)",
+            "prefiltering into {} {w0}x{h0}x{}",
             out.name(),
             out.layer_count()
         ),
         env,
-        face,
-        w0 as u64 * h0 as u64 * out.layer_count() as u64 * 4 / 3,
+        working,
+        chain * 4 / 3,
         "a smaller --size or --cube-size",
     )
 }

@@ -34,7 +34,7 @@ fn ext_of(f: Format) -> &'static str {
 
 impl RenderPlan {
     /// The file of frame `i`: the output itself, or `NAME-0000.EXT`… for a turntable.
-    fn frame_path(&self, i: usize) -> PathBuf {
+    pub(super) fn frame_path(&self, i: usize) -> PathBuf {
         if self.frames > 1 {
             sibling(&self.output, &format!("{i:04}"), ext_of(self.format))
         } else {

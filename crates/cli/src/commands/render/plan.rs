@@ -445,7 +445,8 @@ impl RenderPlan {
     /// animated PNG; the diagnostic channels are four RGB `f32` images made in bands and
     /// then copied (twice their size); a fisheye frame is made from a cube of faces half
     /// its width (each face rendered as RGBA, then kept as RGB) and is square; writing
-    /// copies one frame. Meshes and the environment are not counted.
+    /// copies one frame, and its encoder holds its buffers. Meshes and the environment are not
+    /// counted.
     fn image_bytes(&self) -> u64 {
         let (w, h) = (self.camera.width as u64, self.camera.height as u64);
         let frames = self.frames as u64;
@@ -463,9 +464,19 @@ impl RenderPlan {
         if frames > 1 && self.format == Format::Png {
             per_frame += pixels * 16;
         }
+        let (pw, ph) = match self.fisheye {
+            Some(_) => (w, w),
+            None => (w, h),
+        };
+        let encoder = mirrorball_io::write_buffer_bytes(
+            &self.frame_path(0),
+            (pw as u32, ph as u32, 4),
+            &Default::default(),
+        );
         per_frame
             .saturating_mul(frames)
             .saturating_add(scratch)
             .saturating_add(pixels * 16)
+            .saturating_add(encoder)
     }
 }
