@@ -565,13 +565,19 @@ impl Bake {
     /// encoders and container writers count there): every cube encoded in the bake's
     /// encoding, and supercompressed when asked.
     pub fn write_work(&self) -> u64 {
-        let texels = self.texels();
+        let sq = |f: u32| 6 * f as u64 * f as u64;
+        // three's background is six Radiance files; every other cube is in the encoding.
+        let rgbe = match self.engine {
+            Engine::Three => self.spec.background_face.map_or(0, sq),
+            _ => 0,
+        };
+        let texels = self.texels() - rgbe;
         let encoding = self.encoding();
         let zstd = self.opts.zstd.map_or(0, |_| {
             let bytes = encoding.image_bytes(1024, 1024) as u64 * texels / (1024 * 1024);
             mirrorball_io::zstd_work(bytes)
         });
-        encoding.work(texels) + zstd
+        encoding.work(texels) + zstd + mirrorball_io::rgbe_work(rgbe)
     }
 
     /// Texels of every cube made (four `f32` channels each), for the memory estimate.

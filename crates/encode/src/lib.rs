@@ -165,7 +165,7 @@ impl Encoding {
         let per_texel = match self {
             Encoding::Bc6hUnsigned => 650,
             Encoding::Bc6hSigned => 500,
-            _ => 10,
+            _ => 20,
         };
         texels * per_texel
     }

@@ -568,9 +568,9 @@ mod cost {
     const RESAMPLE_SRC: u64 = 40;
     const RESAMPLE_OUT: u64 = 40;
     /// A pyramid (with the bright split) per working cube texel.
-    const PYRAMID: u64 = 60;
+    const PYRAMID: u64 = 120;
     /// The moment hierarchy per working cube texel.
-    const MOMENTS: u64 = 200;
+    const MOMENTS: u64 = 300;
 
     fn cube_texels(face: u32) -> u64 {
         6 * face as u64 * face as u64

@@ -95,6 +95,12 @@ fn header_is_complete(head: &[u8]) -> bool {
     }
 }
 
+/// The work of writing `texels` texels as Radiance RGBE (encoded and run-length coded), in
+/// [`mirrorball_core::work`]'s units: what [`write`] counts.
+pub fn rgbe_work(texels: u64) -> u64 {
+    texels * 15
+}
+
 /// Writes `image` as Radiance RGBE (alpha is dropped), run-length encoded for widths from
 /// 8 to 32767 and flat otherwise, rows encoded on all cores. Negative and NaN values are
 /// written as 0, values beyond the RGBE range as its largest value. Written to a temporary
@@ -126,6 +132,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
                 }
                 encode_scanline(&rgbe, &mut out);
             }
+            mirrorball_core::work::add(rgbe_work((band.len() / c) as u64));
             out
         })
         .collect();

@@ -154,7 +154,7 @@ pub struct CubeWrite {
 /// The work of supercompressing `bytes` bytes with Zstandard at the levels bakes use (3 by
 /// default), in [`mirrorball_core::work`]'s units: what [`write_ktx2`] counts for it.
 pub fn zstd_work(bytes: u64) -> u64 {
-    bytes * 6
+    bytes * 10
 }
 
 /// Refuses what `write` cannot encode, before any work: everything [`Encoding::check`]

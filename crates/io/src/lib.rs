@@ -52,6 +52,7 @@ pub use dds_io::write_dds;
 pub use destination::{check_writable, file_system, free_bytes, output_folder, Folders};
 pub use error::{Error, Fault};
 pub use gltf_ibl::{read_gltf_ibl, write_gltf_ibl, GltfIbl};
+pub use hdr_io::rgbe_work;
 pub use ktx1_io::{filament_sh_text, write_ktx1};
 pub use ktx2_io::{write_ktx2, zstd_work, CubeWrite};
 pub use ldr_io::{lut16 as srgb16_to_linear, lut8 as srgb8_to_linear};
