@@ -138,11 +138,7 @@ impl Prefilterer {
         outputs: &[(Lobe, Projection, u32, u32)],
         opts: PrefilterOptions,
     ) -> Prefilterer {
-        let need = outputs
-            .iter()
-            .map(|(lobe, out, w, h)| needed_face(lobe, out, *w, *h))
-            .max();
-        let face = working_face(src, opts.cube_size, need, opts.max_cube_size);
+        let face = face_for_outputs(src, outputs, &opts);
         Prefilterer::with_face(src, face, opts)
     }
 
@@ -170,11 +166,7 @@ impl Prefilterer {
         outputs: &[(Lobe, Projection, u32, u32)],
         opts: &PrefilterOptions,
     ) -> u64 {
-        let need = outputs
-            .iter()
-            .map(|(lobe, out, w, h)| needed_face(lobe, out, *w, *h))
-            .max();
-        let face = working_face(src, opts.cube_size, need, opts.max_cube_size) as u64;
+        let face = face_for_outputs(src, outputs, opts) as u64;
         let texel = 16u64;
         let cube = 6 * face * face * texel;
         let cube_proj = Projection::Cube(mirrorball_core::CubeMap);
@@ -489,6 +481,21 @@ fn count(opts: &PrefilterOptions, units: u64) {
     }
 }
 
+/// The working cube's face for `outputs` from `src` (the rule is `cube.rs`'s
+/// `needed_face` and `working_face`): what [`Prefilterer::for_outputs`] makes, and what
+/// [`work`] and [`Prefilterer::memory_for_outputs`] count.
+fn face_for_outputs(
+    src: &EnvMap,
+    outputs: &[(Lobe, Projection, u32, u32)],
+    opts: &PrefilterOptions,
+) -> u32 {
+    let need = outputs
+        .iter()
+        .map(|(lobe, out, w, h)| needed_face(lobe, out, *w, *h))
+        .max();
+    working_face(src, opts.cube_size, need, opts.max_cube_size)
+}
+
 /// The work of preparing `src` for `outputs` ([`Prefilterer::for_outputs`]) and rendering
 /// each of them ([`Prefilterer::render_extent`]), in the units
 /// [`PrefilterOptions::progress`] counts: the total a progress bar runs to.
@@ -497,11 +504,7 @@ pub fn work(
     outputs: &[(Lobe, Projection, u32, u32)],
     opts: &PrefilterOptions,
 ) -> u64 {
-    let need = outputs
-        .iter()
-        .map(|(lobe, out, w, h)| needed_face(lobe, out, *w, *h))
-        .max();
-    let face = working_face(src, opts.cube_size, need, opts.max_cube_size);
+    let face = face_for_outputs(src, outputs, opts);
     let uses = |f: &dyn Fn(&Lobe) -> bool| outputs.iter().any(|(l, ..)| f(l));
     let fis = |l: &Lobe| !l.is_mirror() && *l != Lobe::Lambert;
     let mut units = cost::working_cube(src, face);
