@@ -102,28 +102,42 @@ pub fn note(out: &Path, stamp: u64) -> Result<(), CliError> {
         })
 }
 
-/// What a rerun says of the outputs that exist (of frames or jobs, `noun`): `skipped` kept (`unknown` of them with no
-/// record of how they were made), `again` made by other settings or from other inputs.
+/// What a rerun says of the outputs that exist (of frames or jobs, `noun`): `skipped` kept
+/// (`unknown` of them with no record of how they were made), `again` made by other
+/// settings or from other inputs.
 pub fn kept_lines(noun: &str, skipped: u64, unknown: u64, again: u64) -> Vec<String> {
     let mut lines = Vec::new();
-    let frames = |n: u64| mirrorball_core::count(n, noun);
+    // "1 frame …: its output exists", "3 frames …: their outputs exist".
+    let said = |n: u64, what: &str| {
+        let (its, exist, were, them) = match n {
+            1 => ("its output", "exists", "was", "it"),
+            _ => ("their outputs", "exist", "were", "them"),
+        };
+        let what = what
+            .replace("{its}", its)
+            .replace("{exist}", exist)
+            .replace("{were}", were)
+            .replace("{them}", them);
+        format!("{} {what}", mirrorball_core::count(n, noun))
+    };
     if skipped > unknown {
-        lines.push(format!(
-            "{} skipped: their outputs exist, made with these settings from these inputs",
-            frames(skipped - unknown)
+        lines.push(said(
+            skipped - unknown,
+            "skipped: {its} {exist}, made with these settings from these inputs",
         ));
     }
     if unknown > 0 {
-        lines.push(format!(
-            "{} skipped: their outputs exist, with no record of the settings that made them ({}); --overwrite converts them again",
-            frames(unknown),
-            RECORD
+        lines.push(said(
+            unknown,
+            &format!(
+                "skipped: {{its}} {{exist}}, with no record of the settings that made {{them}} ({RECORD}); --overwrite converts {{them}} again"
+            ),
         ));
     }
     if again > 0 {
-        lines.push(format!(
-            "{} converted again: their outputs were made with other settings or from other inputs",
-            frames(again)
+        lines.push(said(
+            again,
+            "converted again: {its} {were} made with other settings or from other inputs",
         ));
     }
     lines
