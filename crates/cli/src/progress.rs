@@ -98,6 +98,15 @@ fn run<T: Send>(
     })
 }
 
+/// Runs `write`, the writing of files the writers count (`mirrorball_io::write_work`
+/// gives `total`), under a bar; under a spinner when they count nothing (`total` 0).
+pub fn writing<T: Send>(total: u64, quiet: bool, write: impl FnOnce() -> T + Send) -> T {
+    if total == 0 {
+        return with_spinner("writing", quiet, write);
+    }
+    with_work_progress("writing", total, quiet, |_| write())
+}
+
 /// Runs `work` while a spinner with the elapsed time says `label`: for work that cannot
 /// count its progress (encoding and writing a file).
 pub fn with_spinner<T: Send>(label: &str, quiet: bool, work: impl FnOnce() -> T + Send) -> T {

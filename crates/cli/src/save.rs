@@ -184,7 +184,17 @@ pub fn picture_extent(
     opts: &SaveOptions,
     stereo: Stereo,
 ) -> (u64, u64) {
-    let (w, h) = projection.layer_extent(size);
+    picture_extent_of(out, projection, projection.layer_extent(size), opts, stereo)
+}
+
+/// [`picture_extent`] of a map of `projection` whose layers are `w`×`h`.
+fn picture_extent_of(
+    out: &str,
+    projection: Projection,
+    (w, h): (u32, u32),
+    opts: &SaveOptions,
+    stereo: Stereo,
+) -> (u64, u64) {
     let n = projection.layer_count();
     let format = Format::from_path(Path::new(out));
     if format.is_some_and(Format::is_cube_container) || layer_files(out, n, opts).is_some() {
@@ -217,6 +227,41 @@ pub fn size_bound(
     crate::size::pictures(format, &what, |s| {
         picture_extent(out, projection, s, opts, stereo)
     })
+}
+
+/// About the work of writing `maps` to `out` as [`save`] and [`save_eyes`] do (a cube
+/// container's mips included), in the units the writers count (`mirrorball_io::write_work`):
+/// what a bar over the writing runs to.
+pub fn write_work(out: &str, maps: &[&EnvMap], opts: &SaveOptions) -> u64 {
+    let Some(format) = Format::from_path(Path::new(out)) else {
+        return 0;
+    };
+    // Each map's pictures: its faces in a cube container or one file a layer, else the
+    // packed picture (a cross's empty cells are written too), its layers copied into it
+    // first.
+    let (mut written, mut packed) = (0u64, 0u64);
+    for m in maps {
+        let (w, h) = (m.width(), m.height());
+        let layers = m.layers().len() as u64;
+        let (pw, ph) = picture_extent_of(out, *m.projection(), (w, h), opts, Stereo::Mono);
+        if format.is_cube_container() || layer_files(out, m.layers().len(), opts).is_some() {
+            written += pw * ph * layers;
+        } else {
+            written += pw * ph;
+            packed += w as u64 * h as u64 * layers;
+        }
+    }
+    // A cube container's mips are made first (`MipChain::resampled`).
+    let mut mips = 0;
+    if opts.mips && format.is_cube_container() {
+        written = written * 4 / 3;
+        mips = maps.iter().map(|m| MipChain::resampled_work(m)).sum();
+    }
+    match mirrorball_io::write_work(format, written, &opts.write) {
+        // Writers that count nothing: no bar at all, the packing alone would mislead it.
+        0 => 0,
+        w => w + mirrorball_core::work::PACK * packed + mips,
+    }
 }
 
 /// The layout `out` gets for a map of `layers` layers.

@@ -471,8 +471,12 @@ impl Layout {
             return None;
         }
         let (cw, ch) = (env.width(), env.height());
+        // Each layer's copy counted for progress bars as it lands (`work::PACK`).
+        let layer_work = crate::work::PACK * cw as u64 * ch as u64;
         if let Layout::Cells(cells) = self {
-            return Some(pack_cells(&cells, env));
+            let out = pack_cells(&cells, env);
+            crate::work::add(layer_work * n as u64);
+            return Some(out);
         }
         let (gc, gr) = self.grid(n);
         let mut out = Image::new(cw * gc, ch * gr, env.channels());
@@ -483,6 +487,7 @@ impl Layout {
             } else {
                 out.paste(layer, col * cw, row * ch);
             }
+            crate::work::add(layer_work);
         }
         Some(out)
     }

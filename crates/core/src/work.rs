@@ -11,6 +11,20 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 static DONE: AtomicU64 = AtomicU64::new(0);
 
+/// A conversion ([`crate::resample`]) per source texel (its pyramid built and read) and per
+/// output texel made.
+const RESAMPLE_SRC: u64 = 40;
+const RESAMPLE_OUT: u64 = 40;
+
+/// The work of converting a map of `src_texels` texels into one of `out_texels`.
+pub fn resample(src_texels: u64, out_texels: u64) -> u64 {
+    src_texels * RESAMPLE_SRC + out_texels * RESAMPLE_OUT
+}
+
+/// A layer's texel copied into a packed picture ([`crate::Layout::pack`]; the picture's
+/// allocation included).
+pub const PACK: u64 = 50;
+
 /// Counts `units` of finished work.
 pub fn add(units: u64) {
     DONE.fetch_add(units, Ordering::Relaxed);

@@ -72,23 +72,48 @@ impl MipChain {
     /// edge. Unlike [`MipChain::build`], the weights are the resampler's (density at the
     /// integration points), so energy is conserved to the resampler's accuracy rather than
     /// exactly; it is kept for the files `convert` has always written.
+    ///
+    /// Each level is counted in `mirrorball_core::work` once made ([`MipChain::resampled_work`]).
     pub fn resampled(env: &EnvMap) -> MipChain {
         let mut levels = vec![env.clone()];
         let proj = *env.projection();
         let mut size = env.width() / 2;
+        let texels = |m: &EnvMap| m.width() as u64 * m.height() as u64 * m.layers().len() as u64;
         while size >= 1 {
-            levels.push(mirrorball_core::resample(
+            let level = mirrorball_core::resample(
                 env,
                 proj,
                 size,
                 &mirrorball_core::ResampleOptions::default(),
+            );
+            mirrorball_core::work::add(mirrorball_core::work::resample(
+                texels(env),
+                texels(&level),
             ));
+            levels.push(level);
             if size == 1 {
                 break;
             }
             size /= 2;
         }
         MipChain { levels }
+    }
+
+    /// The work [`MipChain::resampled`] counts for `env`: each level converted from it.
+    pub fn resampled_work(env: &EnvMap) -> u64 {
+        let texels = env.width() as u64 * env.height() as u64 * env.layers().len() as u64;
+        let mut work = 0;
+        let mut size = env.width() / 2;
+        while size >= 1 {
+            let (w, h) = env.projection().layer_extent(size);
+            let out = w as u64 * h as u64 * env.layers().len() as u64;
+            work += mirrorball_core::work::resample(texels, out);
+            if size == 1 {
+                break;
+            }
+            size /= 2;
+        }
+        work
     }
 
     /// Wraps levels made elsewhere (each must be the same projection; not checked).

@@ -567,9 +567,6 @@ mod cost {
     const BRIGHT: u64 = 600;
     /// An irradiance texel from the moment hierarchy.
     const LAMBERT: u64 = 2500;
-    /// Resampling per source texel read and per working cube texel made.
-    const RESAMPLE_SRC: u64 = 40;
-    const RESAMPLE_OUT: u64 = 40;
     /// A pyramid (with the bright split) per working cube texel.
     const PYRAMID: u64 = 120;
     /// The moment hierarchy per working cube texel.
@@ -582,7 +579,7 @@ mod cost {
     /// Making the working cube of face `face` from `src`.
     pub fn working_cube(src: &EnvMap, face: u32) -> u64 {
         let src_texels = src.width() as u64 * src.height() as u64 * src.layers().len() as u64;
-        src_texels * RESAMPLE_SRC + cube_texels(face) * RESAMPLE_OUT
+        mirrorball_core::work::resample(src_texels, cube_texels(face))
     }
 
     /// A pyramid of the working cube of face `face`.

@@ -324,6 +324,11 @@ pub fn write(
     }
 }
 
+/// The work of packing (and, for ZIP, compressing) one texel as mirrorball's own writers
+/// do, in [`mirrorball_core::work`]'s units: what they count (PIZ, B44 and the others are
+/// written by the `exr` crate, which counts nothing).
+pub(crate) const EXR_WORK: u64 = 60;
+
 /// Bytes [`write`] holds besides `image` (`w`×`h`, `c` channels) while it writes it: for
 /// ZIP and ZIPS, a batch of 32 blocks compressed (at most their packed size) and each
 /// thread's packed block; uncompressed, its two line buffers; for the other compressions,
@@ -400,6 +405,7 @@ where
                         crate::exr_zip::THREAD_ZIP.with_borrow_mut(|deflater| {
                             crate::exr_zip::compress(raw, scratch, deflater, &mut packed)
                         });
+                        mirrorball_core::work::add(EXR_WORK * (bh * w) as u64);
                         Chunk {
                             layer_index: 0,
                             compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
@@ -472,6 +478,7 @@ fn write_uncompressed(
                 let y = start + k;
                 rec[..4].copy_from_slice(&((y0 + y as i64) as i32).to_le_bytes());
                 rec[4..8].copy_from_slice(&size.to_le_bytes());
+                mirrorball_core::work::add(EXR_WORK * w as u64);
                 pack_lines(
                     &data[y * w * c..(y + 1) * w * c],
                     w,

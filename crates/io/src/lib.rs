@@ -472,6 +472,27 @@ fn read_format(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     }
 }
 
+/// About the work of writing `texels` texels (every layer and level) as `format` with
+/// `opts`, in [`mirrorball_core::work`]'s units: what the writers count as they go, so a
+/// progress bar runs to it. 0 for what no writer counts (PNG, JPEG, OpenEXR written by the
+/// `exr` crate: PIZ, RLE, PXR24).
+pub fn write_work(format: Format, texels: u64, opts: &WriteOptions) -> u64 {
+    match format {
+        Format::Exr => match opts.exr_compression {
+            ExrCompression::Zip | ExrCompression::Zips | ExrCompression::None => {
+                exr_io::EXR_WORK * texels
+            }
+            _ => 0,
+        },
+        Format::Hdr => hdr_io::rgbe_work(texels),
+        Format::Ktx2 | Format::Dds => match opts.precision {
+            Some(Precision::Float) => Encoding::Rgba32F.work(texels),
+            _ => Encoding::Rgba16F.work(texels),
+        },
+        Format::Png | Format::Jpeg | Format::Webp => 0,
+    }
+}
+
 /// Writes one flat image (EXR, HDR, PNG or JPEG), atomically. (Several files that belong
 /// together: [`OutputSet`].)
 pub fn write_image(path: &Path, image: &Image, opts: &WriteOptions) -> Result<(), Error> {

@@ -5,7 +5,7 @@ use crate::budget;
 use crate::error::CliError;
 use crate::fit;
 use crate::guard::Files;
-use crate::progress::{with_progress, with_spinner};
+use crate::progress::{with_progress, with_spinner, writing};
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
@@ -366,9 +366,8 @@ pub fn run(a: ConvertArgs) -> Result<(), CliError> {
             let t_conv = t1.elapsed();
             drop(src);
             let t2 = Instant::now();
-            let saved = with_spinner("writing", a.quiet, || {
-                save::save(&out, &a.output, &plan.save)
-            })?;
+            let work = save::write_work(&a.output, &[&out], &plan.save);
+            let saved = writing(work, a.quiet, || save::save(&out, &a.output, &plan.save))?;
             plan.say_clipped(&a.output, &saved.report);
             (saved.files, t_conv, Some(t2.elapsed()))
         }
@@ -576,7 +575,8 @@ fn convert_pair(
     let t_conv = t1.elapsed();
     let eyes_read = eyes.len();
     drop(eyes);
-    let saved = with_spinner("writing", a.quiet, || {
+    let work = save::write_work(&a.output, &out.iter().collect::<Vec<_>>(), &plan.save);
+    let saved = writing(work, a.quiet, || {
         save::save_eyes(&out, plan.stereo, &a.output, &plan.save)
     })?;
     plan.say_clipped(&a.output, &saved.report);
