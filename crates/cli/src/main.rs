@@ -177,8 +177,13 @@ pub struct ConvertArgs {
     /// Write the full mip chain (KTX2/DDS).
     #[arg(long)]
     mips: bool,
-    /// Most points per axis when integrating over an output texel (1 = plain bilinear).
-    #[arg(long, default_value_t = mirrorball_core::ResampleOptions::default().max_samples)]
+    /// Most points per axis when integrating over an output texel, 1..=16 (1 = plain
+    /// bilinear).
+    #[arg(
+        long,
+        default_value_t = mirrorball_core::ResampleOptions::default().max_samples,
+        value_parser = clap::value_parser!(u32).range(1..=16)
+    )]
     max_samples: u32,
     /// Print nothing but errors.
     #[arg(short, long)]

@@ -154,7 +154,7 @@ impl Plan {
             resample: ResampleOptions {
                 rotation,
                 exposure: a.exposure,
-                max_samples: a.max_samples.max(1),
+                max_samples: a.max_samples,
                 progress: None,
                 progress_unit: 1,
             },
