@@ -4,9 +4,10 @@
 //! want of a margin, one that does not fit is refused before it starts) and at most 1.5×.
 //! Each run peaks at a few hundred MB, where the job's maps dominate the process's own.
 //!
-//! A test binary of its own: a child's `ru_maxrss` includes the resident memory of the
+//! A test binary of its own: a child's `ru_maxrss` starts at the resident memory of the
 //! process it was spawned from (the kernel counts the memory it leaves at `exec`), so the
-//! spawning process must stay small, which the other tests' in-process maps do not let it.
+//! spawning process must stay well under every child's peak, which the other tests'
+//! in-process maps do not let it (this one's, mostly its own mapped binary, is about 100 MB).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -154,10 +155,12 @@ fn estimates_hold_to_the_measured_peak() {
     ];
     let mut table = Vec::new();
     let mut wrong = Vec::new();
+    let mut least_peak = u64::MAX;
     for args in &cases {
         let t = std::time::Instant::now();
         let est = estimate(args);
         let peak = peak(args, &dir.path().join("log.txt"));
+        least_peak = least_peak.min(peak);
         let secs = t.elapsed().as_secs_f64();
         let ratio = est as f64 / peak as f64;
         let line = format!(
@@ -176,11 +179,13 @@ fn estimates_hold_to_the_measured_peak() {
         std::fs::create_dir(p("frames")).unwrap();
     }
     println!("{}", table.join("\n"));
-    // What every child's peak includes of this process (see the module's note).
+    // A child's peak starts at what it inherits of this process (see the module's note):
+    // it is the child's own only while this process stays well under every child's.
     assert!(
-        own_peak() < 100_000_000,
-        "the test process peaked at {} MB: its children's peaks include it",
-        own_peak() / 1_000_000
+        own_peak() < least_peak / 2,
+        "the test process peaked at {} MB, a child at {} MB: the children's peaks may be this process's",
+        own_peak() / 1_000_000,
+        least_peak / 1_000_000
     );
     assert!(
         wrong.is_empty(),
