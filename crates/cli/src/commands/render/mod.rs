@@ -61,15 +61,17 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
 
 /// The plan's environment and objects, loaded.
 fn load_scene(plan: &RenderPlan) -> Result<Scene, CliError> {
-    let environment = match &plan.env_file {
-        Some(f) => Some(load_environment(plan, f)?),
-        None => None,
-    };
+    // The meshes first: a missing or broken one is said before the environment, the longer
+    // read, is read.
     let objects = plan
         .objects
         .iter()
         .map(load_object)
         .collect::<Result<Vec<_>, _>>()?;
+    let environment = match &plan.env_file {
+        Some(f) => Some(load_environment(plan, f)?),
+        None => None,
+    };
     Ok(Scene {
         objects,
         environment,
