@@ -313,19 +313,32 @@ fn write_offsets(out: &mut Vec<u8>, offsets: &[u64], width: usize) {
     }
 }
 
-/// `stco`/`co64`: whether any offset moved, and whether it became `co64`.
-fn shift_chunk_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, bool), String> {
-    let p = t.payload().expect("a leaf");
-    let (count, width) = movie::table(&t.kind, p)?;
-    let old = read_offsets(p, 8, count, width);
+/// `old` offsets of `width` bytes, each [`moved`]: `None` when none moved, else the new
+/// offsets and whether they need 64 bits (they had them, or one passed 4 GiB).
+fn shifted(
+    old: &[u64],
+    width: usize,
+    at: &Span,
+    shift: i64,
+) -> Result<Option<(Vec<u64>, bool)>, String> {
     let new = old
         .iter()
         .map(|&o| moved(o, at, shift))
         .collect::<Result<Vec<_>, _>>()?;
     if new == old {
-        return Ok((false, false));
+        return Ok(None);
     }
     let wide = width == 8 || new.iter().any(|&o| o > u64::from(u32::MAX));
+    Ok(Some((new, wide)))
+}
+
+/// `stco`/`co64`: whether any offset moved, and whether it became `co64`.
+fn shift_chunk_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, bool), String> {
+    let p = t.payload().expect("a leaf");
+    let (count, width) = movie::table(&t.kind, p)?;
+    let Some((new, wide)) = shifted(&read_offsets(p, 8, count, width), width, at, shift)? else {
+        return Ok((false, false));
+    };
     let mut body = (count as u32).to_be_bytes().to_vec();
     write_offsets(&mut body, &new, if wide { 8 } else { 4 });
     let kind = if wide { *b"co64" } else { *b"stco" };
@@ -353,14 +366,9 @@ fn shift_aux_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, bool)
         ));
     }
     let old = read_offsets(p, head + 4, count, width);
-    let new = old
-        .iter()
-        .map(|&o| moved(o, at, shift))
-        .collect::<Result<Vec<_>, _>>()?;
-    if new == old {
+    let Some((new, wide)) = shifted(&old, width, at, shift)? else {
         return Ok((false, false));
-    }
-    let wide = width == 8 || new.iter().any(|&o| o > u64::from(u32::MAX));
+    };
     let mut body = p[4..head + 4].to_vec();
     write_offsets(&mut body, &new, if wide { 8 } else { 4 });
     let promoted = wide && width == 4;
