@@ -395,7 +395,7 @@ mod tests {
         ] {
             let e = parse("m", text, None).unwrap_err();
             assert!(e.message.contains(says), "{text:?}: {}", e.message);
-            assert_eq!(e.code(), 2);
+            assert_eq!(crate::error::exit_code(&e), 2);
         }
     }
 }

@@ -9,15 +9,11 @@
 //! - `manifest.rs` — JSON-lines or CSV manifests, each job a `convert` of its own;
 //!   `shard.rs` — `--shard i/n`; `log.rs` — the one JSON line per frame or job.
 
-mod log;
 mod manifest;
-mod packing;
-mod pattern;
-mod pipe;
-mod pipeline;
 mod record;
 mod sequence;
-mod shard;
+
+use mirrorball::frames::{log, packing, pattern, pipe, pipeline, shard};
 
 use crate::choice::names;
 use crate::error::CliError;

@@ -1,0 +1,12 @@
+//! Frames: many maps of one shape converted by one plan. File-name patterns of sequences
+//! ([`pattern`]), slices of a job for array schedulers ([`shard`]), raw video frames in
+//! FFmpeg's pixel formats ([`pipe`]), where each texel of a packed raw frame comes from
+//! ([`packing`]), the read → convert → write loop ([`pipeline`]) and the JSON line a job
+//! logs ([`log`]).
+
+pub mod log;
+pub mod packing;
+pub mod pattern;
+pub mod pipe;
+pub mod pipeline;
+pub mod shard;
