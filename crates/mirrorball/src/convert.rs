@@ -523,3 +523,12 @@ pub fn convert_layers(
     set.finish()?;
     Ok(report)
 }
+
+/// " x6" after a layer's size, for maps of several layers.
+pub fn times(layers: usize) -> String {
+    if layers > 1 {
+        format!(" x{layers}")
+    } else {
+        String::new()
+    }
+}

@@ -23,10 +23,17 @@
 //! - [`budget`]: memory estimates, refused with a message when a job would not fit.
 //! - [`guard`]: no output is an input or another output; every output can be written.
 //!
-//! ## Frames
-//! [`frames`]: file-name patterns, `--shard i/n`, raw video frames as FFmpeg's `rawvideo`
-//! pixel formats (`pipe`), the packing of a planned remap straight into output bytes, and
-//! the three-stage read → convert → write loop (`pipeline`).
+//! ## Conversions
+//! - [`convert`]: a [`convert::ConvertRequest`] (plain values) becomes a checked
+//!   [`convert::ConvertPlan`] before any file is read; the plan reads, checks memory and
+//!   converts.
+//! - [`frames`]: many frames by one planned remap: file-name patterns, `--shard i/n`, raw
+//!   video frames as FFmpeg's `rawvideo` pixel formats (`pipe`), the packing of a planned
+//!   remap straight into output bytes, the three-stage read → convert → write loop
+//!   (`pipeline`), and [`frames::run`] of a [`frames::FramesRequest`].
+//!
+//! Long jobs tell their caller what they do through [`Hooks`] (lines for people, progress);
+//! [`Quiet`] says nothing.
 //!
 //! ## Errors
 //! Every function returns [`Error`]: a message naming the file or setting and the problem,
@@ -38,6 +45,7 @@ pub mod error;
 pub mod fit;
 pub mod frames;
 pub mod guard;
+pub mod hooks;
 pub mod load;
 pub mod materials;
 pub mod save;
@@ -45,6 +53,7 @@ pub mod size;
 pub mod spec;
 
 pub use error::Error;
+pub use hooks::{Hooks, Quiet};
 pub use load::{load, InputPlan, Source};
 pub use mirrorball_bake as bake;
 pub use mirrorball_core as core;

@@ -8,9 +8,9 @@ use crate::progress::{with_progress, with_spinner, writing};
 use crate::save;
 use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
-use mirrorball::convert::{convert_layers, ConvertPlan, ConvertRequest};
+use mirrorball::convert::{convert_layers, times, ConvertPlan, ConvertRequest};
 use mirrorball_core::{resample, EnvMap, Remap, WorldProjection};
-use mirrorball_io::{Folders, Precision};
+use mirrorball_io::Precision;
 use std::ops::{Deref, DerefMut};
 use std::time::Instant;
 
@@ -81,24 +81,6 @@ fn parse<T: mirrorball_core::Choice>(
 }
 
 impl Plan {
-    /// The plan of `a`, its output written to files: each checked writable, its folders
-    /// made as `folders` says (one file's must exist; a sequence makes its own).
-    pub(crate) fn new(a: &ConvertArgs, folders: Folders) -> Result<Plan, CliError> {
-        Ok(Plan {
-            plan: ConvertPlan::new(&request(a)?, folders)?,
-            quiet: a.quiet,
-        })
-    }
-
-    /// The plan of `a` whose output goes elsewhere (a pipe: `a.output` only names the
-    /// container its frames are packed as), so no folder of it is checked.
-    pub(crate) fn unwritten(a: &ConvertArgs) -> Result<Plan, CliError> {
-        Ok(Plan {
-            plan: ConvertPlan::unwritten(&request(a)?)?,
-            quiet: a.quiet,
-        })
-    }
-
     /// Says what `file` could not hold (unless `--quiet`), with the ways to keep it.
     pub(crate) fn say_clipped(&self, file: &str, report: &fit::Report) {
         if let (Some(line), false) = (self.clipped_line(file, report), self.quiet) {
@@ -265,13 +247,4 @@ fn convert_pair(
         );
     }
     Ok(())
-}
-
-/// " x6" after a layer's size, for maps of several layers.
-pub(crate) fn times(layers: usize) -> String {
-    if layers > 1 {
-        format!(" x{layers}")
-    } else {
-        String::new()
-    }
 }

@@ -287,7 +287,10 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         let t = Instant::now();
         // A job of one conversion is recorded as a sequence's frame is (`record.rs`).
         let outs = outputs(&args);
-        let stamp = record::stamp(&record::settings(&args), Path::new(&args.input));
+        let stamp = record::stamp(
+            &record::settings(&super::frames_request(&args)?),
+            Path::new(&args.input),
+        );
         if let Some(o) = outs.as_ref().filter(|o| o.iter().all(|p| p.exists())) {
             match made.verdict(&o[0], stamp) {
                 _ if a.frames.overwrite => {}
