@@ -6,7 +6,7 @@
 //!
 //! The layers below it are re-exported: [`core`] (projections, maps, layouts, resampling
 //! and planned remaps; no I/O), [`io`] (every container, atomic writes), [`filter`] (mip
-//! pyramids, samplers, SH9, prefiltering) and [`render`] (the CPU renderer).
+//! pyramids, samplers, SH9, prefiltering) and [`renderer`] (the CPU renderer).
 //!
 //! ## Reading and writing
 //! - [`load`]: a file (or one file per layer, `{face}` in the name) into an [`EnvMap`] with
@@ -32,6 +32,10 @@
 //!   remap straight into output bytes, the three-stage read → convert → write loop
 //!   (`pipeline`), and [`frames::run`] of a [`frames::FramesRequest`].
 //!
+//! - [`render`]: a [`render::RenderRequest`] (the scene file's schema and the materials'
+//!   grammar in [`render::schema`] and [`materials`]) becomes a checked
+//!   [`render::RenderPlan`]; [`render::run`] loads, renders and writes.
+//!
 //! Long jobs tell their caller what they do through [`Hooks`] (lines for people, progress);
 //! [`Quiet`] says nothing.
 //!
@@ -48,6 +52,7 @@ pub mod guard;
 pub mod hooks;
 pub mod load;
 pub mod materials;
+pub mod render;
 pub mod save;
 pub mod size;
 pub mod spec;
@@ -60,7 +65,7 @@ pub use mirrorball_core as core;
 pub use mirrorball_core::{EnvMap, Fault, Layout, Projection, ProjectionKind};
 pub use mirrorball_filter as filter;
 pub use mirrorball_io as io;
-pub use mirrorball_render as render;
+pub use mirrorball_render as renderer;
 pub use mirrorball_spherical as spherical;
 pub use save::{save, SaveOptions, Saved};
 pub use spec::ProjSpec;

@@ -7,8 +7,8 @@ use super::prefilter::outputs;
 use crate::error::CliError;
 use crate::load;
 use crate::save::{self, SaveOptions};
-use crate::RenderArgs;
-use clap::{Args, Parser};
+use clap::Args;
+use mirrorball::render::RenderRequest;
 use mirrorball_io::WriteOptions;
 use mirrorball_studio::{Export, Host, Opened, SceneView, Studio};
 use std::io::Write;
@@ -67,30 +67,25 @@ fn is_scene(p: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("json") || e.eq_ignore_ascii_case("toml"))
 }
 
-/// `mirrorball render`'s arguments, as `render ARGS…` would parse them.
-#[derive(Parser)]
-struct AsRender {
-    #[command(flatten)]
-    args: RenderArgs,
-}
-
 /// The scene `render` would draw with `scene` (or its defaults) at one sample a pixel (the
 /// viewport's).
 fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
-    let mut argv: Vec<std::ffi::OsString> =
-        vec!["render".into(), "--quiet".into(), "--ss".into(), "1".into()];
+    let mut request = RenderRequest {
+        ss: 1,
+        given: vec!["ss".into()],
+        ..RenderRequest::default()
+    };
     match scene {
-        Some(s) => argv.push(s.into()),
-        // `render` wants an environment for a mirror: the scene waiting for one is planned
-        // with a material that needs none, then made a mirror.
-        None => argv.extend(["--material", "cheap-chrome", "--no-background"].map(Into::into)),
+        Some(s) => request.scene = Some(s.to_string_lossy().into_owned()),
+        // A mirror wants an environment: the scene waiting for one is planned with a
+        // material that needs none, then made a mirror.
+        None => {
+            request.material = "cheap-chrome".into();
+            request.no_background = true;
+        }
     }
-    let mut args = AsRender::try_parse_from(argv)
-        .map_err(|e| CliError::request(e.to_string()))?
-        .args;
-    args.given = vec!["ss".into()];
     let (mut scene_data, camera, settings, exposure, tone, builtins) =
-        super::render::studio_scene(&args)?;
+        mirrorball::render::studio_scene(&request)?;
     if scene.is_none() {
         scene_data.background = true;
         for o in &mut scene_data.objects {
@@ -104,7 +99,9 @@ fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
         settings,
         exposure,
         tone,
-        source: scene.map(super::render::schema::portable).transpose()?,
+        source: scene
+            .map(mirrorball::render::schema::portable)
+            .transpose()?,
         builtins,
     })
 }
@@ -197,14 +194,14 @@ impl CliHost {
         let written = dir.join(format!("scene.{ext}"));
         std::fs::write(&written, bytes).map_err(stored)?;
         let shown = written.display().to_string();
-        let as_written = super::render::schema::as_written(&written)
+        let as_written = mirrorball::render::schema::as_written(&written)
             .map_err(|e| e.to_string().replace(&shown, name))?;
         let files = dir.join("files");
         std::fs::create_dir(&files).map_err(stored)?;
         // What each file the scene names became, to name it as the scene does in messages.
         let mut renamed: Vec<(String, String)> = Vec::new();
         let mut resolved = as_written.clone();
-        super::render::schema::map_files(&mut resolved, |f| -> Result<String, String> {
+        mirrorball::render::schema::map_files(&mut resolved, |f| -> Result<String, String> {
             let file_name = Path::new(f).file_name().and_then(|n| n.to_str());
             let bytes: &[u8] = match alongside.iter().find(|(n, _)| Some(n.as_str()) == file_name) {
                 Some((_, b)) => b,

@@ -1,14 +1,14 @@
-//! `RenderArgs → RenderPlan`: every flag parsed and checked, the output's folder and format
+//! `RenderRequest → RenderPlan`: every flag parsed and checked, the output's folder and format
 //! checked, the scene file applied (the flags given on the command line winning over it),
 //! the meshes' triangles and the images' memory counted, before anything is loaded.
 
-use super::material::parse_material;
 use super::schema;
+use super::RenderRequest;
 use crate::budget;
-use crate::commands::InputPlan;
-use crate::error::CliError;
+use crate::error::Error;
+use crate::load::InputPlan;
+use crate::materials::parse_material;
 use crate::spec::{bad, parse_dir, ProjSpec};
-use crate::RenderArgs;
 use mirrorball_core::glam::{Mat4, Vec3};
 use mirrorball_core::{Choice, UnknownName, WorldProjection};
 use mirrorball_io::Format;
@@ -21,14 +21,14 @@ use std::path::{Path, PathBuf};
 
 /// Where a mesh comes from.
 #[derive(Clone, Debug)]
-pub(super) enum MeshSource {
+pub enum MeshSource {
     Builtin(Builtin, u32),
     File(PathBuf),
 }
 
 /// One object to load.
 #[derive(Clone, Debug)]
-pub(super) struct ObjectPlan {
+pub struct ObjectPlan {
     pub source: MeshSource,
     pub model: Mat4,
     /// Centre the file's mesh and scale it to unit size before `model`.
@@ -37,7 +37,7 @@ pub(super) struct ObjectPlan {
 }
 
 /// Everything `render` will do, checked.
-pub(super) struct RenderPlan {
+pub struct RenderPlan {
     pub objects: Vec<ObjectPlan>,
     pub env_file: Option<String>,
     pub input: InputPlan,
@@ -63,15 +63,14 @@ pub(super) struct RenderPlan {
     pub fisheye: Option<(mirrorball_core::Lens, f64)>,
     /// Pan since the previous frame, radians (motion blur).
     pub pan_blur: Option<f32>,
-    pub quiet: bool,
 }
 
-fn parse_vec3(option: &str, s: &str) -> Result<Vec3, CliError> {
+fn parse_vec3(option: &str, s: &str) -> Result<Vec3, Error> {
     let d = parse_dir(s).map_err(|e| bad(option, e))?;
     Ok(d.as_vec3())
 }
 
-fn parse_point(option: &str, s: &str) -> Result<Vec3, CliError> {
+fn parse_point(option: &str, s: &str) -> Result<Vec3, Error> {
     let parts: Vec<f32> = s
         .split(',')
         .map(|p| p.trim().parse::<f32>())
@@ -83,7 +82,7 @@ fn parse_point(option: &str, s: &str) -> Result<Vec3, CliError> {
     Ok(Vec3::new(parts[0], parts[1], parts[2]))
 }
 
-fn parse_colour(option: &str, s: &str) -> Result<[f32; 3], CliError> {
+fn parse_colour(option: &str, s: &str) -> Result<[f32; 3], Error> {
     let v = parse_point(option, s)?;
     if v.min_element() < 0.0 {
         return Err(bad(option, format!("'{s}' has a negative channel")));
@@ -93,7 +92,7 @@ fn parse_colour(option: &str, s: &str) -> Result<[f32; 3], CliError> {
 
 /// The sides an image written to `output` as `format` may have (the size rule:
 /// `crate::size`).
-pub(super) fn side_bound(output: &Path, format: Format) -> crate::size::Bound {
+pub fn side_bound(output: &Path, format: Format) -> crate::size::Bound {
     let what = output.display().to_string();
     crate::size::pictures(format, &what, |n| (n as u64, 1))
 }
@@ -101,7 +100,7 @@ pub(super) fn side_bound(output: &Path, format: Format) -> crate::size::Bound {
 /// `--size WIDTHxHEIGHT` of an image written as `format`: each side within what the
 /// container holds and mirrorball reads back, as the size rule says (`crate::size`), and
 /// the picture within mirrorball's reading bound.
-fn parse_size(s: &str, output: &Path, format: Format) -> Result<(u32, u32), CliError> {
+fn parse_size(s: &str, output: &Path, format: Format) -> Result<(u32, u32), Error> {
     let not_a_size = || bad("--size", format!("'{s}' is not WIDTHxHEIGHT"));
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(not_a_size)?;
     let (w, h) = (
@@ -128,7 +127,7 @@ fn parse_size(s: &str, output: &Path, format: Format) -> Result<(u32, u32), CliE
 }
 
 /// A built-in's name (at `level`, or its default tessellation) or a mesh file's path.
-pub(super) fn parse_object(s: &str, level: Option<u32>) -> Result<MeshSource, CliError> {
+pub fn parse_object(s: &str, level: Option<u32>) -> Result<MeshSource, Error> {
     if let Ok(b) = s.parse::<Builtin>() {
         let l = level.unwrap_or(b.default_tessellation());
         if !(1..=4096).contains(&l) {
@@ -167,7 +166,7 @@ pub(super) fn parse_object(s: &str, level: Option<u32>) -> Result<MeshSource, Cl
 }
 
 /// `--mode`, in the words of its message.
-fn parse_mode(s: &str) -> Result<Indexing, CliError> {
+fn parse_mode(s: &str) -> Result<Indexing, Error> {
     Indexing::from_name(s).ok_or_else(|| {
         let known: Vec<String> = Indexing::all()
             .map(|m| format!("{}|{}", m.number(), m.name()))
@@ -178,7 +177,7 @@ fn parse_mode(s: &str) -> Result<Indexing, CliError> {
 }
 
 /// `--material` with `--tint` and `--f0` as its defaults.
-fn flag_material(a: &RenderArgs) -> Result<Material, CliError> {
+fn flag_material(a: &RenderRequest) -> Result<Material, Error> {
     let tint = parse_colour("--tint", &a.tint)?;
     if !(0.0..=1.0).contains(&a.f0) {
         return Err(bad("--f0", format!("{} is outside [0, 1]", a.f0)));
@@ -188,7 +187,7 @@ fn flag_material(a: &RenderArgs) -> Result<Material, CliError> {
 
 /// The camera of `--eye`, `--target`, `--up`, `--fov` or `--ortho`, `--near`, `--far`,
 /// `w`×`h` pixels.
-fn flag_camera(a: &RenderArgs, (width, height): (u32, u32)) -> Result<Camera, CliError> {
+fn flag_camera(a: &RenderRequest, (width, height): (u32, u32)) -> Result<Camera, Error> {
     let eye = parse_point("--eye", &a.eye)?;
     let target = parse_point("--target", &a.target)?;
     let up = parse_vec3("--up", &a.up)?;
@@ -211,7 +210,7 @@ fn flag_camera(a: &RenderArgs, (width, height): (u32, u32)) -> Result<Camera, Cl
 }
 
 /// `--object` (at `--tessellation`) with `material`.
-fn flag_object(a: &RenderArgs, material: Material) -> Result<ObjectPlan, CliError> {
+fn flag_object(a: &RenderRequest, material: Material) -> Result<ObjectPlan, Error> {
     let source = parse_object(&a.object, a.tessellation)?;
     Ok(ObjectPlan {
         normalize: matches!(source, MeshSource::File(_)),
@@ -222,7 +221,7 @@ fn flag_object(a: &RenderArgs, material: Material) -> Result<ObjectPlan, CliErro
 }
 
 /// `--env-as` at `--env-size`.
-fn flag_env_as(a: &RenderArgs) -> Result<Option<(ProjSpec, u32)>, CliError> {
+fn flag_env_as(a: &RenderRequest) -> Result<Option<(ProjSpec, u32)>, Error> {
     let Some(s) = &a.env_as else {
         return Ok(None);
     };
@@ -240,7 +239,7 @@ fn flag_env_as(a: &RenderArgs) -> Result<Option<(ProjSpec, u32)>, CliError> {
 
 /// `--output`: its format (one render writes); its folder is checked with every output's
 /// (`output::files`).
-fn flag_output(a: &RenderArgs) -> Result<(PathBuf, Format), CliError> {
+fn flag_output(a: &RenderRequest) -> Result<(PathBuf, Format), Error> {
     let output = PathBuf::from(&a.output);
     let format = Format::from_path(&output).ok_or_else(|| {
         bad(
@@ -268,7 +267,7 @@ fn flag_output(a: &RenderArgs) -> Result<(PathBuf, Format), CliError> {
 }
 
 /// `--fisheye` with `--fisheye-lens`: a field of view the lens covers, and no diagnostics.
-fn flag_fisheye(a: &RenderArgs) -> Result<Option<(mirrorball_core::Lens, f64)>, CliError> {
+fn flag_fisheye(a: &RenderRequest) -> Result<Option<(mirrorball_core::Lens, f64)>, Error> {
     let Some(fov) = a.fisheye else {
         return Ok(None);
     };
@@ -278,9 +277,9 @@ fn flag_fisheye(a: &RenderArgs) -> Result<Option<(mirrorball_core::Lens, f64)>, 
         .map_err(|e| bad("--fisheye-lens", e.to_string()))?;
     lens.fov_range()
         .check("--fisheye", fov)
-        .map_err(|e| CliError::request(format!("{e} (the {} lens)", lens.name())))?;
+        .map_err(|e| Error::request(format!("{e} (the {} lens)", lens.name())))?;
     if a.aovs || a.diagnostics {
-        return Err(CliError::request(
+        return Err(Error::request(
             "--fisheye: the diagnostic channels and diagram are made for the cube views, not the fisheye; drop --aovs/--diagnostics",
         ));
     }
@@ -288,7 +287,7 @@ fn flag_fisheye(a: &RenderArgs) -> Result<Option<(mirrorball_core::Lens, f64)>, 
 }
 
 /// `--pan-blur`, in radians.
-fn flag_pan_blur(a: &RenderArgs) -> Result<Option<f32>, CliError> {
+fn flag_pan_blur(a: &RenderRequest) -> Result<Option<f32>, Error> {
     match a.pan_blur {
         Some(d) if d.is_finite() && d.abs() < 180.0 => Ok(Some(d.to_radians())),
         Some(d) => Err(bad("--pan-blur", format!("{d}° is outside (−180°, 180°)"))),
@@ -298,8 +297,8 @@ fn flag_pan_blur(a: &RenderArgs) -> Result<Option<f32>, CliError> {
 
 impl RenderPlan {
     /// The plan of the flags, then of the scene file (if any), checked whole.
-    pub fn new(a: &RenderArgs) -> Result<RenderPlan, CliError> {
-        let input = crate::commands::input_plan(&a.input_args)?;
+    pub fn new(a: &RenderRequest) -> Result<RenderPlan, Error> {
+        let input = a.input.clone();
         let indexing = parse_mode(&a.mode)?;
         let attach = a
             .attach
@@ -352,7 +351,6 @@ impl RenderPlan {
             diagnostics: a.diagnostics,
             fisheye: flag_fisheye(a)?,
             pan_blur: flag_pan_blur(a)?,
-            quiet: a.quiet,
         };
         if let Some(scene) = &a.scene {
             schema::apply(&mut plan, Path::new(scene), &a.given)?;
@@ -372,13 +370,13 @@ impl RenderPlan {
     }
 
     /// An environment map, unless nothing reads one.
-    fn check_environment(&self) -> Result<(), CliError> {
+    fn check_environment(&self) -> Result<(), Error> {
         let needs_env =
             self.background || self.objects.iter().any(|o| o.material.uses_environment());
         if !needs_env || self.env_file.is_some() {
             return Ok(());
         }
-        Err(CliError::request(match &self.scene {
+        Err(Error::request(match &self.scene {
             Some(scene) => format!(
                 "{scene}: no environment map: give `environment.file` in the scene or \
                  --env (or use materials that need none, cheap-chrome or diffuse, with \
@@ -392,7 +390,7 @@ impl RenderPlan {
 
     /// Each built-in is within the budget; so must they be together (a scene can list any
     /// number).
-    fn check_triangles(&self) -> Result<(), CliError> {
+    fn check_triangles(&self) -> Result<(), Error> {
         let triangles: u64 = self
             .objects
             .iter()
@@ -402,7 +400,7 @@ impl RenderPlan {
             })
             .sum();
         if triangles > MAX_TRIANGLES {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "{}the built-in meshes make {triangles} triangles in all; at most \
                  {MAX_TRIANGLES} are allowed: lower their tessellations",
                 self.scene_prefix(),
@@ -412,7 +410,7 @@ impl RenderPlan {
     }
 
     /// The images within the memory budget.
-    fn check_memory(&self) -> Result<(), CliError> {
+    fn check_memory(&self) -> Result<(), Error> {
         let (w, h) = (self.camera.width, self.camera.height);
         let frames = if self.frames > 1 {
             format!(", {} frames", self.frames)

@@ -1,9 +1,9 @@
 //! Scene files (`docs/render-scene.md`, `examples/scenes/`): JSON or TOML, one schema, read
 //! into the plan; the flags given on the command line then win over what the file set.
 
-use super::material::{material_of, MaterialEntry};
 use super::plan::{parse_object, MeshSource, ObjectPlan, RenderPlan};
-use crate::error::CliError;
+use crate::error::Error;
+use crate::materials::{material_of, MaterialEntry};
 use crate::spec::{bad, ProjSpec};
 use mirrorball_core::glam::{Mat4, Vec3};
 use mirrorball_core::{Choice, Fault};
@@ -74,7 +74,7 @@ struct EnvEntry {
 
 /// Applies the scene file at `path` to the plan of the flags, then puts back what the flags
 /// in `given` (clap's ids) set.
-pub(super) fn apply(plan: &mut RenderPlan, path: &Path, given: &[String]) -> Result<(), CliError> {
+pub fn apply(plan: &mut RenderPlan, path: &Path, given: &[String]) -> Result<(), Error> {
     let flags = FlagValues::of(plan);
     let scene = Scene::read(path)?;
     scene.apply(plan)?;
@@ -86,10 +86,10 @@ pub(super) fn apply(plan: &mut RenderPlan, path: &Path, given: &[String]) -> Res
 /// checked as `render` reads it, then its environment's file and each mesh that is not a
 /// built-in made absolute (they are relative to the scene file's folder). The studio
 /// exports the scene from it.
-pub fn portable(path: &Path) -> Result<serde_json::Value, CliError> {
+pub fn portable(path: &Path) -> Result<serde_json::Value, Error> {
     let scene = Scene::read(path)?;
     let mut v = scene.as_json()?;
-    map_files(&mut v, |f| -> Result<String, CliError> {
+    map_files(&mut v, |f| -> Result<String, Error> {
         let p = scene.relative(f);
         Ok(std::path::absolute(&p).map_or(p, |a| a.to_string_lossy().into_owned()))
     })?;
@@ -98,7 +98,7 @@ pub fn portable(path: &Path) -> Result<serde_json::Value, CliError> {
 
 /// The scene file at `path` as JSON, checked as `render` reads it (its messages), the files
 /// it names as it wrote them.
-pub fn as_written(path: &Path) -> Result<serde_json::Value, CliError> {
+pub fn as_written(path: &Path) -> Result<serde_json::Value, Error> {
     Scene::read(path)?.as_json()
 }
 
@@ -140,7 +140,7 @@ struct Scene<'a> {
 
 impl<'a> Scene<'a> {
     /// Reads and parses `path`, TOML by its extension, else JSON.
-    fn read(path: &'a Path) -> Result<Scene<'a>, CliError> {
+    fn read(path: &'a Path) -> Result<Scene<'a>, Error> {
         let name = path.display();
         // A picture's name where the scene goes is the output given without -o.
         let hint = if mirrorball_io::Format::from_path(path).is_some() {
@@ -149,7 +149,7 @@ impl<'a> Scene<'a> {
             ""
         };
         let cannot = |fault, why: &dyn std::fmt::Display| {
-            CliError::new(
+            Error::new(
                 fault,
                 format!("{name}: cannot read the scene file: {why}{hint}"),
             )
@@ -163,18 +163,18 @@ impl<'a> Scene<'a> {
         let text = std::fs::read_to_string(path).map_err(|e| cannot(Fault::of_io(e.kind()), &e))?;
         let file: SceneFile = if is_toml(path) {
             toml::from_str(&text)
-                .map_err(|e| CliError::input(format!("{name}: not a valid TOML scene: {e}")))?
+                .map_err(|e| Error::input(format!("{name}: not a valid TOML scene: {e}")))?
         } else {
             serde_json::from_str(&text)
-                .map_err(|e| CliError::input(format!("{name}: not a valid JSON scene: {e}")))?
+                .map_err(|e| Error::input(format!("{name}: not a valid JSON scene: {e}")))?
         };
         Ok(Scene { file, path })
     }
 
     /// The file as JSON (a TOML file's tables as JSON objects).
-    fn as_json(&self) -> Result<serde_json::Value, CliError> {
+    fn as_json(&self) -> Result<serde_json::Value, Error> {
         let text = std::fs::read_to_string(self.path)
-            .map_err(|e| CliError::input(format!("{}: {e}", self.path.display())))?;
+            .map_err(|e| Error::input(format!("{}: {e}", self.path.display())))?;
         if self.is_toml() {
             toml::from_str(&text).map_err(|e| self.error(e.to_string()))
         } else {
@@ -199,12 +199,12 @@ impl<'a> Scene<'a> {
     }
 
     /// The input's fault, in the file's name.
-    fn error(&self, e: String) -> CliError {
-        CliError::input(format!("{}: {e}", self.path.display()))
+    fn error(&self, e: String) -> Error {
+        Error::input(format!("{}: {e}", self.path.display()))
     }
 
     /// Lets what the file says override the plan's values.
-    fn apply(&self, plan: &mut RenderPlan) -> Result<(), CliError> {
+    fn apply(&self, plan: &mut RenderPlan) -> Result<(), Error> {
         let sf = &self.file;
         self.apply_meshes(plan)?;
         if let Some(c) = &sf.camera {
@@ -232,7 +232,7 @@ impl<'a> Scene<'a> {
 
     /// The file's meshes replace the flag's object; its default material replaces the
     /// flag's material.
-    fn apply_meshes(&self, plan: &mut RenderPlan) -> Result<(), CliError> {
+    fn apply_meshes(&self, plan: &mut RenderPlan) -> Result<(), Error> {
         let sf = &self.file;
         let default_material = match &sf.material {
             Some(m) => material_of(m).map_err(|e| self.error(e))?,
@@ -260,7 +260,7 @@ impl<'a> Scene<'a> {
         i: usize,
         m: &MeshEntry,
         default_material: &Material,
-    ) -> Result<ObjectPlan, CliError> {
+    ) -> Result<ObjectPlan, Error> {
         let source = match Builtin::from_name(&m.mesh) {
             Some(_) => parse_object(&m.mesh, m.tessellation),
             None => parse_object(&self.relative(&m.mesh), None),
@@ -292,7 +292,7 @@ impl<'a> Scene<'a> {
         c: &CameraEntry,
         flags: &Camera,
         side: &crate::size::Bound,
-    ) -> Result<Camera, CliError> {
+    ) -> Result<Camera, Error> {
         let lens = match (c.ortho_half_height, c.fov) {
             (Some(h), _) => CameraLens::Orthographic { half_height: h },
             (None, Some(f)) => CameraLens::Perspective { fov_y_deg: f },
@@ -330,7 +330,7 @@ impl<'a> Scene<'a> {
     }
 
     /// `environment`: the map, its projection, attachment, filter and intensity.
-    fn apply_environment(&self, e: &EnvEntry, plan: &mut RenderPlan) -> Result<(), CliError> {
+    fn apply_environment(&self, e: &EnvEntry, plan: &mut RenderPlan) -> Result<(), Error> {
         plan.env_file = Some(self.relative(&e.file));
         if let Some(p) = &e.projection {
             plan.input.from = Some(

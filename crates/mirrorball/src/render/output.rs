@@ -3,8 +3,9 @@
 //! diagram beside it, and a turntable's frames as one animated PNG.
 
 use super::plan::{MeshSource, RenderPlan};
-use crate::error::CliError;
+use crate::error::Error;
 use crate::guard::Files;
+use crate::hooks::Hooks;
 use mirrorball_core::Image;
 use mirrorball_io::{Format, Precision, WriteOptions};
 use mirrorball_render::tone;
@@ -34,7 +35,7 @@ fn ext_of(f: Format) -> &'static str {
 
 impl RenderPlan {
     /// The file of frame `i`: the output itself, or `NAME-0000.EXT`… for a turntable.
-    pub(super) fn frame_path(&self, i: usize) -> PathBuf {
+    pub fn frame_path(&self, i: usize) -> PathBuf {
         if self.frames > 1 {
             sibling(&self.output, &format!("{i:04}"), ext_of(self.format))
         } else {
@@ -43,7 +44,7 @@ impl RenderPlan {
     }
 
     /// Whether the frames are also written as one animated PNG.
-    pub(super) fn animated(&self) -> bool {
+    pub fn animated(&self) -> bool {
         self.frames > 1 && self.format == Format::Png
     }
 
@@ -52,17 +53,15 @@ impl RenderPlan {
         sibling(&self.output, "turntable", "png")
     }
 
-    /// Prints that `p` was written, unless quiet.
-    fn wrote(&self, p: &Path) {
-        if !self.quiet {
-            eprintln!("wrote {}", p.display());
-        }
+    /// Says that `p` was written.
+    fn wrote(&self, p: &Path, hooks: &dyn Hooks) {
+        hooks.note(&format!("wrote {}", p.display()));
     }
 }
 
 /// Every file the render reads and writes, checked so that no output is an input or
 /// another output.
-pub(super) fn files(plan: &RenderPlan) -> Files {
+pub fn files(plan: &RenderPlan) -> Files {
     let mut f = Files::new();
     if let Some(e) = &plan.env_file {
         f.input_arg("the environment", e);
@@ -96,7 +95,7 @@ pub(super) fn files(plan: &RenderPlan) -> Files {
 
 /// About how many bytes the render writes: each frame (four channels, before compression),
 /// its diagnostic channels (four RGB `f32` EXRs) and diagram, and the animated PNG.
-pub(super) fn bytes(plan: &RenderPlan) -> u64 {
+pub fn bytes(plan: &RenderPlan) -> u64 {
     let pixels = plan.camera.width as u64 * plan.camera.height as u64;
     let mut frame = plan.format.bytes_estimate(pixels, 4, None);
     if plan.aovs {
@@ -113,7 +112,12 @@ pub(super) fn bytes(plan: &RenderPlan) -> u64 {
 
 /// A frame's colour in the output's format: for PNG and JPEG exposed and tone-mapped, for
 /// EXR and HDR linear times 2^exposure; JPEG and HDR without alpha.
-fn write_colour(path: &Path, img: &Image, plan: &RenderPlan) -> Result<(), CliError> {
+fn write_colour(
+    path: &Path,
+    img: &Image,
+    plan: &RenderPlan,
+    hooks: &dyn Hooks,
+) -> Result<(), Error> {
     let img = match plan.format {
         Format::Png | Format::Jpeg => tone::to_display(img, plan.exposure, plan.tone),
         _ => {
@@ -136,30 +140,31 @@ fn write_colour(path: &Path, img: &Image, plan: &RenderPlan) -> Result<(), CliEr
         plan.exposure,
         &report,
     )];
-    if let (Some(line), false) = (report.line(&path.display().to_string(), &keep), plan.quiet) {
-        eprintln!("{line}");
+    if let Some(line) = report.line(&path.display().to_string(), &keep) {
+        hooks.note(&line);
     }
     mirrorball_io::write_image(path, &img, &WriteOptions::default())?;
     Ok(())
 }
 
 /// Frame `i` and, as the plan asks, its diagram and diagnostic channels.
-pub(super) fn write_frame(
+pub fn write_frame(
     plan: &RenderPlan,
     scene: &Scene,
     i: usize,
     f: &Rendered,
-) -> Result<(), CliError> {
+    hooks: &dyn Hooks,
+) -> Result<(), Error> {
     let path = plan.frame_path(i);
-    write_colour(&path, &f.color, plan)?;
-    plan.wrote(&path);
+    write_colour(&path, &f.color, plan, hooks)?;
+    plan.wrote(&path, hooks);
     if plan.diagnostics {
         let cam = plan.frame_camera(i);
         let d = mirrorball_render::texture_space_diagram(scene, &cam, &plan.settings, f, 512)
-            .map_err(|e| CliError::from(e).context("--diagnostics"))?;
+            .map_err(|e| Error::from(e).context("--diagnostics"))?;
         let p = sibling(&path, "diag", "png");
         mirrorball_io::write_image(&p, &d, &WriteOptions::default())?;
-        plan.wrote(&p);
+        plan.wrote(&p, hooks);
     }
     if let Some(aovs) = f.aovs.as_ref().filter(|_| plan.aovs) {
         let opts = WriteOptions {
@@ -170,25 +175,27 @@ pub(super) fn write_frame(
         for (tag, img) in AOV_TAGS.into_iter().zip(images) {
             let p = sibling(&path, tag, "exr");
             mirrorball_io::write_image(&p, img, &opts)?;
-            plan.wrote(&p);
+            plan.wrote(&p, hooks);
         }
     }
     Ok(())
 }
 
 /// The turntable's frames, tone-mapped, as one animated PNG at 24 frames a second.
-pub(super) fn write_animation(plan: &RenderPlan, frames: &[Image]) -> Result<(), CliError> {
+pub fn write_animation(
+    plan: &RenderPlan,
+    frames: &[Image],
+    hooks: &dyn Hooks,
+) -> Result<(), Error> {
     if frames.is_empty() {
         return Ok(());
     }
     let p = plan.animation_path();
     mirrorball_io::write_apng(&p, frames, 24)?;
-    if !plan.quiet {
-        eprintln!(
-            "wrote {} (animated PNG, {} frames)",
-            p.display(),
-            frames.len()
-        );
-    }
+    hooks.note(&format!(
+        "wrote {} (animated PNG, {} frames)",
+        p.display(),
+        frames.len()
+    ));
     Ok(())
 }
