@@ -1,7 +1,6 @@
 //! Named choices on the command line: the help lists each flag's values from the table of
 //! the [`Choice`] that owns them, the one the plan parses the flag's text with.
 
-use crate::error::CliError;
 use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
 use mirrorball_core::Choice;
 
@@ -28,17 +27,7 @@ pub fn names_of<T: Choice>(offered: &[T]) -> Names {
     )
 }
 
-/// The value of `T` that `given` (the text of `flag`) names, or the request's error
-/// `FLAG: unknown 'given' (a, b, c)`, listing the canonical names.
-pub fn parse_flag<T: Choice>(flag: &str, given: &str) -> Result<T, CliError> {
-    T::parse_name(given).map_err(|e| {
-        CliError::request(format!(
-            "{flag}: unknown '{}' ({})",
-            e.given.to_ascii_lowercase(),
-            e.list()
-        ))
-    })
-}
+pub use mirrorball::spec::parse_flag;
 
 impl TypedValueParser for Names {
     type Value = String;

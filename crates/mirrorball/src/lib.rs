@@ -36,6 +36,10 @@
 //!   grammar in [`render::schema`] and [`materials`]) becomes a checked
 //!   [`render::RenderPlan`]; [`render::run`] loads, renders and writes.
 //!
+//! - [`prefilter`]: a [`prefilter::PrefilterRequest`] becomes a checked
+//!   [`prefilter::Plan`]; [`prefilter::run`] reads, prefilters and writes the chain, its SH9
+//!   JSON, preview and BRDF table.
+//!
 //! Long jobs tell their caller what they do through [`Hooks`] (lines for people, progress);
 //! [`Quiet`] says nothing.
 //!
@@ -52,6 +56,7 @@ pub mod guard;
 pub mod hooks;
 pub mod load;
 pub mod materials;
+pub mod prefilter;
 pub mod render;
 pub mod save;
 pub mod size;

@@ -10,7 +10,6 @@ use crate::spec::{bad, ProjSpec};
 use crate::{load, ConvertArgs};
 use mirrorball::convert::{convert_layers, times, ConvertPlan, ConvertRequest};
 use mirrorball_core::{resample, EnvMap, Remap, WorldProjection};
-use mirrorball_io::Precision;
 use std::ops::{Deref, DerefMut};
 use std::time::Instant;
 
@@ -34,10 +33,7 @@ impl DerefMut for Plan {
     }
 }
 
-pub fn parse_precision(p: Option<&str>) -> Result<Option<Precision>, CliError> {
-    p.map(|p| crate::choice::parse_flag("--precision", p))
-        .transpose()
-}
+pub use mirrorball::spec::parse_precision;
 
 /// `a`'s flags as the library's request.
 pub(crate) fn request(a: &ConvertArgs) -> Result<ConvertRequest, CliError> {

@@ -14,7 +14,6 @@ pub mod tag;
 use crate::error::CliError;
 use crate::spec::{bad, ProjSpec};
 use crate::InputArgs;
-use mirrorball_core::Layout;
 
 pub use mirrorball::load::InputPlan;
 
@@ -34,10 +33,4 @@ pub fn input_plan(a: &InputArgs) -> Result<InputPlan, CliError> {
     })
 }
 
-/// A layout flag's value, if given.
-pub fn parse_layout(flag: &str, given: Option<&str>) -> Result<Option<Layout>, CliError> {
-    given
-        .map(str::parse::<Layout>)
-        .transpose()
-        .map_err(|e| bad(flag, e))
-}
+pub use mirrorball::spec::parse_layout;

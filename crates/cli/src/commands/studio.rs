@@ -3,11 +3,11 @@
 //! environments, so that the page shows the CLI's messages; the URL (with its token) is the
 //! first line of standard output.
 
-use super::prefilter::outputs;
 use crate::error::CliError;
 use crate::load;
 use crate::save::{self, SaveOptions};
 use clap::Args;
+use mirrorball::prefilter::outputs;
 use mirrorball::render::RenderRequest;
 use mirrorball_io::WriteOptions;
 use mirrorball_studio::{Export, Host, Opened, SceneView, Studio};

@@ -3,7 +3,7 @@
 //! and the line that reports them.
 
 use super::plan::Plan;
-use crate::error::CliError;
+use crate::error::Error;
 use crate::fit;
 use crate::load;
 use crate::save;
@@ -17,7 +17,7 @@ use serde_json::json;
 use std::path::{Path, PathBuf};
 
 /// `dir/stem{suffix}` beside `out`.
-pub(super) fn beside(out: &str, suffix: &str) -> PathBuf {
+pub fn beside(out: &str, suffix: &str) -> PathBuf {
     let p = Path::new(out);
     let stem = p
         .file_stem()
@@ -29,7 +29,7 @@ pub(super) fn beside(out: &str, suffix: &str) -> PathBuf {
 }
 
 /// The file for level `i` of a flat (one file per level) output.
-pub(super) fn level_path(out: &str, i: usize) -> String {
+pub fn level_path(out: &str, i: usize) -> String {
     if out.contains("{level}") {
         return out.replace("{level}", &i.to_string());
     }
@@ -63,7 +63,7 @@ fn by_folder(paths: &[&Path]) -> Vec<(PathBuf, Vec<String>)> {
 /// Refuses, before any work, to replace a side file (SH JSON, preview, BRDF table) that
 /// no mirrorball run wrote (its folder's record, `mirrorball_io::Owned`, does not list
 /// it), unless `overwrite`: the message names the file.
-pub(super) fn check_side_files(paths: &[&Path], overwrite: bool) -> Result<(), CliError> {
+pub fn check_side_files(paths: &[&Path], overwrite: bool) -> Result<(), Error> {
     for (dir, names) in by_folder(paths) {
         mirrorball_io::Owned::read(&dir)?.check(&names, overwrite)?;
     }
@@ -73,7 +73,7 @@ pub(super) fn check_side_files(paths: &[&Path], overwrite: bool) -> Result<(), C
 /// Records the side files in their folders' records, just before they are written: a run
 /// stopped between the two leaves a record naming a file that is not there, which costs
 /// nothing, where the other order would leave a file of ours that the next run refuses.
-pub(super) fn record_side_files(paths: &[&Path]) -> Result<(), CliError> {
+pub fn record_side_files(paths: &[&Path]) -> Result<(), Error> {
     for (dir, names) in by_folder(paths) {
         let mut owned = mirrorball_io::Owned::read(&dir)?;
         if names.iter().all(|n| owned.owns(n)) {
@@ -87,10 +87,7 @@ pub(super) fn record_side_files(paths: &[&Path]) -> Result<(), CliError> {
 
 /// The chain: one cube container, or each level's file(s). Returns the files written and
 /// what their storage could not hold, each level a part of the report.
-pub(super) fn write_chain(
-    plan: &Plan,
-    chain: &[EnvMap],
-) -> Result<(Vec<String>, fit::Report), CliError> {
+pub fn write_chain(plan: &Plan, chain: &[EnvMap]) -> Result<(Vec<String>, fit::Report), Error> {
     let mut written = Vec::new();
     if plan.format.is_cube_container() {
         let report = write_cube_chain(
@@ -115,12 +112,12 @@ pub(super) fn write_chain(
 /// `prefilter` writes, and the studio's download of its chain. Each level is measured
 /// against the file's storage first (NaN and infinities the work made replaced by 0 unless
 /// `keep_invalid`); returns what the file could not hold.
-pub(crate) fn write_cube_chain(
+pub fn write_cube_chain(
     path: &Path,
     chain: &[EnvMap],
     write: &WriteOptions,
     keep_invalid: bool,
-) -> Result<fit::Report, CliError> {
+) -> Result<fit::Report, Error> {
     let storage = Format::from_path(path)
         .unwrap_or(Format::Ktx2)
         .storage(write.precision);
@@ -148,7 +145,7 @@ fn describe(lobe: &Lobe) -> serde_json::Value {
 }
 
 /// What the chain's JSON says besides the coefficients.
-pub(super) struct Described<'a> {
+pub struct Described<'a> {
     pub chain: &'a [EnvMap],
     pub lobes: &'a [Lobe],
     pub projection: &'a Projection,
@@ -206,12 +203,7 @@ fn sh_document(plan: &Plan, sh9: &sh::Sh9, d: &Described) -> serde_json::Value {
 }
 
 /// The SH JSON at `p`.
-pub(super) fn write_sh(
-    plan: &Plan,
-    p: &Path,
-    sh9: &sh::Sh9,
-    d: &Described,
-) -> Result<(), CliError> {
+pub fn write_sh(plan: &Plan, p: &Path, sh9: &sh::Sh9, d: &Described) -> Result<(), Error> {
     let text =
         serde_json::to_string_pretty(&sh_document(plan, sh9, d)).expect("JSON values serialise");
     mirrorball_io::atomic_write(p, |w| {
@@ -223,7 +215,7 @@ pub(super) fn write_sh(
 }
 
 /// The preview sheet at `p`, 8-bit.
-pub(super) fn write_preview(plan: &Plan, p: &Path, chain: &[EnvMap]) -> Result<(), CliError> {
+pub fn write_preview(plan: &Plan, p: &Path, chain: &[EnvMap]) -> Result<(), Error> {
     let sheet = preview_sheet(chain, plan.preview_exposure);
     mirrorball_io::write_image(
         p,
@@ -237,7 +229,7 @@ pub(super) fn write_preview(plan: &Plan, p: &Path, chain: &[EnvMap]) -> Result<(
 }
 
 /// The split-sum BRDF table at `p`: 16-bit in a PNG, float in an EXR.
-pub(super) fn write_lut(plan: &Plan, p: &Path) -> Result<(), CliError> {
+pub fn write_lut(plan: &Plan, p: &Path) -> Result<(), Error> {
     let lut = BrdfLut::new(plan.lut_size, 1024, Visibility::SchlickUe4);
     let precision = if Format::from_path(p) == Some(Format::Png) {
         Precision::U16
@@ -256,7 +248,7 @@ pub(super) fn write_lut(plan: &Plan, p: &Path) -> Result<(), CliError> {
 }
 
 /// Each level as `WIDTH:LOBE` for the report: `512:r=0.000 256:r=0.125 …`.
-pub(super) fn levels_detail(chain: &[EnvMap], lobes: &[Lobe]) -> String {
+pub fn levels_detail(chain: &[EnvMap], lobes: &[Lobe]) -> String {
     let detail: Vec<String> = chain
         .iter()
         .zip(lobes)

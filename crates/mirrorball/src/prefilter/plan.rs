@@ -1,17 +1,16 @@
-//! `PrefilterArgs → Plan`: the lobe, the output's container, precision and sizes, the
+//! `PrefilterRequest → Plan`: the lobe, the output's container, precision and sizes, the
 //! roughness or exponents per level, the compression and SH window, the side outputs' paths
 //! (SH JSON, preview, BRDF table), and every file read or written, checked before any file
 //! is read.
 
 use super::outputs::{beside, check_side_files, level_path};
-use crate::choice::parse_flag;
-use crate::commands::convert::parse_precision;
-use crate::commands::{parse_layout, InputPlan};
-use crate::error::CliError;
+use super::PrefilterRequest;
+use crate::error::Error;
 use crate::guard::Files;
+use crate::load::InputPlan;
 use crate::save::{self, SaveOptions};
 use crate::spec::{bad, ProjSpec};
-use crate::PrefilterArgs;
+use crate::spec::{parse_flag, parse_layout, parse_precision};
 use mirrorball_core::{Layout, Stereo, WorldProjection};
 use mirrorball_filter::sh::Window;
 use mirrorball_filter::IrradianceMethod;
@@ -20,7 +19,7 @@ use mirrorball_io::{Format, Precision, WriteOptions};
 use std::path::{Path, PathBuf};
 
 /// Everything `prefilter` will do, checked before any file is read.
-pub(super) struct Plan {
+pub struct Plan {
     pub input: InputPlan,
     /// The input file, as given.
     pub source: String,
@@ -45,12 +44,11 @@ pub(super) struct Plan {
     pub lut_size: u32,
     pub save: SaveOptions,
     pub opts: PrefilterOptions,
-    pub quiet: bool,
 }
 
 impl Plan {
-    pub fn new(a: &PrefilterArgs) -> Result<Plan, CliError> {
-        let input = crate::commands::input_plan(&a.input_args)?;
+    pub fn new(a: &PrefilterRequest) -> Result<Plan, Error> {
+        let input = a.input_plan.clone();
         let kind = parse_flag::<LobeKind>("--lobe", &a.lobe)?;
         let to = ProjSpec::parse(&a.to).map_err(|e| bad("--to", e))?;
         let layout = parse_layout("--layout", a.layout.as_deref())?;
@@ -94,7 +92,6 @@ impl Plan {
             lut_size: a.lut_size,
             save,
             opts,
-            quiet: a.quiet,
         };
         let plan = plan.with_side_outputs(a)?;
         plan.files()?.check()?;
@@ -106,7 +103,7 @@ impl Plan {
     }
 
     /// The paths of the SH JSON, the preview sheet and the BRDF table, each checked.
-    fn with_side_outputs(mut self, a: &PrefilterArgs) -> Result<Plan, CliError> {
+    fn with_side_outputs(mut self, a: &PrefilterRequest) -> Result<Plan, Error> {
         self.sh_path = (!a.no_sh).then(|| {
             a.sh.clone()
                 .map(PathBuf::from)
@@ -120,7 +117,7 @@ impl Plan {
         });
         if let Some(p) = &self.preview_path {
             if Format::from_path(p) != Some(Format::Png) {
-                return Err(CliError::request(format!(
+                return Err(Error::request(format!(
                     "--preview {}: the preview sheet is a .png",
                     p.display()
                 )));
@@ -129,14 +126,14 @@ impl Plan {
         self.lut_path = a.lut.clone().map(PathBuf::from);
         if let Some(p) = &self.lut_path {
             if !matches!(Format::from_path(p), Some(Format::Exr | Format::Png)) {
-                return Err(CliError::request(format!(
+                return Err(Error::request(format!(
                     "--lut {}: write the BRDF table as .exr (or .png)",
                     p.display()
                 )));
             }
         }
         if a.lut_size == 0 || a.lut_size > 4096 {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "--lut-size: {} is outside 1..=4096",
                 a.lut_size
             )));
@@ -146,7 +143,7 @@ impl Plan {
 
     /// Refuses the job when the outputs' file system lacks room for a chain from level 0 at
     /// `size` (at most four channels), the preview and the BRDF table.
-    pub fn check_room(&self, size: u32) -> Result<(), CliError> {
+    pub fn check_room(&self, size: u32) -> Result<(), Error> {
         let out = self.to.build(None).map_err(|e| bad("--to", e))?;
         let (w, h) = out.layer_extent(size);
         let chain = w as u64 * h as u64 * out.layer_count() as u64 * 4 / 3;
@@ -176,7 +173,7 @@ impl Plan {
 
     /// Every file read and written: the input, the container or every level the chain may
     /// have (its length is known once the source is read), and the side outputs.
-    fn files(&self) -> Result<Files, CliError> {
+    fn files(&self) -> Result<Files, Error> {
         let mut files = Files::new();
         files.input_arg("the input", &self.source);
         if self.format.is_cube_container() {
@@ -214,7 +211,7 @@ impl Plan {
 }
 
 /// The output as one file: the cube container, or level 0's file of flat outputs.
-fn output_probe(a: &PrefilterArgs) -> String {
+fn output_probe(a: &PrefilterRequest) -> String {
     if Format::from_path(Path::new(&a.output)).is_some_and(|f| f.is_cube_container()) {
         a.output.clone()
     } else {
@@ -225,13 +222,13 @@ fn output_probe(a: &PrefilterArgs) -> String {
 /// The output's format (flat outputs are checked with the name of level 0): not JPEG,
 /// prefiltered radiance being HDR.
 fn output_format(
-    a: &PrefilterArgs,
+    a: &PrefilterRequest,
     to: &ProjSpec,
     layout: Option<Layout>,
-) -> Result<Format, CliError> {
+) -> Result<Format, Error> {
     let format = save::check(&output_probe(a), to.kind, layout)?;
     if format == Format::Jpeg {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{}: prefiltered radiance is HDR; write .exr, .hdr, .ktx2 or .dds (PNG for previews)",
             a.output
         )));
@@ -240,7 +237,7 @@ fn output_format(
 }
 
 /// `--precision` and `--layout`, where the container takes them ([`save::check_flags`]).
-fn output_precision(a: &PrefilterArgs, format: Format) -> Result<Option<Precision>, CliError> {
+fn output_precision(a: &PrefilterRequest, format: Format) -> Result<Option<Precision>, Error> {
     let precision = parse_precision(a.precision.as_deref())?;
     let given: &[&str] = if a.layout.is_some() {
         &["--layout"]
@@ -254,11 +251,11 @@ fn output_precision(a: &PrefilterArgs, format: Format) -> Result<Option<Precisio
 /// `--size` (within what level 0's file holds; a power of two for a cube container's
 /// chain) and `--levels`.
 fn check_sizes(
-    a: &PrefilterArgs,
+    a: &PrefilterRequest,
     format: Format,
     to: &ProjSpec,
     save: &SaveOptions,
-) -> Result<Option<u32>, CliError> {
+) -> Result<Option<u32>, Error> {
     let size = match a.size {
         Some(s) => {
             let out = to.build(None).map_err(|e| bad("--to", e))?;
@@ -269,28 +266,26 @@ fn check_sizes(
     };
     if let Some(s) = size {
         if format.is_cube_container() && !s.is_power_of_two() && a.levels != Some(1) {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "--size {s}: a cube map's mip chain halves exactly only from a power of two"
             )));
         }
     }
     if let Some(l) = a.levels {
         if l == 0 || l > 16 {
-            return Err(CliError::request(format!(
-                "--levels: {l} is outside 1..=16"
-            )));
+            return Err(Error::request(format!("--levels: {l} is outside 1..=16")));
         }
     }
     Ok(size)
 }
 
 /// `--exponents` (Phong only): non-negative numbers, `inf` or `mirror` for a mirror.
-fn parse_exponents(a: &PrefilterArgs, kind: LobeKind) -> Result<Option<Vec<f64>>, CliError> {
+fn parse_exponents(a: &PrefilterRequest, kind: LobeKind) -> Result<Option<Vec<f64>>, Error> {
     let Some(s) = &a.exponents else {
         return Ok(None);
     };
     if kind != LobeKind::Phong {
-        return Err(CliError::request("--exponents applies to --lobe phong"));
+        return Err(Error::request("--exponents applies to --lobe phong"));
     }
     let v: Result<Vec<f64>, _> = s
         .split(',')
@@ -304,7 +299,7 @@ fn parse_exponents(a: &PrefilterArgs, kind: LobeKind) -> Result<Option<Vec<f64>>
         })
         .collect();
     v.map(Some).map_err(|t| {
-        CliError::request(format!(
+        Error::request(format!(
             "--exponents: '{t}' is not a non-negative number (or inf)"
         ))
     })
@@ -312,24 +307,22 @@ fn parse_exponents(a: &PrefilterArgs, kind: LobeKind) -> Result<Option<Vec<f64>>
 
 /// `--samples` and `--cube-size`, and `--preview-exposure` (checked here, in the order
 /// the flags were always checked).
-fn prefilter_options(a: &PrefilterArgs) -> Result<PrefilterOptions, CliError> {
+fn prefilter_options(a: &PrefilterRequest) -> Result<PrefilterOptions, Error> {
     if a.samples == 0 || a.samples > 65536 {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "--samples: {} is outside 1..=65536",
             a.samples
         )));
     }
     if let Some(c) = a.cube_size {
         if c == 0 || c > 4096 {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "--cube-size: {c} is outside 1..=4096"
             )));
         }
     }
     if !a.preview_exposure.is_finite() {
-        return Err(CliError::request(
-            "--preview-exposure must be a finite number",
-        ));
+        return Err(Error::request("--preview-exposure must be a finite number"));
     }
     Ok(PrefilterOptions {
         samples: a.samples,
@@ -339,9 +332,9 @@ fn prefilter_options(a: &PrefilterArgs) -> Result<PrefilterOptions, CliError> {
 }
 
 /// `--mapping`: a named mapping or a list of roughness values.
-fn parse_mapping(a: &PrefilterArgs) -> Result<RoughnessMapping, CliError> {
+fn parse_mapping(a: &PrefilterRequest) -> Result<RoughnessMapping, Error> {
     RoughnessMapping::parse(&a.mapping).ok_or_else(|| {
-        CliError::request(format!(
+        Error::request(format!(
             "--mapping: '{}' is not linear, ue4, filament or a list of roughness values in [0, 1]",
             a.mapping
         ))
@@ -349,9 +342,9 @@ fn parse_mapping(a: &PrefilterArgs) -> Result<RoughnessMapping, CliError> {
 }
 
 /// `--compress`.
-fn parse_compression(a: &PrefilterArgs) -> Result<Compression, CliError> {
+fn parse_compression(a: &PrefilterRequest) -> Result<Compression, Error> {
     Compression::parse(&a.compress).ok_or_else(|| {
-        CliError::request(format!(
+        Error::request(format!(
             "--compress: '{}' is not none, clamp:MAX, soft:MAX or soft:KNEE:MAX (KNEE < MAX, both > 0)",
             a.compress
         ))
@@ -359,9 +352,9 @@ fn parse_compression(a: &PrefilterArgs) -> Result<Compression, CliError> {
 }
 
 /// `--sh-window`.
-fn parse_window(a: &PrefilterArgs) -> Result<Window, CliError> {
+fn parse_window(a: &PrefilterRequest) -> Result<Window, Error> {
     Window::parse(&a.sh_window).ok_or_else(|| {
-        CliError::request(format!(
+        Error::request(format!(
             "--sh-window: '{}' is not none, hann[:W], lanczos[:W] or auto",
             a.sh_window
         ))

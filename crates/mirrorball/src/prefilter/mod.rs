@@ -1,21 +1,20 @@
-//! `mirrorball prefilter`: prefiltered lighting (Lambert, Phong, GGX) as a mip chain, with
-//! spherical-harmonic coefficients and a preview sheet.
+//! Prefiltered lighting (Lambert, Phong, GGX) as a mip chain, with spherical-harmonic
+//! coefficients and a preview sheet: what `mirrorball prefilter` writes.
 //!
-//! `args → Plan (lobe, levels, roughness per level, outputs checked: plan.rs) → read →
+//! `PrefilterRequest → Plan (lobe, levels, roughness per level, outputs checked: plan.rs) → read →
 //! sanitize → optional clamp/soft compression (energy report) → Prefilterer (working cube,
 //! bright split) → one lobe per level (progress bar) → KTX2/DDS cube with the chain, or one
 //! image per level → SH JSON → preview PNG (outputs.rs)`.
 
-pub(crate) mod outputs;
+pub mod outputs;
 mod plan;
 
 use crate::budget;
-use crate::error::CliError;
-use crate::load;
-use crate::progress::with_progress;
+use crate::error::Error;
+use crate::hooks::Hooks;
+use crate::load::{self, InputPlan};
 use crate::save;
 use crate::spec::bad;
-use crate::PrefilterArgs;
 use mirrorball_core::{count, EnvMap, Projection, ProjectionKind, WorldProjection};
 use mirrorball_filter::mip::level_count;
 use mirrorball_filter::sh;
@@ -24,7 +23,7 @@ use mirrorball_filter::{
     MipChain, MipFilter, Prefilterer, RoughnessMapping,
 };
 use outputs::Described;
-use plan::Plan;
+pub use plan::Plan;
 use std::time::Instant;
 
 /// The chain's shape, known once the source is read.
@@ -37,10 +36,73 @@ struct Chain {
     levels: usize,
 }
 
-pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
-    let mut plan = Plan::new(&a)?;
+/// What to prefilter, as plain values: the command line's `prefilter` flags (each
+/// documented there), their text as given.
+#[derive(Clone, Debug)]
+pub struct PrefilterRequest {
+    pub input: String,
+    pub output: String,
+    pub lobe: String,
+    pub size: Option<i64>,
+    pub to: String,
+    pub levels: Option<usize>,
+    pub mapping: String,
+    pub exponents: Option<String>,
+    pub samples: u32,
+    pub cube_size: Option<u32>,
+    pub compress: String,
+    pub sh_window: String,
+    pub irradiance: String,
+    pub sh: Option<String>,
+    pub no_sh: bool,
+    pub preview: Option<String>,
+    pub no_preview: bool,
+    pub preview_exposure: f32,
+    pub lut: Option<String>,
+    pub lut_size: u32,
+    pub overwrite: bool,
+    pub layout: Option<String>,
+    pub precision: Option<String>,
+    pub input_plan: InputPlan,
+}
+
+impl PrefilterRequest {
+    /// The command line's defaults for `lobe` from `input` to `output`.
+    pub fn new(input: &str, output: &str, lobe: &str) -> PrefilterRequest {
+        PrefilterRequest {
+            input: input.into(),
+            output: output.into(),
+            lobe: lobe.into(),
+            size: None,
+            to: "cube".into(),
+            levels: None,
+            mapping: "linear".into(),
+            exponents: None,
+            samples: 128,
+            cube_size: None,
+            compress: "none".into(),
+            sh_window: "none".into(),
+            irradiance: "exact".into(),
+            sh: None,
+            no_sh: false,
+            preview: None,
+            no_preview: false,
+            preview_exposure: 0.0,
+            lut: None,
+            lut_size: 128,
+            overwrite: false,
+            layout: None,
+            precision: None,
+            input_plan: InputPlan::default(),
+        }
+    }
+}
+
+/// Prefilters what `a` asks for and writes its files, saying what it does through `hooks`.
+pub fn run(a: &PrefilterRequest, hooks: &dyn Hooks) -> Result<(), Error> {
+    let mut plan = Plan::new(a)?;
     let t0 = Instant::now();
-    let (env, energy) = read(&plan)?;
+    let (env, energy) = read(&plan, hooks)?;
     let shape = chain_shape(&plan, &env)?;
     if plan.size.is_none() {
         plan.check_room(shape.size)?;
@@ -50,7 +112,7 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
 
     let t1 = Instant::now();
     let sh9 = sh::project(&env);
-    let chain = prefilter(&mut plan, &env, &shape, &lobes, &sh9);
+    let chain = prefilter(&mut plan, &env, &shape, &lobes, &sh9, hooks);
     let t_filter = t1.elapsed();
 
     let t2 = Instant::now();
@@ -66,7 +128,7 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
         )])
         .collect();
     if let Some(line) = report.line(&plan.output, &keep) {
-        say(&plan, line);
+        hooks.note(&line);
     }
     if let Some(p) = &plan.sh_path {
         let described = Described {
@@ -87,49 +149,34 @@ pub fn run(a: PrefilterArgs) -> Result<(), CliError> {
         outputs::write_lut(&plan, p)?;
         written.push(p.display().to_string());
     }
-    say(
-        &plan,
-        format!(
-            "wrote {}: {} {} [{}] (read {:.2}s, prefilter {:.2}s, write {:.2}s)",
-            written.join(", "),
-            shape.projection.name(),
-            count(chain.len() as u64, "level"),
-            outputs::levels_detail(&chain, &lobes),
-            (t1 - t0).as_secs_f64(),
-            t_filter.as_secs_f64(),
-            t2.elapsed().as_secs_f64()
-        ),
-    );
+    hooks.note(&format!(
+        "wrote {}: {} {} [{}] (read {:.2}s, prefilter {:.2}s, write {:.2}s)",
+        written.join(", "),
+        shape.projection.name(),
+        count(chain.len() as u64, "level"),
+        outputs::levels_detail(&chain, &lobes),
+        (t1 - t0).as_secs_f64(),
+        t_filter.as_secs_f64(),
+        t2.elapsed().as_secs_f64()
+    ));
     Ok(())
-}
-
-/// Prints `s`, unless quiet.
-fn say(plan: &Plan, s: String) {
-    if !plan.quiet {
-        eprintln!("{s}");
-    }
 }
 
 /// The source, prepared (sanitized unless asked not to), and compressed as `--compress`
 /// says, with its energy report.
-fn read(plan: &Plan) -> Result<(EnvMap, Option<EnergyReport>), CliError> {
+fn read(plan: &Plan, hooks: &dyn Hooks) -> Result<(EnvMap, Option<EnergyReport>), Error> {
     let (env, notes) = load::read_prepared(&plan.source, &plan.input)?;
-    if !plan.quiet {
-        notes.iter().for_each(|line| eprintln!("{line}"));
-    }
+    notes.iter().for_each(|line| hooks.note(line));
     let mut env = env;
     let energy = (plan.compression != Compression::None).then(|| {
         let r = compress(&mut env, plan.compression);
-        say(
-            plan,
-            format!(
-                "compressed {} texels (luminance max {:.4e} → {:.4e}): {:.3}% of the energy removed",
-                r.texels,
-                r.max_before,
-                r.max_after,
-                100.0 * r.fraction_removed
-            ),
-        );
+        hooks.note(&format!(
+            "compressed {} texels (luminance max {:.4e} → {:.4e}): {:.3}% of the energy removed",
+            r.texels,
+            r.max_before,
+            r.max_after,
+            100.0 * r.fraction_removed
+        ));
         r
     });
     Ok((env, energy))
@@ -138,7 +185,7 @@ fn read(plan: &Plan) -> Result<(EnvMap, Option<EnergyReport>), CliError> {
 /// The output's projection, level 0's size (32 for Lambert; else about the source's, at
 /// most 512, a power of two in a cube container) and the number of levels; a list of values
 /// per level must say every level (padding would be a silent guess).
-fn chain_shape(plan: &Plan, env: &EnvMap) -> Result<Chain, CliError> {
+fn chain_shape(plan: &Plan, env: &EnvMap) -> Result<Chain, Error> {
     let projection: Projection = plan.to.build(None).map_err(|e| bad("--to", e))?;
     let size = plan.size.unwrap_or_else(|| match plan.kind {
         LobeKind::Lambert => 32,
@@ -163,7 +210,7 @@ fn chain_shape(plan: &Plan, env: &EnvMap) -> Result<Chain, CliError> {
         _ => None,
     };
     if let Some((flag, what, n)) = listed.filter(|&(_, _, n)| n != levels) {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{flag} lists {} but the chain has {} ({w0}x{h0} down to {}); give {levels}, or --levels {n}",
             count(n as u64, what),
             count(levels as u64, "level"),
@@ -193,7 +240,7 @@ fn lobes(plan: &Plan, levels: usize) -> Vec<Lobe> {
 /// The prefilterer's peak (its working cube and pyramids, as fine as the levels rendered
 /// need), the chain (the source's channels, with its mips) and the source held meanwhile.
 /// Lambert from SH makes no working cube.
-fn check_memory(plan: &Plan, shape: &Chain, env: &EnvMap, lobes: &[Lobe]) -> Result<(), CliError> {
+fn check_memory(plan: &Plan, shape: &Chain, env: &EnvMap, lobes: &[Lobe]) -> Result<(), Error> {
     let (w0, h0) = shape.extent;
     let out = shape.projection;
     let working = match (plan.kind, plan.irradiance) {
@@ -227,6 +274,7 @@ fn prefilter(
     shape: &Chain,
     lobes: &[Lobe],
     sh9: &sh::Sh9,
+    hooks: &dyn Hooks,
 ) -> Vec<EnvMap> {
     let (out, size, levels) = (shape.projection, shape.size, shape.levels);
     // The work the bar runs to, in the prefilterer's units (none for SH irradiance, which
@@ -238,11 +286,11 @@ fn prefilter(
         }
         _ => mirrorball_filter::chain_work(env, lobes, out, size, &plan.opts),
     };
-    let quiet = plan.quiet;
-    with_progress("prefilter", work, quiet, |counter| {
+    let mut chain = Vec::new();
+    hooks.progress("prefilter", work, &mut |counter| {
         plan.opts.progress = Some(counter);
         let opts = plan.opts.clone();
-        match (plan.kind, plan.irradiance) {
+        chain = match (plan.kind, plan.irradiance) {
             (LobeKind::Lambert, method) => {
                 let top = match method {
                     IrradianceMethod::Exact => {
@@ -260,5 +308,6 @@ fn prefilter(
             }
             _ => Prefilterer::for_chain(env, lobes, out, size, opts).render_chain(lobes, out, size),
         }
-    })
+    });
+    chain
 }
