@@ -32,6 +32,16 @@ pub struct Log {
 }
 
 impl Log {
+    /// The line of frame `m`, written to `output` (its name) in the time since `since`.
+    pub fn done(&self, m: &super::pipeline::Meta, output: String, since: std::time::Instant) {
+        self.line(
+            json!({"frame": m.number, "input": m.input, "output": output}),
+            Status::Done,
+            since.elapsed(),
+            None,
+        );
+    }
+
     /// Writes `fields` with `status` and `seconds` added, as one line.
     pub fn line(&self, mut fields: Value, status: Status, took: Duration, error: Option<&str>) {
         if !self.on {

@@ -80,24 +80,109 @@ fn resolved(path: &Path, dirs: &mut std::collections::HashMap<PathBuf, PathBuf>)
 /// Converts the frames `r` names, saying what it does through `hooks`.
 pub fn run(r: &FramesRequest, hooks: &dyn Hooks) -> Result<(), Error> {
     let a = &r.convert;
-    let shard = r.shard;
-    let in_fmt = r.pix_fmt;
-    let out_fmt = r.out_pix_fmt.or(in_fmt);
     if a.input == a.output && a.input != "-" {
         return Err(Error::request(format!(
             "{}: the output pattern is the input pattern, so each frame would overwrite itself; choose another name or folder",
             a.output
         )));
     }
+    let (input, first_of_all, empty_slice) = frames_input(r)?;
+    let output = frames_output(r, &input)?;
+
+    let first_number = first_of_all.as_ref().map_or(0, |fr| fr.number);
+    let (plan, dst) = frame_plan(a, first_of_all.as_ref(), &output)?;
+    if matches!(output, Output::Pipe(_))
+        && dst.layer_count() > 1
+        && plan.save.layout == Some(Layout::Separate)
+    {
+        return Err(Error::request(
+            "output -: a raw frame is one picture; give a packed --layout (hcross, vcross, hstrip, vstrip)",
+        ));
+    }
+    if let (Some((at, len)), Some(s)) = (empty_slice, r.shard) {
+        hooks.note(&format!(
+            "--shard {}/{}: frames {at}..{at} of {len}: this slice is empty, nothing to do",
+            s.index, s.count
+        ));
+        return Ok(());
+    }
+
+    // Frames from files: outputs named, checked against every input, and those done already.
+    let log = Log {
+        on: r.json,
+        to_stderr: matches!(output, Output::Pipe(_)),
+    };
+    let outputs_of = |path: &Path| -> Vec<PathBuf> {
+        let s = path.to_string_lossy();
+        save::layer_files(&s, dst.layer_count(), &plan.save)
+            .unwrap_or_else(|| vec![path.to_path_buf()])
+    };
+    let Some((input, skipped)) = frames_todo(r, input, (&output, &outputs_of), &log, hooks)? else {
+        return Ok(());
+    };
+    let _folder = match &output {
+        Output::Files(p) => MadeFolder::for_output(&p.path(first_number))?,
+        Output::File(s) => MadeFolder::for_output(Path::new(s))?,
+        Output::Pipe(_) => MadeFolder(None),
+    };
+    convert_frames(r, hooks, &plan, dst, input, output, log, skipped)
+}
+
+/// The request as one frame's conversion (the sequence's first frame, its output), checked
+/// by convert's own plan, and the output's projection.
+fn frame_plan(
+    a: &ConvertRequest,
+    first_of_all: Option<&Frame>,
+    output: &Output,
+) -> Result<(Plan, Projection), Error> {
+    // The request as one frame's conversion, checked by convert's own plan.
+    let mut probe = a.clone();
+    let first_number = first_of_all.map_or(0, |fr| fr.number);
+    probe.input = match first_of_all {
+        Some(fr) => fr.path.to_string_lossy().into_owned(),
+        None => "-".into(),
+    };
+    probe.output = match output {
+        Output::Files(p) => p.path(first_number).to_string_lossy().into_owned(),
+        Output::File(s) => s.clone(),
+        // A pipe's frames are packed pictures: checked as an EXR of the same layout.
+        Output::Pipe(_) => "frame.exr".into(),
+    };
+    let mut plan = match output {
+        Output::Pipe(_) => Plan::unwritten(&probe)?,
+        _ => Plan::new(&probe, mirrorball_io::Folders::MakeOne)?,
+    };
+    // `--for`'s engine axes: frames are made by one planned `Remap`, so a cube output takes
+    // them as the rotation they are (its texel centres map to texel centres).
+    if !plan.orient.is_identity() {
+        plan.resample.rotation = plan.resample.rotation.then(plan.orient.rotation());
+        plan.orient = mirrorball_core::AxisMap::IDENTITY;
+    }
+    let dst: Projection = plan
+        .to
+        .build(None)
+        .map_err(|e| crate::spec::bad("--to", e))?;
+    Ok((plan, dst))
+}
+
+/// Where `r`'s frames come from: this shard's files or the pipe; the whole sequence's first
+/// frame (it stands for every shard's in the request's checks, so that each shard, an empty
+/// one too, accepts or refuses alike); and, for an empty slice, where it starts and the
+/// sequence's length.
+#[allow(clippy::type_complexity)]
+fn frames_input(
+    r: &FramesRequest,
+) -> Result<(Input, Option<Frame>, Option<(usize, usize)>), Error> {
+    let a = &r.convert;
     let mut first_of_all = None;
     let mut empty_slice = None;
     let input = if a.input == "-" {
-        if shard.is_some() {
+        if r.shard.is_some() {
             return Err(Error::request(
                 "--shard slices frames from files; standard input (-) is one stream, so give each machine its own stream instead",
             ));
         }
-        let (Some((w, h)), Some(fmt)) = (r.in_size, in_fmt) else {
+        let (Some((w, h)), Some(fmt)) = (r.in_size, r.pix_fmt) else {
             return Err(Error::request(
                 "input -: raw frames need --in-size WIDTHxHEIGHT and --pix-fmt (rgb24, rgb48le, rgbf32le, gbrpf32le)",
             ));
@@ -124,14 +209,20 @@ pub fn run(r: &FramesRequest, hooks: &dyn Hooks) -> Result<(), Error> {
         // The whole sequence's first frame stands for every shard's in the request's
         // checks, so that each shard, an empty one too, accepts or refuses alike.
         first_of_all = Some(frames[0].clone());
-        let slice = shard.map_or(0..frames.len(), |s| s.range(frames.len()));
+        let slice = r.shard.map_or(0..frames.len(), |s| s.range(frames.len()));
         if slice.is_empty() {
             empty_slice = Some((slice.start, frames.len()));
         }
         Input::Files(frames[slice].to_vec())
     };
-    let output = if a.output == "-" {
-        let fmt = out_fmt.ok_or_else(|| {
+    Ok((input, first_of_all, empty_slice))
+}
+
+/// Where `r`'s frames go: files of a pattern, one file, or the pipe.
+fn frames_output(r: &FramesRequest, input: &Input) -> Result<Output, Error> {
+    let a = &r.convert;
+    Ok(if a.output == "-" {
+        let fmt = r.out_pix_fmt.or(r.pix_fmt).ok_or_else(|| {
             Error::request("output -: raw frames need --pix-fmt (or --out-pix-fmt): rgb24, rgb48le, rgbf32le, gbrpf32le")
         })?;
         if a.precision.is_some() || a.mips || a.compression.is_some() {
@@ -143,7 +234,7 @@ pub fn run(r: &FramesRequest, hooks: &dyn Hooks) -> Result<(), Error> {
     } else {
         match Pattern::output(&a.output)? {
             Some(p) => Output::Files(p),
-            None => match &input {
+            None => match input {
                 Input::Files(_) if Pattern::parse(&a.input)?.is_none() => {
                     Output::File(a.output.clone())
                 }
@@ -155,61 +246,21 @@ pub fn run(r: &FramesRequest, hooks: &dyn Hooks) -> Result<(), Error> {
                 }
             },
         }
-    };
+    })
+}
 
-    // The request as one frame's conversion, checked by convert's own plan.
-    let mut probe = a.clone();
-    let first_number = first_of_all.as_ref().map_or(0, |fr| fr.number);
-    probe.input = match &first_of_all {
-        Some(fr) => fr.path.to_string_lossy().into_owned(),
-        None => "-".into(),
-    };
-    probe.output = match &output {
-        Output::Files(p) => p.path(first_number).to_string_lossy().into_owned(),
-        Output::File(s) => s.clone(),
-        // A pipe's frames are packed pictures: checked as an EXR of the same layout.
-        Output::Pipe(_) => "frame.exr".into(),
-    };
-    let mut plan = match output {
-        Output::Pipe(_) => Plan::unwritten(&probe)?,
-        _ => Plan::new(&probe, mirrorball_io::Folders::MakeOne)?,
-    };
-    // `--for`'s engine axes: frames are made by one planned `Remap`, so a cube output takes
-    // them as the rotation they are (its texel centres map to texel centres).
-    if !plan.orient.is_identity() {
-        plan.resample.rotation = plan.resample.rotation.then(plan.orient.rotation());
-        plan.orient = mirrorball_core::AxisMap::IDENTITY;
-    }
-    let dst: Projection = plan
-        .to
-        .build(None)
-        .map_err(|e| crate::spec::bad("--to", e))?;
-    if matches!(output, Output::Pipe(_))
-        && dst.layer_count() > 1
-        && plan.save.layout == Some(Layout::Separate)
-    {
-        return Err(Error::request(
-            "output -: a raw frame is one picture; give a packed --layout (hcross, vcross, hstrip, vstrip)",
-        ));
-    }
-    if let (Some((at, len)), Some(s)) = (empty_slice, shard) {
-        hooks.note(&format!(
-            "--shard {}/{}: frames {at}..{at} of {len}: this slice is empty, nothing to do",
-            s.index, s.count
-        ));
-        return Ok(());
-    }
+/// The files a frame's output name stands for (one a layer, or itself).
+type OutputsOf<'a> = dyn Fn(&Path) -> Vec<PathBuf> + 'a;
 
-    // Frames from files: outputs named, checked against every input, and those done already.
-    let log = Log {
-        on: r.json,
-        to_stderr: matches!(output, Output::Pipe(_)),
-    };
-    let outputs_of = |path: &Path| -> Vec<PathBuf> {
-        let s = path.to_string_lossy();
-        save::layer_files(&s, dst.layer_count(), &plan.save)
-            .unwrap_or_else(|| vec![path.to_path_buf()])
-    };
+/// `r`'s frames less those whose outputs the same settings made from the same input (`record.rs`),
+/// each output checked against every input frame; `None` when nothing is left to do.
+fn frames_todo(
+    r: &FramesRequest,
+    input: Input,
+    (output, outputs_of): (&Output, &OutputsOf),
+    log: &Log,
+    hooks: &dyn Hooks,
+) -> Result<Option<(Input, u64)>, Error> {
     let settings = record::settings(r);
     let mut made = record::Made::default();
     let (mut skipped, mut unknown, mut again) = (0u64, 0u64, 0u64);
@@ -222,7 +273,7 @@ pub fn run(r: &FramesRequest, hooks: &dyn Hooks) -> Result<(), Error> {
                 .collect();
             let mut todo = Vec::with_capacity(frames.len());
             for fr in frames {
-                let outs = match &output {
+                let outs = match output {
                     Output::Files(p) => outputs_of(&p.path(fr.number)),
                     Output::File(s) => outputs_of(Path::new(s)),
                     Output::Pipe(_) => Vec::new(),
@@ -259,18 +310,13 @@ pub fn run(r: &FramesRequest, hooks: &dyn Hooks) -> Result<(), Error> {
                 hooks.note(&line);
             }
             if todo.is_empty() {
-                return Ok(());
+                return Ok(None);
             }
             Input::Files(todo)
         }
         pipe => pipe,
     };
-    let _folder = match &output {
-        Output::Files(p) => MadeFolder::for_output(&p.path(first_number))?,
-        Output::File(s) => MadeFolder::for_output(Path::new(s))?,
-        Output::Pipe(_) => MadeFolder(None),
-    };
-    convert_frames(r, hooks, &plan, dst, input, output, log, skipped)
+    Ok(Some((input, skipped)))
 }
 
 /// The output folder, made for the frames when missing (`save::make_folder`); removed again
@@ -594,6 +640,167 @@ fn convert_frames(
         Input::Files(fr) => fr.len() as u64,
         Input::Pipe { .. } => 0,
     };
+    let t0 = Instant::now();
+    let planned = plan_first_frame(hooks, plan, dst, input, &output)?;
+    let t_plan = t0.elapsed();
+    let t1 = Instant::now();
+    let (w, h) = planned.extent;
+    let (result, n) = pump(r, (hooks, plan, dst), (&output, log), planned, total);
+    let secs = t1.elapsed().as_secs_f64();
+    hooks.note(&format!(
+        "{} to {} {w}x{h}{} in {secs:.2}s ({:.2} frames/s; planned in {:.2}s){}",
+        mirrorball_core::count(n, "frame"),
+        dst.name(),
+        times(dst.layer_count()),
+        n as f64 / secs.max(1e-9),
+        t_plan.as_secs_f64(),
+        skipped_note(skipped),
+    ));
+    result
+}
+
+/// Converts and writes every frame after planning: the pipeline run as the output takes
+/// its frames (a coded pipe, packed rows, or maps); its result and the frames written.
+fn pump(
+    r: &FramesRequest,
+    (hooks, plan, dst): (&dyn Hooks, &Plan, Projection),
+    (output, log): (&Output, Log),
+    planned: Planned,
+    total: u64,
+) -> (Result<(), Error>, u64) {
+    let Planned {
+        mut reader,
+        first,
+        from,
+        extent: (w, h),
+        packed,
+        remap,
+        picture,
+        coded,
+    } = planned;
+    let c = first.1[0].channels();
+    // Frames are encoded as their rows are made: a strip's or a cross's from its layers'
+    // rows, turned cells' (EAC) from the plan laid out as the packed picture.
+    let encode =
+        |fmt: PixFmt, packing: &Packing, rows: &RemapRows, bytes: &mut Vec<u8>| match &picture {
+            Some(p) => p.encode_rows(fmt, rows, bytes),
+            None => packing.encode_rows(fmt, rows, bytes),
+        };
+    let settings = record::settings(r);
+
+    let fresh = || fresh_eyes(plan.stereo.eyes(), dst, (w, h, c));
+    let mut first = Some(first);
+    let stdout = std::io::stdout();
+    let logged = |m: &Meta, out: String, t: Instant| log.done(m, out, t);
+    let mut bytes = Vec::new();
+    let mut put = |m: &Meta, eyes: &Eyes| -> Result<(), Error> {
+        let t = Instant::now();
+        let out = put_frame(
+            m,
+            eyes,
+            (output, &packed),
+            (plan, hooks),
+            &settings,
+            &mut bytes,
+        );
+        logged(m, out?, t);
+        Ok(())
+    };
+    let mut done = None;
+    hooks.progress("frames", total, &mut |counter| {
+        let counted = AtomicU64::new(0);
+        let mut next = |spare: Option<Eyes>| first.take().map(Ok).or_else(|| reader.next(spare));
+        let mut put_bytes = |m: &Meta, bytes: &Vec<u8>| {
+            let t = Instant::now();
+            pipe::write_frame(&mut stdout.lock(), bytes, m.number)?;
+            logged(m, "-".into(), t);
+            counter.fetch_add(1, Ordering::Relaxed);
+            Ok(())
+        };
+        let r = match &packed {
+            // Rows made from the frame's codes (`run_coded`).
+            Some((_, Some(packing), fmt)) if coded.is_some() => run_coded(
+                (&mut reader, first.take()),
+                (&remap, coded.expect("a coded pipe")),
+                &|rows: &RemapRows, bytes: &mut Vec<u8>| encode(*fmt, packing, rows, bytes),
+                &mut put_bytes,
+                &counted,
+            ),
+            // Rows made and encoded together: no float copy of the output frame.
+            Some((_, Some(packing), fmt)) => run_packed(
+                &mut next,
+                &remap,
+                &|rows: &RemapRows, bytes: &mut Vec<u8>| encode(*fmt, packing, rows, bytes),
+                &mut put_bytes,
+                &counted,
+            ),
+            _ => pipeline::run(
+                &mut next,
+                &|m: &Meta, src: &Eyes, out: &mut Eyes| {
+                    pipeline::convert_eyes((&remap, from), m, src, out)
+                },
+                &fresh,
+                &mut |m: &Meta, e: &Eyes| {
+                    put(m, e)?;
+                    counter.fetch_add(1, Ordering::Relaxed);
+                    Ok(())
+                },
+                &counted,
+            ),
+        };
+        done = Some((r, counted.load(Ordering::Relaxed)));
+    });
+    done.expect("the work ran")
+}
+
+/// Empty, or how many frames were skipped because their outputs exist.
+fn skipped_note(skipped: u64) -> String {
+    match skipped {
+        0 => String::new(),
+        k => format!("; {k} skipped, their outputs exist"),
+    }
+}
+
+/// Output frames to fill: `eyes` maps of `dst` layers `w`×`h` of `c` channels.
+fn fresh_eyes(eyes: usize, dst: Projection, (w, h, c): (u32, u32, usize)) -> Eyes {
+    (0..eyes)
+        .map(|_| {
+            let layers = (0..dst.layer_count())
+                .map(|_| Image::new(w, h, c))
+                .collect();
+            EnvMap::new(dst, layers).expect("layers of the plan's shape")
+        })
+        .collect()
+}
+
+/// How a pipe writes its frames: the layout, where each packed texel of a 2d frame comes
+/// from, and the pixel format.
+type PipeOut = (Layout, Option<Packing>, PixFmt);
+
+/// What the first frame decides: the reader (at the second frame), the first frame, how
+/// its eyes are held, the output layers' extent, a pipe's packing, the planned conversion
+/// (laid out as the packed picture where cells turn) and, for a coded pipe, its frames'
+/// size and format.
+struct Planned<'a> {
+    reader: Reader<'a>,
+    first: (Meta, Eyes),
+    from: Stereo,
+    extent: (u32, u32),
+    packed: Option<PipeOut>,
+    remap: Remap,
+    picture: Option<Picture>,
+    coded: Option<(u32, u32, PixFmt)>,
+}
+
+/// Reads the first frame and plans the conversion from its shape (a pipe's planned while
+/// the frame is on its way), its memory checked.
+fn plan_first_frame<'a>(
+    hooks: &'a dyn Hooks,
+    plan: &'a Plan,
+    dst: Projection,
+    input: Input,
+    output: &Output,
+) -> Result<Planned<'a>, Error> {
     let mut reader = Reader {
         hooks,
         plan,
@@ -605,7 +812,6 @@ fn convert_frames(
         stereo: None,
         limits: mirrorball_io::Limits::default(),
     };
-    let t0 = Instant::now();
     // Raw frames cross pipes in 1 MiB rounds, not 64 KiB ones (io's `widen_pipe`).
     if matches!(reader.input, Input::Pipe { .. }) {
         mirrorball_io::widen_pipe(std::io::stdin(), mirrorball_io::PIPE_BYTES);
@@ -621,7 +827,6 @@ fn convert_frames(
         Input::Files(_) => None,
     };
     let (first, early) = std::thread::scope(|s| {
-        let output = &output;
         let early = blank.map(|(w, h)| s.spawn(move || plan_for_blank(plan, output, dst, w, h)));
         let first = reader.next(None);
         (first, early.and_then(|e| e.join().ok().flatten()))
@@ -636,14 +841,58 @@ fn convert_frames(
         .size
         .unwrap_or_else(|| save::default_size(src0, dst.kind()));
     let (w, h) = dst.layer_extent(size);
-    let c = src0.channels();
     let shape0 = Shape::of(src0, (w, h));
-    let packed = pipe_packing(plan, &output, dst, (w, h));
+    let packed = pipe_packing(plan, output, dst, (w, h));
     let packing = packed.as_ref().and_then(|(_, p, _)| p.as_ref());
     let (remap, picture) = match early {
         Some((shape, remap, picture)) if shape == shape0 => (remap, picture),
         _ => plan_frames(&shape0, dst, plan, packing),
     };
+    check_frames_memory(plan, &eyes0, (dst, w, h), output, meta0.number, &remap)?;
+    if let Some((layout, _, fmt)) = &packed {
+        note_pipe_output(hooks, plan, (dst, w, h), *layout, *fmt);
+    }
+    // A raw frame of integer codes that is the source's one layer as it is (no eyes to
+    // split, no layout to unpack, no lens overlap to blend) is read by the plan as it came:
+    // no float copy of it is made (`Remap::rows_coded`: the same bytes out).
+    let coded = match (&reader.input, &packed) {
+        (Input::Pipe { w, h, fmt }, Some((_, Some(p), _)))
+            if fmt.has_codes()
+                && remap.takes_codes()
+                && from == Stereo::Mono
+                && eyes0.len() == 1
+                && matches!(reader.decided, Some((_, Layout::Separate)))
+                && (src0.width(), src0.height()) == (*w, *h) =>
+        {
+            Some((*w, *h, *fmt))
+        }
+        _ => None,
+    };
+    Ok(Planned {
+        reader,
+        first: (meta0, eyes0),
+        from,
+        extent: (w, h),
+        packed,
+        remap,
+        picture,
+        coded,
+    })
+}
+
+/// Refuses frames that would not fit in memory: the pipeline's frames in flight, source
+/// (as `eyes0`, the first) and output (`dst` layers `w`×`h`), the plan `remap`, and the
+/// picture being written (frame number `first`'s).
+fn check_frames_memory(
+    plan: &Plan,
+    eyes0: &Eyes,
+    (dst, w, h): (Projection, u32, u32),
+    output: &Output,
+    first: u64,
+    remap: &Remap,
+) -> Result<(), Error> {
+    let src0 = &eyes0[0];
+    let c = src0.channels();
     let frame_bytes = |env_texels: u64| budget::f32_texels(env_texels, c as u64);
     let source = frame_bytes(
         src0.width() as u64
@@ -655,9 +904,9 @@ fn convert_frames(
     let made = frame_bytes(w as u64 * h as u64 * dst.layer_count() as u64 * out_eyes as u64);
     // The frame being written is packed into a picture (a file's layout; a pair's eyes
     // joined for a pipe).
-    let written = match &output {
+    let written = match output {
         Output::Files(p) => save::write_bytes(
-            &p.path(meta0.number).to_string_lossy(),
+            &p.path(first).to_string_lossy(),
             dst.kind(),
             (w, h, dst.layer_count()),
             (out_eyes, c),
@@ -680,188 +929,123 @@ fn convert_frames(
         0,
         FRAMES_IN_FLIGHT * (source + made) + remap.memory_bytes() as u64 + written,
         "a smaller --size",
-    )?;
-    if let Some((layout, _, fmt)) = &packed {
-        let (pw, ph) = if *layout == Layout::Separate {
-            (w, h)
-        } else {
-            layout.extent(dst.layer_count(), w, h)
-        };
-        let (pw, ph) = plan.stereo.extent(pw, ph);
-        hooks.note(&format!(
-            "writing {pw}x{ph} {fmt} frames to standard output: {} {w}x{h}{} ({layout}{})",
-            dst.name(),
-            times(dst.layer_count()),
-            match plan.stereo {
-                Stereo::Mono => String::new(),
-                s => format!(", each eye of a {s} pair"),
-            }
-        ));
-    }
-    // A raw frame of integer codes that is the source's one layer as it is (no eyes to
-    // split, no layout to unpack, no lens overlap to blend) is read by the plan as it came:
-    // no float copy of it is made (`Remap::rows_coded`: the same bytes out).
-    let coded = match (&reader.input, &packed) {
-        (Input::Pipe { w, h, fmt }, Some((_, Some(p), _)))
-            if fmt.has_codes()
-                && remap.takes_codes()
-                && from == Stereo::Mono
-                && eyes0.len() == 1
-                && matches!(reader.decided, Some((_, Layout::Separate)))
-                && (src0.width(), src0.height()) == (*w, *h) =>
-        {
-            Some((*w, *h, *fmt))
-        }
-        _ => None,
-    };
-    // Frames are encoded as their rows are made: a strip's or a cross's from its layers'
-    // rows, turned cells' (EAC) from the plan laid out as the packed picture.
-    let encode =
-        |fmt: PixFmt, packing: &Packing, rows: &RemapRows, bytes: &mut Vec<u8>| match &picture {
-            Some(p) => p.encode_rows(fmt, rows, bytes),
-            None => packing.encode_rows(fmt, rows, bytes),
-        };
-    let t_plan = t0.elapsed();
-    let settings = record::settings(r);
+    )
+}
 
-    let fresh = || -> Eyes {
-        (0..plan.stereo.eyes())
-            .map(|_| {
-                let layers = (0..dst.layer_count())
-                    .map(|_| Image::new(w, h, c))
-                    .collect();
-                EnvMap::new(dst, layers).expect("layers of the plan's shape")
-            })
-            .collect()
+/// Says what a pipe's frames will be.
+fn note_pipe_output(
+    hooks: &dyn Hooks,
+    plan: &Plan,
+    (dst, w, h): (Projection, u32, u32),
+    layout: Layout,
+    fmt: PixFmt,
+) {
+    let (pw, ph) = if layout == Layout::Separate {
+        (w, h)
+    } else {
+        layout.extent(dst.layer_count(), w, h)
     };
-    let mut first = Some((meta0, eyes0));
-    let stdout = std::io::stdout();
-    let logged = |m: &Meta, out: String, t: Instant| {
-        log.line(
-            json!({"frame": m.number, "input": m.input, "output": out}),
-            Status::Done,
-            t.elapsed(),
-            None,
-        );
-    };
-    let mut bytes = Vec::new();
-    let mut put = |m: &Meta, eyes: &Eyes| -> Result<(), Error> {
-        let t = Instant::now();
-        let out: String = match (&output, &packed) {
-            (Output::Pipe(_), Some((layout, packing, fmt))) => {
-                // A 2d frame's packing makes its rows as they are encoded (below), so
-                // only stereo pairs come here, packed whole.
-                debug_assert!(packing.is_none());
-                let pic = save::pack_eyes(eyes, plan.stereo, *layout)
-                    .map_err(|e| e.context(format!("--layout {layout}")))?;
-                Packing::single(pic.width(), pic.height()).encode_layers(
-                    *fmt,
-                    std::slice::from_ref(&pic),
-                    &mut bytes,
-                );
-                pipe::write_frame(&mut stdout.lock(), &bytes, m.number)?;
-                "-".into()
-            }
-            (Output::Files(p), _) => {
-                save_frame(eyes, &p.path(m.number), (plan, hooks), &m.input, &settings)?
-            }
-            (Output::File(s), _) => {
-                save_frame(eyes, Path::new(s), (plan, hooks), &m.input, &settings)?
-            }
-            _ => unreachable!("a pipe has its format"),
-        };
-        logged(m, out, t);
-        Ok(())
-    };
-    let t1 = Instant::now();
-    let mut done = None;
-    hooks.progress("frames", total, &mut |counter| {
-        let counted = AtomicU64::new(0);
-        let mut next = |spare: Option<Eyes>| first.take().map(Ok).or_else(|| reader.next(spare));
-        let mut put_bytes = |m: &Meta, bytes: &Vec<u8>| {
-            let t = Instant::now();
-            pipe::write_frame(&mut stdout.lock(), bytes, m.number)?;
-            logged(m, "-".into(), t);
-            counter.fetch_add(1, Ordering::Relaxed);
+    let (pw, ph) = plan.stereo.extent(pw, ph);
+    hooks.note(&format!(
+        "writing {pw}x{ph} {fmt} frames to standard output: {} {w}x{h}{} ({layout}{})",
+        dst.name(),
+        times(dst.layer_count()),
+        match plan.stereo {
+            Stereo::Mono => String::new(),
+            s => format!(", each eye of a {s} pair"),
+        }
+    ));
+}
+
+/// Frames whose output rows are made and encoded together: no float copy of the output
+/// frame exists.
+fn run_packed(
+    next: &mut pipeline::Next<'_>,
+    remap: &Remap,
+    encode: &(dyn Fn(&RemapRows, &mut Vec<u8>) + Sync),
+    put_bytes: &mut pipeline::Put<'_, Vec<u8>>,
+    counted: &AtomicU64,
+) -> Result<(), Error> {
+    pipeline::run(
+        next,
+        &|m: &Meta, src: &Eyes, bytes: &mut Vec<u8>| {
+            let rows = remap.rows(&src[0]).map_err(|e| pipeline::misfit(m, e))?;
+            encode(&rows, bytes);
             Ok(())
+        },
+        &Vec::new,
+        put_bytes,
+        counted,
+    )
+}
+
+/// A coded pipe's frames: rows made from each frame's codes and encoded together, so no
+/// float copy of the source frame or of the output frame exists (the first frame, read to
+/// decide the projection, is converted from its maps: the same bytes).
+fn run_coded(
+    (reader, first): (&mut Reader, Option<(Meta, Eyes)>),
+    (remap, codes): (&Remap, (u32, u32, PixFmt)),
+    encode: &(dyn Fn(&RemapRows, &mut Vec<u8>) + Sync),
+    put_bytes: &mut pipeline::Put<'_, Vec<u8>>,
+    counted: &AtomicU64,
+) -> Result<(), Error> {
+    let mut first = first.map(|(m, eyes)| (m, Source::Maps(eyes)));
+    let mut next_codes = |spare: Option<Source>| {
+        if let Some(f) = first.take() {
+            return Some(Ok(f));
+        }
+        let spare = match spare {
+            Some(Source::Codes(bytes)) => Some(bytes),
+            _ => None,
         };
-        let r = match &packed {
-            // Rows made from the frame's codes and encoded together: no float copy of the
-            // source frame or of the output frame (the first frame, read to decide the
-            // projection, is converted from its maps: the same bytes).
-            Some((_, Some(packing), fmt)) if coded.is_some() => {
-                let codes = coded.expect("a coded pipe");
-                let mut first = first.take().map(|(m, eyes)| (m, Source::Maps(eyes)));
-                let mut next_codes = |spare: Option<Source>| {
-                    if let Some(f) = first.take() {
-                        return Some(Ok(f));
-                    }
-                    let spare = match spare {
-                        Some(Source::Codes(bytes)) => Some(bytes),
-                        _ => None,
-                    };
-                    reader
-                        .next_codes(spare)
-                        .map(|r| r.map(|(m, bytes)| (m, Source::Codes(bytes))))
-                };
-                pipeline::run(
-                    &mut next_codes,
-                    &|m: &Meta, src: &Source, bytes: &mut Vec<u8>| {
-                        let rows = source_rows(&remap, codes, m, src)?;
-                        encode(*fmt, packing, &rows, bytes);
-                        Ok(())
-                    },
-                    &Vec::new,
-                    &mut put_bytes,
-                    &counted,
-                )
-            }
-            // Rows made and encoded together: no float copy of the output frame.
-            Some((_, Some(packing), fmt)) => pipeline::run(
-                &mut next,
-                &|m: &Meta, src: &Eyes, bytes: &mut Vec<u8>| {
-                    let rows = remap.rows(&src[0]).map_err(|e| pipeline::misfit(m, e))?;
-                    encode(*fmt, packing, &rows, bytes);
-                    Ok(())
-                },
-                &Vec::new,
-                &mut put_bytes,
-                &counted,
-            ),
-            _ => pipeline::run(
-                &mut next,
-                &|m: &Meta, src: &Eyes, out: &mut Eyes| {
-                    pipeline::convert_eyes((&remap, from), m, src, out)
-                },
-                &fresh,
-                &mut |m: &Meta, e: &Eyes| {
-                    put(m, e)?;
-                    counter.fetch_add(1, Ordering::Relaxed);
-                    Ok(())
-                },
-                &counted,
-            ),
-        };
-        done = Some((r, counted.load(Ordering::Relaxed)));
-    });
-    let (result, n) = done.expect("the work ran");
-    let secs = t1.elapsed().as_secs_f64();
-    {
-        hooks.note(&format!(
-            "{} to {} {w}x{h}{} in {secs:.2}s ({:.2} frames/s; planned in {:.2}s){}",
-            mirrorball_core::count(n, "frame"),
-            dst.name(),
-            times(dst.layer_count()),
-            n as f64 / secs.max(1e-9),
-            t_plan.as_secs_f64(),
-            if skipped > 0 {
-                format!("; {skipped} skipped, their outputs exist")
-            } else {
-                String::new()
-            }
-        ));
-    }
-    result
+        reader
+            .next_codes(spare)
+            .map(|r| r.map(|(m, bytes)| (m, Source::Codes(bytes))))
+    };
+    pipeline::run(
+        &mut next_codes,
+        &|m: &Meta, src: &Source, bytes: &mut Vec<u8>| {
+            let rows = source_rows(remap, codes, m, src)?;
+            encode(&rows, bytes);
+            Ok(())
+        },
+        &Vec::new,
+        put_bytes,
+        counted,
+    )
+}
+
+/// Writes one output frame (both eyes of a pair): a stereo pair packed whole into a pipe, or
+/// a frame's file(s); the name for the log.
+fn put_frame(
+    m: &Meta,
+    eyes: &Eyes,
+    (output, packed): (&Output, &Option<PipeOut>),
+    (plan, hooks): (&Plan, &dyn Hooks),
+    settings: &str,
+    bytes: &mut Vec<u8>,
+) -> Result<String, Error> {
+    Ok(match (output, packed) {
+        (Output::Pipe(_), Some((layout, packing, fmt))) => {
+            // A 2d frame's packing makes its rows as they are encoded (below), so
+            // only stereo pairs come here, packed whole.
+            debug_assert!(packing.is_none());
+            let pic = save::pack_eyes(eyes, plan.stereo, *layout)
+                .map_err(|e| e.context(format!("--layout {layout}")))?;
+            Packing::single(pic.width(), pic.height()).encode_layers(
+                *fmt,
+                std::slice::from_ref(&pic),
+                bytes,
+            );
+            pipe::write_frame(&mut std::io::stdout().lock(), bytes, m.number)?;
+            "-".into()
+        }
+        (Output::Files(p), _) => {
+            save_frame(eyes, &p.path(m.number), (plan, hooks), &m.input, settings)?
+        }
+        (Output::File(s), _) => save_frame(eyes, Path::new(s), (plan, hooks), &m.input, settings)?,
+        _ => unreachable!("a pipe has its format"),
+    })
 }
 
 /// Writes one frame's file(s) through io's atomic writes and records how it was made (from
