@@ -48,7 +48,9 @@
 //! and its [`Fault`] (the input, the request or the system).
 
 pub mod budget;
+pub mod compare;
 pub mod convert;
+pub mod demo;
 pub mod error;
 pub mod fit;
 pub mod frames;

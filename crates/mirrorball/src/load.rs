@@ -58,6 +58,18 @@ pub struct Source {
 }
 
 impl Source {
+    /// One map, no second eye.
+    fn one(env: EnvMap, description: String, decided: String, invalid: u64) -> Source {
+        Source {
+            env,
+            description,
+            decided,
+            right: None,
+            stereo: Stereo::Mono,
+            invalid,
+        }
+    }
+
     /// What was read and decided, for the user, after replacing NaN, infinite and negative
     /// texels by 0 unless `keep_invalid` (with a warning when any were).
     pub fn prepare(&mut self, input: &str, keep_invalid: bool) -> Vec<String> {
@@ -183,36 +195,8 @@ pub fn load_eyes(
         return Err(one_picture(stereo, "the file holds six cube faces"));
     }
     if layers.len() == 6 {
-        // A cube container: KTX2 or DDS.
-        let (spec, proj) = match (&recorded, from) {
-            (Some(info), None) if info.projection.layer_count() == 6 => {
-                (info.projection.spec(), info.projection)
-            }
-            _ => multi_layer(from)?,
-        };
-        if proj.layer_count() != 6 {
-            return Err(Error::request(format!(
-                "{input}: holds six cube faces, which cannot be read as {}",
-                spec.kind
-            )));
-        }
-        let decided = match (&recorded, from) {
-            (Some(_), None) => format!("{proj}, recorded in the file"),
-            _ => format!(
-                "{} (six faces in the container){}",
-                spec.kind,
-                records_other(&proj)
-            ),
-        };
-        let env = EnvMap::new(proj, layers).map_err(|e| Error::input(format!("{input}: {e}")))?;
-        return Ok(Source {
-            env,
-            description,
-            decided,
-            right: None,
-            stereo: Stereo::Mono,
-            invalid,
-        });
+        let (env, decided) = cube_container(input, layers, from, &recorded, records_other)?;
+        return Ok(Source::one(env, description, decided, invalid));
     }
     let image = layers
         .into_iter()
@@ -225,34 +209,13 @@ pub fn load_eyes(
         && layout.is_none()
         && recorded.is_none()
         && format == Format::Exr;
-    match declared.filter(|_| tagged) {
-        Some(ProjectionKind::LatLong) => {
-            let env = EnvMap::new(LatLong.into(), vec![openexr::latlong_to_mirrorball(&image)])
-                .map_err(|e| Error::input(format!("{input}: {e}")))?;
-            return Ok(Source {
-                env,
-                description,
-                decided: "the file is tagged envmap=latlong: OpenEXR's lat-long (+Z at the centre), turned half a turn into mirrorball's (--from latlong reads the picture as mirrorball's)".to_string(),
-                right: None,
-        stereo: Stereo::Mono,
-                invalid,
-            });
-        }
-        Some(ProjectionKind::Cube) => {
-            let faces = openexr::cube_to_faces(&image)
-                .map_err(|e| Error::input(format!("{input}: {e}")))?;
-            let env = EnvMap::new(CubeMap.into(), faces)
-                .map_err(|e| Error::input(format!("{input}: {e}")))?;
-            return Ok(Source {
-                env,
-                description,
-                decided: "the file is tagged envmap=cube: OpenEXR's vertical strip of faces, read into OpenGL's faces (--from cube --layout vstrip reads the picture as mirrorball's strip)".to_string(),
-                right: None,
-        stereo: Stereo::Mono,
-                invalid,
-            });
-        }
-        _ => {}
+    if let Some((env, decided)) = declared
+        .filter(|_| tagged)
+        .map(|kind| openexr_tagged(input, &image, kind))
+        .transpose()?
+        .flatten()
+    {
+        return Ok(Source::one(env, description, decided.into(), invalid));
     }
     let (env, right, decided) = interpret_eyes(
         input,
@@ -461,6 +424,65 @@ fn multi_layer(from: Option<&ProjSpec>) -> Result<(ProjSpec, Projection), Error>
         .build(None)
         .map_err(|e| Error::request(format!("--from: {e}")))?;
     Ok((spec, proj))
+}
+
+/// A cube container's six faces (KTX2, DDS) as the map `from` or the file's record says.
+fn cube_container(
+    input: &str,
+    layers: Vec<Image>,
+    from: Option<&ProjSpec>,
+    recorded: &Option<mirrorball_io::MapInfo>,
+    records_other: impl Fn(&Projection) -> String,
+) -> Result<(EnvMap, String), Error> {
+    // A cube container: KTX2 or DDS.
+    let (spec, proj) = match (recorded, from) {
+        (Some(info), None) if info.projection.layer_count() == 6 => {
+            (info.projection.spec(), info.projection)
+        }
+        _ => multi_layer(from)?,
+    };
+    if proj.layer_count() != 6 {
+        return Err(Error::request(format!(
+            "{input}: holds six cube faces, which cannot be read as {}",
+            spec.kind
+        )));
+    }
+    let decided = match (recorded, from) {
+        (Some(_), None) => format!("{proj}, recorded in the file"),
+        _ => format!(
+            "{} (six faces in the container){}",
+            spec.kind,
+            records_other(&proj)
+        ),
+    };
+    let env = EnvMap::new(proj, layers).map_err(|e| Error::input(format!("{input}: {e}")))?;
+    Ok((env, decided))
+}
+
+/// A picture whose OpenEXR `envmap` tag alone says its projection, in OpenEXR's conventions
+/// (ImfEnvmap) turned into mirrorball's, with what was decided; `None` for other tags.
+fn openexr_tagged(
+    input: &str,
+    image: &Image,
+    kind: ProjectionKind,
+) -> Result<Option<(EnvMap, &'static str)>, Error> {
+    let bad = |e: &dyn std::fmt::Display| Error::input(format!("{input}: {e}"));
+    Ok(match kind {
+        ProjectionKind::LatLong => Some((
+            EnvMap::new(LatLong.into(), vec![openexr::latlong_to_mirrorball(image)])
+                .map_err(|e| bad(&e))?,
+            "the file is tagged envmap=latlong: OpenEXR's lat-long (+Z at the centre), turned half a turn into mirrorball's (--from latlong reads the picture as mirrorball's)",
+        )),
+        ProjectionKind::Cube => Some((
+            EnvMap::new(
+                CubeMap.into(),
+                openexr::cube_to_faces(image).map_err(|e| bad(&e))?,
+            )
+            .map_err(|e| bad(&e))?,
+            "the file is tagged envmap=cube: OpenEXR's vertical strip of faces, read into OpenGL's faces (--from cube --layout vstrip reads the picture as mirrorball's strip)",
+        )),
+        _ => None,
+    })
 }
 
 /// Reads one file per layer: `{face}` becomes px nx py ny pz nz (cube) or front back.
