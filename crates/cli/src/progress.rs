@@ -140,4 +140,13 @@ impl mirrorball::Hooks for Printer {
     fn progress(&self, label: &str, total: u64, work: &mut (dyn FnMut(Arc<AtomicU64>) + Send)) {
         with_progress(label, total, self.quiet, work)
     }
+
+    fn work_progress(
+        &self,
+        label: &str,
+        total: u64,
+        work: &mut (dyn FnMut(Arc<AtomicU64>) + Send),
+    ) {
+        with_work_progress(label, total, self.quiet, work)
+    }
 }

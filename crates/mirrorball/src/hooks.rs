@@ -13,6 +13,17 @@ pub trait Hooks: Sync {
     /// Runs `work`, which advances the counter it is given towards `total` (a job's units:
     /// frames, rows), while the caller shows it as `label`.
     fn progress(&self, label: &str, total: u64, work: &mut (dyn FnMut(Arc<AtomicU64>) + Send));
+
+    /// [`Hooks::progress`] for work counted in `mirrorball_core::work`'s units, of which
+    /// the writers count what they finish too (a bar over the prefilter and the writing).
+    fn work_progress(
+        &self,
+        label: &str,
+        total: u64,
+        work: &mut (dyn FnMut(Arc<AtomicU64>) + Send),
+    ) {
+        self.progress(label, total, work)
+    }
 }
 
 /// Hooks that say nothing and show nothing.

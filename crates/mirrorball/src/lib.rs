@@ -47,6 +47,7 @@
 //! Every function returns [`Error`]: a message naming the file or setting and the problem,
 //! and its [`Fault`] (the input, the request or the system).
 
+pub mod bake;
 pub mod budget;
 pub mod compare;
 pub mod convert;
@@ -67,7 +68,6 @@ pub mod spec;
 pub use error::Error;
 pub use hooks::{Hooks, Quiet};
 pub use load::{load, InputPlan, Source};
-pub use mirrorball_bake as bake;
 pub use mirrorball_core as core;
 pub use mirrorball_core::{EnvMap, Fault, Layout, Projection, ProjectionKind};
 pub use mirrorball_filter as filter;

@@ -234,18 +234,9 @@ fn outputs(a: &ConvertArgs) -> Option<Vec<PathBuf>> {
     )
 }
 
-pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
-    let name = a
-        .frames
-        .manifest
-        .as_deref()
-        .expect("routed here for --manifest");
-    if !a.input.is_empty() || !a.output.is_empty() {
-        return Err(CliError::request(format!(
-            "--manifest {name}: the jobs' inputs and outputs are in the manifest; give no INPUT OUTPUT on the command line"
-        )));
-    }
-    let shard = a.frames.shard.as_deref().map(Shard::parse).transpose()?;
+/// The jobs of the manifest `name` (JSON lines or CSV, by its extension or its content),
+/// each with its flags parsed as `convert`'s; each job's output its own.
+fn read_jobs(name: &str) -> Result<(Vec<Job>, Vec<ConvertArgs>), CliError> {
     mirrorball_io::Error::check_input(std::path::Path::new(name))
         .map_err(|e| CliError::from(e).context("--manifest"))?;
     let text = std::fs::read_to_string(name)
@@ -273,6 +264,21 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         }
         parsed.push(args);
     }
+    Ok((jobs, parsed))
+}
+pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
+    let name = a
+        .frames
+        .manifest
+        .as_deref()
+        .expect("routed here for --manifest");
+    if !a.input.is_empty() || !a.output.is_empty() {
+        return Err(CliError::request(format!(
+            "--manifest {name}: the jobs' inputs and outputs are in the manifest; give no INPUT OUTPUT on the command line"
+        )));
+    }
+    let shard = a.frames.shard.as_deref().map(Shard::parse).transpose()?;
+    let (jobs, parsed) = read_jobs(name)?;
     let range = shard.map_or(0..jobs.len(), |s| s.range(jobs.len()));
     let log = Log {
         on: true,

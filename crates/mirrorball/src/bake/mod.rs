@@ -1,46 +1,74 @@
-//! `mirrorball bake IN --for ENGINE OUT-DIR`: everything one engine needs for image-based
-//! lighting, in its convention, with a README saying how to load it.
+//! Baking (`mirrorball bake IN --for ENGINE OUT-DIR`): everything one engine needs for
+//! image-based lighting, in its convention, with a README saying how to load it. The
+//! engines' rules are `mirrorball_bake`'s, re-exported here.
 //!
-//! `args → Plan (engine, size, encoding, folder and files checked: plan.rs) → read and
+//! `BakeRequest → Plan (engine, size, encoding, folder and files checked: plan.rs) → read and
 //! prepare (as prefilter) → the source checked against the encoding → memory estimated →
 //! mirrorball_bake::Bake::lighting (progress bar) → Bake::write (the files land together)`.
-//! The pipeline's steps are the bake library's; this module only reads, reports and times.
+//! The pipeline's steps are the bake crate's; this module reads, reports and times.
 
 mod plan;
 
+pub use mirrorball_bake::{
+    list, Bake, BakeOptions, ChainSpec, Description, Engine, Lighting, Written, ENGINES, MAX_SIZE,
+};
+pub use plan::{BakePlan, Plan};
+
 use crate::budget;
-use crate::error::CliError;
+use crate::error::Error;
 use crate::fit;
-use crate::load;
-use crate::progress::with_work_progress;
-use crate::BakeArgs;
+use crate::hooks::Hooks;
+use crate::load::{self, InputPlan};
 use mirrorball_core::Choice;
-use plan::{BakePlan, Plan};
 use std::time::Instant;
 
-pub fn run(a: BakeArgs) -> Result<(), CliError> {
-    let plan = match Plan::new(&a)? {
-        Plan::List => {
-            print!("{}", mirrorball_bake::list());
-            return Ok(());
-        }
-        Plan::Bake(p) => *p,
-    };
-    bake(plan)
+/// What to bake, as plain values: the command line's `bake` flags (each documented there),
+/// their text as given.
+#[derive(Clone, Debug)]
+pub struct BakeRequest {
+    pub input: Option<String>,
+    /// The engine's name, or `list`.
+    pub engine: String,
+    pub out_dir: Option<String>,
+    pub size: i64,
+    pub background_size: Option<i64>,
+    pub overwrite: bool,
+    pub encoding: Option<String>,
+    pub effort: String,
+    pub zstd: Option<i32>,
+    pub no_zstd: bool,
+    pub mapping: Option<String>,
+    pub samples: u32,
+    pub input_plan: InputPlan,
 }
 
-fn bake(mut plan: BakePlan) -> Result<(), CliError> {
-    let quiet = plan.quiet;
-    let say = |s: String| {
-        if !quiet {
-            eprintln!("{s}");
+impl BakeRequest {
+    /// The command line's defaults for baking `input` for `engine` into `out_dir`.
+    pub fn new(input: &str, engine: &str, out_dir: &str) -> BakeRequest {
+        BakeRequest {
+            input: Some(input.into()),
+            engine: engine.into(),
+            out_dir: Some(out_dir.into()),
+            size: 256,
+            background_size: None,
+            overwrite: false,
+            encoding: None,
+            effort: "basic".into(),
+            zstd: None,
+            no_zstd: false,
+            mapping: None,
+            samples: 128,
+            input_plan: InputPlan::default(),
         }
-    };
+    }
+}
+
+/// Bakes what `plan` says, saying what it does through `hooks`.
+pub fn run(mut plan: BakePlan, hooks: &dyn Hooks) -> Result<(), Error> {
+    let say = |s: String| hooks.note(&s);
     let t0 = Instant::now();
     let (env, notes) = load::read_prepared(&plan.source, &plan.input)?;
-    if !plan.quiet {
-        notes.iter().for_each(|line| eprintln!("{line}"));
-    }
+    notes.iter().for_each(|line| hooks.note(line));
     plan.bake.check(&env)?;
     plan.bake.fit(&env);
     let size = plan.bake.opts.size;
@@ -59,15 +87,19 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
     // prefilter's units and the writers' are the same: about a nanosecond of one core).
     let work = plan.bake.lighting_work(&env, &plan.prefilter) + plan.bake.write_work();
     let t1 = Instant::now();
-    let (report, written, t2) = with_work_progress("baking", work, quiet, |counter| {
+    let mut env = Some(env);
+    let mut done = None;
+    hooks.work_progress("baking", work, &mut |counter| {
         plan.prefilter.progress = Some(counter);
+        let env = env.take().expect("the work runs once");
         let mut lighting = plan.bake.lighting(&env, plan.prefilter.clone());
         drop(env);
         let report = measure(&mut lighting, &plan);
         let t2 = Instant::now();
         let written = plan.bake.write_into(&lighting, &plan.dir);
-        (report, written, t2)
+        done = Some((report, written, t2));
     });
+    let (report, written, t2) = done.expect("the work ran");
     let dir = format!("{}/", plan.dir.display());
     if let Some(line) = report.line(&dir, &keep_advice(&plan, &report)) {
         say(line);
