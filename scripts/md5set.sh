@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The md5 of a fixed set of outputs (converts, prefilters, bakes, renders, pipe frames) made
+# The md5 of a fixed set of outputs (converts, prefilters, bakes, renders, pipe frames, a
+# compare's difference picture, the demo) made
 # from the bundled maps: run with two builds and diff the lists to show which outputs a
 # change altered. Usage: scripts/md5set.sh BINARY OUTDIR > list.txt
 set -euo pipefail
@@ -24,7 +25,10 @@ for e in bevy three babylon gltf filament unity unreal ktx2; do q bake "$A/sky.e
 q render -o door.png --object quad --env "$A/venice.exr" --mode texgen --attach eye --size 96x64
 q render -o bunny.png --object "$ROOT/assets/meshes/bunny.obj" --env "$A/studio.exr" --mode pixel --size 96x64
 q convert "$A/city.exr" src.png --to latlong --size 256
+q compare "$A/city.exr" c.exr --diff diff.png
+q demo --out demo --size 64
 if command -v ffmpeg >/dev/null; then
   ffmpeg -v error -i src.png -f rawvideo -pix_fmt rgb24 - | "$MB" convert - - --from latlong --in-size 256x128 --pix-fmt rgb24 --to cube --size 32 --layout hstrip > pipe.rgb 2>/dev/null || echo "FAILED: pipe" >&2
 fi
-find . -type f ! -name src.png | sort | xargs md5sum
+# The demo's index and summary hold timings.
+find . -type f ! -name src.png ! -path ./demo/index.html ! -path ./demo/summary.txt | sort | xargs md5sum
