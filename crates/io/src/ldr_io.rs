@@ -322,21 +322,23 @@ pub fn lut16() -> &'static [f32] {
 }
 
 /// The linear values halfway between consecutive 8-bit codes: code k covers
-/// `[T[k-1], T[k])`, so encoding is a binary search that rounds to nearest exactly.
-fn thresholds8() -> &'static [f32; 255] {
+/// `[T[k-1], T[k])`, so encoding is a binary search that rounds to nearest exactly. The one
+/// home of 8-bit sRGB encoding: PNG, JPEG and raw `rgb24` frames all follow it.
+pub fn thresholds8() -> &'static [f32; 255] {
     static T: OnceLock<[f32; 255]> = OnceLock::new();
     T.get_or_init(|| std::array::from_fn(|k| srgb_to_linear((k as f64 + 0.5) / 255.0) as f32))
 }
 
 /// Linear light to the nearest 8-bit sRGB code, clamping to [0, 1] (NaN gives 0).
 #[inline]
-fn encode8(l: f32, t: &[f32; 255]) -> u8 {
+pub fn encode8(l: f32, t: &[f32; 255]) -> u8 {
     t.partition_point(|&x| x <= l) as u8
 }
 
-/// Linear light to the nearest 16-bit sRGB code, clamping to [0, 1] (NaN gives 0).
+/// Linear light to the nearest 16-bit sRGB code, clamping to [0, 1] (NaN gives 0): the one
+/// home of 16-bit sRGB encoding (PNG and raw `rgb48le` frames).
 #[inline]
-fn encode16(l: f32) -> u16 {
+pub fn encode16(l: f32) -> u16 {
     if l > 0.0 {
         (linear_to_srgb(l.min(1.0) as f64) * 65535.0 + 0.5) as u16
     } else {

@@ -202,134 +202,209 @@ impl PixFmt {
     }
 }
 
-/// The sRGB encoding scaled to integer codes, fast: linear on the standard's linear
-/// segment, and above it by the `f32` bit pattern from 2⁻⁹ (below the knee, 0.0031308) to 1.
+/// The sRGB encoding scaled to integer codes, fast, and exactly io's (`srgb8_code`,
+/// `srgb16_code`: what PNG and JPEG files hold), so a raw frame and a file of one map carry
+/// the same codes.
 ///
-/// 16-bit codes are piecewise linear in the bit pattern, 2⁹ pieces per octave (4609
-/// entries): within a piece the curve `1.055 L^(1/2.4)` bends by at most `h²/8 · |f''|`,
-/// with `h = L/2⁹`: `0.243/(8·2¹⁸) ≈ 1.2·10⁻⁷` of the value, under 0.01 of a code.
+/// 8-bit codes: io's codes change at 255 thresholds (`srgb8_thresholds`). From 2⁻¹³ (below
+/// the first threshold, 1.52·10⁻⁴) to 1 the `f32` bit pattern is cut into 2⁷ pieces per
+/// octave; each piece holds at most one threshold (the thresholds are at least 3·10⁻⁴
+/// apart below the knee and 8.9·10⁻³ near 1, wider than the pieces there; checked when the
+/// table is made), so a value's code is its piece's first code, plus one at or past the
+/// piece's threshold.
 ///
-/// 8-bit codes are read straight off a table of 2¹² pieces per octave (36864 bytes), each
-/// the code at its piece's centre: the code's slope is at most `255 · 1.055/2.4 · ln 2 ≈
-/// 77.7` codes per octave, so a piece spans under 0.019 of a code and its centre is within
-/// 0.0095 of every value in it.
-///
-/// Either way a code is the nearest one, or its neighbour for values within 0.01 of a code
-/// of a rounding boundary (the exact encoder, a `powf` per value, is io's, for files).
+/// 16-bit codes: an estimate, piecewise linear in the bit pattern from 2⁻⁹ (2⁹ pieces per
+/// octave: within a piece the curve bends by under 0.01 of a code) and linear below the
+/// knee, is the nearest code or its neighbour; one step against the exact thresholds
+/// between codes (each the smallest `f32` io encodes to the next code) makes it io's.
 pub struct SrgbTable {
-    /// Code value (scaled, not rounded) at the start of each 2⁹-per-octave piece, and one
-    /// past the end.
+    /// 16-bit: the code value (scaled, not rounded) at the start of each 2⁹-per-octave
+    /// piece from 2⁻⁹, and one past the end.
     at: Vec<f32>,
-    /// For 8-bit codes: the code of each 2¹²-per-octave piece (as `f32`, for the eight-lane
-    /// table lookup).
-    direct: Vec<f32>,
+    /// 8-bit: each piece's first code (as `f32`, for the eight-lane lookup).
+    first: Vec<f32>,
+    /// 8-bit: the threshold after each piece's first code (infinite past 255); 16-bit: the
+    /// threshold after each code, `thresholds[k]` the smallest value of code `k + 1`.
+    thresholds: Vec<f32>,
     scale: f32,
 }
 
-/// The bit pattern of 2⁻⁹, where the tables start.
+/// The bit pattern of 2⁻⁹, where the 16-bit estimate's table starts.
 const TABLE_FROM: u32 = 0x3b00_0000;
-/// Mantissa bits below a piece's index.
+/// Mantissa bits below a 16-bit piece's index.
 const PIECE_SHIFT: u32 = 14;
-/// Mantissa bits below a direct 8-bit piece's index.
-const DIRECT_SHIFT: u32 = 11;
+/// The bit pattern of 2⁻¹³, where the 8-bit table starts.
+const TABLE8_FROM: u32 = 0x3900_0000;
+/// Mantissa bits below an 8-bit piece's index.
+const PIECE8_SHIFT: u32 = 16;
 
 impl SrgbTable {
     /// The table for codes `0..=scale` (255 or 65535).
     pub fn get(scale: f32) -> &'static SrgbTable {
         static T8: OnceLock<SrgbTable> = OnceLock::new();
         static T16: OnceLock<SrgbTable> = OnceLock::new();
-        let cell = if scale <= 255.0 { &T8 } else { &T16 };
-        cell.get_or_init(|| {
-            let code = |bits: u32| linear_to_srgb(f32::from_bits(bits) as f64) * scale as f64;
-            let pieces = ((1.0f32.to_bits() - TABLE_FROM) >> PIECE_SHIFT) as usize;
-            let at = (0..=pieces)
-                .map(|k| code(TABLE_FROM + ((k as u32) << PIECE_SHIFT)) as f32)
-                .collect();
-            let direct = if scale <= 255.0 {
-                let n = (1.0f32.to_bits() - TABLE_FROM) >> DIRECT_SHIFT;
-                (0..n)
-                    .map(|k| {
-                        let centre = TABLE_FROM + (k << DIRECT_SHIFT) + (1 << (DIRECT_SHIFT - 1));
-                        code(centre).round() as f32
-                    })
-                    .collect()
-            } else {
-                Vec::new()
-            };
-            SrgbTable { at, direct, scale }
-        })
+        if scale <= 255.0 {
+            T8.get_or_init(SrgbTable::eight)
+        } else {
+            T16.get_or_init(SrgbTable::sixteen)
+        }
+    }
+
+    fn eight() -> SrgbTable {
+        let t = mirrorball_io::srgb8_thresholds();
+        assert!(
+            t[0] > f32::from_bits(TABLE8_FROM),
+            "no code above 0 below the table"
+        );
+        let pieces = (1.0f32.to_bits() - TABLE8_FROM) >> PIECE8_SHIFT;
+        let (mut first, mut thresholds) = (Vec::new(), Vec::new());
+        for k in 0..pieces {
+            let start = f32::from_bits(TABLE8_FROM + (k << PIECE8_SHIFT));
+            let end = f32::from_bits(TABLE8_FROM + ((k + 1) << PIECE8_SHIFT));
+            let c = mirrorball_io::srgb8_code(start, t) as usize;
+            let next = t.get(c).copied().unwrap_or(f32::INFINITY);
+            assert!(
+                t.get(c + 1).is_none_or(|&after| after >= end),
+                "two 8-bit thresholds in the piece from {start}"
+            );
+            first.push(c as f32);
+            thresholds.push(next);
+        }
+        SrgbTable {
+            at: Vec::new(),
+            first,
+            thresholds,
+            scale: 255.0,
+        }
+    }
+
+    fn sixteen() -> SrgbTable {
+        let code = |bits: u32| linear_to_srgb(f32::from_bits(bits) as f64) * 65535.0;
+        let pieces = ((1.0f32.to_bits() - TABLE_FROM) >> PIECE_SHIFT) as usize;
+        let at = (0..=pieces)
+            .map(|k| code(TABLE_FROM + ((k as u32) << PIECE_SHIFT)) as f32)
+            .collect();
+        // The smallest value io encodes to code k + 1, found from its real threshold by
+        // stepping one `f32` at a time.
+        let enc = |l: f32| mirrorball_io::srgb16_code(l) as u32;
+        let thresholds = (0..65535u32)
+            .map(|k| {
+                let mut g =
+                    mirrorball_core::color::srgb_to_linear((k as f64 + 0.5) / 65535.0) as f32;
+                while enc(g) > k {
+                    g = f32::from_bits(g.to_bits() - 1);
+                }
+                while enc(g) <= k {
+                    g = f32::from_bits(g.to_bits() + 1);
+                }
+                g
+            })
+            .collect();
+        SrgbTable {
+            at,
+            first: Vec::new(),
+            thresholds,
+            scale: 65535.0,
+        }
     }
 
     /// The code of linear `l`, clamped to `[0, scale]` (NaN gives 0).
     #[cfg(test)]
     pub fn code(&self, l: f32) -> u32 {
-        if self.direct.is_empty() {
+        if self.first.is_empty() {
             self.code16(l)
         } else {
             self.code8(l)
         }
     }
 
-    /// The linear segment's code of `l <= 0.0031308` (0 for NaN and negatives: `max`
-    /// keeps 0 over NaN), or `None` above it; `scale` at and above 1.
-    #[inline(always)]
-    fn ends(&self, l: f32) -> Option<u32> {
-        if l.is_nan() || l <= mirrorball_core::color::SRGB_LINEAR_KNEE as f32 {
-            return Some(
-                (l.max(0.0) * (mirrorball_core::color::SRGB_SLOPE as f32 * self.scale) + 0.5)
-                    as u32,
-            );
-        }
-        (l >= 1.0).then_some(self.scale as u32)
-    }
-
     /// [`SrgbTable::code`] of an 8-bit table.
     #[inline(always)]
     pub fn code8(&self, l: f32) -> u32 {
-        if let Some(c) = self.ends(l) {
-            return c;
+        if l >= 1.0 {
+            return 255;
         }
-        self.direct[((l.to_bits() - TABLE_FROM) >> DIRECT_SHIFT) as usize] as u32
+        if l.is_nan() || l < f32::from_bits(TABLE8_FROM) {
+            return 0; // NaN, negatives and values under the first threshold
+        }
+        let k = ((l.to_bits() - TABLE8_FROM) >> PIECE8_SHIFT) as usize;
+        self.first[k] as u32 + u32::from(l >= self.thresholds[k])
     }
 
-    /// [`SrgbTable::code8`] or [`SrgbTable::code16`] (the table's) of eight values at once:
-    /// the same arithmetic lane by lane, so the same codes (tested).
+    /// The 16-bit estimate of `l` in `(0, 1)`: the nearest code or a neighbour.
     #[inline(always)]
-    fn codes_x8(&self, x8: X8, l: F32x8) -> I32x8 {
-        let zero = x8.splat(0.0);
-        let knee = x8.splat(mirrorball_core::color::SRGB_LINEAR_KNEE as f32);
-        let slope = x8.splat(mirrorball_core::color::SRGB_SLOPE as f32 * self.scale);
-        // `ends`: NaN and negatives to 0 (`gt` is false for NaN).
-        let linear = l.gt(zero).select(l, zero) * slope + x8.splat(0.5);
-        let rel = l.to_bits() - x8.splat_i32(TABLE_FROM as i32);
-        // Lanes outside the table's range read a clamped entry, and are not chosen.
-        let table = if self.direct.is_empty() {
-            let k = rel.shift_right(PIECE_SHIFT);
-            let t = (rel & x8.splat_i32((1 << PIECE_SHIFT) - 1)).to_f32()
-                * x8.splat(1.0 / (1 << PIECE_SHIFT) as f32);
-            let (a, b) = (
-                x8.gather(&self.at, k),
-                x8.gather(&self.at, k + x8.splat_i32(1)),
-            );
-            a + (b - a) * t + x8.splat(0.5)
-        } else {
-            x8.gather(&self.direct, rel.shift_right(DIRECT_SHIFT))
-        };
-        let above = l.ge(x8.splat(1.0)).select(x8.splat(self.scale), table);
-        l.gt(knee).select(above, linear).trunc_i32()
-    }
-
-    /// [`SrgbTable::code`] of a 16-bit table.
-    #[inline(always)]
-    pub fn code16(&self, l: f32) -> u32 {
-        if let Some(c) = self.ends(l) {
-            return c;
+    fn estimate16(&self, l: f32) -> u32 {
+        if l <= mirrorball_core::color::SRGB_LINEAR_KNEE as f32 {
+            return (l * (mirrorball_core::color::SRGB_SLOPE as f32 * self.scale) + 0.5) as u32;
         }
         let rel = l.to_bits() - TABLE_FROM;
         let k = (rel >> PIECE_SHIFT) as usize;
         let t = (rel & ((1 << PIECE_SHIFT) - 1)) as f32 * (1.0 / (1 << PIECE_SHIFT) as f32);
         let (a, b) = (self.at[k], self.at[k + 1]);
         (a + (b - a) * t + 0.5) as u32
+    }
+
+    /// [`SrgbTable::code`] of a 16-bit table.
+    #[inline(always)]
+    pub fn code16(&self, l: f32) -> u32 {
+        if l >= 1.0 {
+            return 65535;
+        }
+        if l.is_nan() || l <= 0.0 {
+            return 0; // NaN and negatives
+        }
+        let e = self.estimate16(l).min(65535);
+        let down = e > 0 && l < self.thresholds[e as usize - 1];
+        let up = e < 65535 && l >= self.thresholds[e as usize];
+        e - u32::from(down) + u32::from(up)
+    }
+
+    /// [`SrgbTable::code8`] or [`SrgbTable::code16`] (the table's) of eight values at once:
+    /// the same arithmetic lane by lane, so the same codes (tested).
+    #[inline(always)]
+    fn codes_x8(&self, x8: X8, l: F32x8) -> I32x8 {
+        let one = x8.splat(1.0);
+        let (zero_i, scale_i) = (x8.splat_i32(0), x8.splat_i32(self.scale as i32));
+        if !self.first.is_empty() {
+            let inside = l.ge(x8.splat(f32::from_bits(TABLE8_FROM))) & l.lt(one);
+            let rel = l.to_bits() - x8.splat_i32(TABLE8_FROM as i32);
+            let k = inside.select_i32(rel.shift_right(PIECE8_SHIFT), zero_i);
+            let (first, next) = (x8.gather(&self.first, k), x8.gather(&self.thresholds, k));
+            let code = (first - l.ge(next).to_i32().to_f32()).trunc_i32();
+            let code = inside.select_i32(code, zero_i);
+            return l.ge(one).select_i32(scale_i, code);
+        }
+        let zero = x8.splat(0.0);
+        let knee = x8.splat(mirrorball_core::color::SRGB_LINEAR_KNEE as f32);
+        let slope = x8.splat(mirrorball_core::color::SRGB_SLOPE as f32 * self.scale);
+        let linear = (l * slope + x8.splat(0.5)).trunc_i32();
+        let inside = l.gt(zero) & l.lt(one);
+        let above = inside & l.gt(knee);
+        let rel = l.to_bits() - x8.splat_i32(TABLE_FROM as i32);
+        let k = above.select_i32(rel.shift_right(PIECE_SHIFT), zero_i);
+        let t = (rel & x8.splat_i32((1 << PIECE_SHIFT) - 1)).to_f32()
+            * x8.splat(1.0 / (1 << PIECE_SHIFT) as f32);
+        let (a, b) = (
+            x8.gather(&self.at, k),
+            x8.gather(&self.at, k + x8.splat_i32(1)),
+        );
+        let table = (a + (b - a) * t + x8.splat(0.5)).trunc_i32();
+        let e = above.select_i32(table, linear);
+        let e = inside.select_i32(e, zero_i);
+        // One step against the exact thresholds (`code16`).
+        let top = x8.splat_i32(65535);
+        let has_below = e.gt(zero_i);
+        let has_above = e.lt(top);
+        let below = x8.gather(
+            &self.thresholds,
+            has_below.select_i32(e - x8.splat_i32(1), zero_i),
+        );
+        let at = x8.gather(&self.thresholds, has_above.select_i32(e, zero_i));
+        let down = has_below & l.lt(below);
+        let up = has_above & !l.lt(at);
+        let e = e + down.to_i32() - up.to_i32();
+        let e = inside.select_i32(e, zero_i);
+        l.ge(one).select_i32(scale_i, e)
     }
 }
 
@@ -416,32 +491,66 @@ pub fn parse_size(flag: &str, s: &str) -> Result<(u32, u32), Error> {
 mod tests {
     use super::*;
 
-    #[test]
-    fn the_fast_srgb_codes_are_the_nearest_or_a_neighbour() {
-        for scale in [255.0f32, 65535.0] {
-            let t = SrgbTable::get(scale);
-            let n = 1_000_000;
-            let mut near_boundary = 0;
-            for i in 0..=n {
-                let l = (i as f32 / n as f32).powi(2) * 1.01;
-                let real = linear_to_srgb(l.min(1.0) as f64) * scale as f64;
-                let (exact, fast) = (real.round() as i64, t.code(l) as i64);
-                if fast != exact {
-                    // Only a neighbour, and only within 0.01 of a code of the boundary.
-                    let off = (real - real.floor() - 0.5).abs();
-                    assert!(
-                        (fast - exact).abs() == 1 && off < 0.01,
-                        "{l}: {fast} vs {exact} ({real}) of {scale}"
-                    );
-                    near_boundary += 1;
-                }
+    /// Values where codes change (each threshold and its neighbours a few `f32` steps
+    /// away), the ends of every table piece, the classes NaN, infinities, negatives,
+    /// zero and denormals, and a dense sweep of [0, 1.01].
+    fn probes(thresholds: &[f32]) -> Vec<f32> {
+        let mut v = vec![
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -1.0,
+            -0.0,
+            0.0,
+            1e-40,
+            f32::MIN_POSITIVE,
+            0.0031308,
+            f32::from_bits(0.0031308f32.to_bits() + 1),
+            f32::from_bits(1.0f32.to_bits() - 1),
+            1.0,
+            7.0,
+        ];
+        for &t in thresholds {
+            let b = t.to_bits();
+            v.extend((b.saturating_sub(3)..=b + 3).map(f32::from_bits));
+        }
+        for (from, shift) in [(TABLE8_FROM, PIECE8_SHIFT), (TABLE_FROM, PIECE_SHIFT)] {
+            let mut b = from;
+            while b < 1.0f32.to_bits() {
+                v.extend([b - 1, b, b + 1].map(f32::from_bits));
+                b += 1 << shift;
             }
-            assert!(near_boundary < n / 50, "{near_boundary} of {n} off by one");
-            assert_eq!(t.code(f32::NAN), 0);
-            assert_eq!(t.code(-1.0), 0);
-            assert_eq!(t.code(7.0), scale as u32);
-            assert_eq!(t.code(1.0), scale as u32);
-            assert_eq!(t.code(0.0), 0);
+        }
+        v.extend((0..=300_000).map(|i| (i as f32 / 300_000.0).powi(2) * 1.01));
+        v
+    }
+
+    #[test]
+    fn the_fast_srgb_codes_are_the_files_codes() {
+        let t8 = SrgbTable::get(255.0);
+        let exact8 = mirrorball_io::srgb8_thresholds();
+        for l in probes(exact8) {
+            assert_eq!(
+                t8.code(l),
+                mirrorball_io::srgb8_code(l, exact8) as u32,
+                "8-bit code of {l:e}"
+            );
+        }
+        let t16 = SrgbTable::get(65535.0);
+        for l in probes(&t16.thresholds) {
+            assert_eq!(
+                t16.code(l),
+                mirrorball_io::srgb16_code(l) as u32,
+                "16-bit code of {l:e}"
+            );
+        }
+        // Each 16-bit threshold is the first value of its code.
+        for (k, &t) in t16.thresholds.iter().enumerate() {
+            assert_eq!(mirrorball_io::srgb16_code(t) as usize, k + 1);
+            assert_eq!(
+                mirrorball_io::srgb16_code(f32::from_bits(t.to_bits() - 1)) as usize,
+                k
+            );
         }
     }
 
@@ -472,6 +581,8 @@ mod tests {
                 .step_by(4093)
                 .map(f32::from_bits),
         );
+        values.extend(probes(mirrorball_io::srgb8_thresholds()));
+        values.extend(probes(&SrgbTable::get(65535.0).thresholds));
         while values.len() % 8 != 0 {
             values.push(0.5);
         }
