@@ -258,6 +258,7 @@ impl State {
             "baseObject": self.base_object(),
             "objectChoices": self.object_choices(),
             "errors": self.errors,
+            "projections": projections(),
         })
     }
 }
@@ -344,7 +345,6 @@ fn describe_scene(v: &SceneView) -> Value {
         "objects": objects,
         "environment": environment,
         "notes": notes,
-        "projections": projections(),
     })
 }
 
