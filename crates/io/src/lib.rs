@@ -416,6 +416,78 @@ pub struct WriteOptions {
     /// The projection (and packing) of the picture, recorded where the container has a place
     /// for it (see the crate documentation).
     pub declared: Option<MapInfo>,
+    /// What a picture that is no environment map is ([`Picture`]: a preview sheet, a BRDF
+    /// table), recorded under [`CONTENT_KEY`] in PNG and OpenEXR files that declare no
+    /// projection, so that `info` names it.
+    pub note: Option<Picture>,
+}
+
+/// The key under which a picture that is no environment map records what it is.
+pub const CONTENT_KEY: &str = "mirrorball:content";
+
+/// Pictures mirrorball writes that are no environment map (see [`WriteOptions::note`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Picture {
+    /// `prefilter`'s preview sheet: each level as a lat-long thumbnail, four to a row.
+    PreviewSheet,
+    /// The split-sum BRDF table (A, B in red and green over N·V and roughness).
+    BrdfTable,
+}
+
+impl Picture {
+    /// Every kind, and the text each records.
+    pub const ALL: [(Picture, &'static str); 2] = [
+        (Picture::PreviewSheet, "preview-sheet"),
+        (Picture::BrdfTable, "brdf-table"),
+    ];
+
+    /// The text recorded under [`CONTENT_KEY`].
+    pub fn text(self) -> &'static str {
+        Picture::ALL
+            .iter()
+            .find(|(p, _)| *p == self)
+            .expect("listed")
+            .1
+    }
+
+    /// What `info` names as its projection: the thumbnails' lat-long for the sheet, none
+    /// for the table (it is a function of two numbers, not of a direction).
+    pub fn projection(self) -> &'static str {
+        match self {
+            Picture::PreviewSheet => "latlong",
+            Picture::BrdfTable => "none",
+        }
+    }
+
+    /// For people.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Picture::PreviewSheet => {
+                "prefilter's preview sheet: each level as a 256x128 lat-long thumbnail, four to a row"
+            }
+            Picture::BrdfTable => {
+                "the split-sum BRDF table: A and B in red and green over N.V (across) and roughness (down); no environment map"
+            }
+        }
+    }
+}
+
+/// What the picture at `path` records it is ([`CONTENT_KEY`]: PNG `tEXt`, OpenEXR string
+/// attribute), reading only its header; `None` for other files and those that record none.
+pub fn picture_of(path: &Path) -> Option<Picture> {
+    let text = match Format::from_path(path)? {
+        Format::Png => {
+            let mut f = std::io::BufReader::new(std::fs::File::open(path).ok()?);
+            let texts = meta_text::read_texts(&mut f).ok()?;
+            texts.into_iter().find(|(k, _)| k == CONTENT_KEY)?.1
+        }
+        Format::Exr => exr_io::content_text(path)?,
+        _ => return None,
+    };
+    Picture::ALL
+        .iter()
+        .find(|(_, t)| *t == text.trim())
+        .map(|(p, _)| *p)
 }
 
 /// What [`read`] found in a file.

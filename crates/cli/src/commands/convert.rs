@@ -119,6 +119,7 @@ impl Plan {
             exr_compression: parse_compression(a.compression.as_deref())?,
             jpeg_quality: 92,
             declared: None,
+            note: None,
         };
         let save = SaveOptions {
             layout,

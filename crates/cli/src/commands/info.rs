@@ -16,6 +16,19 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
         }
         return Ok(());
     }
+    if let Some(p) = mirrorball_io::picture_of(std::path::Path::new(&a.input)) {
+        let v = serde_json::json!({"file": a.input, "projection": p.projection(), "content": p.describe()});
+        match a.json {
+            true => println!("{v:#}"),
+            false => println!(
+                "file:        {}\nprojection:  {} ({})",
+                a.input,
+                p.projection(),
+                p.describe()
+            ),
+        }
+        return Ok(());
+    }
     let input = InputPlan::new(&a.input_args)?;
     // One face of a set (`cube/px.hdr`) is read with its set, as `{face}` reads it.
     let set = (input.from.is_none() && input.layout.is_none())

@@ -190,7 +190,7 @@ fn info_reads_every_file_every_bake_engine_writes_and_names_its_projection() {
 }
 
 /// `info` reads back every file `prefilter` writes (the chain in each container, the SH
-/// JSON) and names its projection.
+/// JSON, the preview sheet and the BRDF table) and names its projection.
 #[test]
 fn info_reads_every_file_prefilter_writes_and_names_its_projection() {
     let dir = tempfile::tempdir().unwrap();
@@ -222,15 +222,23 @@ fn info_reads_every_file_prefilter_writes_and_names_its_projection() {
             "8",
             "--to",
             to,
-            "--no-preview",
+            "--lut",
+            folder.join(["lut.exr", "lut.png"][i % 2]).to_str().unwrap(),
             "-q",
         ]);
         let files = written_files(&folder);
-        assert!(files.iter().any(|f| f.ends_with(".json")), "{files:?}");
+        for side in [".json", "_preview.png", "lut."] {
+            assert!(files.iter().any(|f| f.contains(side)), "{side}: {files:?}");
+        }
         for f in files {
-            let want = match f.ends_with(".json") {
-                true => mirrorball_io::SH_PROJECTION,
-                false => to,
+            let want = if f.ends_with(".json") {
+                mirrorball_io::SH_PROJECTION
+            } else if f.contains("_preview.png") {
+                mirrorball_io::Picture::PreviewSheet.projection()
+            } else if f.starts_with("lut.") {
+                mirrorball_io::Picture::BrdfTable.projection()
+            } else {
+                to
             };
             assert_eq!(
                 info_projection(&folder.join(&f)).as_deref(),

@@ -230,6 +230,7 @@ pub(super) fn write_preview(plan: &Plan, p: &Path, chain: &[EnvMap]) -> Result<(
         &sheet,
         &WriteOptions {
             precision: Some(Precision::U8),
+            note: Some(mirrorball_io::Picture::PreviewSheet),
             ..Default::default()
         },
     )?;
@@ -249,6 +250,7 @@ pub(super) fn write_lut(plan: &Plan, p: &Path) -> Result<(), CliError> {
         &lut.to_image(),
         &WriteOptions {
             precision: Some(precision),
+            note: Some(mirrorball_io::Picture::BrdfTable),
             ..Default::default()
         },
     )?;
