@@ -318,3 +318,27 @@ fn info_reads_every_writable_container_and_names_its_projection() {
         }
     }
 }
+
+/// A picture of v360's padded `eac` shape that records nothing is read as EAC (not as a
+/// cube in EAC's packing), and `--from cube` cannot read it so.
+#[test]
+fn a_padded_eac_frame_without_a_record_is_read_as_eac() {
+    let dir = tempfile::tempdir().unwrap();
+    for n in [16u32, 24] {
+        let (w, h) = Layout::eac().extent(6, n, n);
+        let frame = dir.path().join(format!("frame{n}.exr"));
+        let img = mirrorball_core::Image::new(w, h, 3);
+        mirrorball_io::write_image(&frame, &img, &Default::default()).unwrap();
+        assert_eq!(info_projection(&frame).as_deref(), Ok("eac"), "{w}x{h}");
+        let o = run(&[
+            "info",
+            frame.to_str().unwrap(),
+            "--from",
+            "cube",
+            "--in-layout",
+            "eac",
+        ]);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(stderr(&o).contains("use --from eac"), "{}", stderr(&o));
+    }
+}
