@@ -7,7 +7,9 @@
 //! long). We do the same for any projection: the points are `uv_k = (½, ½) + k·(sx/w, sy/h)`
 //! on the layer that looks along the view axis (−Z: the cube's −Z face, the paraboloid's
 //! front half; layer 0 otherwise), their directions come from the projection's `uv_to_dir`,
-//! and the angle is `atan2(|a × b|, a·b)`.
+//! and the angle is `atan2(|a × b|, a·b)`. Where the layer's centre is not inside its domain
+//! by a pixel (the dual fisheye, whose lenses touch there), the walks start at the point
+//! that looks along the view axis instead (the front lens's centre) ([`walk_start`]).
 //!
 //! Where the domain ends between two boundaries (a disk map's rim, crossed on the diagonal)
 //! the last step is cut at the rim, and reported as partial.
@@ -69,7 +71,39 @@ pub fn view_layer<P: WorldProjection + ?Sized>(p: &P) -> usize {
 
 /// Walks from `(½, ½)` in steps of `step` (in `uv`) until the domain or the layer ends.
 pub fn walk<P: WorldProjection + ?Sized>(p: &P, layer: usize, step: DVec2, name: &str) -> Walk {
+    walk_from(p, layer, DVec2::splat(0.5), step, name)
+}
+
+/// Where the walks of `layer` start: the layer's centre `(½, ½)`, or, where a pixel's step
+/// from it in some walk's direction leaves the domain (the dual fisheye's centre, where its
+/// two lenses touch), the point that looks along the view axis (the front lens's centre).
+pub fn walk_start<P: WorldProjection + ?Sized>(p: &P, layer: usize, steps: &[DVec2]) -> DVec2 {
     let c = DVec2::splat(0.5);
+    let inside = |uv: DVec2| {
+        (0.0..=1.0).contains(&uv.x)
+            && (0.0..=1.0).contains(&uv.y)
+            && p.uv_to_dir(layer, uv).is_some()
+    };
+    if inside(c) && steps.iter().all(|&s| inside(c + s)) {
+        return c;
+    }
+    match p.dir_to_uv(VIEW) {
+        Some((l, uv)) if l == layer => uv,
+        _ => c,
+    }
+}
+
+/// [`walk`] from `start` (the centre of the layer's domain): the rim, where the last step
+/// is cut, found along the walk's own ray.
+pub fn walk_from<P: WorldProjection + ?Sized>(
+    p: &P,
+    layer: usize,
+    start: DVec2,
+    step: DVec2,
+    name: &str,
+) -> Walk {
+    let c = start;
+    let centred = c == DVec2::splat(0.5);
     let inside = |uv: DVec2| {
         (0.0..=1.0).contains(&uv.x)
             && (0.0..=1.0).contains(&uv.y)
@@ -93,7 +127,11 @@ pub fn walk<P: WorldProjection + ?Sized>(p: &P, layer: usize, step: DVec2, name:
         // Cut the last step at the domain's boundary, if any of it is inside.
         let along = step.normalize();
         let angle = along.y.atan2(along.x);
-        let rb = boundary_radius(p, layer, angle);
+        let rb = if centred {
+            boundary_radius(p, layer, angle)
+        } else {
+            rim_along(&inside, c, along, (step * (k + 1) as f64).length())
+        };
         let r_here = (step * k as f64).length();
         let frac = (rb - r_here) / step.length();
         if frac > 1e-9 {
@@ -124,6 +162,24 @@ pub fn walk<P: WorldProjection + ?Sized>(p: &P, layer: usize, step: DVec2, name:
     }
 }
 
+/// The distance from `c` along the unit vector `along` to the rim of the domain
+/// (`inside`), known to be crossed before `beyond`: by bisection.
+fn rim_along(inside: &impl Fn(DVec2) -> bool, c: DVec2, along: DVec2, beyond: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, beyond);
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if inside(c + along * mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
 /// Zimmons' measure on `p` at edge `size`: horizontal, vertical and diagonal walks.
 ///
 /// ```
@@ -140,11 +196,16 @@ pub fn profile(p: &Projection, size: u32) -> Profile {
     let (w, h) = p.layer_extent(size);
     let layer = view_layer(p);
     let (sx, sy) = (1.0 / w as f64, 1.0 / h as f64);
-    let walks = vec![
-        walk(p, layer, DVec2::new(sx, 0.0), "horizontal"),
-        walk(p, layer, DVec2::new(0.0, -sy), "vertical"),
-        walk(p, layer, DVec2::new(sx, -sy), "diagonal"),
+    let steps = [
+        ("horizontal", DVec2::new(sx, 0.0)),
+        ("vertical", DVec2::new(0.0, -sy)),
+        ("diagonal", DVec2::new(sx, -sy)),
     ];
+    let start = walk_start(p, layer, &steps.map(|s| s.1));
+    let walks = steps
+        .iter()
+        .map(|&(name, step)| walk_from(p, layer, start, step, name))
+        .collect();
     Profile {
         projection: p.name().to_string(),
         size,

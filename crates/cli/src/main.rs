@@ -68,18 +68,24 @@ enum Command {
     Tag(commands::tag::TagArgs),
 }
 
+/// `--from`'s long help: the names from core's table of projections, then the keys.
+fn from_help() -> String {
+    format!(
+        "Projection of the input, `NAME[:key=value…]` (guessed from the file when omitted).\n\
+         Names:\n{}\
+         Keys: look=+x|-z|x,y,z  fov=DEG  lens=equidistant|equisolid|stereographic|orthographic\n\
+         max-lat=DEG  hfov=DEG vfov=DEG (cylinders, half-equirect, views)  d=NUM (pannini)\n\
+         yaw=DEG pitch=DEG roll=DEG (views: right, up, about the view axis).",
+        mirrorball_core::ProjectionKind::help_list()
+    )
+}
+
 /// How to read an input file.
 #[derive(Args, Debug, Clone)]
 pub struct InputArgs {
-    /// Projection of the input, `NAME[:key=value…]` (guessed from the file when omitted).
-    /// Names: latlong, cube, sphere, paraboloid, continuous-cube, mercator, angular, fisheye,
-    /// octahedral, equal-area-octahedral, cylindrical, cylindrical-equal-area, half-equirect,
-    /// hammer, sinusoidal, perspective, pannini (aliases: equirect, cubemap, matcap, probe,
-    /// cea, vr180, rectilinear, flat, …).
-    /// Keys: look=+x|-z|x,y,z  fov=DEG  lens=equidistant|equisolid|stereographic|orthographic
-    /// max-lat=DEG  hfov=DEG vfov=DEG (cylinders, half-equirect, views)  d=NUM (pannini)
-    /// yaw=DEG pitch=DEG roll=DEG (views: right, up, about the view axis).
-    #[arg(long, value_name = "PROJECTION")]
+    /// Projection of the input, `NAME[:key=value…]` (guessed from the file when omitted;
+    /// --help lists the names and keys).
+    #[arg(long, value_name = "PROJECTION", long_help = from_help())]
     from: Option<String>,
     /// Layout of the input's layers: hcross, vcross, hstrip, vstrip, separate, or v360's
     /// c3x2, c6x1, c1x6 (with `:forder=rludfb:frot=000000`) and eac.

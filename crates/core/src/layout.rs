@@ -364,6 +364,56 @@ impl Layout {
         }
     }
 
+    /// Whether this layout can hold a map of `kind`: the table of which layouts each
+    /// projection takes. One picture a layer holds any projection; the strips hold the
+    /// projections of several layers (a strip of one layer would not be read back as one:
+    /// its cells are square); the crosses and v360's unpadded cells hold six faces (the
+    /// cube, the continuous cube and EAC); v360's padded `eac` holds EAC only (its border is
+    /// continued in equi-angular face coordinates, so that plain cube faces in it are read
+    /// wrong by every EAC reader).
+    pub fn holds(self, kind: ProjectionKind) -> bool {
+        let layers = kind.default_projection().layer_count();
+        match self {
+            Layout::Separate => true,
+            Layout::HorizontalStrip | Layout::VerticalStrip => layers > 1,
+            Layout::Cells(c) if c.eac_pad => kind == ProjectionKind::Eac,
+            Layout::HorizontalCross | Layout::VerticalCross | Layout::Cells(_) => layers == 6,
+        }
+    }
+
+    /// Why this layout cannot hold a map of `kind`, naming the projections it holds: `eac
+    /// holds v360's padded equi-angular faces, not a cube map: use --to eac (or another
+    /// layout)`; `None` when it can ([`Layout::holds`]). `flag` is the flag that names the
+    /// projection (`--to`, `--from`); the caller puts its layout flag before the message.
+    pub fn refusal(self, kind: ProjectionKind, flag: &str) -> Option<String> {
+        if self.holds(kind) {
+            return None;
+        }
+        let takes: Vec<String> = ProjectionKind::ALL
+            .into_iter()
+            .filter(|&k| self.holds(k))
+            .map(|k| format!("{flag} {k}"))
+            .collect();
+        let why = match self {
+            Layout::Cells(c) if c.eac_pad => {
+                format!("v360's padded equi-angular faces, not a {kind} map")
+            }
+            Layout::HorizontalStrip | Layout::VerticalStrip => format!(
+                "several layers, and a {kind} map has {}",
+                crate::count(kind.default_projection().layer_count() as u64, "layer")
+            ),
+            _ => format!(
+                "six faces, and a {kind} map has {}",
+                crate::count(kind.default_projection().layer_count() as u64, "layer")
+            ),
+        };
+        let one_of = UnknownNameList(&takes);
+        Some(format!(
+            "{} holds {why}: use {one_of} (or another layout)",
+            self.name()
+        ))
+    }
+
     /// v360's `eac` arrangement (see [`CubeCells`]): the default layout of an EAC map.
     pub const fn eac() -> Layout {
         Layout::Cells(CubeCells::EAC)
@@ -425,6 +475,22 @@ impl Layout {
     /// The layout for a single picture of `w`×`h` holding `layers` layers, judged by its
     /// aspect ratio alone, with the cell size. `None` if no layout fits.
     pub fn from_extent(w: u32, h: u32, layers: usize) -> Option<(Layout, u32, u32)> {
+        Layout::from_extent_where(w, h, layers, |_| true)
+    }
+
+    /// [`Layout::from_extent`] among the layouts that hold a map of `kind`
+    /// ([`Layout::holds`]): a cube is never read from v360's padded `eac`.
+    pub fn from_extent_of(w: u32, h: u32, kind: ProjectionKind) -> Option<(Layout, u32, u32)> {
+        let layers = kind.default_projection().layer_count();
+        Layout::from_extent_where(w, h, layers, |l| l.holds(kind))
+    }
+
+    fn from_extent_where(
+        w: u32,
+        h: u32,
+        layers: usize,
+        accept: impl Fn(Layout) -> bool,
+    ) -> Option<(Layout, u32, u32)> {
         if layers == 1 {
             return Some((Layout::Separate, w, h));
         }
@@ -434,7 +500,7 @@ impl Layout {
             Layout::HorizontalStrip,
             Layout::VerticalStrip,
         ] {
-            if !l.fits(layers) {
+            if !l.fits(layers) || !accept(l) {
                 continue;
             }
             let (c, r) = l.grid(layers);
@@ -444,6 +510,9 @@ impl Layout {
         }
         if layers == 6 {
             for cells in [CubeCells::EAC, CubeCells::v360(CellGrid::C3x2)] {
+                if !accept(Layout::Cells(cells)) {
+                    continue;
+                }
                 if let Some(n) = cells.face_size(w, h) {
                     return Some((Layout::Cells(cells), n, n));
                 }
@@ -828,13 +897,25 @@ pub struct Guess {
     pub reason: String,
 }
 
+/// `a`, `a or b`, `a, b or c`.
+struct UnknownNameList<'a>(&'a [String]);
+
+impl fmt::Display for UnknownNameList<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0.split_last() {
+            None => Ok(()),
+            Some((last, [])) => f.write_str(last),
+            Some((last, rest)) => write!(f, "{} or {last}", rest.join(", ")),
+        }
+    }
+}
+
 /// Guesses projection and layout of a `w`×`h` picture: 2:1 is lat-long, 4:3 and 3:4 are cube
 /// crosses, 6:1 and 1:6 cube strips, 1:1 a sphere map; a declared kind wins when its layout
 /// fits. `None` when nothing fits.
 pub fn guess(w: u32, h: u32, declared: Option<ProjectionKind>) -> Option<Guess> {
     if let Some(kind) = declared {
-        let n = kind.default_projection().layer_count();
-        if let Some((layout, _, _)) = Layout::from_extent(w, h, n) {
+        if let Some((layout, _, _)) = Layout::from_extent_of(w, h, kind) {
             let reason = format!("the file declares a {kind} map; {w}x{h} fits {layout}");
             return Some(Guess {
                 kind,
@@ -858,11 +939,12 @@ pub fn guess(w: u32, h: u32, declared: Option<ProjectionKind>) -> Option<Guess> 
         );
     }
     if let Some((layout, _, _)) = Layout::from_extent(w, h, 6) {
-        return g(
-            ProjectionKind::Cube,
-            layout,
-            &format!("the shape of a cube {layout}"),
-        );
+        // v360's padded `eac` holds EAC only: a picture of its shape is an EAC frame.
+        let kind = std::iter::once(ProjectionKind::Cube)
+            .chain(ProjectionKind::ALL)
+            .find(|&k| layout.holds(k))
+            .unwrap_or(ProjectionKind::Cube);
+        return g(kind, layout, &format!("the shape of a {kind} {layout}"));
     }
     if w == h {
         return g(

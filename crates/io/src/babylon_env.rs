@@ -221,6 +221,49 @@ pub(crate) fn check_faces(path: &Path, levels: &[[Rgba8Face; 6]], width: u32) ->
     Ok(())
 }
 
+/// Level 0 of a bundle's specular cube (`.env`, or a glTF light's images): its six faces
+/// decoded from RGBD (each face as the PNG holds it, in the engine's axes), declared a cube.
+pub(crate) fn cube_loaded(
+    path: &Path,
+    levels: &[[Rgba8Face; 6]],
+    limits: &crate::Limits,
+    format: crate::Format,
+    what: &str,
+) -> Result<crate::Loaded, Error> {
+    let level0 = levels
+        .first()
+        .ok_or_else(|| Error::input(path, "no specular levels".into()))?;
+    let n = level0[0].size;
+    crate::ktx2_io::check_limits(path, n, n, limits)?;
+    let layers = level0
+        .iter()
+        .map(|f| mirrorball_encode::Encoding::Rgbd.decode(&f.texels, f.size, f.size))
+        .collect();
+    Ok(crate::Loaded {
+        layers,
+        declared: Some(mirrorball_core::ProjectionKind::Cube),
+        recorded: None,
+        format,
+        description: format!(
+            "{what}, RGBD 8-bit PNG faces, {} (level 0 read)",
+            mirrorball_core::count(levels.len() as u64, "mip level")
+        ),
+        invalid: None,
+    })
+}
+
+/// [`read_babylon_env`]'s level 0, for [`crate::read`].
+pub(crate) fn read(path: &Path, limits: &crate::Limits) -> Result<crate::Loaded, Error> {
+    let env = read_babylon_env(path)?;
+    cube_loaded(
+        path,
+        &env.levels,
+        limits,
+        crate::Format::BabylonEnv,
+        "Babylon.js environment (.env)",
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

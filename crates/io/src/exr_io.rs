@@ -223,8 +223,26 @@ fn layer_attributes(opts: &WriteOptions) -> LayerAttributes {
         attributes
             .other
             .extend(text_attribute(crate::PROJECTION_KEY, info.texts().0));
+    } else if let Some(note) = opts.note {
+        // Alone in its map (no projection is declared), so the header's bytes stay the same
+        // from run to run.
+        attributes
+            .other
+            .extend(text_attribute(crate::CONTENT_KEY, note.text().to_string()));
     }
     attributes
+}
+
+/// The [`crate::CONTENT_KEY`] text of the OpenEXR file at `path`, from its header alone.
+pub(crate) fn content_text(path: &Path) -> Option<String> {
+    let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
+    let key = Text::new_or_panic(crate::CONTENT_KEY);
+    meta.headers
+        .iter()
+        .find_map(|h| match h.own_attributes.other.get(&key) {
+            Some(AttributeValue::Text(t)) => Some(t.to_string()),
+            _ => None,
+        })
 }
 
 /// The layout attribute ([`crate::LAYOUT_KEY`]) of a written file, given to the image's

@@ -206,3 +206,15 @@ pub fn read_gltf_ibl(path: &Path) -> Result<GltfIbl, Error> {
         levels,
     })
 }
+
+/// [`read_gltf_ibl`]'s level 0, for [`crate::read`].
+pub(crate) fn read(path: &Path, limits: &crate::Limits) -> Result<crate::Loaded, Error> {
+    let ibl = read_gltf_ibl(path)?;
+    crate::babylon_env::cube_loaded(
+        path,
+        &ibl.levels,
+        limits,
+        crate::Format::GltfIbl,
+        &format!("glTF {EXTENSION} light '{}'", ibl.name),
+    )
+}

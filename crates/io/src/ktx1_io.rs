@@ -132,3 +132,120 @@ pub fn write_ktx1(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
         Ok(())
     })
 }
+
+/// The encoding of a KTX1 file's `glType` and `glInternalFormat`: those [`write_ktx1`]
+/// writes (Filament's three).
+fn encoding_of(gl_type: u32, internal: u32) -> Option<Encoding> {
+    [Encoding::B10G11R11, Encoding::Rgba16F, Encoding::Rgba32F]
+        .into_iter()
+        .find(|&e| gl_format(e).is_some_and(|f| f[0] == gl_type && f[3] == internal))
+}
+
+/// Reads level 0 of a KTX 1.1 cube map as [`write_ktx1`] writes it and Filament's
+/// `Ktx1Reader` reads it (B10G11R11, RGBA16F or RGBA32F, six faces, little-endian): the six
+/// faces, declared a cube; every declared size checked against the file's length and
+/// `limits` before anything is allocated.
+pub fn read(path: &Path, limits: &crate::Limits) -> Result<crate::Loaded, Error> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bad = |p: String| Error::input(path, p);
+    const HEAD: usize = 12 + 13 * 4;
+    if bytes.len() < HEAD || bytes[..12] != IDENTIFIER {
+        return Err(bad("not a KTX 1.1 file (bad identifier)".into()));
+    }
+    let word = |i: usize| u32::from_le_bytes(bytes[12 + 4 * i..16 + 4 * i].try_into().unwrap());
+    if word(0) != 0x0403_0201 {
+        return Err(bad(
+            "a big-endian KTX1 file; mirrorball reads little-endian ones, as cmgen writes".into(),
+        ));
+    }
+    let (gl_type, internal) = (word(1), word(4));
+    let encoding = encoding_of(gl_type, internal).ok_or_else(|| {
+        bad(format!(
+            "KTX1 glType 0x{gl_type:04X}, glInternalFormat 0x{internal:04X}; mirrorball reads \
+             Filament's R11F_G11F_B10F, RGBA16F and RGBA32F"
+        ))
+    })?;
+    let (w, h, depth, array, faces, levels, kvd) = (
+        word(6),
+        word(7),
+        word(8),
+        word(9),
+        word(10),
+        word(11),
+        word(12),
+    );
+    if faces != 6 || w != h || w == 0 || depth != 0 || array != 0 {
+        return Err(bad(format!(
+            "a KTX1 texture of {faces} faces, {w}×{h}×{depth}, {array} array elements; \
+             mirrorball reads cube maps (six square faces)"
+        )));
+    }
+    crate::ktx2_io::check_limits(path, w, h, limits)?;
+    let kvd_end = HEAD
+        .checked_add(kvd as usize)
+        .filter(|&e| e <= bytes.len())
+        .ok_or_else(|| bad(format!("{kvd} bytes of key/value data past the file's end")))?;
+    // Key/value pairs: a size, then key NUL value, padded to 4.
+    let mut pairs = Vec::new();
+    let mut at = HEAD;
+    while at + 4 <= kvd_end {
+        let n = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        let Some(pair) = bytes
+            .get(at + 4..at + 4 + n)
+            .filter(|_| at + 4 + n <= kvd_end)
+        else {
+            return Err(bad("a key/value pair runs past the key/value data".into()));
+        };
+        if let Some(nul) = pair.iter().position(|&b| b == 0) {
+            let key = String::from_utf8_lossy(&pair[..nul]).into_owned();
+            let value = String::from_utf8_lossy(&pair[nul + 1..])
+                .trim_end_matches('\0')
+                .to_string();
+            pairs.push((key, value));
+        }
+        at += 4 + n.div_ceil(4) * 4;
+    }
+    let face_bytes = encoding.image_bytes(w, w);
+    let level0 = kvd_end + 4;
+    let image_size = bytes
+        .get(kvd_end..level0)
+        .map(|b| u32::from_le_bytes(b.try_into().unwrap()) as usize)
+        .ok_or_else(|| bad("the file ends before its first level".into()))?;
+    if image_size != face_bytes {
+        return Err(bad(format!(
+            "level 0's imageSize is {image_size}; a {w}×{w} {} face takes {face_bytes}",
+            encoding.label()
+        )));
+    }
+    if level0 + 6 * face_bytes > bytes.len() {
+        return Err(bad(format!(
+            "the file is truncated: level 0's six faces need {} bytes, {} are left",
+            6 * face_bytes,
+            bytes.len() - level0
+        )));
+    }
+    let layers = (0..6)
+        .map(|f| {
+            let start = level0 + f * face_bytes;
+            encoding.decode(&bytes[start..start + face_bytes], w, w)
+        })
+        .collect();
+    let get = |key: &str| pairs.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
+    let sh = if get("sh").is_some() {
+        ", spherical harmonics"
+    } else {
+        ""
+    };
+    Ok(crate::Loaded {
+        layers,
+        declared: Some(mirrorball_core::ProjectionKind::Cube),
+        recorded: crate::recorded(get, w, w),
+        format: crate::Format::Ktx1,
+        description: format!(
+            "KTX1 cube map (Filament), {}, {}{sh}",
+            encoding.label(),
+            mirrorball_core::count(u64::from(levels.max(1)), "mip level")
+        ),
+        invalid: None,
+    })
+}

@@ -287,6 +287,11 @@ pub fn write(
             let key = mirrorball_spherical::gpano::PNG_KEYWORD;
             chunks.extend(crate::meta_text::itxt_chunk(key, &xmp));
         }
+    } else if let Some(note) = opts.note {
+        chunks.extend(crate::meta_text::text_chunk(
+            crate::CONTENT_KEY,
+            note.text(),
+        ));
     }
     stage(path, |out| {
         PngEncoder::new(crate::meta_text::WithText::new(out, chunks))

@@ -41,6 +41,7 @@ mod output;
 mod owned;
 mod pipe_size;
 mod rgba_png;
+mod sh_file;
 
 pub use alloc::HugePages;
 pub use apng::write_apng;
@@ -64,6 +65,7 @@ pub use output::OutputSet;
 pub use owned::{Owned, RECORD};
 pub use pipe_size::{widen_pipe, PIPE_BYTES};
 pub use rgba_png::Rgba8Face;
+pub use sh_file::{read_sh, ShFile, SH_PROJECTION};
 
 use atomic::Staged;
 use exr_io::WriteBuffers;
@@ -174,6 +176,15 @@ pub enum Format {
     Ktx2,
     /// DirectDraw Surface cube map (DX10 header), RGBA16F or RGBA32F, optional mip chain.
     Dds,
+    /// KTX 1.1 cube map as Filament's cmgen writes it (`.ktx`; read here, written by `bake
+    /// --for filament` through [`write_ktx1`]).
+    Ktx1,
+    /// Babylon.js environment (`.env`: RGBD PNG faces; read here, written by `bake --for
+    /// babylon` through [`write_babylon_env`]).
+    BabylonEnv,
+    /// glTF with an `EXT_lights_image_based` light (`.gltf`; read here, written by `bake
+    /// --for gltf` through [`write_gltf_ibl`]).
+    GltfIbl,
 }
 
 impl Format {
@@ -188,13 +199,23 @@ impl Format {
             "webp" => Format::Webp,
             "ktx2" => Format::Ktx2,
             "dds" => Format::Dds,
+            "ktx" => Format::Ktx1,
+            "env" => Format::BabylonEnv,
+            "gltf" => Format::GltfIbl,
             _ => return None,
         })
     }
 
-    /// Whether the format holds a whole cube (six faces) in one file.
+    /// Whether the format holds a whole cube (six faces) in one file that [`write_cube`]
+    /// writes (the engines' bundles, [`Format::is_bundle`], are written by `bake`).
     pub fn is_cube_container(self) -> bool {
         matches!(self, Format::Ktx2 | Format::Dds)
+    }
+
+    /// Whether the format is an engine's lighting bundle, read for its level-0 cube and
+    /// written only by `bake`: KTX1, Babylon's `.env`, glTF's image-based light.
+    pub fn is_bundle(self) -> bool {
+        matches!(self, Format::Ktx1 | Format::BabylonEnv | Format::GltfIbl)
     }
 
     /// How a file of this format written with `precision` (`None`: its natural one) stores
@@ -215,6 +236,7 @@ impl Format {
         match self {
             Format::Jpeg => u16::MAX as u64,
             Format::Ktx2 | Format::Dds => MAX_CUBE_FACE as u64,
+            Format::Ktx1 | Format::BabylonEnv | Format::GltfIbl => MAX_CUBE_FACE as u64,
             Format::Exr | Format::Hdr | Format::Png | Format::Webp => u32::MAX as u64,
         }
     }
@@ -241,7 +263,7 @@ impl Format {
     }
 
     /// Every format, in the order messages list them.
-    pub const ALL: [Format; 7] = [
+    pub const ALL: [Format; 10] = [
         Format::Exr,
         Format::Hdr,
         Format::Png,
@@ -249,6 +271,9 @@ impl Format {
         Format::Webp,
         Format::Ktx2,
         Format::Dds,
+        Format::Ktx1,
+        Format::BabylonEnv,
+        Format::GltfIbl,
     ];
 
     /// The usual extension, with its dot: `.exr`.
@@ -261,6 +286,9 @@ impl Format {
             Format::Webp => ".webp",
             Format::Ktx2 => ".ktx2",
             Format::Dds => ".dds",
+            Format::Ktx1 => ".ktx",
+            Format::BabylonEnv => ".env",
+            Format::GltfIbl => ".gltf",
         }
     }
 
@@ -274,12 +302,16 @@ impl Format {
             Format::Webp => "WebP",
             Format::Ktx2 => "KTX2",
             Format::Dds => "DDS",
+            Format::Ktx1 => "KTX1",
+            Format::BabylonEnv => "Babylon.js .env",
+            Format::GltfIbl => "glTF image-based light",
         }
     }
 
-    /// Whether mirrorball writes it (WebP it only reads).
+    /// Whether `convert` writes it (WebP it only reads; the engines' bundles only `bake`
+    /// writes).
     pub fn is_written(self) -> bool {
-        self != Format::Webp
+        self != Format::Webp && !self.is_bundle()
     }
 
     /// The precisions its writer takes, its default first: half or float for OpenEXR, KTX2
@@ -291,6 +323,7 @@ impl Format {
             Format::Png => &[Precision::U8, Precision::U16],
             Format::Jpeg => &[Precision::U8],
             Format::Hdr | Format::Webp => &[],
+            Format::Ktx1 | Format::BabylonEnv | Format::GltfIbl => &[],
         }
     }
 }
@@ -385,6 +418,78 @@ pub struct WriteOptions {
     /// The projection (and packing) of the picture, recorded where the container has a place
     /// for it (see the crate documentation).
     pub declared: Option<MapInfo>,
+    /// What a picture that is no environment map is ([`Picture`]: a preview sheet, a BRDF
+    /// table), recorded under [`CONTENT_KEY`] in PNG and OpenEXR files that declare no
+    /// projection, so that `info` names it.
+    pub note: Option<Picture>,
+}
+
+/// The key under which a picture that is no environment map records what it is.
+pub const CONTENT_KEY: &str = "mirrorball:content";
+
+/// Pictures mirrorball writes that are no environment map (see [`WriteOptions::note`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Picture {
+    /// `prefilter`'s preview sheet: each level as a lat-long thumbnail, four to a row.
+    PreviewSheet,
+    /// The split-sum BRDF table (A, B in red and green over N·V and roughness).
+    BrdfTable,
+}
+
+impl Picture {
+    /// Every kind, and the text each records.
+    pub const ALL: [(Picture, &'static str); 2] = [
+        (Picture::PreviewSheet, "preview-sheet"),
+        (Picture::BrdfTable, "brdf-table"),
+    ];
+
+    /// The text recorded under [`CONTENT_KEY`].
+    pub fn text(self) -> &'static str {
+        Picture::ALL
+            .iter()
+            .find(|(p, _)| *p == self)
+            .expect("listed")
+            .1
+    }
+
+    /// What `info` names as its projection: the thumbnails' lat-long for the sheet, none
+    /// for the table (it is a function of two numbers, not of a direction).
+    pub fn projection(self) -> &'static str {
+        match self {
+            Picture::PreviewSheet => "latlong",
+            Picture::BrdfTable => "none",
+        }
+    }
+
+    /// For people.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Picture::PreviewSheet => {
+                "prefilter's preview sheet: each level as a 256x128 lat-long thumbnail, four to a row"
+            }
+            Picture::BrdfTable => {
+                "the split-sum BRDF table: A and B in red and green over N.V (across) and roughness (down); no environment map"
+            }
+        }
+    }
+}
+
+/// What the picture at `path` records it is ([`CONTENT_KEY`]: PNG `tEXt`, OpenEXR string
+/// attribute), reading only its header; `None` for other files and those that record none.
+pub fn picture_of(path: &Path) -> Option<Picture> {
+    let text = match Format::from_path(path)? {
+        Format::Png => {
+            let mut f = std::io::BufReader::new(std::fs::File::open(path).ok()?);
+            let texts = meta_text::read_texts(&mut f).ok()?;
+            texts.into_iter().find(|(k, _)| k == CONTENT_KEY)?.1
+        }
+        Format::Exr => exr_io::content_text(path)?,
+        _ => return None,
+    };
+    Picture::ALL
+        .iter()
+        .find(|(_, t)| *t == text.trim())
+        .map(|(p, _)| *p)
 }
 
 /// What [`read`] found in a file.
@@ -471,6 +576,9 @@ fn read_format(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         // of 255): a panic becomes an error.
         Format::Ktx2 => ldr_io::guard_decoder(path, "KTX2", || ktx2_io::read(path, limits)),
         Format::Dds => ldr_io::guard_decoder(path, "DDS", || dds_io::read(path, limits)),
+        Format::Ktx1 => ktx1_io::read(path, limits),
+        Format::BabylonEnv => babylon_env::read(path, limits),
+        Format::GltfIbl => gltf_ibl::read(path, limits),
     }
 }
 
@@ -492,6 +600,7 @@ pub fn write_work(format: Format, texels: u64, opts: &WriteOptions) -> u64 {
             _ => Encoding::Rgba16F.work(texels),
         },
         Format::Png | Format::Jpeg | Format::Webp => 0,
+        Format::Ktx1 | Format::BabylonEnv | Format::GltfIbl => 0,
     }
 }
 
@@ -537,6 +646,10 @@ pub(crate) fn stage_image(
         Format::Ktx2 | Format::Dds => Err(Error::request(
             path,
             "KTX2 and DDS hold cube maps: convert with --to cube".into(),
+        )),
+        Format::Ktx1 | Format::BabylonEnv | Format::GltfIbl => Err(Error::request(
+            path,
+            format!("{} files are written by bake", format.name()),
         )),
     }
 }
@@ -598,7 +711,8 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 fn unknown_ext() -> String {
-    "unknown file extension (known: .exr .hdr .png .jpg .jpeg .webp .ktx2 .dds)".to_string()
+    "unknown file extension (known: .exr .hdr .png .jpg .jpeg .webp .ktx2 .dds .ktx .env .gltf)"
+        .to_string()
 }
 
 /// [`Loaded::recorded`] from a file's text metadata (`get` looks a key up) for a `w`×`h`
@@ -616,4 +730,39 @@ pub(crate) fn recorded(
         w,
         h,
     ))
+}
+
+/// The layer names of files that hold one layer each, as `{face}` in a name reads them:
+/// a cube's faces, OpenGL order, and a paraboloid's halves.
+pub const LAYER_NAMES: [&[&str]; 2] = [&["px", "nx", "py", "ny", "pz", "nz"], &["front", "back"]];
+
+/// The `{face}` pattern of the set of one-layer files `path` is one of, when its stem ends
+/// in a layer name ([`LAYER_NAMES`]: `px`, … `nz`, `front`, `back`, alone or after `_`, `-`
+/// or `.`) and every file of the set is there: `cube/px.hdr` → `cube/{face}.hdr` (three's
+/// background), `lighting_specular_0_nz.png` → `lighting_specular_0_{face}.png` (a glTF
+/// light's level). A face alone is not a picture of the sphere: read the set.
+pub fn layer_set(path: &str) -> Option<String> {
+    let p = Path::new(path);
+    let stem = p.file_stem()?.to_str()?;
+    let ext = p.extension().and_then(|e| e.to_str());
+    for names in LAYER_NAMES {
+        for name in names {
+            let Some(head) = stem.strip_suffix(name) else {
+                continue;
+            };
+            if !(head.is_empty() || head.ends_with(['_', '-', '.'])) {
+                continue;
+            }
+            let file = match ext {
+                Some(e) => format!("{head}{{face}}.{e}"),
+                None => format!("{head}{{face}}"),
+            };
+            let pattern = p.with_file_name(file).to_str()?.to_string();
+            let all = names
+                .iter()
+                .all(|n| Path::new(&pattern.replace("{face}", n)).is_file());
+            return all.then_some(pattern);
+        }
+    }
+    None
 }

@@ -171,6 +171,7 @@ impl ConvertPlan {
             exr_compression: r.compression.unwrap_or_default(),
             jpeg_quality: 92,
             declared: None,
+            note: None,
         };
         let save = SaveOptions {
             layout: r.layout,

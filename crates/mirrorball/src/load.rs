@@ -306,14 +306,16 @@ pub fn interpret(
     let (w, h) = (image.width(), image.height());
     let (proj, layout, decided) = match (from, layout, recorded) {
         (Some(spec), Some(l), _) => {
+            if let Some(why) = l.refusal(spec.kind, "--from") {
+                return Err(Error::request(format!("--in-layout {why}")));
+            }
             let proj = build_from(spec, w, h)?;
             let note = records_other(&proj);
             (proj, l, format!("as asked{note}"))
         }
         (Some(spec), None, _) => {
-            let n = spec.kind.default_projection().layer_count();
-            let (l, _, _) =
-                Layout::from_extent(w, h, n).ok_or_else(|| no_layout(input, w, h, spec.kind))?;
+            let (l, _, _) = Layout::from_extent_of(w, h, spec.kind)
+                .ok_or_else(|| no_layout(input, w, h, spec.kind))?;
             let proj = build_from(spec, w, h)?;
             let note = records_other(&proj);
             (proj, l, format!("as asked; {w}x{h} fits {l}{note}"))

@@ -138,11 +138,8 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
         )));
     }
     if let Some(l) = layout {
-        if !l.fits(layers) {
-            return Err(Error::request(format!(
-                "--layout {l} needs six faces; a {kind} map has {}",
-                mirrorball_core::count(layers as u64, "layer")
-            )));
+        if let Some(why) = l.refusal(kind, "--to") {
+            return Err(Error::request(format!("--layout {why}")));
         }
         if l != Layout::Separate && out.contains(FACE) {
             return Err(Error::request(format!(

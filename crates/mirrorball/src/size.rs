@@ -73,7 +73,8 @@ pub fn largest(hi: u32, fits: impl Fn(u32) -> bool) -> u32 {
 fn side_reason(format: Format) -> &'static str {
     match format {
         Format::Jpeg => "a JPEG's sides are 16-bit",
-        Format::Ktx2 | Format::Dds => "the largest cube face GPUs take",
+        Format::Ktx2 | Format::Dds | Format::Ktx1 => "the largest cube face GPUs take",
+        Format::BabylonEnv | Format::GltfIbl => "the largest cube face GPUs take",
         Format::Exr | Format::Hdr | Format::Png | Format::Webp => "the format's own limit",
     }
 }

@@ -289,22 +289,16 @@ async fn environment(Shared(app): Shared<AppState>, Query(q): Query<EnvQuery>) -
     let work = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, (StatusCode, String)> {
         let map = if projection != "native" {
             convert(&app, &map, &projection, q.size)?
-        } else if gpu_kind(map.projection()).is_none() {
-            // A projection without a shader (the dual fisheye) is drawn from its exact
-            // lat-long conversion; the header's kind says so.
+        } else {
+            map
+        };
+        // A projection without a shader (the dual fisheye), loaded or asked for, is drawn
+        // from the exact lat-long conversion of that map; the header's kind says so.
+        let map = if gpu_kind(map.projection()).is_none() {
             convert(&app, &map, "latlong", q.size)?
         } else {
             map
         };
-        if gpu_kind(map.projection()).is_none() {
-            return Err((
-                StatusCode::UNPROCESSABLE_ENTITY,
-                format!(
-                    "the viewport does not draw {} maps",
-                    map.projection().name()
-                ),
-            ));
-        }
         let (map, fitted) = match q.limit {
             Some(limit) => fit(&app, map, limit, mips)?,
             None => (map, None),
@@ -677,6 +671,10 @@ async fn directions_of(
         Err(e) => return bad(e.status(), e.body_text()),
     };
     let p = match shown_projection(&app, &q) {
+        // Without a shader (the dual fisheye) the page is sent the lat-long conversion.
+        Ok(p) if gpu_kind(&p).is_none() => {
+            mirrorball_core::ProjectionKind::LatLong.default_projection()
+        }
         Ok(p) => p,
         Err((status, why)) => return bad(status, why),
     };

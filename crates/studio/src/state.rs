@@ -2,7 +2,10 @@
 
 use mirrorball_core::glam::Mat4;
 use mirrorball_core::glam::{DVec3, Mat3};
-use mirrorball_core::{Choice, CylinderRule, EnvMap, Frame, Lens, Projection, RadialMap};
+use mirrorball_core::{
+    Choice, CylinderRule, EnvMap, Frame, Layout, Lens, Projection, ProjectionKind, RadialMap,
+    WorldProjection,
+};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{
     Attach, Builtin, Camera, CameraLens, Environment, Indexing, Material, Mesh, Object, Scene,
@@ -255,6 +258,7 @@ impl State {
             "baseObject": self.base_object(),
             "objectChoices": self.object_choices(),
             "errors": self.errors,
+            "projections": projections(),
         })
     }
 }
@@ -356,7 +360,49 @@ pub fn describe_map(map: &EnvMap) -> Value {
         "layers": map.layers().len(),
         "width": map.width(),
         "height": map.height(),
+        "layout": layout_of(map.layers().len()),
     })
+}
+
+/// Every projection of the core's table, for the page's menu and the tests: its name, what
+/// it is, whether the viewport has its shader (else the page is sent its lat-long
+/// conversion), its layers and the simulator's layout of them.
+pub fn projections() -> Value {
+    let rows: Vec<Value> = ProjectionKind::ALL
+        .into_iter()
+        .map(|k| {
+            let p = k.default_projection();
+            json!({
+                "name": k.name(),
+                "about": k.about(),
+                "gpu": gpu_kind(&p).is_some(),
+                "layers": p.layer_count(),
+                "layout": layout_of(p.layer_count()),
+            })
+        })
+        .collect();
+    Value::Array(rows)
+}
+
+/// The simulator's picture of a map of `layers` layers, from the core's layouts: six as
+/// its horizontal cross, two side by side, else one cell; `grid` (columns, rows) and each
+/// layer's `[column, row]` (`Layout::grid_cell`).
+pub fn layout_of(layers: usize) -> Value {
+    let layout = match layers {
+        6 => Layout::HorizontalCross,
+        1 => Layout::Separate,
+        _ => Layout::HorizontalStrip,
+    };
+    let (c, r) = layout.grid(layers);
+    let cells: Vec<[u32; 2]> = (0..layers)
+        .map(|i| {
+            let (x, y, _) = layout
+                .grid_cell(i, layers)
+                .expect("the layout holds every layer");
+            [x, y]
+        })
+        .collect();
+    json!({ "name": layout.name(), "grid": [c, r], "cells": cells })
 }
 
 /// The projections the viewport's shaders know, by the name the page loads their GLSL under
@@ -572,5 +618,29 @@ mod tests {
             triangles(&s),
             vec![Builtin::Sphere.mesh(12).triangles.len()]
         );
+    }
+
+    /// The page's projection menu and the simulator's layouts come from the core's table:
+    /// every kind, each layer in a cell of its own inside the grid.
+    #[test]
+    fn every_projection_of_the_table_is_listed_with_a_cell_for_each_layer() {
+        let listed = projections();
+        let rows = listed.as_array().unwrap();
+        assert_eq!(rows.len(), ProjectionKind::ALL.len());
+        for (row, kind) in rows.iter().zip(ProjectionKind::ALL) {
+            assert_eq!(row["name"], kind.name());
+            assert_eq!(row["about"], kind.about());
+            let layers = kind.default_projection().layer_count();
+            assert_eq!(row["layers"], layers);
+            let cells = row["layout"]["cells"].as_array().unwrap();
+            assert_eq!(cells.len(), layers, "{kind}");
+            let grid = &row["layout"]["grid"];
+            let mut seen = std::collections::HashSet::new();
+            for c in cells {
+                let (x, y) = (c[0].as_u64().unwrap(), c[1].as_u64().unwrap());
+                assert!(x < grid[0].as_u64().unwrap() && y < grid[1].as_u64().unwrap());
+                assert!(seen.insert((x, y)), "{kind}: two layers in one cell");
+            }
+        }
     }
 }

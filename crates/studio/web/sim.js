@@ -12,13 +12,13 @@
 /** The most triangles whose texture-space edges the map shows (the first ones drawn). */
 const EDGE_TRIANGLES = 4096;
 
-/** Environment payload kind -> the layout of its picture: grid (columns, rows), cell per layer. */
-export function layoutOf(kind) {
-  // The cube as core's horizontal cross (crates/core/src/layout.rs `HCROSS`): +Y above,
-  // -X +Z +X -Z across, -Y below; the dual paraboloid front | back; the others one cell.
-  if (kind === 'cube') return { grid: [4, 3], cells: [[2, 1], [0, 1], [1, 0], [1, 2], [1, 1], [3, 1]] };
-  if (kind === 'paraboloid') return { grid: [2, 1], cells: [[0, 0], [1, 0]] };
-  return { grid: [1, 1], cells: [[0, 0]] };
+/**
+ * The layout of an environment payload's picture: grid (columns, rows), cell per layer, as
+ * the server gives it from the core's layouts (state.rs `layout_of`: six layers as the
+ * horizontal cross, two side by side, one alone), so every projection's every layer shows.
+ */
+export function layoutOf(header) {
+  return header.layout;
 }
 
 /** The angle between unit vectors a and b in degrees (atan2 of |a x b| and a.b: exact near 0). */
@@ -434,7 +434,7 @@ export function attach(studio) {
   async function mapPicture() {
     const h = view.env.header;
     if (sim.map && sim.map.texture === view.env.texture) return sim.map;
-    const { grid, cells } = layoutOf(h.projection);
+    const { grid, cells } = layoutOf(h);
     const [pw, ph] = [grid[0] * h.width, grid[1] * h.height];
     const t = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, t);

@@ -163,6 +163,26 @@ function showObjects() {
   select.value = st.object ?? 'scene';
 }
 
+/**
+ * The projection menu: "as loaded", then every projection of the core's table as the server
+ * lists it (state.rs `projections`), its description as the title.
+ */
+function showProjections() {
+  const select = document.getElementById('projection');
+  const native = select.querySelector('option[value="native"]');
+  select.replaceChildren(
+    native,
+    ...view.state.projections.map((p) => {
+      const o = document.createElement('option');
+      o.value = p.name;
+      o.textContent = p.name;
+      o.title = p.gpu ? p.about : `${p.about} (drawn from its lat-long conversion)`;
+      return o;
+    }),
+  );
+  select.value = view.projection;
+}
+
 /** What the server shows, the controls that depend on it and the objects' meshes. */
 async function loadObjects() {
   view.state = await (await G.api('/api/state')).json();
@@ -172,6 +192,7 @@ async function loadObjects() {
   document.getElementById('pan-blur').value = String(view.panBlur);
   document.getElementById('pan-blur-value').textContent = `${view.panBlur}°`;
   showObjects();
+  showProjections();
   showTessellation();
   await loadMeshes();
 }

@@ -8,13 +8,40 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
     if super::tag::is_movie(&a.input) {
         return super::tag::info(&a.input, a.json);
     }
+    if let Some(sh) = mirrorball_io::read_sh(std::path::Path::new(&a.input))? {
+        match a.json {
+            true => println!("{:#}", sh.info_json(&a.input)),
+            false => print!("{}", sh.info_text(&a.input)),
+        }
+        return Ok(());
+    }
+    if let Some(p) = mirrorball_io::picture_of(std::path::Path::new(&a.input)) {
+        let v = serde_json::json!({"file": a.input, "projection": p.projection(), "content": p.describe()});
+        match a.json {
+            true => println!("{v:#}"),
+            false => println!(
+                "file:        {}\nprojection:  {} ({})",
+                a.input,
+                p.projection(),
+                p.describe()
+            ),
+        }
+        return Ok(());
+    }
     let input = crate::commands::input_plan(&a.input_args)?;
-    let src = load::load(
-        &a.input,
+    // One face of a set (`cube/px.hdr`) is read with its set, as `{face}` reads it.
+    let set = (input.from.is_none() && input.layout.is_none())
+        .then(|| mirrorball_io::layer_set(&a.input))
+        .flatten();
+    let mut src = load::load(
+        set.as_deref().unwrap_or(&a.input),
         input.from.as_ref(),
         input.layout,
         &mirrorball_io::Limits::default(),
     )?;
+    if let Some(set) = &set {
+        src.decided = format!("{}; one file of the set {set}", src.decided);
+    }
     let env = &src.env;
     let s = env.stats();
     let p = env.projection();

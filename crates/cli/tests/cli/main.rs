@@ -16,6 +16,7 @@ mod ranges;
 mod render;
 mod roundtrip;
 mod safety;
+mod tables;
 mod util;
 mod v360;
 mod zoneplate;

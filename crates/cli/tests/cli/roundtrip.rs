@@ -284,7 +284,9 @@ fn openexr_tagged_maps_are_read_in_openexr_conventions() {
         "cube: worst {worst:.3}, median {median:.3} texel"
     );
     // Read as OpenGL's vertical strip, it is far off.
-    let asis = ["--from", "cube", "--layout", "vstrip"];
+    // (`--in-layout`: the input's; `--layout vstrip` is the output's, and a lat-long of one
+    // layer is no strip: refused.)
+    let asis = ["--from", "cube", "--in-layout", "vstrip"];
     let (_, median, _) = latlong_direction_errors(dir.path(), &path, w, &asis);
     assert!(median > 3.0, "as OpenGL's strip: median {median:.3} texel");
 }

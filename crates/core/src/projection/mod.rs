@@ -258,210 +258,161 @@ pub trait WorldProjection {
     }
 }
 
-/// The names of the projections, as the command line spells them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ProjectionKind {
+/// The one registry of projections: each row is a kind's variant (its doc comment), its
+/// names (canonical first, then aliases), a one-line description and its projection with
+/// the documented default parameters. [`ProjectionKind`], [`ProjectionKind::ALL`], its
+/// [`Choice`] table, [`ProjectionKind::about`], [`ProjectionKind::default_projection`] and
+/// the CLI's help ([`ProjectionKind::help_list`]) all come from it; adding a projection is
+/// one row here (and its module).
+macro_rules! projections {
+    ($($(#[$doc:meta])* $kind:ident: [$($name:literal),+ $(,)?], $about:literal, $default:expr;)+) => {
+        /// The names of the projections, as the command line spells them.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum ProjectionKind {
+            $($(#[$doc])* $kind,)+
+        }
+
+        impl ProjectionKind {
+            /// Every kind, in the order the documentation lists them.
+            pub const ALL: [ProjectionKind; [$(stringify!($kind)),+].len()] =
+                [$(ProjectionKind::$kind),+];
+
+            /// One line saying what the projection is, for help texts and tables.
+            pub fn about(self) -> &'static str {
+                match self {
+                    $(ProjectionKind::$kind => $about,)+
+                }
+            }
+
+            /// The projection with its documented default parameters.
+            pub fn default_projection(self) -> Projection {
+                match self {
+                    $(ProjectionKind::$kind => $default,)+
+                }
+            }
+        }
+
+        impl Choice for ProjectionKind {
+            const NAMES: &'static [(Self, &'static [&'static str])] =
+                &[$((ProjectionKind::$kind, &[$($name),+]),)+];
+        }
+    };
+}
+
+projections! {
     /// Latitude-longitude (equirectangular).
-    LatLong,
+    LatLong: ["latlong", "lat-long", "latlon", "equirect", "equirectangular", "longlat", "spherical"],
+        "latitude-longitude (equirectangular), 2:1",
+        Projection::LatLong(LatLong);
     /// OpenGL cube map.
-    Cube,
+    Cube: ["cube", "cubemap", "cube-map"],
+        "six faces, OpenGL order and orientation",
+        Projection::Cube(CubeMap);
     /// OpenGL sphere map.
-    Sphere,
+    Sphere: ["sphere", "spheremap", "sphere-map", "matcap", "mirrorball", "mirror-ball"],
+        "OpenGL's GL_SPHERE_MAP (mirror ball), taken looking along `look`",
+        Projection::Sphere(SphereMap::default());
     /// Dual paraboloid.
-    Paraboloid,
+    Paraboloid: ["paraboloid", "dual-paraboloid", "parabolic", "dp"],
+        "dual paraboloid, front and back halves",
+        Projection::Paraboloid(DualParaboloid::default());
     /// Continuous cube map.
-    ContinuousCube,
+    ContinuousCube: ["continuous-cube", "continuouscube", "ccube"],
+        "the cube folded onto the sphere (Grimm & Niebruegge)",
+        Projection::ContinuousCube(ContinuousCube);
     /// Mercator.
-    Mercator,
+    Mercator: ["mercator"],
+        "Mercator with a latitude limit (`max-lat`)",
+        Projection::Mercator(Mercator::default());
     /// Angular map (light probe).
-    Angular,
+    Angular: ["angular", "angular-map", "lightprobe", "light-probe", "probe"],
+        "Debevec's angular light-probe map",
+        Projection::Angular(AngularMap::default());
     /// Fisheye.
-    Fisheye,
+    Fisheye: ["fisheye", "omnimax", "dome"],
+        "fisheye of any field of view and lens",
+        Projection::Fisheye(Fisheye::default());
     /// Octahedral.
-    Octahedral,
+    Octahedral: ["octahedral", "octahedron", "oct"],
+        "the octahedron unfolded into a square",
+        Projection::Octahedral(Octahedral);
     /// Equal-area octahedral.
-    EqualAreaOctahedral,
+    EqualAreaOctahedral: ["equal-area-octahedral", "eao", "clarberg", "equal-area-oct"],
+        "Clarberg's octahedral map, every texel the same solid angle",
+        Projection::EqualAreaOctahedral(EqualAreaOctahedral);
     /// Central cylindrical (`tan` latitude linear in `v`).
-    Cylindrical,
+    Cylindrical: ["cylindrical", "central-cylindrical", "cylinder"],
+        "central cylinder (`hfov`, `vfov`)",
+        Projection::Cylinder(Cylinder::central());
     /// Lambert's cylindrical equal-area.
-    CylindricalEqualArea,
+    CylindricalEqualArea: ["cylindrical-equal-area", "cylindricalea", "cea", "lambert-cylindrical"],
+        "Lambert's cylindrical equal-area",
+        Projection::Cylinder(Cylinder::equal_area());
     /// Half equirectangular (VR180): the front hemisphere.
-    HalfEquirect,
+    HalfEquirect: ["half-equirect", "hequirect", "half-equirectangular", "vr180"],
+        "the front hemisphere, 1:1 (VR180)",
+        Projection::Cylinder(Cylinder::half_equirect());
     /// Hammer's equal-area ellipse (Hammer–Aitoff).
-    Hammer,
+    Hammer: ["hammer", "hammer-aitoff"],
+        "Hammer's equal-area ellipse, 2:1",
+        Projection::Hammer(Hammer::default());
     /// Sinusoidal (Sanson–Flamsteed).
-    Sinusoidal,
+    Sinusoidal: ["sinusoidal", "sanson-flamsteed"],
+        "sinusoidal (Sanson-Flamsteed) equal-area map, 2:1",
+        Projection::Sinusoidal(Sinusoidal);
     /// Rectilinear (perspective) view.
-    Perspective,
+    Perspective: ["perspective", "rectilinear", "flat", "gnomonic"],
+        "a rectilinear view (`hfov`, `vfov`, `yaw`, `pitch`, `roll`)",
+        Projection::View(View::perspective(90.0, 90.0, 0.0, 0.0, 0.0).expect("valid"));
     /// Pannini view.
-    Pannini,
+    Pannini: ["pannini", "panini"],
+        "a Pannini view (`d`)",
+        Projection::View(View::pannini(1.0, 120.0, 90.0, 0.0, 0.0, 0.0).expect("valid"));
     /// Equi-angular cube map (YouTube's EAC, v360's `eac`).
-    Eac,
+    Eac: ["eac", "equi-angular-cube", "equiangular-cube", "equi-angular-cubemap"],
+        "equi-angular cube map (YouTube's EAC, v360's eac layout)",
+        Projection::Eac(Eac);
     /// Dual fisheye: two lenses back to back in one 2:1 picture.
-    DualFisheye,
+    DualFisheye: ["dual-fisheye", "dfisheye", "dualfisheye", "dual_fisheye"],
+        "two lenses back to back in one 2:1 picture",
+        Projection::DualFisheye(DualFisheye::default());
 }
 
 impl ProjectionKind {
-    /// Every kind, in the order the documentation lists them.
-    pub const ALL: [ProjectionKind; 19] = [
-        ProjectionKind::LatLong,
-        ProjectionKind::Cube,
-        ProjectionKind::Sphere,
-        ProjectionKind::Paraboloid,
-        ProjectionKind::ContinuousCube,
-        ProjectionKind::Mercator,
-        ProjectionKind::Angular,
-        ProjectionKind::Fisheye,
-        ProjectionKind::Octahedral,
-        ProjectionKind::EqualAreaOctahedral,
-        ProjectionKind::Cylindrical,
-        ProjectionKind::CylindricalEqualArea,
-        ProjectionKind::HalfEquirect,
-        ProjectionKind::Hammer,
-        ProjectionKind::Sinusoidal,
-        ProjectionKind::Perspective,
-        ProjectionKind::Pannini,
-        ProjectionKind::Eac,
-        ProjectionKind::DualFisheye,
-    ];
-
     /// The canonical command-line name (the canonical name of [`Choice`]).
     pub fn name(self) -> &'static str {
         Choice::name(self)
     }
 
-    /// The projection with its documented default parameters.
-    pub fn default_projection(self) -> Projection {
-        match self {
-            ProjectionKind::LatLong => Projection::LatLong(LatLong),
-            ProjectionKind::Cube => Projection::Cube(CubeMap),
-            ProjectionKind::Sphere => Projection::Sphere(SphereMap::default()),
-            ProjectionKind::Paraboloid => Projection::Paraboloid(DualParaboloid::default()),
-            ProjectionKind::ContinuousCube => Projection::ContinuousCube(ContinuousCube),
-            ProjectionKind::Mercator => Projection::Mercator(Mercator::default()),
-            ProjectionKind::Angular => Projection::Angular(AngularMap::default()),
-            ProjectionKind::Fisheye => Projection::Fisheye(Fisheye::default()),
-            ProjectionKind::Octahedral => Projection::Octahedral(Octahedral),
-            ProjectionKind::EqualAreaOctahedral => {
-                Projection::EqualAreaOctahedral(EqualAreaOctahedral)
-            }
-            ProjectionKind::Cylindrical => Projection::Cylinder(Cylinder::central()),
-            ProjectionKind::CylindricalEqualArea => Projection::Cylinder(Cylinder::equal_area()),
-            ProjectionKind::HalfEquirect => Projection::Cylinder(Cylinder::half_equirect()),
-            ProjectionKind::Hammer => Projection::Hammer(Hammer::default()),
-            ProjectionKind::Sinusoidal => Projection::Sinusoidal(Sinusoidal),
-            ProjectionKind::Perspective => {
-                Projection::View(View::perspective(90.0, 90.0, 0.0, 0.0, 0.0).expect("valid"))
-            }
-            ProjectionKind::Pannini => {
-                Projection::View(View::pannini(1.0, 120.0, 90.0, 0.0, 0.0, 0.0).expect("valid"))
-            }
-            ProjectionKind::Eac => Projection::Eac(Eac),
-            ProjectionKind::DualFisheye => Projection::DualFisheye(DualFisheye::default()),
-        }
+    /// The aliases of the kind (its names after the canonical one).
+    pub fn aliases(self) -> &'static [&'static str] {
+        Self::NAMES
+            .iter()
+            .find(|(k, _)| *k == self)
+            .map(|(_, n)| &n[1..])
+            .expect("every kind is in the table")
     }
-}
 
-impl Choice for ProjectionKind {
-    const NAMES: &'static [(Self, &'static [&'static str])] = &[
-        (
-            ProjectionKind::LatLong,
-            &[
-                "latlong",
-                "lat-long",
-                "latlon",
-                "equirect",
-                "equirectangular",
-                "longlat",
-                "spherical",
-            ],
-        ),
-        (ProjectionKind::Cube, &["cube", "cubemap", "cube-map"]),
-        (
-            ProjectionKind::Sphere,
-            &[
-                "sphere",
-                "spheremap",
-                "sphere-map",
-                "matcap",
-                "mirrorball",
-                "mirror-ball",
-            ],
-        ),
-        (
-            ProjectionKind::Paraboloid,
-            &["paraboloid", "dual-paraboloid", "parabolic", "dp"],
-        ),
-        (
-            ProjectionKind::ContinuousCube,
-            &["continuous-cube", "continuouscube", "ccube"],
-        ),
-        (ProjectionKind::Mercator, &["mercator"]),
-        (
-            ProjectionKind::Angular,
-            &[
-                "angular",
-                "angular-map",
-                "lightprobe",
-                "light-probe",
-                "probe",
-            ],
-        ),
-        (ProjectionKind::Fisheye, &["fisheye", "omnimax", "dome"]),
-        (
-            ProjectionKind::Octahedral,
-            &["octahedral", "octahedron", "oct"],
-        ),
-        (
-            ProjectionKind::EqualAreaOctahedral,
-            &["equal-area-octahedral", "eao", "clarberg", "equal-area-oct"],
-        ),
-        (
-            ProjectionKind::Cylindrical,
-            &["cylindrical", "central-cylindrical", "cylinder"],
-        ),
-        (
-            ProjectionKind::CylindricalEqualArea,
-            &[
-                "cylindrical-equal-area",
-                "cylindricalea",
-                "cea",
-                "lambert-cylindrical",
-            ],
-        ),
-        (
-            ProjectionKind::HalfEquirect,
-            &[
-                "half-equirect",
-                "hequirect",
-                "half-equirectangular",
-                "vr180",
-            ],
-        ),
-        (ProjectionKind::Hammer, &["hammer", "hammer-aitoff"]),
-        (
-            ProjectionKind::Sinusoidal,
-            &["sinusoidal", "sanson-flamsteed"],
-        ),
-        (
-            ProjectionKind::Perspective,
-            &["perspective", "rectilinear", "flat", "gnomonic"],
-        ),
-        (ProjectionKind::Pannini, &["pannini", "panini"]),
-        (
-            ProjectionKind::Eac,
-            &[
-                "eac",
-                "equi-angular-cube",
-                "equiangular-cube",
-                "equi-angular-cubemap",
-            ],
-        ),
-        (
-            ProjectionKind::DualFisheye,
-            &["dual-fisheye", "dfisheye", "dualfisheye", "dual_fisheye"],
-        ),
-    ];
+    /// Every kind, one a line: `  name  description (also: aliases)`, for a command
+    /// line's help.
+    pub fn help_list() -> String {
+        let width = Self::ALL.iter().map(|k| k.name().len()).max().unwrap_or(0);
+        let mut out = String::new();
+        for k in Self::ALL {
+            let also = k
+                .aliases()
+                .iter()
+                .filter(|a| !a.contains('_'))
+                .copied()
+                .collect::<Vec<_>>();
+            out.push_str(&format!("  {:width$}  {}", k.name(), k.about()));
+            if !also.is_empty() {
+                out.push_str(&format!(" (also: {})", also.join(", ")));
+            }
+            out.push('\n');
+        }
+        out
+    }
 }
 
 impl fmt::Display for ProjectionKind {

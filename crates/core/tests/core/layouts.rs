@@ -151,3 +151,92 @@ fn unpacking_an_owned_picture_gives_what_unpacking_a_borrowed_one_gives() {
         assert_eq!(&owned, env);
     }
 }
+
+/// Every layout the `Choice` table names, v360's cells and `eac` included.
+fn every_layout() -> Vec<Layout> {
+    <Layout as mirrorball_core::Choice>::all().collect()
+}
+
+/// Every projection × layout pair of the tables: a layout that holds the projection packs
+/// a map and unpacks it unchanged; one that does not is refused with a message naming
+/// exactly the projections it holds, and `eac` holds EAC alone.
+#[test]
+fn every_projection_and_layout_pair_round_trips_or_is_refused_naming_the_one_that_fits() {
+    let (mut held, mut refused) = (0, 0);
+    for kind in ProjectionKind::ALL {
+        let e = env(kind, 8);
+        let layers = e.layers().len();
+        for layout in every_layout() {
+            match layout.refusal(kind, "--to") {
+                None => {
+                    assert!(layout.holds(kind), "{kind} {layout}");
+                    held += 1;
+                    if layout == Layout::Separate && layers > 1 {
+                        // One file a layer: nothing is packed.
+                        continue;
+                    }
+                    let img = layout
+                        .pack(&e)
+                        .unwrap_or_else(|| panic!("{kind} {layout}: not packed"));
+                    let back = layout.unpack(&img, *e.projection()).unwrap();
+                    assert_eq!(back, e, "{kind} {layout}");
+                }
+                Some(why) => {
+                    assert!(!layout.holds(kind), "{kind} {layout}");
+                    refused += 1;
+                    assert!(why.starts_with(layout.name()), "{why}");
+                    assert!(why.contains(&format!("a {kind} map")), "{why}");
+                    for other in ProjectionKind::ALL {
+                        let named = why.contains(&format!("--to {other} "))
+                            || why.contains(&format!("--to {other})"))
+                            || why.contains(&format!("--to {other},"));
+                        assert_eq!(named, layout.holds(other), "{other} in: {why}");
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(
+        Layout::eac().refusal(ProjectionKind::Cube, "--to").unwrap(),
+        "eac holds v360's padded equi-angular faces, not a cube map: use --to eac (or another layout)"
+    );
+    let all: Vec<ProjectionKind> = ProjectionKind::ALL
+        .into_iter()
+        .filter(|&k| Layout::eac().holds(k))
+        .collect();
+    assert_eq!(all, [ProjectionKind::Eac]);
+    // Six-layer kinds take all but eac (EAC all), the paraboloid separate and the strips,
+    // the rest separate only.
+    assert_eq!(
+        held + refused,
+        ProjectionKind::ALL.len() * every_layout().len()
+    );
+    assert!(refused >= 15 * 8, "{refused}");
+}
+
+/// A picture of v360's padded `eac` shape is an EAC frame, not a cube laid out so; a
+/// declared cube is never read from it.
+#[test]
+fn a_padded_eac_frame_is_guessed_as_eac() {
+    for n in [8, 64, 512] {
+        let (w, h) = Layout::eac().extent(6, n, n);
+        let g = guess(w, h, None).unwrap();
+        assert_eq!(
+            (g.kind, g.layout),
+            (ProjectionKind::Eac, Layout::eac()),
+            "{w}x{h}"
+        );
+        assert!(g.reason.contains("eac"), "{}", g.reason);
+        assert_ne!(
+            Layout::from_extent_of(w, h, ProjectionKind::Cube).map(|l| l.0),
+            Some(Layout::eac())
+        );
+        assert_eq!(
+            Layout::from_extent_of(w, h, ProjectionKind::Eac),
+            Some((Layout::eac(), n, n))
+        );
+    }
+    // An unpadded 3x2 stays a cube.
+    let g = guess(300, 200, None).unwrap();
+    assert_eq!(g.kind, ProjectionKind::Cube);
+}

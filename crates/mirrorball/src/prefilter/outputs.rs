@@ -222,6 +222,7 @@ pub fn write_preview(plan: &Plan, p: &Path, chain: &[EnvMap]) -> Result<(), Erro
         &sheet,
         &WriteOptions {
             precision: Some(Precision::U8),
+            note: Some(mirrorball_io::Picture::PreviewSheet),
             ..Default::default()
         },
     )?;
@@ -241,6 +242,7 @@ pub fn write_lut(plan: &Plan, p: &Path) -> Result<(), Error> {
         &lut.to_image(),
         &WriteOptions {
             precision: Some(precision),
+            note: Some(mirrorball_io::Picture::BrdfTable),
             ..Default::default()
         },
     )?;

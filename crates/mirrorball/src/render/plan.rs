@@ -250,7 +250,7 @@ fn flag_output(a: &RenderRequest) -> Result<(PathBuf, Format), Error> {
             ),
         )
     })?;
-    if matches!(format, Format::Ktx2 | Format::Dds | Format::Webp) {
+    if format.is_cube_container() || !format.is_written() {
         return Err(bad(
             "--output",
             format!("'{}': render writes .png, .jpg, .exr or .hdr", a.output),
