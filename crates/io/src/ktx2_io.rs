@@ -326,10 +326,37 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
     }
     check_encodable(path, levels, encoding)?;
     let level_count = levels.len();
-    let (vk_format, type_size) = vk_format(encoding);
     let supercompressed = how.zstd.is_some();
 
     let dfd = data_format_descriptor(encoding);
+    let kvd = written_key_value_data(how);
+    let dfd_offset = HEADER_LEN + LEVEL_INDEX_LEN * level_count;
+    let kvd_offset = dfd_offset + dfd.len();
+    let data_start = (kvd_offset + kvd.len()) as u64;
+
+    // Supercompressed levels are made before the index, which holds their lengths.
+    let compressed = compress_levels(path, levels, how)?;
+    let index = level_index(
+        encoding,
+        size,
+        level_count,
+        supercompressed,
+        &compressed,
+        data_start,
+    );
+    let head = ktx2_head(encoding, size, supercompressed, &index, &dfd, &kvd);
+    debug_assert_eq!(head.len() as u64, data_start);
+
+    atomic_write(path, |w| {
+        write_level_data(path, w, levels, how, &head, &index, &compressed)
+    })
+}
+
+/// The key/value data [`write_ktx2`] writes: `KTXorientation` = `rd`, `KTXwriter`, the
+/// declared projection under [`crate::PROJECTION_KEY`], the encoding under
+/// [`ENCODING_KEY`] for RGBD and RGBM, and `how.metadata`, sorted by key.
+fn written_key_value_data(how: &CubeWrite) -> Vec<u8> {
+    let encoding = how.encoding;
     let writer = format!("mirrorball {}", env!("CARGO_PKG_VERSION"));
     // Sorted by key, as the specification requires (code-point order: "KTX…" before
     // "mirrorball:…").
@@ -349,12 +376,18 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
         .iter()
         .map(|(k, v)| (k.as_str(), v.as_str()))
         .collect();
-    let kvd = key_value_data(&pairs);
-    let dfd_offset = HEADER_LEN + LEVEL_INDEX_LEN * level_count;
-    let kvd_offset = dfd_offset + dfd.len();
-    let data_start = (kvd_offset + kvd.len()) as u64;
+    key_value_data(&pairs)
+}
 
-    // Supercompressed levels are made before the index, which holds their lengths.
+/// Each level's six faces encoded and Zstandard-compressed at `how.zstd` (levels in
+/// parallel, the work counted in [`mirrorball_core::work`]), level 0 first; empty when
+/// `how.zstd` is `None`.
+fn compress_levels(
+    path: &Path,
+    levels: &[Vec<Image>],
+    how: &CubeWrite,
+) -> Result<Vec<Vec<u8>>, Error> {
+    let encoding = how.encoding;
     let encode_level = |p: usize| -> Vec<u8> {
         let mut level = Vec::new();
         let mut buf = Vec::new();
@@ -364,9 +397,9 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
         }
         level
     };
-    let compressed: Vec<Vec<u8>> = match how.zstd {
+    Ok(match how.zstd {
         None => Vec::new(),
-        Some(z) => (0..level_count)
+        Some(z) => (0..levels.len())
             .into_par_iter()
             .map(|p| {
                 let level = encode_level(p);
@@ -376,11 +409,21 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
             })
             .collect::<Result<_, _>>()
             .map_err(|e| Error::io(path, e))?,
-    };
+    })
+}
 
-    // The Mip Level Array holds the smallest level first; each level starts on a multiple of
-    // lcm(texel block size, 4) (mipPadding), or of 1 when supercompressed. The Level Index
-    // lists level 0 first.
+/// The Level Index: each level's (byteOffset, byteLength, uncompressedByteLength), level 0
+/// first. The Mip Level Array starting at `data_start` holds the smallest level first; each
+/// level starts on a multiple of lcm(texel block size, 4) (mipPadding), or of 1 when
+/// supercompressed (when `compressed` holds the levels' bytes).
+fn level_index(
+    encoding: Encoding,
+    size: u32,
+    level_count: usize,
+    supercompressed: bool,
+    compressed: &[Vec<u8>],
+    data_start: u64,
+) -> Vec<(u64, u64, u64)> {
     let block = encoding.block_bytes();
     let align = if supercompressed {
         1
@@ -397,7 +440,24 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
         index[p] = (offset, len, raw);
         cursor = offset + len;
     }
+    index
+}
 
+/// Everything before the Mip Level Array: identifier, header, Level Index, Data Format
+/// Descriptor (`dfd`) and key/value data (`kvd`).
+fn ktx2_head(
+    encoding: Encoding,
+    size: u32,
+    supercompressed: bool,
+    index: &[(u64, u64, u64)],
+    dfd: &[u8],
+    kvd: &[u8],
+) -> Vec<u8> {
+    let level_count = index.len();
+    let (vk_format, type_size) = vk_format(encoding);
+    let dfd_offset = HEADER_LEN + LEVEL_INDEX_LEN * level_count;
+    let kvd_offset = dfd_offset + dfd.len();
+    let data_start = (kvd_offset + kvd.len()) as u64;
     let mut head = Vec::with_capacity(data_start as usize);
     head.extend_from_slice(&IDENTIFIER);
     for v in [
@@ -423,39 +483,51 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
     }
     head.extend_from_slice(&0u64.to_le_bytes()); // sgdByteOffset: Zstandard has none
     head.extend_from_slice(&0u64.to_le_bytes()); // sgdByteLength
-    for &(offset, len, raw) in &index {
+    for &(offset, len, raw) in index {
         head.extend_from_slice(&offset.to_le_bytes());
         head.extend_from_slice(&len.to_le_bytes()); // byteLength
         head.extend_from_slice(&raw.to_le_bytes()); // uncompressedByteLength
     }
     debug_assert_eq!(head.len(), dfd_offset);
-    head.extend_from_slice(&dfd);
-    head.extend_from_slice(&kvd);
-    debug_assert_eq!(head.len() as u64, data_start);
+    head.extend_from_slice(dfd);
+    head.extend_from_slice(kvd);
+    head
+}
 
-    atomic_write(path, |w| {
-        let io = |e| Error::io(path, e);
-        w.write_all(&head).map_err(io)?;
-        let mut written = data_start;
-        let mut buf = Vec::new();
-        for p in (0..level_count).rev() {
-            let (offset, len, _) = index[p];
-            let padding = (offset - written) as usize;
-            w.write_all(&[0u8; 16][..padding]).map_err(io)?;
-            written = offset;
-            if let Some(level) = compressed.get(p) {
-                w.write_all(level).map_err(io)?;
-                written += len;
-                continue;
-            }
-            for face in &levels[p] {
-                encoding.encode_with(face, how.effort, &mut buf);
-                w.write_all(&buf).map_err(io)?;
-                written += buf.len() as u64;
-            }
+/// Writes `head`, then the levels smallest first, each after the zero padding that brings
+/// it to its offset in `index`: the compressed bytes when `compressed` holds them, else the
+/// faces encoded one at a time.
+fn write_level_data(
+    path: &Path,
+    w: &mut impl Write,
+    levels: &[Vec<Image>],
+    how: &CubeWrite,
+    head: &[u8],
+    index: &[(u64, u64, u64)],
+    compressed: &[Vec<u8>],
+) -> Result<(), Error> {
+    let io = |e| Error::io(path, e);
+    w.write_all(head).map_err(io)?;
+    // `head` ends where the Mip Level Array starts.
+    let mut written = head.len() as u64;
+    let mut buf = Vec::new();
+    for p in (0..levels.len()).rev() {
+        let (offset, len, _) = index[p];
+        let padding = (offset - written) as usize;
+        w.write_all(&[0u8; 16][..padding]).map_err(io)?;
+        written = offset;
+        if let Some(level) = compressed.get(p) {
+            w.write_all(level).map_err(io)?;
+            written += len;
+            continue;
         }
-        Ok(())
-    })
+        for face in &levels[p] {
+            how.encoding.encode_with(face, how.effort, &mut buf);
+            w.write_all(&buf).map_err(io)?;
+            written += buf.len() as u64;
+        }
+    }
+    Ok(())
 }
 
 /// One sample of a Data Format Descriptor: bit offset, bit length, channel type with its
