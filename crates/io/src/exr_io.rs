@@ -57,7 +57,24 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     )
     .map_err(|e| read_error(path, e))?;
     let headers = chunks.headers();
+    check_headers(path, headers, limits)?;
 
+    let layer_count = headers.len();
+
+    // The common case (a layer of exactly R, G, B and maybe A, half or float) straight from
+    // the decompressed blocks; anything else through the crate's generic image reader.
+    let index = headers.iter().position(is_rgb_layer).unwrap_or(0);
+    if let Some(layout) = block_layout(&headers[index]) {
+        let header = headers[index].clone();
+        return read_laid_out(path, &file, chunks, &header_end, index, header, &layout);
+    }
+    read_generic(path, chunks, layer_count)
+}
+
+/// Checks the headers before any texel is read: there is an RGB layer; every RGB layer is
+/// within the `limits` and fits the file; the first one's compression is one the crate
+/// decodes; and DWAA/DWAB blocks, if any layer has them, are safe to decode.
+fn check_headers(path: &Path, headers: &[Header], limits: &Limits) -> Result<(), Error> {
     let Some(header) = headers.iter().find(|h| is_rgb_layer(h)) else {
         return Err(Error::input(path, no_rgb_layer_problem(headers)));
     };
@@ -81,52 +98,68 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     {
         check_dwa_blocks(path)?;
     }
+    Ok(())
+}
 
-    let layer_count = headers.len();
-
-    // The common case (a layer of exactly R, G, B and maybe A, half or float) straight from
-    // the decompressed blocks; anything else through the crate's generic image reader.
-    let index = headers.iter().position(is_rgb_layer).unwrap_or(0);
-    if let Some(layout) = block_layout(&headers[index]) {
-        let header = headers[index].clone();
-        // A multi-part file (even one of a single part) puts a part number before each
-        // block: that the crate's reader handles.
-        let single_part = !chunks.meta_data().requirements.has_multiple_layers;
-        let (image, invalid) = if single_part && layer_count == 1 && is_zip_scanlines(&header) {
-            drop(chunks);
-            read_zip_file(&file, header_end.load(Ordering::Relaxed), &header, &layout)
-                .map(|(image, invalid)| (image, Some(invalid)))
-        } else {
-            read_blocks(chunks, index, &header, &layout).map(|image| (image, None))
-        }
-        .map_err(|e| read_error(path, e))?;
-        let declared = envmap_kind(header.own_attributes.environment_map);
-        let recorded = recorded_info(&header.own_attributes, image.width(), image.height());
-        let types: Vec<SampleType> = header.channels.list.iter().map(|c| c.sample_type).collect();
-        let layer_name = header
-            .own_attributes
-            .layer_name
-            .as_ref()
-            .map(|n| n.to_string());
-        let tiled = matches!(header.blocks, exr::meta::BlockDescription::Tiles(_));
-        let description = describe(
-            &types,
-            header.compression,
-            image.channels(),
-            tiled,
-            layer_count,
-            layer_name,
-        );
-        return Ok(Loaded {
-            layers: vec![image],
-            declared,
-            recorded,
-            format: Format::Exr,
-            description,
-            invalid,
-        });
+/// Reads layer `index` (`header`, whose channels `layout` places) straight from its
+/// decompressed blocks: a lone single-part ZIP scan-line layer through [`read_zip_file`]
+/// (which also counts the invalid samples), anything else through [`read_blocks`].
+fn read_laid_out(
+    path: &Path,
+    file: &File,
+    chunks: exr::block::reader::Reader<Counted<BufReader<&File>>>,
+    header_end: &AtomicU64,
+    index: usize,
+    header: Header,
+    layout: &[(usize, SampleType)],
+) -> Result<Loaded, Error> {
+    let layer_count = chunks.headers().len();
+    // A multi-part file (even one of a single part) puts a part number before each
+    // block: that the crate's reader handles.
+    let single_part = !chunks.meta_data().requirements.has_multiple_layers;
+    let (image, invalid) = if single_part && layer_count == 1 && is_zip_scanlines(&header) {
+        drop(chunks);
+        read_zip_file(file, header_end.load(Ordering::Relaxed), &header, layout)
+            .map(|(image, invalid)| (image, Some(invalid)))
+    } else {
+        read_blocks(chunks, index, &header, layout).map(|image| (image, None))
     }
+    .map_err(|e| read_error(path, e))?;
+    let declared = envmap_kind(header.own_attributes.environment_map);
+    let recorded = recorded_info(&header.own_attributes, image.width(), image.height());
+    let types: Vec<SampleType> = header.channels.list.iter().map(|c| c.sample_type).collect();
+    let layer_name = header
+        .own_attributes
+        .layer_name
+        .as_ref()
+        .map(|n| n.to_string());
+    let tiled = matches!(header.blocks, exr::meta::BlockDescription::Tiles(_));
+    let description = describe(
+        &types,
+        header.compression,
+        image.channels(),
+        tiled,
+        layer_count,
+        layer_name,
+    );
+    Ok(Loaded {
+        layers: vec![image],
+        declared,
+        recorded,
+        format: Format::Exr,
+        description,
+        invalid,
+    })
+}
 
+/// Reads the first valid RGB(A) layer through the crate's generic image reader (at its
+/// largest resolution level, on this thread) and describes it; `layer_count` is the
+/// number of layers in the file.
+fn read_generic(
+    path: &Path,
+    chunks: exr::block::reader::Reader<Counted<BufReader<&File>>>,
+    layer_count: usize,
+) -> Result<Loaded, Error> {
     // On this thread: the crate's parallel decoding runs blocks on a pool of its own, where
     // a decoder's panic aborts the process instead of reaching `guard_decoder`.
     let exr_image = exr::prelude::read()
