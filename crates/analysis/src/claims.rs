@@ -276,6 +276,15 @@ fn zimmons_cube_map(k: &Known, out: &mut Vec<Claim>) {
     let Known { cube, ps, pc, .. } = k;
     let sh = walk(ps, "horizontal");
     let (ch, cd) = (walk(pc, "horizontal"), walk(pc, "diagonal"));
+    zimmons_cube_axis(ch, out);
+    zimmons_cube_diagonal(cd, out);
+    zimmons_cube_equal_space(cube, out);
+    zimmons_cube_distortion(cube, ps, sh, ch, cd, out);
+}
+
+/// Zimmons' figures 29 and 30: the cube's per-pixel angles along an axis (`ch`, the
+/// 512² cube's horizontal walk) and his formula for them.
+fn zimmons_cube_axis(ch: &Walk, out: &mut Vec<Claim>) {
     out.push(num(
         &format!("{Z}, fig. 29"),
         "cube 512²: angle of the centre pixel along an axis",
@@ -322,6 +331,11 @@ fn zimmons_cube_map(k: &Known, out: &mut Vec<Claim>) {
         "A face spans n/2 pixels either side of its centre at unit distance, so the tangent is \
          y/(n/2); the printed n describes a face twice as wide.",
     ));
+}
+
+/// Zimmons' figure 31: the cube's per-pixel angles along the diagonal (`cd`, the 512²
+/// cube's diagonal walk).
+fn zimmons_cube_diagonal(cd: &Walk, out: &mut Vec<Claim>) {
     out.push(num(
         &format!("{Z}, fig. 31"),
         "cube 512²: angle of the centre pixel along the diagonal",
@@ -351,6 +365,11 @@ fn zimmons_cube_map(k: &Known, out: &mut Vec<Claim>) {
         "His own two angles give 0.316514/0.105781 = 2.99216; the printed ratio is an \
          arithmetic slip. The limit is 3 (atan′(0)/atan′(√2) = 1 + 2).",
     ));
+}
+
+/// Zimmons' equal-space comparison: the face size of a cube with a 512² sphere map's
+/// texels (all, or the useful ones) and its diagonal ratios.
+fn zimmons_cube_equal_space(cube: &Projection, out: &mut Vec<Claim>) {
     let budget_face = (512.0f64 * 512.0 / 6.0).sqrt();
     out.push(num(
         &format!("{Z}, equal-space comparison"),
@@ -395,6 +414,19 @@ fn zimmons_cube_map(k: &Known, out: &mut Vec<Claim>) {
             walk(&d370, "diagonal").ratio
         ),
     ));
+}
+
+/// The cube's two-dimensional distortion, its front/back share and Zimmons' comparison of
+/// its distortion with the sphere map's (`ps`, `sh`: the sphere map's profile and its
+/// horizontal walk; `ch`, `cd`: the cube's axis and diagonal walks).
+fn zimmons_cube_distortion(
+    cube: &Projection,
+    ps: &Profile,
+    sh: &Walk,
+    ch: &Walk,
+    cd: &Walk,
+    out: &mut Vec<Claim>,
+) {
     let dens_ratio = cube.density(0, DVec2::splat(0.5)) / cube.density(0, DVec2::ZERO);
     // The cube's largest texel is at the face centre, its smallest in a corner (the tests
     // check this against a full scan).

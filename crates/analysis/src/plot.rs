@@ -208,16 +208,29 @@ impl LineChart {
         let (ml, mr, mb) = (62.0, 14.0, 42.0);
         let (px, py, pw, ph) = (x + ml, y + mt, w - ml - mr, h - mt - mb);
         let (xr, yr) = self.ranges();
-        let fy = |v: f64| -> f64 {
-            let t = if self.log_y {
-                (v.log10() - yr[0].log10()) / (yr[1].log10() - yr[0].log10())
-            } else {
-                (v - yr[0]) / (yr[1] - yr[0])
-            };
-            py + ph * (1.0 - t)
+        let area = PlotArea {
+            px,
+            py,
+            pw,
+            ph,
+            xr,
+            yr,
+            log_y: self.log_y,
         };
-        let fx = |v: f64| px + pw * (v - xr[0]) / (xr[1] - xr[0]);
-        s += &text(
+        self.draw_titles(&mut s, x, y, w);
+        self.draw_grid(&mut s, &area);
+        self.draw_axis_labels(&mut s, &area, x, y, h);
+        // The clip path's id, from the rectangle: unique per chart of a figure.
+        let clip = format!("clip{}", (x * 7919.0 + y * 104729.0 + w * 13.0 + h) as u64);
+        self.draw_lines(&mut s, &area, &clip);
+        self.draw_legend(&mut s, &area);
+        s
+    }
+
+    /// The title, centred at the top of the rectangle `(x, y, w, …)`, and the subtitle
+    /// under it when there is one.
+    fn draw_titles(&self, s: &mut String, x: f64, y: f64, w: f64) {
+        *s += &text(
             x + w / 2.0,
             y + 16.0,
             &self.title,
@@ -226,7 +239,7 @@ impl LineChart {
             "font-weight=\"bold\"",
         );
         if !self.subtitle.is_empty() {
-            s += &text(
+            *s += &text(
                 x + w / 2.0,
                 y + 31.0,
                 &self.subtitle,
@@ -235,6 +248,13 @@ impl LineChart {
                 "fill=\"#444\"",
             );
         }
+    }
+
+    /// The grid lines and tick labels of both axes, then the plot rectangle's frame.
+    fn draw_grid(&self, s: &mut String, area: &PlotArea) {
+        let (xr, yr) = (area.xr, area.yr);
+        let (px, py, pw, ph) = (area.px, area.py, area.pw, area.ph);
+        let (fx, fy) = (|v| area.fx(v), |v| area.fy(v));
         // Grid and ticks.
         let xt = nice_ticks(xr[0], xr[1], ((pw / 70.0) as usize).max(2));
         for t in &xt {
@@ -244,7 +264,7 @@ impl LineChart {
                 "<line x1=\"{tx:.1}\" y1=\"{py:.1}\" x2=\"{tx:.1}\" y2=\"{:.1}\" stroke=\"#e3e3e3\"/>",
                 py + ph
             );
-            s += &text(tx, py + ph + 14.0, &fmt_tick(*t), 11.0, "middle", "");
+            *s += &text(tx, py + ph + 14.0, &fmt_tick(*t), 11.0, "middle", "");
         }
         let yt: Vec<f64> = if self.log_y {
             let (a, b) = (yr[0].log10().floor() as i32, yr[1].log10().ceil() as i32);
@@ -264,13 +284,19 @@ impl LineChart {
                 "<line x1=\"{px:.1}\" y1=\"{ty:.1}\" x2=\"{:.1}\" y2=\"{ty:.1}\" stroke=\"#e3e3e3\"/>",
                 px + pw
             );
-            s += &text(px - 5.0, ty + 4.0, &fmt_tick(*t), 11.0, "end", "");
+            *s += &text(px - 5.0, ty + 4.0, &fmt_tick(*t), 11.0, "end", "");
         }
         let _ = writeln!(
                 s,
                 "<rect x=\"{px:.1}\" y=\"{py:.1}\" width=\"{pw:.1}\" height=\"{ph:.1}\" fill=\"none\" stroke=\"#444\"/>"
         );
-        s += &text(
+    }
+
+    /// The x label under the plot and the y label, rotated, left of it (the chart's
+    /// rectangle is `(x, y, …, h)`).
+    fn draw_axis_labels(&self, s: &mut String, area: &PlotArea, x: f64, y: f64, h: f64) {
+        let (px, py, pw, ph) = (area.px, area.py, area.pw, area.ph);
+        *s += &text(
             px + pw / 2.0,
             y + h - 8.0,
             &self.x_label,
@@ -279,7 +305,7 @@ impl LineChart {
             "",
         );
         let (lx, ly) = (x + 14.0, py + ph / 2.0);
-        s += &text(
+        *s += &text(
             lx,
             ly,
             &self.y_label,
@@ -287,8 +313,14 @@ impl LineChart {
             "middle",
             &format!("transform=\"rotate(-90 {lx:.1} {ly:.1})\""),
         );
+    }
+
+    /// The series as paths (a dot for a single point), clipped to the plot rectangle by the
+    /// clip path `clip`, then the markers with their labels.
+    fn draw_lines(&self, s: &mut String, area: &PlotArea, clip: &str) {
+        let (px, py, pw, ph) = (area.px, area.py, area.pw, area.ph);
+        let (fx, fy) = (|v| area.fx(v), |v| area.fy(v));
         // Lines, clipped to the plot rectangle.
-        let clip = format!("clip{}", (x * 7919.0 + y * 104729.0 + w * 13.0 + h) as u64);
         let _ = writeln!(
                 s,
                 "<clipPath id=\"{clip}\"><rect x=\"{px:.1}\" y=\"{py:.1}\" width=\"{pw:.1}\" height=\"{ph:.1}\"/></clipPath>\n<g clip-path=\"url(#{clip})\">"
@@ -332,14 +364,20 @@ impl LineChart {
                 );
             }
         }
-        s += "</g>\n";
+        *s += "</g>\n";
         for m in &self.markers {
             let (tx, ty) = (fx(m.at[0]), fy(m.at[1]));
             let _ = writeln!(s, "<circle cx=\"{tx:.1}\" cy=\"{ty:.1}\" r=\"3.5\" fill=\"none\" stroke=\"#000\" stroke-width=\"1.2\"/>");
             let anchor = if tx > px + pw * 0.6 { "end" } else { "start" };
             let dx = if anchor == "end" { -6.0 } else { 6.0 };
-            s += &text(tx + dx, ty - 6.0, &m.label, 11.0, anchor, "");
+            *s += &text(tx + dx, ty - 6.0, &m.label, 11.0, anchor, "");
         }
+    }
+
+    /// The legend, when it is wanted and a series has a name: a box in the corner
+    /// [`LineChart::legend`] names, a line and the name of each series.
+    fn draw_legend(&self, s: &mut String, area: &PlotArea) {
+        let (px, py, pw, ph) = (area.px, area.py, area.pw, area.ph);
         // Legend.
         let show = self.legend != Legend::None && self.series.iter().any(|s| !s.name.is_empty());
         if show {
@@ -382,15 +420,47 @@ impl LineChart {
                     yy - 4.0,
                     se.color
                 );
-                s += &text(lx + 30.0, yy, &se.name, 11.0, "start", "");
+                *s += &text(lx + 30.0, yy, &se.name, 11.0, "start", "");
             }
         }
-        s
     }
 
     /// The chart as a standalone SVG of `w×h` px.
     pub fn svg(&self, w: f64, h: f64) -> String {
         document(w, h, &self.draw(0.0, 0.0, w, h))
+    }
+}
+
+/// Where a [`LineChart`] plots: the rectangle `(px, py, pw, ph)` inside its margins and the
+/// ranges `xr`, `yr` it spans (`yr` logarithmically when `log_y`).
+struct PlotArea {
+    px: f64,
+    py: f64,
+    pw: f64,
+    ph: f64,
+    xr: [f64; 2],
+    yr: [f64; 2],
+    log_y: bool,
+}
+
+impl PlotArea {
+    /// The x coordinate of the value `v`.
+    #[inline]
+    fn fx(&self, v: f64) -> f64 {
+        let (px, pw, xr) = (self.px, self.pw, self.xr);
+        px + pw * (v - xr[0]) / (xr[1] - xr[0])
+    }
+
+    /// The y coordinate of the value `v` (upwards; logarithmic when `log_y`).
+    #[inline]
+    fn fy(&self, v: f64) -> f64 {
+        let (py, ph, yr) = (self.py, self.ph, self.yr);
+        let t = if self.log_y {
+            (v.log10() - yr[0].log10()) / (yr[1].log10() - yr[0].log10())
+        } else {
+            (v - yr[0]) / (yr[1] - yr[0])
+        };
+        py + ph * (1.0 - t)
     }
 }
 

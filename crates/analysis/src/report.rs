@@ -1100,6 +1100,29 @@ fn sci(x: f64) -> String {
 /// The report as one HTML page with the figures inline.
 pub fn html(a: &Analysis) -> String {
     let r = &a.report;
+    let mut s = html_head(r);
+    html_texels(&mut s, r);
+    html_figure(&mut s, a, "analysis-solid-angle-heatmaps");
+    html_figure(&mut s, a, "analysis-anisotropy-heatmaps");
+    html_zimmons(&mut s, r);
+    html_figure(&mut s, a, "analysis-zimmons-1d");
+    html_cone(&mut s, r);
+    html_figure(&mut s, a, "analysis-reflection-cone");
+    html_frustum(&mut s, r);
+    html_indexing_line(&mut s, r);
+    html_figure(&mut s, a, "analysis-indexing-line");
+    html_indexing_worst(&mut s, r);
+    html_figure(&mut s, a, "analysis-indexing-meshes");
+    html_singularities(&mut s, r);
+    html_figure(&mut s, a, "analysis-rims");
+    html_claims(&mut s, r);
+    s += "</table>\n</html>\n";
+    s
+}
+
+/// The page's head, style sheet and title, and the paragraph on the generator, the sizing
+/// and the time taken.
+fn html_head(r: &Report) -> String {
     let mut s = String::from(
         "<!doctype html>\n<html lang=\"en\"><meta charset=\"utf-8\"><title>mirrorball analyze</title>\n<style>\
          body{font:14px/1.45 system-ui,sans-serif;margin:2em auto;max-width:1320px;color:#222}\
@@ -1123,7 +1146,27 @@ pub fn html(a: &Analysis) -> String {
         esc(&r.generator),
         r.seconds
     );
-    s += "<h2>Texels</h2>\n<table><tr><th>projection</th><th>layers × w × h</th><th>texels</th><th>used (exact area)</th>\
+    s
+}
+
+/// The figure `id` of `a` (its SVG, title and caption), if `a` has it.
+fn html_figure(s: &mut String, a: &Analysis, id: &str) {
+    if let Some(f) = a.figures.iter().find(|f| f.id == id) {
+        let _ = writeln!(
+            s,
+            "<figure id=\"{}\">{}<figcaption><b>{}.</b> {}</figcaption></figure>",
+            f.id,
+            f.svg.trim_start_matches(|c| c != '<'),
+            esc(&f.title),
+            esc(&f.caption)
+        );
+    }
+}
+
+/// The texel table: sizes, used area, full and rim texels, solid angle per texel and its
+/// ratios, anisotropy, front/back shares and the crossover radius of each projection.
+fn html_texels(s: &mut String, r: &Report) {
+    *s += "<h2>Texels</h2>\n<table><tr><th>projection</th><th>layers × w × h</th><th>texels</th><th>used (exact area)</th>\
           <th>full / partial texels</th><th>solid angle per texel, full: min … max (sr)</th><th>max/min full</th><th>max/min with rim texels</th>\
           <th>anisotropy max</th><th>mean (per texel)</th><th>mean (over the sphere)</th><th>front / back / unused texels</th><th>crossover radius (uv)</th></tr>\n";
     for e in &r.projections {
@@ -1164,24 +1207,14 @@ pub fn html(a: &Analysis) -> String {
             cross
         );
     }
-    s += "</table>\n<p>Full texels lie wholly inside the covered domain; rim texels count only their covered part, so their ratio \
+    *s += "</table>\n<p>Full texels lie wholly inside the covered domain; rim texels count only their covered part, so their ratio \
           is unbounded. Front is the hemisphere the default camera looks at (−Z), judged at the texel centre. The crossover \
           is where front meets back, when that is a circle about a layer's centre.</p>\n";
-    let fig = |s: &mut String, id: &str| {
-        if let Some(f) = a.figures.iter().find(|f| f.id == id) {
-            let _ = writeln!(
-                s,
-                "<figure id=\"{}\">{}<figcaption><b>{}.</b> {}</figcaption></figure>",
-                f.id,
-                f.svg.trim_start_matches(|c| c != '<'),
-                esc(&f.title),
-                esc(&f.caption)
-            );
-        }
-    };
-    fig(&mut s, "analysis-solid-angle-heatmaps");
-    fig(&mut s, "analysis-anisotropy-heatmaps");
-    s += "<h2>Zimmons' one-dimensional measure</h2>\n<table><tr><th>projection</th><th>walk</th><th>pixels</th><th>first (°)</th><th>last full (°)</th><th>min</th><th>max</th><th>max/min</th></tr>\n";
+}
+
+/// The table of Zimmons' one-dimensional measure: each projection's walks.
+fn html_zimmons(s: &mut String, r: &Report) {
+    *s += "<h2>Zimmons' one-dimensional measure</h2>\n<table><tr><th>projection</th><th>walk</th><th>pixels</th><th>first (°)</th><th>last full (°)</th><th>min</th><th>max</th><th>max/min</th></tr>\n";
     for e in &r.projections {
         for w in &e.profile.walks {
             let _ = writeln!(
@@ -1199,9 +1232,12 @@ pub fn html(a: &Analysis) -> String {
             );
         }
     }
-    s += "</table>\n";
-    fig(&mut s, "analysis-zimmons-1d");
-    s += "<h2>Greene: a reflection cone and a camera frustum</h2>\n";
+    *s += "</table>\n";
+}
+
+/// Greene's reflection cone: its paragraph and the table of each projection's drawing of it.
+fn html_cone(s: &mut String, r: &Report) {
+    *s += "<h2>Greene: a reflection cone and a camera frustum</h2>\n";
     let _ = writeln!(
         s,
         "<p>Reflection cone: {:.4} sr ({}), corners {:.2}° from the axis ({:.3}, {:.3}, {:.3}).</p>\n<table><tr><th>projection</th><th>drawn at</th><th>pieces</th><th>layers</th><th>texels inside</th><th>their solid angle / exact</th><th>edge bend (texels)</th><th>all edges mapped</th></tr>",
@@ -1227,8 +1263,12 @@ pub fn html(a: &Analysis) -> String {
             if c.fully_covered { "yes" } else { "no" }
         );
     }
-    s += "</table>\n";
-    fig(&mut s, "analysis-reflection-cone");
+    *s += "</table>\n";
+}
+
+/// Greene's camera frustum: its paragraph and the brute-force table, then the heading of
+/// the per-vertex indexing section.
+fn html_frustum(s: &mut String, r: &Report) {
     let f = &r.frustum;
     let _ = writeln!(
         s,
@@ -1249,7 +1289,11 @@ pub fn html(a: &Analysis) -> String {
             b.projection, b.size, b.texels, b.solid_angle, b.relative_error
         );
     }
-    s += "</table>\n<h2>Per-vertex indexing</h2>\n";
+    *s += "</table>\n<h2>Per-vertex indexing</h2>\n";
+}
+
+/// The per-vertex indexing set-up and the table of Zimmons' line, by segment count.
+fn html_indexing_line(s: &mut String, r: &Report) {
     let ix = &r.indexing;
     let _ = writeln!(
         s,
@@ -1290,8 +1334,12 @@ pub fn html(a: &Analysis) -> String {
             run.worst_viewer.worst.at[0]
         );
     }
-    s += "</table>\n";
-    fig(&mut s, "analysis-indexing-line");
+    *s += "</table>\n";
+}
+
+/// The paragraph on the worst vector errors of the quad and the sphere.
+fn html_indexing_worst(s: &mut String, r: &Report) {
+    let ix = &r.indexing;
     let worst_of = |res: &[ViewResult]| {
         res.iter()
             .max_by(|a, b| a.worst.degrees.total_cmp(&b.worst.degrees))
@@ -1315,8 +1363,12 @@ pub fn html(a: &Analysis) -> String {
         ws.worst.at[1],
         ws.worst.incidence_deg
     );
-    fig(&mut s, "analysis-indexing-meshes");
-    s += "<h2>The sphere map's singularity and the paraboloid's rim</h2>\n<table><tr><th>edge</th><th>sphere: first / last (°)</th><th>ratio</th><th>outermost anisotropy</th>\
+}
+
+/// The table of the sphere map's singularity, the paraboloid's rim and the cube's ratios,
+/// by edge size.
+fn html_singularities(s: &mut String, r: &Report) {
+    *s += "<h2>The sphere map's singularity and the paraboloid's rim</h2>\n<table><tr><th>edge</th><th>sphere: first / last (°)</th><th>ratio</th><th>outermost anisotropy</th>\
           <th>paraboloid: first / last (°)</th><th>ratio</th><th>outermost anisotropy</th><th>cube: ratio</th><th>outermost anisotropy</th></tr>\n";
     let sg = &r.singularities;
     for i in 0..sg.sphere.len() {
@@ -1327,9 +1379,13 @@ pub fn html(a: &Analysis) -> String {
             a.size, a.first_deg, a.last_deg, a.ratio, a.outermost_anisotropy, b.first_deg, b.last_deg, b.ratio, b.outermost_anisotropy, c.ratio, c.outermost_anisotropy
         );
     }
-    s += "</table>\n";
-    fig(&mut s, "analysis-rims");
-    s += "<h2>The documents' claims</h2>\n<p>Verdicts by the numbers: <i>confirmed</i> within half a unit of the last printed digit; \
+    *s += "</table>\n";
+}
+
+/// The claims table: each claim of the documents, measured, with its verdict (the table is
+/// left open).
+fn html_claims(s: &mut String, r: &Report) {
+    *s += "<h2>The documents' claims</h2>\n<p>Verdicts by the numbers: <i>confirmed</i> within half a unit of the last printed digit; \
           <i>off in the last digits</i> within ten units of it; <i>contradicted</i> beyond.</p>\n<table><tr><th>source</th><th>claim</th><th>document</th>\
           <th>measured</th><th>verdict</th><th>why</th></tr>\n";
     for c in &r.claims {
@@ -1346,6 +1402,4 @@ pub fn html(a: &Analysis) -> String {
             esc(&c.why)
         );
     }
-    s += "</table>\n</html>\n";
-    s
 }

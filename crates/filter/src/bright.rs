@@ -91,9 +91,38 @@ pub(crate) struct BrightSet {
 /// the bright set, or `None` when no texel exceeds the threshold.
 pub(crate) fn split(cube: &mut EnvMap, k: f32, max_texels: usize) -> Option<BrightSet> {
     let size = cube.width() as usize;
-    let c = cube.channels();
     let geom = FaceGeometry::new(size);
-    let lum = |p: &[f32]| (p[0] + p[1] + p[2]) * (1.0 / 3.0);
+    let (total, tau) = bright_threshold(cube, &geom, k, max_texels)?;
+    let (level, keys, moved) = move_bright_texels(cube, &geom, tau);
+    if level.e.is_empty() {
+        return None;
+    }
+    let levels = cluster_levels(level, keys, size);
+    Some(BrightSet {
+        levels,
+        threshold: tau,
+        fraction: moved / total,
+    })
+}
+
+/// A texel's luminance, the mean of its first three channels.
+#[inline]
+fn texel_lum(p: &[f32]) -> f32 {
+    (p[0] + p[1] + p[2]) * (1.0 / 3.0)
+}
+
+/// The total energy (solid-angle-weighted luminance) of `cube` and the luminance threshold
+/// of the bright set: `k` times the mean radiance, raised so that at most `max_texels`
+/// texels exceed it. `None` when the total is not positive and finite, `max_texels` is 0
+/// or no texel exceeds `k` times the mean.
+fn bright_threshold(
+    cube: &EnvMap,
+    geom: &FaceGeometry,
+    k: f32,
+    max_texels: usize,
+) -> Option<(f64, f32)> {
+    let c = cube.channels();
+    let lum = texel_lum;
     let mut total = 0.0f64;
     for img in cube.layers() {
         for (p, g) in img.data().chunks_exact(c).zip(&geom.texels) {
@@ -119,6 +148,20 @@ pub(crate) fn split(cube: &mut EnvMap, k: f32, max_texels: usize) -> Option<Brig
         let (_, t, _) = lums.select_nth_unstable_by(n - max_texels - 1, f32::total_cmp);
         tau = tau.max(*t);
     }
+    Some((total, tau))
+}
+
+/// Level 0 of the bright set: every texel of `cube` brighter than `tau` is scaled down to
+/// luminance `tau` in place, and what it loses (times its solid angle) becomes a cluster at
+/// its direction. Returns the level, each texel's (face, x, y) and the energy moved.
+fn move_bright_texels(
+    cube: &mut EnvMap,
+    geom: &FaceGeometry,
+    tau: f32,
+) -> (BrightLevel, Vec<(usize, usize, usize)>, f64) {
+    let size = cube.width() as usize;
+    let c = cube.channels();
+    let lum = texel_lum;
     // Level 0: the bright texels themselves, keyed by (face, x, y).
     let mut level = BrightLevel::new(size);
     let mut keys: Vec<(usize, usize, usize)> = Vec::new();
@@ -148,49 +191,72 @@ pub(crate) fn split(cube: &mut EnvMap, k: f32, max_texels: usize) -> Option<Brig
             keys.push((f, i % size, i / size));
         }
     }
-    if level.e.is_empty() {
-        return None;
-    }
+    (level, keys, moved)
+}
+
+/// The levels of the cluster tree from level 0 (`level`, its texels' `keys`, faces of
+/// `size` texels) up to one cluster per face: each level is sorted by parent, and its runs
+/// merged into the level above ([`merge_runs`]).
+fn cluster_levels(
+    mut level: BrightLevel,
+    mut keys: Vec<(usize, usize, usize)>,
+    size: usize,
+) -> Vec<BrightLevel> {
     // Coarser levels: sort the level below by parent, merge runs, energy-weighted centroid.
     let mut levels = Vec::new();
     let mut s = size;
     loop {
-        let parent = |k: &(usize, usize, usize)| (k.0, k.1 / 2, k.2 / 2);
         let mut perm: Vec<usize> = (0..keys.len()).collect();
-        perm.sort_by_key(|&i| parent(&keys[i]));
+        perm.sort_by_key(|&i| parent_key(&keys[i]));
         let sorted = level.permuted(&perm);
         let sorted_keys: Vec<_> = perm.iter().map(|&i| keys[i]).collect();
         if s == 1 {
             levels.push(sorted);
             break;
         }
-        let mut up = BrightLevel::new(s / 2);
-        let mut up_keys = Vec::new();
-        let mut i = 0;
-        while i < sorted_keys.len() {
-            let pk = parent(&sorted_keys[i]);
-            let mut j = i;
-            let (mut d, mut e) = (Vec3::ZERO, Vec4::ZERO);
-            while j < sorted_keys.len() && parent(&sorted_keys[j]) == pk {
-                let w = (sorted.e[j].x + sorted.e[j].y + sorted.e[j].z).max(1e-30);
-                d += Vec3::new(sorted.x[j], sorted.y[j], sorted.z[j]) * w;
-                e += sorted.e[j];
-                j += 1;
-            }
-            up.push(d.normalize_or_zero(), e, (i as u32, (j - i) as u32));
-            up_keys.push(pk);
-            i = j;
-        }
+        let (up, up_keys) = merge_runs(&sorted, &sorted_keys, s);
         levels.push(sorted);
         level = up;
         keys = up_keys;
         s /= 2;
     }
-    Some(BrightSet {
-        levels,
-        threshold: tau,
-        fraction: moved / total,
-    })
+    levels
+}
+
+/// The key of a cluster's parent: the same face, half the coordinates.
+#[inline]
+fn parent_key(k: &(usize, usize, usize)) -> (usize, usize, usize) {
+    (k.0, k.1 / 2, k.2 / 2)
+}
+
+/// The level above `sorted` (a level of faces of `s` texels, sorted by parent, with its
+/// `sorted_keys`): each run of clusters with one parent becomes a cluster at their
+/// energy-weighted centroid with their summed energy, pointing at the run. Returns the
+/// level and its keys.
+fn merge_runs(
+    sorted: &BrightLevel,
+    sorted_keys: &[(usize, usize, usize)],
+    s: usize,
+) -> (BrightLevel, Vec<(usize, usize, usize)>) {
+    let parent = parent_key;
+    let mut up = BrightLevel::new(s / 2);
+    let mut up_keys = Vec::new();
+    let mut i = 0;
+    while i < sorted_keys.len() {
+        let pk = parent(&sorted_keys[i]);
+        let mut j = i;
+        let (mut d, mut e) = (Vec3::ZERO, Vec4::ZERO);
+        while j < sorted_keys.len() && parent(&sorted_keys[j]) == pk {
+            let w = (sorted.e[j].x + sorted.e[j].y + sorted.e[j].z).max(1e-30);
+            d += Vec3::new(sorted.x[j], sorted.y[j], sorted.z[j]) * w;
+            e += sorted.e[j];
+            j += 1;
+        }
+        up.push(d.normalize_or_zero(), e, (i as u32, (j - i) as u32));
+        up_keys.push(pk);
+        i = j;
+    }
+    (up, up_keys)
 }
 
 /// A zonal kernel `K(c)` evaluated in `f32` for the bright sum.

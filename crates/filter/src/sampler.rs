@@ -371,96 +371,19 @@ impl Sampler {
         let (w, h) = (lv.width(), lv.height());
         let base = self.chain.level(0);
         let scale = w as f64 / base.width() as f64;
-        // The reconstruction filter, `δ` texel² added to the footprint's covariance along
-        // both texel axes of this level: up to one texel when the minor semi-axis is under
-        // a texel (magnification: the filter is then at least one texel in radius, a smooth
-        // interpolation of the texel centres as in Heckbert's and pbrt's EWA), and once the
-        // footprint spans a few texels, minus the `texel²/12` of variance per axis that the
-        // box-averaged texels add (the footprint's covariance is `S/4` for `exp(−2r²)`).
         let minor_t = minor * scale;
-        let delta = if minor_t < 1.0 {
-            1.0 - minor_t * minor_t
-        } else {
-            -(minor_t * minor_t - 1.0).min(1.0) / 3.0
-        };
-        // This level's texel steps in the tangent plane (`M`'s columns over `w`, `h`), and
-        // the footprint in its texels (`M⁻¹` of the tangent semi-diameters, so widened as
-        // `fp` was).
-        let (cu, cv) = match uv_derivatives(proj, e.layer, e.uv) {
-            Some((du, dv)) => (
-                DVec2::new(fp.t1.dot(du), fp.t2.dot(du)) / w as f64,
-                DVec2::new(fp.t1.dot(dv), fp.t2.dot(dv)) / h as f64,
-            ),
-            None => (DVec2::ZERO, DVec2::ZERO),
-        };
-        let det_c = cu.x * cv.y - cv.x * cu.y;
-        let (a, b) = if det_c.abs() > 1e-300 {
-            let to_texels =
-                |t: DVec2| DVec2::new(cv.y * t.x - cv.x * t.y, -cu.y * t.x + cu.x * t.y) / det_c;
-            (to_texels(fp.p), to_texels(fp.q))
-        } else {
-            (
-                e.a * DVec2::new(w as f64, h as f64),
-                e.b * DVec2::new(w as f64, h as f64),
-            )
-        };
+        let delta = reconstruction_delta(minor_t);
+        let (cu, cv, a, b) = level_footprint(proj, e, fp, w, h);
         let q = fp.quadratic_form([
             delta * (cu.x * cu.x + cv.x * cv.x),
             delta * (cu.x * cu.y + cv.x * cv.y),
             delta * (cu.y * cu.y + cv.y * cv.y),
         ]);
-        // The same ellipse in this level's texels, `S = a aᵀ + b bᵀ + δ I`, grown a little
-        // (the map is not linear across the footprint): its bounding box, and per row the
-        // span inside it plus a texel of margin each side.
-        let grow2 = 1.25f64 * 1.25;
-        let s00 = (a.x * a.x + b.x * b.x + delta) * grow2;
-        let s01 = (a.x * a.y + b.x * b.y) * grow2;
-        let s11 = (a.y * a.y + b.y * b.y + delta) * grow2;
-        let ru = s00.max(0.0).sqrt() + 1.0;
-        let rv = s11.max(0.0).sqrt() + 1.0;
-        let (cx, cy) = (e.uv.x * w as f64 - 0.5, e.uv.y * h as f64 - 0.5);
-        let (mut x0, mut x1) = ((cx - ru).ceil() as i64, (cx + ru).floor() as i64);
-        let (y0, y1) = ((cy - rv).ceil() as i64, (cy + rv).floor() as i64);
-        let mut whole_rows = false;
-        if x1 - x0 + 1 > w as i64 && proj.layer_count() == 1 {
-            // Wider than a whole row (near a pole): each column once.
-            x0 = 0;
-            x1 = w as i64 - 1;
-            whole_rows = true;
-        }
-        // Each row visits only the span of the ellipse, not its whole bounding box: a point
-        // `p` from the centre is inside when `pᵀ S⁻¹ p ≤ 1`, i.e. for the row's `py`,
-        // `s11·px² − 2 s01 py·px + s00 py² − det S ≤ 0`, plus a texel of margin each side (a
-        // thin diagonal ellipse covers a small part of its box). Only where the map is
-        // smooth inside a layer (cube faces, lat-long): the disk and octahedral maps fold
-        // their parametrisation, and a footprint across a fold reaches texels far from its
-        // linearised ellipse, which the whole box keeps.
-        let smooth = matches!(proj, Projection::Cube(_) | Projection::LatLong(_));
-        let det_s = s00 * s11 - s01 * s01;
-        let span = |ty: i64| -> (i64, i64) {
-            if !smooth || whole_rows || det_s < 1e-18 || s11 < 1e-18 {
-                return (x0, x1);
-            }
-            let py = ty as f64 - cy;
-            let qb = -2.0 * py * s01;
-            let qc = py * py * s00 - det_s;
-            let disc = qb * qb - 4.0 * s11 * qc;
-            if disc < 0.0 {
-                // The row passes beyond the ellipse: only the margin's texel.
-                let m = (-qb / (2.0 * s11) + cx).round() as i64;
-                return (m.max(x0), m.min(x1));
-            }
-            let r = disc.sqrt();
-            let (lo, hi) = ((-qb - r) / (2.0 * s11) + cx, (-qb + r) / (2.0 * s11) + cx);
-            (
-                ((lo - 1.0).ceil() as i64).max(x0),
-                ((hi + 1.0).floor() as i64).min(x1),
-            )
-        };
+        let rows = EllipseRows::new(proj, e.uv, a, b, delta, w, h);
         let omega = &self.omega[l];
         let mut acc = [0.0f64; 4];
         let mut wsum = 0.0;
-        let mut add = |layer: usize, px: u32, py: u32| {
+        let add = |layer: usize, px: u32, py: u32| {
             let om = omega[layer.min(omega.len() - 1)][(py * w + px) as usize];
             if om <= 0.0 {
                 return;
@@ -480,34 +403,7 @@ impl Sampler {
             }
             wsum += wt;
         };
-        // Texels beyond the layer's edge are gathered first and summed once each afterwards:
-        // a large footprint reaches some of them twice through a seam. (A per-thread buffer,
-        // sorted and deduplicated: no allocation per lookup, no quadratic search.)
-        OUTSIDE.with(|cell| {
-            let mut outside = cell.borrow_mut();
-            outside.clear();
-            for ty in y0..=y1 {
-                let (sx0, sx1) = span(ty);
-                for tx in sx0..=sx1 {
-                    if tx >= 0 && ty >= 0 && tx < w as i64 && ty < h as i64 {
-                        add(e.layer, tx as u32, ty as u32);
-                    } else {
-                        let t = proj.wrap_texel(e.layer, tx, ty, w, h);
-                        outside.push(((t.0 as u64) << 48) | ((t.1 as u64) << 24) | t.2 as u64);
-                    }
-                }
-            }
-            outside.sort_unstable();
-            outside.dedup();
-            for &key in outside.iter() {
-                let (layer, px, py) = (
-                    (key >> 48) as usize,
-                    ((key >> 24) & 0xFF_FFFF) as u32,
-                    (key & 0xFF_FFFF) as u32,
-                );
-                add(layer, px, py);
-            }
-        });
+        visit_texels(&rows, proj, e.layer, w, h, add);
         if wsum > 0.0 {
             for v in &mut acc {
                 *v /= wsum;
@@ -522,6 +418,199 @@ impl Sampler {
             out.map(|v| v as f64)
         }
     }
+}
+
+/// The reconstruction filter of [`Sampler::ewa_level`], `δ` texel² added to the
+/// footprint's covariance along both texel axes of the level, for a minor semi-axis of
+/// `minor_t` of the level's texels: up to one texel when the minor semi-axis is under a
+/// texel (magnification: the filter is then at least one texel in radius, a smooth
+/// interpolation of the texel centres as in Heckbert's and pbrt's EWA), and once the
+/// footprint spans a few texels, minus the `texel²/12` of variance per axis that the
+/// box-averaged texels add (the footprint's covariance is `S/4` for `exp(−2r²)`).
+#[inline]
+fn reconstruction_delta(minor_t: f64) -> f64 {
+    if minor_t < 1.0 {
+        1.0 - minor_t * minor_t
+    } else {
+        -(minor_t * minor_t - 1.0).min(1.0) / 3.0
+    }
+}
+
+/// A level's texel steps in the tangent plane and the footprint in its texels, for a
+/// `w`×`h` level of `proj`: `(cu, cv)` are `M`'s columns over `w`, `h`, and `(a, b)` the
+/// footprint `M⁻¹` of the tangent semi-diameters (so widened as `fp` was), or `e`'s `uv`
+/// semi-diameters scaled to texels where `M` is singular.
+#[inline]
+fn level_footprint(
+    proj: &Projection,
+    e: &UvEllipse,
+    fp: &Tangent,
+    w: u32,
+    h: u32,
+) -> (DVec2, DVec2, DVec2, DVec2) {
+    let (cu, cv) = match uv_derivatives(proj, e.layer, e.uv) {
+        Some((du, dv)) => (
+            DVec2::new(fp.t1.dot(du), fp.t2.dot(du)) / w as f64,
+            DVec2::new(fp.t1.dot(dv), fp.t2.dot(dv)) / h as f64,
+        ),
+        None => (DVec2::ZERO, DVec2::ZERO),
+    };
+    let det_c = cu.x * cv.y - cv.x * cu.y;
+    let (a, b) = if det_c.abs() > 1e-300 {
+        let to_texels =
+            |t: DVec2| DVec2::new(cv.y * t.x - cv.x * t.y, -cu.y * t.x + cu.x * t.y) / det_c;
+        (to_texels(fp.p), to_texels(fp.q))
+    } else {
+        (
+            e.a * DVec2::new(w as f64, h as f64),
+            e.b * DVec2::new(w as f64, h as f64),
+        )
+    };
+    (cu, cv, a, b)
+}
+
+/// The texels [`Sampler::ewa_level`] visits: the footprint ellipse in the level's texels,
+/// `S = a aᵀ + b bᵀ + δ I`, grown a little (the map is not linear across the footprint),
+/// its bounding box `x0..=x1` × `y0..=y1` about the centre `(cx, cy)`, and per row the span
+/// inside it ([`EllipseRows::span`]).
+struct EllipseRows {
+    s00: f64,
+    s01: f64,
+    s11: f64,
+    /// `det S`.
+    det_s: f64,
+    cx: f64,
+    cy: f64,
+    x0: i64,
+    x1: i64,
+    y0: i64,
+    y1: i64,
+    /// The box is wider than a whole row (near a pole) and was cut to each column once.
+    whole_rows: bool,
+    /// The map is smooth inside a layer (cube faces, lat-long), so rows may be cut to the
+    /// ellipse's span.
+    smooth: bool,
+}
+
+impl EllipseRows {
+    /// The rows of the ellipse with conjugate radii `a`, `b` (texels) plus `delta` texel²,
+    /// centred at `uv` of a `w`×`h` level of `proj`.
+    #[inline]
+    fn new(
+        proj: &Projection,
+        uv: DVec2,
+        a: DVec2,
+        b: DVec2,
+        delta: f64,
+        w: u32,
+        h: u32,
+    ) -> EllipseRows {
+        let grow2 = 1.25f64 * 1.25;
+        let s00 = (a.x * a.x + b.x * b.x + delta) * grow2;
+        let s01 = (a.x * a.y + b.x * b.y) * grow2;
+        let s11 = (a.y * a.y + b.y * b.y + delta) * grow2;
+        let ru = s00.max(0.0).sqrt() + 1.0;
+        let rv = s11.max(0.0).sqrt() + 1.0;
+        let (cx, cy) = (uv.x * w as f64 - 0.5, uv.y * h as f64 - 0.5);
+        let (mut x0, mut x1) = ((cx - ru).ceil() as i64, (cx + ru).floor() as i64);
+        let (y0, y1) = ((cy - rv).ceil() as i64, (cy + rv).floor() as i64);
+        let mut whole_rows = false;
+        if x1 - x0 + 1 > w as i64 && proj.layer_count() == 1 {
+            // Wider than a whole row (near a pole): each column once.
+            x0 = 0;
+            x1 = w as i64 - 1;
+            whole_rows = true;
+        }
+        // The disk and octahedral maps fold their parametrisation, and a footprint across a
+        // fold reaches texels far from its linearised ellipse, which the whole box keeps.
+        let smooth = matches!(proj, Projection::Cube(_) | Projection::LatLong(_));
+        let det_s = s00 * s11 - s01 * s01;
+        EllipseRows {
+            s00,
+            s01,
+            s11,
+            det_s,
+            cx,
+            cy,
+            x0,
+            x1,
+            y0,
+            y1,
+            whole_rows,
+            smooth,
+        }
+    }
+
+    /// The columns row `ty` visits. Each row visits only the span of the ellipse, not its
+    /// whole bounding box: a point `p` from the centre is inside when `pᵀ S⁻¹ p ≤ 1`, i.e.
+    /// for the row's `py`, `s11·px² − 2 s01 py·px + s00 py² − det S ≤ 0`, plus a texel of
+    /// margin each side (a thin diagonal ellipse covers a small part of its box). Only
+    /// where the map is smooth inside a layer; otherwise, and for whole rows or a
+    /// degenerate ellipse, the whole box's columns.
+    #[inline]
+    fn span(&self, ty: i64) -> (i64, i64) {
+        let (s00, s01, s11, det_s) = (self.s00, self.s01, self.s11, self.det_s);
+        let (x0, x1, cx) = (self.x0, self.x1, self.cx);
+        if !self.smooth || self.whole_rows || det_s < 1e-18 || s11 < 1e-18 {
+            return (x0, x1);
+        }
+        let py = ty as f64 - self.cy;
+        let qb = -2.0 * py * s01;
+        let qc = py * py * s00 - det_s;
+        let disc = qb * qb - 4.0 * s11 * qc;
+        if disc < 0.0 {
+            // The row passes beyond the ellipse: only the margin's texel.
+            let m = (-qb / (2.0 * s11) + cx).round() as i64;
+            return (m.max(x0), m.min(x1));
+        }
+        let r = disc.sqrt();
+        let (lo, hi) = ((-qb - r) / (2.0 * s11) + cx, (-qb + r) / (2.0 * s11) + cx);
+        (
+            ((lo - 1.0).ceil() as i64).max(x0),
+            ((hi + 1.0).floor() as i64).min(x1),
+        )
+    }
+}
+
+/// Calls `add(layer, x, y)` for each texel of `rows` once, for a `w`×`h` level of `proj`
+/// whose footprint is centred in `layer`. Texels beyond the layer's edge are gathered first
+/// and summed once each afterwards: a large footprint reaches some of them twice through a
+/// seam. (A per-thread buffer, sorted and deduplicated: no allocation per lookup, no
+/// quadratic search.)
+#[inline]
+fn visit_texels(
+    rows: &EllipseRows,
+    proj: &Projection,
+    layer: usize,
+    w: u32,
+    h: u32,
+    mut add: impl FnMut(usize, u32, u32),
+) {
+    OUTSIDE.with(|cell| {
+        let mut outside = cell.borrow_mut();
+        outside.clear();
+        for ty in rows.y0..=rows.y1 {
+            let (sx0, sx1) = rows.span(ty);
+            for tx in sx0..=sx1 {
+                if tx >= 0 && ty >= 0 && tx < w as i64 && ty < h as i64 {
+                    add(layer, tx as u32, ty as u32);
+                } else {
+                    let t = proj.wrap_texel(layer, tx, ty, w, h);
+                    outside.push(((t.0 as u64) << 48) | ((t.1 as u64) << 24) | t.2 as u64);
+                }
+            }
+        }
+        outside.sort_unstable();
+        outside.dedup();
+        for &key in outside.iter() {
+            let (layer, px, py) = (
+                (key >> 48) as usize,
+                ((key >> 24) & 0xFF_FFFF) as u32,
+                (key & 0xFF_FFFF) as u32,
+            );
+            add(layer, px, py);
+        }
+    });
 }
 
 /// `exp(−2)`: the EWA weight at the ellipse, subtracted so that weights fall to zero there.

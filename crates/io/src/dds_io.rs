@@ -158,51 +158,114 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     };
 
     let (format, cube, kind) = match &header10 {
-        Some(h10) => {
-            let format = match h10.dxgi_format {
-                DxgiFormat::R16G16B16A16_Float => TexelFormat::Encoded(Encoding::Rgba16F),
-                DxgiFormat::R32G32B32A32_Float => TexelFormat::Encoded(Encoding::Rgba32F),
-                DxgiFormat::R32G32B32_Float => TexelFormat::Rgb32F,
-                DxgiFormat::R11G11B10_Float => TexelFormat::Encoded(Encoding::B10G11R11),
-                DxgiFormat::R9G9B9E5_SharedExp => TexelFormat::Encoded(Encoding::Rgb9E5),
-                DxgiFormat::BC6H_UF16 => TexelFormat::Encoded(Encoding::Bc6hUnsigned),
-                DxgiFormat::BC6H_SF16 => TexelFormat::Encoded(Encoding::Bc6hSigned),
-                other => return Err(unsupported_format(path, &format!("{other:?}"))),
-            };
-            if h10.resource_dimension != D3D10ResourceDimension::Texture2D {
-                return Err(invalid(format!(
-                    "DDS {:?} resources are not supported (only 2D textures and cube maps)",
-                    h10.resource_dimension
-                )));
-            }
-            let cube = h10.misc_flag.contains(MiscFlag::TEXTURECUBE);
-            if h10.array_size > 1 {
-                return Err(invalid(format!(
-                    "DDS {} arrays ({} elements) are not supported",
-                    if cube { "cube-map" } else { "texture" },
-                    h10.array_size
-                )));
-            }
-            (format, cube, "DX10")
-        }
-        None => {
-            let format = match header.spf.fourcc {
-                Some(FourCC(FourCC::A16B16G16R16F)) => TexelFormat::Encoded(Encoding::Rgba16F),
-                Some(FourCC(FourCC::A32B32G32R32F)) => TexelFormat::Encoded(Encoding::Rgba32F),
-                Some(FourCC(code)) => {
-                    return Err(unsupported_format(path, &format!("FourCC {code:#010x}")))
-                }
-                None => return Err(unsupported_format(path, "uncompressed integer (bit masks)")),
-            };
-            let cube = header.caps2.contains(Caps2::CUBEMAP);
-            if cube && !header.caps2.contains(Caps2::CUBEMAP_ALLFACES) {
-                return Err(invalid(
-                    "DDS cube map without all six faces is not supported".into(),
-                ));
-            }
-            (format, cube, "legacy header")
-        }
+        Some(h10) => dx10_format(path, h10)?,
+        None => legacy_format(path, &header)?,
     };
+    let mips = check_dds_shape(path, &header, cube, limits)?;
+    let (width, height) = (header.width, header.height);
+
+    // Each face (array layer) holds its whole mip chain; check the file holds them all.
+    let level0 = format.image_bytes(width, height);
+    let chain: u64 = (0..mips)
+        .map(|p| format.image_bytes((width >> p).max(1), (height >> p).max(1)))
+        .sum();
+    let faces: u64 = if cube { 6 } else { 1 };
+    let data_start = HEADER_LEN + if header10.is_some() { HEADER10_LEN } else { 0 };
+    let need = data_start + faces * chain;
+    if file_len < need {
+        return Err(invalid(format!(
+            "file is truncated: its header declares {need} bytes, but the file has {file_len}"
+        )));
+    }
+
+    let layers = read_faces(path, &mut r, format, (width, height), faces, level0, chain)?;
+
+    let levels = mip_phrase(mips);
+    let (declared, description) = if cube {
+        (
+            Some(ProjectionKind::Cube),
+            format!("DDS cube map ({kind}), {}, {levels}", format.name()),
+        )
+    } else {
+        (
+            None,
+            format!("DDS 2D texture ({kind}), {}, {levels}", format.name()),
+        )
+    };
+    Ok(Loaded {
+        layers,
+        declared,
+        recorded: None,
+        format: Format::Dds,
+        description,
+        invalid: None,
+    })
+}
+
+/// The texel format a DX10 extended header declares, whether it is a cube map, and the
+/// header kind for the description (`"DX10"`). Only 2D textures and cube maps, not arrays,
+/// are read.
+fn dx10_format(path: &Path, h10: &Header10) -> Result<(TexelFormat, bool, &'static str), Error> {
+    let invalid = |problem: String| Error::input(path, problem);
+    let format = match h10.dxgi_format {
+        DxgiFormat::R16G16B16A16_Float => TexelFormat::Encoded(Encoding::Rgba16F),
+        DxgiFormat::R32G32B32A32_Float => TexelFormat::Encoded(Encoding::Rgba32F),
+        DxgiFormat::R32G32B32_Float => TexelFormat::Rgb32F,
+        DxgiFormat::R11G11B10_Float => TexelFormat::Encoded(Encoding::B10G11R11),
+        DxgiFormat::R9G9B9E5_SharedExp => TexelFormat::Encoded(Encoding::Rgb9E5),
+        DxgiFormat::BC6H_UF16 => TexelFormat::Encoded(Encoding::Bc6hUnsigned),
+        DxgiFormat::BC6H_SF16 => TexelFormat::Encoded(Encoding::Bc6hSigned),
+        other => return Err(unsupported_format(path, &format!("{other:?}"))),
+    };
+    if h10.resource_dimension != D3D10ResourceDimension::Texture2D {
+        return Err(invalid(format!(
+            "DDS {:?} resources are not supported (only 2D textures and cube maps)",
+            h10.resource_dimension
+        )));
+    }
+    let cube = h10.misc_flag.contains(MiscFlag::TEXTURECUBE);
+    if h10.array_size > 1 {
+        return Err(invalid(format!(
+            "DDS {} arrays ({} elements) are not supported",
+            if cube { "cube-map" } else { "texture" },
+            h10.array_size
+        )));
+    }
+    Ok((format, cube, "DX10"))
+}
+
+/// The texel format a legacy header's FourCC declares (RGBA16F or RGBA32F), whether it is a
+/// cube map (which must have all six faces), and the header kind for the description
+/// (`"legacy header"`).
+fn legacy_format(path: &Path, header: &Header) -> Result<(TexelFormat, bool, &'static str), Error> {
+    let format = match header.spf.fourcc {
+        Some(FourCC(FourCC::A16B16G16R16F)) => TexelFormat::Encoded(Encoding::Rgba16F),
+        Some(FourCC(FourCC::A32B32G32R32F)) => TexelFormat::Encoded(Encoding::Rgba32F),
+        Some(FourCC(code)) => {
+            return Err(unsupported_format(path, &format!("FourCC {code:#010x}")))
+        }
+        None => return Err(unsupported_format(path, "uncompressed integer (bit masks)")),
+    };
+    let cube = header.caps2.contains(Caps2::CUBEMAP);
+    if cube && !header.caps2.contains(Caps2::CUBEMAP_ALLFACES) {
+        return Err(Error::input(
+            path,
+            "DDS cube map without all six faces is not supported".into(),
+        ));
+    }
+    Ok((format, cube, "legacy header"))
+}
+
+/// Checks the header's shape, in this order: not a volume texture, not empty, square when
+/// a `cube` map, within the `limits`, and no more mip levels than its size has. Returns the
+/// number of mip levels (at least 1).
+fn check_dds_shape(
+    path: &Path,
+    header: &Header,
+    cube: bool,
+    limits: &Limits,
+) -> Result<u32, Error> {
+    let invalid = |problem: String| Error::input(path, problem);
     if header.caps2.contains(Caps2::VOLUME) || header.depth.unwrap_or(1) > 1 {
         return Err(invalid("DDS volume textures are not supported".into()));
     }
@@ -225,21 +288,22 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             max_levels(width, height)
         )));
     }
+    Ok(mips)
+}
 
-    // Each face (array layer) holds its whole mip chain; check the file holds them all.
-    let level0 = format.image_bytes(width, height);
-    let chain: u64 = (0..mips)
-        .map(|p| format.image_bytes((width >> p).max(1), (height >> p).max(1)))
-        .sum();
-    let faces: u64 = if cube { 6 } else { 1 };
-    let data_start = HEADER_LEN + if header10.is_some() { HEADER10_LEN } else { 0 };
-    let need = data_start + faces * chain;
-    if file_len < need {
-        return Err(invalid(format!(
-            "file is truncated: its header declares {need} bytes, but the file has {file_len}"
-        )));
-    }
-
+/// Reads and decodes level 0 (`level0` bytes, `width`×`height` texels of `format`) of each
+/// of the `faces` faces, skipping the rest of each face's mip chain (`chain` bytes a face in
+/// all) to the next.
+fn read_faces(
+    path: &Path,
+    r: &mut BufReader<File>,
+    format: TexelFormat,
+    (width, height): (u32, u32),
+    faces: u64,
+    level0: u64,
+    chain: u64,
+) -> Result<Vec<Image>, Error> {
+    let io = |e| Error::io(path, e);
     let mut layers = Vec::with_capacity(faces as usize);
     let mut bytes = vec![0u8; level0 as usize];
     for face in 0..faces {
@@ -250,27 +314,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             r.seek_relative((chain - level0) as i64).map_err(io)?;
         }
     }
-
-    let levels = mip_phrase(mips);
-    let (declared, description) = if cube {
-        (
-            Some(ProjectionKind::Cube),
-            format!("DDS cube map ({kind}), {}, {levels}", format.name()),
-        )
-    } else {
-        (
-            None,
-            format!("DDS 2D texture ({kind}), {}, {levels}", format.name()),
-        )
-    };
-    Ok(Loaded {
-        layers,
-        declared,
-        recorded: None,
-        format: Format::Dds,
-        description,
-        invalid: None,
-    })
+    Ok(layers)
 }
 
 fn unsupported_format(path: &Path, what: &str) -> Error {

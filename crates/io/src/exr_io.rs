@@ -57,7 +57,24 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     )
     .map_err(|e| read_error(path, e))?;
     let headers = chunks.headers();
+    check_headers(path, headers, limits)?;
 
+    let layer_count = headers.len();
+
+    // The common case (a layer of exactly R, G, B and maybe A, half or float) straight from
+    // the decompressed blocks; anything else through the crate's generic image reader.
+    let index = headers.iter().position(is_rgb_layer).unwrap_or(0);
+    if let Some(layout) = block_layout(&headers[index]) {
+        let header = headers[index].clone();
+        return read_laid_out(path, &file, chunks, &header_end, index, header, &layout);
+    }
+    read_generic(path, chunks, layer_count)
+}
+
+/// Checks the headers before any texel is read: there is an RGB layer; every RGB layer is
+/// within the `limits` and fits the file; the first one's compression is one the crate
+/// decodes; and DWAA/DWAB blocks, if any layer has them, are safe to decode.
+fn check_headers(path: &Path, headers: &[Header], limits: &Limits) -> Result<(), Error> {
     let Some(header) = headers.iter().find(|h| is_rgb_layer(h)) else {
         return Err(Error::input(path, no_rgb_layer_problem(headers)));
     };
@@ -81,52 +98,68 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     {
         check_dwa_blocks(path)?;
     }
+    Ok(())
+}
 
-    let layer_count = headers.len();
-
-    // The common case (a layer of exactly R, G, B and maybe A, half or float) straight from
-    // the decompressed blocks; anything else through the crate's generic image reader.
-    let index = headers.iter().position(is_rgb_layer).unwrap_or(0);
-    if let Some(layout) = block_layout(&headers[index]) {
-        let header = headers[index].clone();
-        // A multi-part file (even one of a single part) puts a part number before each
-        // block: that the crate's reader handles.
-        let single_part = !chunks.meta_data().requirements.has_multiple_layers;
-        let (image, invalid) = if single_part && layer_count == 1 && is_zip_scanlines(&header) {
-            drop(chunks);
-            read_zip_file(&file, header_end.load(Ordering::Relaxed), &header, &layout)
-                .map(|(image, invalid)| (image, Some(invalid)))
-        } else {
-            read_blocks(chunks, index, &header, &layout).map(|image| (image, None))
-        }
-        .map_err(|e| read_error(path, e))?;
-        let declared = envmap_kind(header.own_attributes.environment_map);
-        let recorded = recorded_info(&header.own_attributes, image.width(), image.height());
-        let types: Vec<SampleType> = header.channels.list.iter().map(|c| c.sample_type).collect();
-        let layer_name = header
-            .own_attributes
-            .layer_name
-            .as_ref()
-            .map(|n| n.to_string());
-        let tiled = matches!(header.blocks, exr::meta::BlockDescription::Tiles(_));
-        let description = describe(
-            &types,
-            header.compression,
-            image.channels(),
-            tiled,
-            layer_count,
-            layer_name,
-        );
-        return Ok(Loaded {
-            layers: vec![image],
-            declared,
-            recorded,
-            format: Format::Exr,
-            description,
-            invalid,
-        });
+/// Reads layer `index` (`header`, whose channels `layout` places) straight from its
+/// decompressed blocks: a lone single-part ZIP scan-line layer through [`read_zip_file`]
+/// (which also counts the invalid samples), anything else through [`read_blocks`].
+fn read_laid_out(
+    path: &Path,
+    file: &File,
+    chunks: exr::block::reader::Reader<Counted<BufReader<&File>>>,
+    header_end: &AtomicU64,
+    index: usize,
+    header: Header,
+    layout: &[(usize, SampleType)],
+) -> Result<Loaded, Error> {
+    let layer_count = chunks.headers().len();
+    // A multi-part file (even one of a single part) puts a part number before each
+    // block: that the crate's reader handles.
+    let single_part = !chunks.meta_data().requirements.has_multiple_layers;
+    let (image, invalid) = if single_part && layer_count == 1 && is_zip_scanlines(&header) {
+        drop(chunks);
+        read_zip_file(file, header_end.load(Ordering::Relaxed), &header, layout)
+            .map(|(image, invalid)| (image, Some(invalid)))
+    } else {
+        read_blocks(chunks, index, &header, layout).map(|image| (image, None))
     }
+    .map_err(|e| read_error(path, e))?;
+    let declared = envmap_kind(header.own_attributes.environment_map);
+    let recorded = recorded_info(&header.own_attributes, image.width(), image.height());
+    let types: Vec<SampleType> = header.channels.list.iter().map(|c| c.sample_type).collect();
+    let layer_name = header
+        .own_attributes
+        .layer_name
+        .as_ref()
+        .map(|n| n.to_string());
+    let tiled = matches!(header.blocks, exr::meta::BlockDescription::Tiles(_));
+    let description = describe(
+        &types,
+        header.compression,
+        image.channels(),
+        tiled,
+        layer_count,
+        layer_name,
+    );
+    Ok(Loaded {
+        layers: vec![image],
+        declared,
+        recorded,
+        format: Format::Exr,
+        description,
+        invalid,
+    })
+}
 
+/// Reads the first valid RGB(A) layer through the crate's generic image reader (at its
+/// largest resolution level, on this thread) and describes it; `layer_count` is the
+/// number of layers in the file.
+fn read_generic(
+    path: &Path,
+    chunks: exr::block::reader::Reader<Counted<BufReader<&File>>>,
+    layer_count: usize,
+) -> Result<Loaded, Error> {
     // On this thread: the crate's parallel decoding runs blocks on a pool of its own, where
     // a decoder's panic aborts the process instead of reaching `guard_decoder`.
     let exr_image = exr::prelude::read()
@@ -836,7 +869,6 @@ fn read_zip_file(
         static SCRATCH: RefCell<Scratch> =
             const { RefCell::new((Vec::new(), Vec::new(), Vec::new())) };
     }
-    let truncated = || exr::error::Error::Invalid("missing bytes: the file is truncated".into());
     let file_len = file.metadata()?.len();
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
     let n = layout.len();
@@ -847,15 +879,7 @@ fn read_zip_file(
     // The offset table: one u64 a block (the count follows from the header's size, which
     // the caller has checked against the limits).
     let count = h.div_ceil(lines);
-    let table_len = count as u64 * 8;
-    if table_at
-        .checked_add(table_len)
-        .is_none_or(|end| end > file_len)
-    {
-        return Err(truncated());
-    }
-    let mut table = vec![0u8; count * 8];
-    read_at(file, &mut table, table_at)?;
+    let table = read_offset_table(file, table_at, count, file_len)?;
     // Zeroed texels in huge pages where the system has them (see `Image::new`): a 4096×2048
     // float source would otherwise take ~25,000 page faults as the blocks land.
     let mut image = Image::new(w as u32, h as u32, n);
@@ -865,65 +889,139 @@ fn read_zip_file(
         .map(|r| Mutex::new(Some(r)))
         .collect();
     let invalid = AtomicU64::new(0);
-    table.par_chunks_exact(8).try_for_each(|entry| {
-        let at = u64::from_le_bytes(entry.try_into().expect("8 bytes"));
-        let mut head = [0u8; 8];
-        if at.checked_add(8).is_none_or(|end| end > file_len) {
-            return Err(truncated());
-        }
-        read_at(file, &mut head, at)?;
-        let y = i32::from_le_bytes(head[..4].try_into().expect("4 bytes")) as i64;
-        let size = i32::from_le_bytes(head[4..].try_into().expect("4 bytes"));
-        let dy = y - top;
-        let k = usize::try_from(dy / lines as i64)
-            .ok()
-            .filter(|_| dy >= 0 && dy % lines as i64 == 0);
-        let slot = k.and_then(|k| rows.get(k)).ok_or_else(outside)?;
-        let out = slot
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .take()
-            .ok_or_else(|| {
-                exr::error::Error::Invalid(format!("two blocks claim the lines from {y}").into())
-            })?;
-        let bh = out.len() / (w * n);
-        let expected = bh * line_bytes;
-        // A ZIP block is never larger than its raw lines (the writer stores those instead).
-        let size = usize::try_from(size)
-            .ok()
-            .filter(|&s| s <= expected)
-            .ok_or_else(|| {
-                exr::error::Error::Invalid(
-                    format!("the block of lines from {y} declares an impossible size").into(),
-                )
-            })?;
-        if (at + 8)
-            .checked_add(size as u64)
-            .is_none_or(|end| end > file_len)
-        {
-            return Err(truncated());
-        }
-        SCRATCH.with_borrow_mut(|(block, inflated, raw)| {
-            block.resize(size, 0);
-            read_at(file, block, at + 8)?;
-            let lines = crate::exr_zip::THREAD_ZIP
-                .with_borrow_mut(|zip| crate::exr_zip::inflate(block, expected, inflated, zip))
-                .map_err(|e| exr::error::Error::Invalid(e.into()))?;
-            // Counted as the texels are laid out, or while the block is in cache: a clean
-            // map then needs no other pass.
-            let bad = match lines {
-                crate::exr_zip::Lines::Split { evens, odds } if float => {
-                    scatter_split_f32(evens, odds, out, w, bh, layout)
-                }
-                _ => {
-                    scatter(lines.to_bytes(raw), out, w, 0, w, bh, layout, false)?;
-                    mirrorball_core::count_invalid(out, n == 4)
-                }
-            };
-            invalid.fetch_add(bad, Ordering::Relaxed);
-            Ok(())
+    table
+        .par_chunks_exact(8)
+        .try_for_each(|entry| -> Result<(), exr::error::Error> {
+            let (at, y, size) = read_block_head(file, entry, file_len)?;
+            let out = claim_block_rows(&rows, y, top, lines)?;
+            let bh = out.len() / (w * n);
+            let expected = bh * line_bytes;
+            let size = checked_block_size(size, expected, y, at, file_len)?;
+            SCRATCH.with_borrow_mut(|(block, inflated, raw)| {
+                block.resize(size, 0);
+                read_at(file, block, at + 8)?;
+                let lines = crate::exr_zip::THREAD_ZIP
+                    .with_borrow_mut(|zip| crate::exr_zip::inflate(block, expected, inflated, zip))
+                    .map_err(|e| exr::error::Error::Invalid(e.into()))?;
+                // Counted as the texels are laid out, or while the block is in cache: a clean
+                // map then needs no other pass.
+                let bad = match lines {
+                    crate::exr_zip::Lines::Split { evens, odds } if float => {
+                        scatter_split_f32(evens, odds, out, w, bh, layout)
+                    }
+                    _ => {
+                        scatter(lines.to_bytes(raw), out, w, 0, w, bh, layout, false)?;
+                        mirrorball_core::count_invalid(out, n == 4)
+                    }
+                };
+                invalid.fetch_add(bad, Ordering::Relaxed);
+                Ok(())
+            })
+        })?;
+    check_no_missing_block(&rows, top, lines)?;
+    drop(rows);
+    Ok((image, invalid.into_inner()))
+}
+
+/// The error for a block or table that reaches past the end of the file.
+fn truncated_zip_file() -> exr::error::Error {
+    exr::error::Error::Invalid("missing bytes: the file is truncated".into())
+}
+
+/// Reads the offset table of a [`read_zip_file`] layer: `count` little-endian u64s at
+/// byte `table_at`, which must lie inside the file's `file_len` bytes.
+fn read_offset_table(
+    file: &File,
+    table_at: u64,
+    count: usize,
+    file_len: u64,
+) -> Result<Vec<u8>, exr::error::Error> {
+    let table_len = count as u64 * 8;
+    if table_at
+        .checked_add(table_len)
+        .is_none_or(|end| end > file_len)
+    {
+        return Err(truncated_zip_file());
+    }
+    let mut table = vec![0u8; count * 8];
+    read_at(file, &mut table, table_at)?;
+    Ok(table)
+}
+
+/// Reads the 8 bytes at the offset an offset table `entry` gives: the block's first line
+/// (y) and its compressed size. Returns the offset, y and the size as declared.
+fn read_block_head(
+    file: &File,
+    entry: &[u8],
+    file_len: u64,
+) -> Result<(u64, i64, i32), exr::error::Error> {
+    let at = u64::from_le_bytes(entry.try_into().expect("8 bytes"));
+    let mut head = [0u8; 8];
+    if at.checked_add(8).is_none_or(|end| end > file_len) {
+        return Err(truncated_zip_file());
+    }
+    read_at(file, &mut head, at)?;
+    let y = i32::from_le_bytes(head[..4].try_into().expect("4 bytes")) as i64;
+    let size = i32::from_le_bytes(head[4..].try_into().expect("4 bytes"));
+    Ok((at, y, size))
+}
+
+/// Takes the rows of texels the block of `lines` lines from `y` fills (the layer starting
+/// at line `top`): an error when `y` is not the first line of one of `rows`, or when
+/// another block has taken them already.
+fn claim_block_rows<'a>(
+    rows: &[std::sync::Mutex<Option<&'a mut [f32]>>],
+    y: i64,
+    top: i64,
+    lines: usize,
+) -> Result<&'a mut [f32], exr::error::Error> {
+    let dy = y - top;
+    let k = usize::try_from(dy / lines as i64)
+        .ok()
+        .filter(|_| dy >= 0 && dy % lines as i64 == 0);
+    let slot = k.and_then(|k| rows.get(k)).ok_or_else(outside)?;
+    slot.lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .take()
+        .ok_or_else(|| {
+            exr::error::Error::Invalid(format!("two blocks claim the lines from {y}").into())
         })
-    })?;
+}
+
+/// The compressed `size` of the block of lines from `y` at byte `at`, checked: at most the
+/// `expected` bytes of its raw lines (a ZIP block is never larger: the writer stores those
+/// instead), and inside the file's `file_len` bytes.
+fn checked_block_size(
+    size: i32,
+    expected: usize,
+    y: i64,
+    at: u64,
+    file_len: u64,
+) -> Result<usize, exr::error::Error> {
+    let size = usize::try_from(size)
+        .ok()
+        .filter(|&s| s <= expected)
+        .ok_or_else(|| {
+            exr::error::Error::Invalid(
+                format!("the block of lines from {y} declares an impossible size").into(),
+            )
+        })?;
+    if (at + 8)
+        .checked_add(size as u64)
+        .is_none_or(|end| end > file_len)
+    {
+        return Err(truncated_zip_file());
+    }
+    Ok(size)
+}
+
+/// Fails, naming its first line, if any block of `lines` lines (the layer starting at line
+/// `top`) was never filled.
+fn check_no_missing_block(
+    rows: &[std::sync::Mutex<Option<&mut [f32]>>],
+    top: i64,
+    lines: usize,
+) -> Result<(), exr::error::Error> {
     if let Some(k) = rows
         .iter()
         .position(|r| r.lock().unwrap_or_else(|p| p.into_inner()).is_some())
@@ -936,8 +1034,7 @@ fn read_zip_file(
             .into(),
         ));
     }
-    drop(rows);
-    Ok((image, invalid.into_inner()))
+    Ok(())
 }
 
 /// [`pack_lines`] for float channels (`layout` all [`SampleType::F32`], `c` 3 or 4): each

@@ -326,10 +326,37 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
     }
     check_encodable(path, levels, encoding)?;
     let level_count = levels.len();
-    let (vk_format, type_size) = vk_format(encoding);
     let supercompressed = how.zstd.is_some();
 
     let dfd = data_format_descriptor(encoding);
+    let kvd = written_key_value_data(how);
+    let dfd_offset = HEADER_LEN + LEVEL_INDEX_LEN * level_count;
+    let kvd_offset = dfd_offset + dfd.len();
+    let data_start = (kvd_offset + kvd.len()) as u64;
+
+    // Supercompressed levels are made before the index, which holds their lengths.
+    let compressed = compress_levels(path, levels, how)?;
+    let index = level_index(
+        encoding,
+        size,
+        level_count,
+        supercompressed,
+        &compressed,
+        data_start,
+    );
+    let head = ktx2_head(encoding, size, supercompressed, &index, &dfd, &kvd);
+    debug_assert_eq!(head.len() as u64, data_start);
+
+    atomic_write(path, |w| {
+        write_level_data(path, w, levels, how, &head, &index, &compressed)
+    })
+}
+
+/// The key/value data [`write_ktx2`] writes: `KTXorientation` = `rd`, `KTXwriter`, the
+/// declared projection under [`crate::PROJECTION_KEY`], the encoding under
+/// [`ENCODING_KEY`] for RGBD and RGBM, and `how.metadata`, sorted by key.
+fn written_key_value_data(how: &CubeWrite) -> Vec<u8> {
+    let encoding = how.encoding;
     let writer = format!("mirrorball {}", env!("CARGO_PKG_VERSION"));
     // Sorted by key, as the specification requires (code-point order: "KTX…" before
     // "mirrorball:…").
@@ -349,12 +376,18 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
         .iter()
         .map(|(k, v)| (k.as_str(), v.as_str()))
         .collect();
-    let kvd = key_value_data(&pairs);
-    let dfd_offset = HEADER_LEN + LEVEL_INDEX_LEN * level_count;
-    let kvd_offset = dfd_offset + dfd.len();
-    let data_start = (kvd_offset + kvd.len()) as u64;
+    key_value_data(&pairs)
+}
 
-    // Supercompressed levels are made before the index, which holds their lengths.
+/// Each level's six faces encoded and Zstandard-compressed at `how.zstd` (levels in
+/// parallel, the work counted in [`mirrorball_core::work`]), level 0 first; empty when
+/// `how.zstd` is `None`.
+fn compress_levels(
+    path: &Path,
+    levels: &[Vec<Image>],
+    how: &CubeWrite,
+) -> Result<Vec<Vec<u8>>, Error> {
+    let encoding = how.encoding;
     let encode_level = |p: usize| -> Vec<u8> {
         let mut level = Vec::new();
         let mut buf = Vec::new();
@@ -364,9 +397,9 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
         }
         level
     };
-    let compressed: Vec<Vec<u8>> = match how.zstd {
+    Ok(match how.zstd {
         None => Vec::new(),
-        Some(z) => (0..level_count)
+        Some(z) => (0..levels.len())
             .into_par_iter()
             .map(|p| {
                 let level = encode_level(p);
@@ -376,11 +409,21 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
             })
             .collect::<Result<_, _>>()
             .map_err(|e| Error::io(path, e))?,
-    };
+    })
+}
 
-    // The Mip Level Array holds the smallest level first; each level starts on a multiple of
-    // lcm(texel block size, 4) (mipPadding), or of 1 when supercompressed. The Level Index
-    // lists level 0 first.
+/// The Level Index: each level's (byteOffset, byteLength, uncompressedByteLength), level 0
+/// first. The Mip Level Array starting at `data_start` holds the smallest level first; each
+/// level starts on a multiple of lcm(texel block size, 4) (mipPadding), or of 1 when
+/// supercompressed (when `compressed` holds the levels' bytes).
+fn level_index(
+    encoding: Encoding,
+    size: u32,
+    level_count: usize,
+    supercompressed: bool,
+    compressed: &[Vec<u8>],
+    data_start: u64,
+) -> Vec<(u64, u64, u64)> {
     let block = encoding.block_bytes();
     let align = if supercompressed {
         1
@@ -397,7 +440,24 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
         index[p] = (offset, len, raw);
         cursor = offset + len;
     }
+    index
+}
 
+/// Everything before the Mip Level Array: identifier, header, Level Index, Data Format
+/// Descriptor (`dfd`) and key/value data (`kvd`).
+fn ktx2_head(
+    encoding: Encoding,
+    size: u32,
+    supercompressed: bool,
+    index: &[(u64, u64, u64)],
+    dfd: &[u8],
+    kvd: &[u8],
+) -> Vec<u8> {
+    let level_count = index.len();
+    let (vk_format, type_size) = vk_format(encoding);
+    let dfd_offset = HEADER_LEN + LEVEL_INDEX_LEN * level_count;
+    let kvd_offset = dfd_offset + dfd.len();
+    let data_start = (kvd_offset + kvd.len()) as u64;
     let mut head = Vec::with_capacity(data_start as usize);
     head.extend_from_slice(&IDENTIFIER);
     for v in [
@@ -423,39 +483,51 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
     }
     head.extend_from_slice(&0u64.to_le_bytes()); // sgdByteOffset: Zstandard has none
     head.extend_from_slice(&0u64.to_le_bytes()); // sgdByteLength
-    for &(offset, len, raw) in &index {
+    for &(offset, len, raw) in index {
         head.extend_from_slice(&offset.to_le_bytes());
         head.extend_from_slice(&len.to_le_bytes()); // byteLength
         head.extend_from_slice(&raw.to_le_bytes()); // uncompressedByteLength
     }
     debug_assert_eq!(head.len(), dfd_offset);
-    head.extend_from_slice(&dfd);
-    head.extend_from_slice(&kvd);
-    debug_assert_eq!(head.len() as u64, data_start);
+    head.extend_from_slice(dfd);
+    head.extend_from_slice(kvd);
+    head
+}
 
-    atomic_write(path, |w| {
-        let io = |e| Error::io(path, e);
-        w.write_all(&head).map_err(io)?;
-        let mut written = data_start;
-        let mut buf = Vec::new();
-        for p in (0..level_count).rev() {
-            let (offset, len, _) = index[p];
-            let padding = (offset - written) as usize;
-            w.write_all(&[0u8; 16][..padding]).map_err(io)?;
-            written = offset;
-            if let Some(level) = compressed.get(p) {
-                w.write_all(level).map_err(io)?;
-                written += len;
-                continue;
-            }
-            for face in &levels[p] {
-                encoding.encode_with(face, how.effort, &mut buf);
-                w.write_all(&buf).map_err(io)?;
-                written += buf.len() as u64;
-            }
+/// Writes `head`, then the levels smallest first, each after the zero padding that brings
+/// it to its offset in `index`: the compressed bytes when `compressed` holds them, else the
+/// faces encoded one at a time.
+fn write_level_data(
+    path: &Path,
+    w: &mut impl Write,
+    levels: &[Vec<Image>],
+    how: &CubeWrite,
+    head: &[u8],
+    index: &[(u64, u64, u64)],
+    compressed: &[Vec<u8>],
+) -> Result<(), Error> {
+    let io = |e| Error::io(path, e);
+    w.write_all(head).map_err(io)?;
+    // `head` ends where the Mip Level Array starts.
+    let mut written = head.len() as u64;
+    let mut buf = Vec::new();
+    for p in (0..levels.len()).rev() {
+        let (offset, len, _) = index[p];
+        let padding = (offset - written) as usize;
+        w.write_all(&[0u8; 16][..padding]).map_err(io)?;
+        written = offset;
+        if let Some(level) = compressed.get(p) {
+            w.write_all(level).map_err(io)?;
+            written += len;
+            continue;
         }
-        Ok(())
-    })
+        for face in &levels[p] {
+            how.encoding.encode_with(face, how.effort, &mut buf);
+            w.write_all(&buf).map_err(io)?;
+            written += buf.len() as u64;
+        }
+    }
+    Ok(())
 }
 
 /// One sample of a Data Format Descriptor: bit offset, bit length, channel type with its
@@ -620,7 +692,77 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let vk_format = read_u32(&head, 12);
     let scheme = read_u32(&head, 44);
 
-    let format = match vk_format {
+    let format = read_texel_format(path, &header, vk_format)?;
+    let zstd = read_supercompression(path, &header, scheme)?;
+    let (width, height) = (header.pixel_width, header.pixel_height);
+    check_read_shape(path, &header)?;
+    let faces = header.face_count;
+    check_limits(path, width, height, limits)?;
+    let level_count = header.level_count.max(1);
+    if level_count > max_levels(width, height) {
+        return Err(invalid(format!(
+            "{level_count} mip levels declared for a {width}×{height} texture, which has at most {}",
+            max_levels(width, height)
+        )));
+    }
+
+    // The level index and the sections it points to must lie inside the file, and each level
+    // must hold exactly the texels its size calls for, before anything big is read.
+    let mut index = vec![0u8; LEVEL_INDEX_LEN * level_count as usize];
+    file.read_exact(&mut index).map_err(io)?;
+    let (end, level0_raw) = check_level_index(path, &header, &index, format, zstd)?;
+    let end = check_sections(path, &header, end, file_len)?;
+    let bytes = read_checked_prefix(path, &header, file, end)?;
+    let reader = ktx2::Reader::new(bytes.as_slice())
+        .map_err(|e| invalid(format!("invalid KTX2 file: {e}")))?;
+    let level0 = reader
+        .levels()
+        .next()
+        .ok_or_else(|| invalid("KTX2 file has no mip levels".into()))?;
+
+    let get = |key: &str| {
+        reader
+            .key_value_data()
+            .find(|(k, _)| *k == key)
+            .map(|(_, v)| {
+                String::from_utf8_lossy(v)
+                    .trim_end_matches('\0')
+                    .to_string()
+            })
+    };
+    let format = resolve_8bit_encoding(path, format, &get)?;
+    let inflated;
+    let level0 = if zstd {
+        inflated = inflate_level0(path, level0.data, level0_raw)?;
+        &inflated[..]
+    } else {
+        level0.data
+    };
+
+    let mut layers = decode_faces(path, format, level0, width, height, faces)?;
+
+    let levels = mip_phrase(level_count);
+    let recorded = crate::recorded(get, width, height);
+    let (declared, description) = orient_and_describe(&reader, format, &levels, &mut layers);
+    Ok(Loaded {
+        layers,
+        declared,
+        recorded,
+        format: Format::Ktx2,
+        description,
+        invalid: None,
+    })
+}
+
+/// The texel format of a KTX2 file's `vk_format`, or the error that names the formats
+/// mirrorball reads. `R8G8B8A8_UNORM` comes back as RGBD; [`resolve_8bit_encoding`] tells
+/// RGBD from RGBM once the key/value data is read.
+fn read_texel_format(
+    path: &Path,
+    header: &ktx2::Header,
+    vk_format: u32,
+) -> Result<TexelFormat, Error> {
+    Ok(match vk_format {
         VK_FORMAT_R16G16B16A16_SFLOAT => TexelFormat::Encoded(Encoding::Rgba16F),
         VK_FORMAT_R32G32B32A32_SFLOAT => TexelFormat::Encoded(Encoding::Rgba32F),
         VK_FORMAT_R16G16B16_SFLOAT => TexelFormat::Rgb16F,
@@ -635,26 +777,44 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             let name = header
                 .format
                 .map_or("VK_FORMAT_UNDEFINED".to_string(), |f| format!("{f:?}"));
-            return Err(invalid(format!(
-                "unsupported KTX2 format {name} ({vk_format}); mirrorball reads float formats: \
-                 RGBA16F, RGBA32F, RGB16F, RGB32F, B10G11R11, E5B9G9R9 and BC6H (and RGBD or \
-                 RGBM 8-bit when the file records which)"
-            )));
+            return Err(Error::input(
+                path,
+                format!(
+                    "unsupported KTX2 format {name} ({vk_format}); mirrorball reads float formats: \
+                     RGBA16F, RGBA32F, RGB16F, RGB32F, B10G11R11, E5B9G9R9 and BC6H (and RGBD or \
+                     RGBM 8-bit when the file records which)"
+                ),
+            ));
         }
-    };
-    let zstd = match scheme {
-        0 => false,
-        SUPERCOMPRESSION_ZSTD => true,
+    })
+}
+
+/// Whether the file's levels are Zstandard-compressed (supercompressionScheme 2) rather
+/// than plain (0); any other scheme is an error.
+fn read_supercompression(path: &Path, header: &ktx2::Header, scheme: u32) -> Result<bool, Error> {
+    match scheme {
+        0 => Ok(false),
+        SUPERCOMPRESSION_ZSTD => Ok(true),
         s => {
             let name = header
                 .supercompression_scheme
                 .map_or(String::new(), |s| format!("{s:?} "));
-            return Err(invalid(format!(
-                "KTX2 supercompression scheme {name}({s}) is not supported; save the file \
-                 without supercompression or with Zstandard"
-            )));
+            Err(Error::input(
+                path,
+                format!(
+                    "KTX2 supercompression scheme {name}({s}) is not supported; save the file \
+                     without supercompression or with Zstandard"
+                ),
+            ))
         }
-    };
+    }
+}
+
+/// Rejects the texture shapes the reader does not take, in this order: 1D (height 0), 3D
+/// (a depth), arrays (a layer count), cube maps with non-square faces and face counts other
+/// than 1 or 6.
+fn check_read_shape(path: &Path, header: &ktx2::Header) -> Result<(), Error> {
+    let invalid = |problem: String| Error::input(path, problem);
     let (width, height) = (header.pixel_width, header.pixel_height);
     if height == 0 {
         return Err(invalid("1D KTX2 textures are not supported".into()));
@@ -668,40 +828,39 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             header.layer_count
         )));
     }
-    let faces = header.face_count;
-    match faces {
-        1 => {}
-        6 if width == height => {}
-        6 => {
-            return Err(invalid(format!(
-                "KTX2 cube map with non-square faces ({width}×{height})"
-            )))
-        }
-        n => {
-            return Err(invalid(format!(
-                "invalid KTX2 face count {n} (must be 1 or 6)"
-            )))
-        }
+    match header.face_count {
+        1 => Ok(()),
+        6 if width == height => Ok(()),
+        6 => Err(invalid(format!(
+            "KTX2 cube map with non-square faces ({width}×{height})"
+        ))),
+        n => Err(invalid(format!(
+            "invalid KTX2 face count {n} (must be 1 or 6)"
+        ))),
     }
-    check_limits(path, width, height, limits)?;
-    let level_count = header.level_count.max(1);
-    if level_count > max_levels(width, height) {
-        return Err(invalid(format!(
-            "{level_count} mip levels declared for a {width}×{height} texture, which has at most {}",
-            max_levels(width, height)
-        )));
-    }
+}
 
-    // The level index and the sections it points to must lie inside the file, and each level
-    // must hold exactly the texels its size calls for, before anything big is read.
-    let mut index = vec![0u8; LEVEL_INDEX_LEN * level_count as usize];
-    file.read_exact(&mut index).map_err(io)?;
+/// Checks each entry of the level index (`index`, `LEVEL_INDEX_LEN` bytes a level): a
+/// level must hold exactly the bytes its faces of `format` call for (uncompressed bytes
+/// when `zstd`), and its end must not overflow. Returns the furthest byte the header, the
+/// index and the levels reach, and level 0's uncompressed length.
+fn check_level_index(
+    path: &Path,
+    header: &ktx2::Header,
+    index: &[u8],
+    format: TexelFormat,
+    zstd: bool,
+) -> Result<(u64, u64), Error> {
+    let invalid = |problem: String| Error::input(path, problem);
+    let (width, height) = (header.pixel_width, header.pixel_height);
+    let faces = header.face_count;
+    let level_count = header.level_count.max(1);
     let mut end = (HEADER_LEN + index.len()) as u64;
     let mut level0_raw = 0u64;
     for p in 0..level_count as usize {
-        let offset = read_u64(&index, p * LEVEL_INDEX_LEN);
-        let len = read_u64(&index, p * LEVEL_INDEX_LEN + 8);
-        let raw = read_u64(&index, p * LEVEL_INDEX_LEN + 16);
+        let offset = read_u64(index, p * LEVEL_INDEX_LEN);
+        let len = read_u64(index, p * LEVEL_INDEX_LEN + 8);
+        let raw = read_u64(index, p * LEVEL_INDEX_LEN + 16);
         let (w, h) = ((width >> p).max(1), (height >> p).max(1));
         let want = u64::from(faces) * format.image_bytes(w, h);
         // Supercompressed levels hold any number of bytes that inflate to exactly the
@@ -723,6 +882,20 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             .ok_or_else(|| invalid(format!("mip level {p} has an impossible offset")))?;
         end = end.max(level_end);
     }
+    Ok((end, level0_raw))
+}
+
+/// Checks the Data Format Descriptor, key/value data and supercompression global data
+/// sections: their size is at most [`MAX_METADATA`], there is no global data, and together
+/// with `end` (what the level index reaches) they lie inside the file's `file_len` bytes.
+/// Returns the furthest byte any section reaches.
+fn check_sections(
+    path: &Path,
+    header: &ktx2::Header,
+    end: u64,
+    file_len: u64,
+) -> Result<u64, Error> {
+    let invalid = |problem: String| Error::input(path, problem);
     let index_fields = &header.index;
     let metadata =
         u64::from(index_fields.dfd_byte_length) + u64::from(index_fields.kvd_byte_length);
@@ -731,7 +904,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             "implausibly large KTX2 metadata ({metadata} bytes of descriptor and key/value data)"
         )));
     }
-    end = end
+    let end = end
         .max(u64::from(index_fields.dfd_byte_offset) + u64::from(index_fields.dfd_byte_length))
         .max(u64::from(index_fields.kvd_byte_offset) + u64::from(index_fields.kvd_byte_length));
     if index_fields.sgd_byte_length != 0 {
@@ -742,7 +915,20 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             "file is truncated: its index refers to byte {end}, but the file has {file_len} bytes"
         )));
     }
+    Ok(end)
+}
 
+/// Reads the file's first `end` bytes, fails if it has shrunk below them meanwhile, and
+/// rejects a Data Format Descriptor the `ktx2` crate would panic on ([`dfd_problem`]).
+fn read_checked_prefix(
+    path: &Path,
+    header: &ktx2::Header,
+    mut file: File,
+    end: u64,
+) -> Result<Vec<u8>, Error> {
+    let io = |e| Error::io(path, e);
+    let invalid = |problem: String| Error::input(path, problem);
+    let index_fields = &header.index;
     let mut bytes = Vec::with_capacity(end as usize);
     file.seek(SeekFrom::Start(0)).map_err(io)?;
     file.take(end).read_to_end(&mut bytes).map_err(io)?;
@@ -758,64 +944,84 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     ) {
         return Err(invalid(format!("invalid KTX2 file: {problem}")));
     }
-    let reader = ktx2::Reader::new(bytes.as_slice())
-        .map_err(|e| invalid(format!("invalid KTX2 file: {e}")))?;
-    let level0 = reader
-        .levels()
-        .next()
-        .ok_or_else(|| invalid("KTX2 file has no mip levels".into()))?;
+    Ok(bytes)
+}
 
-    let get = |key: &str| {
-        reader
-            .key_value_data()
-            .find(|(k, _)| *k == key)
-            .map(|(_, v)| {
-                String::from_utf8_lossy(v)
-                    .trim_end_matches('\0')
-                    .to_string()
-            })
-    };
-    let format = match format {
+/// Tells RGBD from RGBM for `R8G8B8A8_UNORM` data by the value `get` finds under
+/// [`ENCODING_KEY`] (an error when it is neither); other formats are returned as they are.
+fn resolve_8bit_encoding(
+    path: &Path,
+    format: TexelFormat,
+    get: &impl Fn(&str) -> Option<String>,
+) -> Result<TexelFormat, Error> {
+    Ok(match format {
         TexelFormat::Encoded(Encoding::Rgbd) => match get(ENCODING_KEY).as_deref() {
             Some("rgbd") => TexelFormat::Encoded(Encoding::Rgbd),
             Some("rgbm") => TexelFormat::Encoded(Encoding::Rgbm),
             other => {
-                return Err(invalid(format!(
-                    "8-bit KTX2 (R8G8B8A8_UNORM) is read only as RGBD or RGBM, recorded under \
-                     {ENCODING_KEY}; this file records {}",
-                    other.map_or("nothing".to_string(), |o| format!("'{o}'"))
-                )))
+                return Err(Error::input(
+                    path,
+                    format!(
+                        "8-bit KTX2 (R8G8B8A8_UNORM) is read only as RGBD or RGBM, recorded under \
+                         {ENCODING_KEY}; this file records {}",
+                        other.map_or("nothing".to_string(), |o| format!("'{o}'"))
+                    ),
+                ))
             }
         },
         f => f,
-    };
-    let inflated;
-    let level0 = if zstd {
-        inflated = zstd::bulk::decompress(level0.data, level0_raw as usize)
-            .map_err(|e| invalid(format!("mip level 0 is not valid Zstandard data: {e}")))?;
-        if inflated.len() as u64 != level0_raw {
-            return Err(invalid(format!(
-                "mip level 0 inflates to {} bytes, not the {level0_raw} its index gives",
-                inflated.len()
-            )));
-        }
-        &inflated[..]
-    } else {
-        level0.data
-    };
+    })
+}
 
+/// Inflates the Zstandard-compressed level 0 (`data`), which must come to exactly
+/// `level0_raw` bytes.
+fn inflate_level0(path: &Path, data: &[u8], level0_raw: u64) -> Result<Vec<u8>, Error> {
+    let invalid = |problem: String| Error::input(path, problem);
+    let inflated = zstd::bulk::decompress(data, level0_raw as usize)
+        .map_err(|e| invalid(format!("mip level 0 is not valid Zstandard data: {e}")))?;
+    if inflated.len() as u64 != level0_raw {
+        return Err(invalid(format!(
+            "mip level 0 inflates to {} bytes, not the {level0_raw} its index gives",
+            inflated.len()
+        )));
+    }
+    Ok(inflated)
+}
+
+/// Decodes the `faces` images of `format` (`width`×`height` each) that level 0 holds, in
+/// the order they are stored.
+fn decode_faces(
+    path: &Path,
+    format: TexelFormat,
+    level0: &[u8],
+    width: u32,
+    height: u32,
+    faces: u32,
+) -> Result<Vec<Image>, Error> {
     let face_len = format.image_bytes(width, height) as usize;
     let mut layers = Vec::with_capacity(faces as usize);
     for face in level0.chunks_exact(face_len).take(faces as usize) {
         layers.push(format.decode(face, width, height));
     }
     if layers.len() != faces as usize {
-        return Err(invalid("mip level 0 is shorter than its faces".into()));
+        return Err(Error::input(
+            path,
+            "mip level 0 is shorter than its faces".into(),
+        ));
     }
+    Ok(layers)
+}
 
-    let levels = mip_phrase(level_count);
-    let recorded = crate::recorded(get, width, height);
-    let (declared, description) = if faces == 6 {
+/// The declared projection and the description of what was read. Six layers are a cube
+/// map, kept as they are; one is a 2D texture, flipped to top-row-first, left-column-first
+/// by its `KTXorientation` (`l…` flips it left to right, `.u` top to bottom).
+fn orient_and_describe(
+    reader: &ktx2::Reader<&[u8]>,
+    format: TexelFormat,
+    levels: &str,
+    layers: &mut [Image],
+) -> (Option<ProjectionKind>, String) {
+    if layers.len() == 6 {
         // Cube faces are always `rd` (the specification requires it), so they are kept as is.
         (
             Some(ProjectionKind::Cube),
@@ -838,13 +1044,5 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             None,
             format!("KTX2 2D texture, {}, {levels}", format.name()),
         )
-    };
-    Ok(Loaded {
-        layers,
-        declared,
-        recorded,
-        format: Format::Ktx2,
-        description,
-        invalid: None,
-    })
+    }
 }

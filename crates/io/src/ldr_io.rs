@@ -184,33 +184,7 @@ pub fn write(
     image: &Image,
     opts: &WriteOptions,
 ) -> Result<Staged, Error> {
-    let sixteen = match (format, opts.precision) {
-        (Format::Png | Format::Jpeg, None | Some(Precision::U8)) => false,
-        (Format::Png, Some(Precision::U16)) => true,
-        (Format::Png, Some(p)) => {
-            return Err(Error::request(
-                path,
-                format!(
-                    "PNG stores 8- or 16-bit integer texels, not {}; use .exr for half or float",
-                    precision_name(p)
-                ),
-            ))
-        }
-        (Format::Jpeg, Some(p)) => {
-            return Err(Error::request(
-                path,
-                format!(
-                    "JPEG stores 8-bit integer texels, not {}; use .png for 16 bits or .exr \
-                     for half or float",
-                    precision_name(p)
-                ),
-            ))
-        }
-        (other, _) => {
-            let problem = format!("writing {other:?} as an 8/16-bit image is not supported");
-            return Err(Error::request(path, problem));
-        }
-    };
+    let sixteen = sixteen_bit(path, format, opts)?;
     check_writable_size(path, image)?;
     let (w, h) = (image.width(), image.height());
     if format == Format::Jpeg && (w > u16::MAX as u32 || h > u16::MAX as u32) {
@@ -221,35 +195,83 @@ pub fn write(
     }
 
     if format == Format::Jpeg {
-        let quality = match opts.jpeg_quality {
-            0 => DEFAULT_JPEG_QUALITY,
-            q => q.min(100),
-        };
-        let bytes = encode_u8(image, 3);
-        let Some(info) = &opts.declared else {
-            return stage(path, |out| {
-                JpegEncoder::new_with_quality(out, quality)
-                    .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
-                    .map_err(|e| encode_error(path, "JPEG", e))
-            });
-        };
-        // The projection and layout in a comment segment, spliced into the encoded file.
-        let mut jpeg = Vec::new();
-        JpegEncoder::new_with_quality(&mut jpeg, quality)
-            .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
-            .map_err(|e| encode_error(path, "JPEG", e))?;
-        let (projection, layout) = info.texts();
-        let mut pairs = vec![(crate::PROJECTION_KEY, projection)];
-        pairs.extend(layout.map(|l| (crate::LAYOUT_KEY, l)));
-        let mut jpeg = crate::meta_text::with_jpeg_comment(jpeg, &pairs);
-        if let Some(xmp) = panorama_xmp(info, w, h) {
-            jpeg = crate::meta_text::with_jpeg_xmp(jpeg, &xmp);
-        }
-        return stage(path, |out| {
-            std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
-        });
+        return write_jpeg(path, image, opts);
     }
+    write_png(path, image, opts, sixteen)
+}
 
+/// Whether [`write`] stores 16-bit samples (PNG with [`Precision::U16`]) rather than 8-bit
+/// ones; an error for the precisions PNG and JPEG do not store and for other formats.
+fn sixteen_bit(path: &Path, format: Format, opts: &WriteOptions) -> Result<bool, Error> {
+    match (format, opts.precision) {
+        (Format::Png | Format::Jpeg, None | Some(Precision::U8)) => Ok(false),
+        (Format::Png, Some(Precision::U16)) => Ok(true),
+        (Format::Png, Some(p)) => Err(Error::request(
+            path,
+            format!(
+                "PNG stores 8- or 16-bit integer texels, not {}; use .exr for half or float",
+                precision_name(p)
+            ),
+        )),
+        (Format::Jpeg, Some(p)) => Err(Error::request(
+            path,
+            format!(
+                "JPEG stores 8-bit integer texels, not {}; use .png for 16 bits or .exr \
+                 for half or float",
+                precision_name(p)
+            ),
+        )),
+        (other, _) => {
+            let problem = format!("writing {other:?} as an 8/16-bit image is not supported");
+            Err(Error::request(path, problem))
+        }
+    }
+}
+
+/// Stages `image` as an 8-bit RGB JPEG at [`WriteOptions::jpeg_quality`] (92 when 0, at
+/// most 100), with [`WriteOptions::declared`] in a comment segment and GPano XMP in `APP1`
+/// when it is given.
+fn write_jpeg(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, Error> {
+    let (w, h) = (image.width(), image.height());
+    let quality = match opts.jpeg_quality {
+        0 => DEFAULT_JPEG_QUALITY,
+        q => q.min(100),
+    };
+    let bytes = encode_u8(image, 3);
+    let Some(info) = &opts.declared else {
+        return stage(path, |out| {
+            JpegEncoder::new_with_quality(out, quality)
+                .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
+                .map_err(|e| encode_error(path, "JPEG", e))
+        });
+    };
+    // The projection and layout in a comment segment, spliced into the encoded file.
+    let mut jpeg = Vec::new();
+    JpegEncoder::new_with_quality(&mut jpeg, quality)
+        .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
+        .map_err(|e| encode_error(path, "JPEG", e))?;
+    let (projection, layout) = info.texts();
+    let mut pairs = vec![(crate::PROJECTION_KEY, projection)];
+    pairs.extend(layout.map(|l| (crate::LAYOUT_KEY, l)));
+    let mut jpeg = crate::meta_text::with_jpeg_comment(jpeg, &pairs);
+    if let Some(xmp) = panorama_xmp(info, w, h) {
+        jpeg = crate::meta_text::with_jpeg_xmp(jpeg, &xmp);
+    }
+    stage(path, |out| {
+        std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
+    })
+}
+
+/// Stages `image` as an RGB or RGBA PNG of 8-bit or (`sixteen`) 16-bit samples, with
+/// [`WriteOptions::declared`] in `tEXt` chunks and GPano XMP in an `iTXt` chunk when it is
+/// given.
+fn write_png(
+    path: &Path,
+    image: &Image,
+    opts: &WriteOptions,
+    sixteen: bool,
+) -> Result<Staged, Error> {
+    let (w, h) = (image.width(), image.height());
     let c = image.channels();
     let (bytes, color) = if sixteen {
         let samples = encode_u16(image);
