@@ -57,6 +57,7 @@ pub mod fit;
 pub mod frames;
 pub mod guard;
 pub mod hooks;
+pub mod info;
 pub mod load;
 pub mod materials;
 pub mod prefilter;

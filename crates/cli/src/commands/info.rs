@@ -1,111 +1,21 @@
-//! `mirrorball info`: what a file holds.
+//! `mirrorball info`: what a file holds (the library's `info::describe`; a video's 360°
+//! metadata through `tag`), printed for people or as JSON.
 
 use crate::error::CliError;
-use crate::{load, InfoArgs};
-use mirrorball_core::WorldProjection;
+use crate::InfoArgs;
 
 pub fn run(a: InfoArgs) -> Result<(), CliError> {
     if super::tag::is_movie(&a.input) {
         return super::tag::info(&a.input, a.json);
     }
-    if let Some(sh) = mirrorball_io::read_sh(std::path::Path::new(&a.input))? {
-        match a.json {
-            true => println!("{:#}", sh.info_json(&a.input)),
-            false => print!("{}", sh.info_text(&a.input)),
-        }
-        return Ok(());
-    }
-    if let Some(p) = mirrorball_io::picture_of(std::path::Path::new(&a.input)) {
-        let v = serde_json::json!({"file": a.input, "projection": p.projection(), "content": p.describe()});
-        match a.json {
-            true => println!("{v:#}"),
-            false => println!(
-                "file:        {}\nprojection:  {} ({})",
-                a.input,
-                p.projection(),
-                p.describe()
-            ),
-        }
-        return Ok(());
-    }
     let input = crate::commands::input_plan(&a.input_args)?;
-    // One face of a set (`cube/px.hdr`) is read with its set, as `{face}` reads it.
-    let set = (input.from.is_none() && input.layout.is_none())
-        .then(|| mirrorball_io::layer_set(&a.input))
-        .flatten();
-    let mut src = load::load(
-        set.as_deref().unwrap_or(&a.input),
-        input.from.as_ref(),
-        input.layout,
-        &mirrorball_io::Limits::default(),
-    )?;
-    if let Some(set) = &set {
-        src.decided = format!("{}; one file of the set {set}", src.decided);
-    }
-    let env = &src.env;
-    let s = env.stats();
-    let p = env.projection();
-    let panorama = super::tag::photo_panorama(&a.input, env.width(), env.height())?;
-    if a.json {
-        let v = serde_json::json!({
-            "file": a.input,
-            "container": src.description,
-            "projection": p.name(),
-            "spec": p.to_string(),
-            "decided": src.decided,
-            "layers": env.layers().len(),
-            "width": env.width(),
-            "height": env.height(),
-            "channels": env.channels(),
-            "solid_angle_sr": s.solid_angle,
-            "covered_solid_angle_sr": p.covered_solid_angle(),
-            "min": s.min,
-            "max": s.max,
-            "mean_rgb": s.mean,
-            "nan_values": s.nan,
-            "inf_values": s.inf,
-            "negative_values": s.negative,
-            "panorama": panorama,
-        });
-        println!(
+    let info = mirrorball::info::describe(&a.input, &input)?;
+    match a.json {
+        true => println!(
             "{}",
-            serde_json::to_string_pretty(&v).expect("serialisable")
-        );
-        return Ok(());
+            serde_json::to_string_pretty(&info.json).expect("serialisable")
+        ),
+        false => print!("{}", info.text),
     }
-    println!("file:        {}", a.input);
-    println!("container:   {}", src.description);
-    println!("projection:  {} ({})", p.name(), src.decided);
-    if let Some(pano) = &panorama {
-        println!("panorama:    {pano}");
-    }
-    println!(
-        "size:        {}x{}{}, {} channels",
-        env.width(),
-        env.height(),
-        if env.layers().len() > 1 {
-            format!(" x {} layers", env.layers().len())
-        } else {
-            String::new()
-        },
-        env.channels()
-    );
-    println!(
-        "covers:      {:.6} sr ({:.2}% of the sphere)",
-        s.solid_angle,
-        s.solid_angle / (4.0 * std::f64::consts::PI) * 100.0
-    );
-    println!("radiance:    min {:.6e}  max {:.6e}", s.min, s.max);
-    println!(
-        "mean (RGB):  {:.6e} {:.6e} {:.6e}  (weighted by solid angle)",
-        s.mean[0], s.mean[1], s.mean[2]
-    );
-    println!(
-        "invalid:     {} NaN, {} infinite, {} negative colour values ({} in all; convert and prefilter set them to 0)",
-        s.nan,
-        s.inf,
-        s.negative,
-        s.nan + s.inf + s.negative
-    );
     Ok(())
 }

@@ -190,30 +190,3 @@ fn track_json(t: &VideoTrack, b: &str, r: &Result<Option<Reading>, String>) -> s
         "problem": problem,
     })
 }
-
-/// What a PNG's or JPEG's GPano XMP says, for `info`: `None` for other files and for
-/// pictures without it.
-pub fn photo_panorama(input: &str, w: u32, h: u32) -> Result<Option<String>, CliError> {
-    let photo = matches!(extension(input).as_deref(), Some("png" | "jpg" | "jpeg"));
-    if !photo || input.contains(crate::load::FACE) {
-        return Ok(None);
-    }
-    let Some(xmp) = mirrorball_io::read_xmp(Path::new(input))? else {
-        return Ok(None);
-    };
-    Ok(
-        mirrorball_spherical::gpano::parse(&xmp, w, h).map(|r| match r {
-            Ok(c) => {
-                let as_read = match c.mapping() {
-                    Some(m) => format!("{}", m.projection()),
-                    None => "off-centre, not a mirrorball projection".into(),
-                };
-                format!(
-                    "GPano equirectangular, {}x{} of a {}x{} panorama at ({}, {}): {as_read}",
-                    c.width, c.height, c.full_width, c.full_height, c.left, c.top
-                )
-            }
-            Err(e) => format!("GPano: {e}"),
-        }),
-    )
-}
