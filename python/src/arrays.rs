@@ -199,16 +199,8 @@ pub fn pictures(
                     ));
                 }
             }
-            Invalid::Zero => flat.par_chunks_mut(c).for_each(|px| {
-                for v in &mut px[..3] {
-                    if !(v.is_finite() && *v > 0.0) {
-                        *v = 0.0;
-                    }
-                }
-                if c == 4 && !px[3].is_finite() {
-                    px[3] = 0.0;
-                }
-            }),
+            // Core's rule, after the pictures are made.
+            Invalid::Zero => {}
         }
     }
     let images = if count == 1 {
@@ -218,6 +210,12 @@ pub fn pictures(
             .map(|p| Image::from_vec(w as u32, h as u32, c, p.to_vec()).expect("checked shape"))
             .collect()
     };
+    let mut images = images;
+    if invalid == Invalid::Zero {
+        images.par_iter_mut().for_each(|img| {
+            mirrorball_core::sanitize_layer(img);
+        });
+    }
     Ok(Pictures {
         images,
         lead,
