@@ -3,17 +3,12 @@
 //! Raw arguments become a validated plan (projection specs parsed, output container and
 //! layout checked, folders checked) before any file is read or any work starts.
 
-mod budget;
 mod choice;
 mod commands;
 mod error;
-mod fit;
-mod guard;
-mod load;
 mod progress;
-mod save;
-mod size;
-mod spec;
+
+use mirrorball::{budget, fit, guard, load, save, size, spec};
 
 use choice::{names, names_of};
 use clap::parser::ValueSource;
@@ -639,7 +634,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("mirrorball: error: {e}");
-            ExitCode::from(e.code())
+            ExitCode::from(error::exit_code(&e))
         }
     }
 }

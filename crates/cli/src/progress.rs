@@ -123,3 +123,21 @@ pub fn with_spinner<T: Send>(label: &str, quiet: bool, work: impl FnOnce() -> T 
     bar.finish_and_clear();
     out
 }
+
+/// The library's [`mirrorball::Hooks`] for a command: lines printed on standard error and
+/// progress drawn as a bar, unless quiet.
+pub struct Printer {
+    pub quiet: bool,
+}
+
+impl mirrorball::Hooks for Printer {
+    fn note(&self, line: &str) {
+        if !self.quiet {
+            eprintln!("{line}");
+        }
+    }
+
+    fn progress(&self, label: &str, total: u64, work: &mut (dyn FnMut(Arc<AtomicU64>) + Send)) {
+        with_progress(label, total, self.quiet, work)
+    }
+}

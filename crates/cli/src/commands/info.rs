@@ -1,6 +1,5 @@
 //! `mirrorball info`: what a file holds.
 
-use super::InputPlan;
 use crate::error::CliError;
 use crate::{load, InfoArgs};
 use mirrorball_core::WorldProjection;
@@ -9,7 +8,7 @@ pub fn run(a: InfoArgs) -> Result<(), CliError> {
     if super::tag::is_movie(&a.input) {
         return super::tag::info(&a.input, a.json);
     }
-    let input = InputPlan::new(&a.input_args)?;
+    let input = crate::commands::input_plan(&a.input_args)?;
     let src = load::load(
         &a.input,
         input.from.as_ref(),

@@ -16,28 +16,22 @@ use crate::spec::{bad, ProjSpec};
 use crate::InputArgs;
 use mirrorball_core::Layout;
 
-/// The validated input options.
-pub struct InputPlan {
-    pub from: Option<ProjSpec>,
-    pub layout: Option<Layout>,
-    pub keep_invalid: bool,
-}
+pub use mirrorball::load::InputPlan;
 
-impl InputPlan {
-    pub fn new(a: &InputArgs) -> Result<InputPlan, CliError> {
-        let from = a
-            .from
-            .as_deref()
-            .map(ProjSpec::parse)
-            .transpose()
-            .map_err(|e| bad("--from", e))?;
-        let layout = parse_layout("--in-layout", a.in_layout.as_deref())?;
-        Ok(InputPlan {
-            from,
-            layout,
-            keep_invalid: a.keep_invalid,
-        })
-    }
+/// The input flags as the library's [`InputPlan`].
+pub fn input_plan(a: &InputArgs) -> Result<InputPlan, CliError> {
+    let from = a
+        .from
+        .as_deref()
+        .map(ProjSpec::parse)
+        .transpose()
+        .map_err(|e| bad("--from", e))?;
+    let layout = parse_layout("--in-layout", a.in_layout.as_deref())?;
+    Ok(InputPlan {
+        from,
+        layout,
+        keep_invalid: a.keep_invalid,
+    })
 }
 
 /// A layout flag's value, if given.

@@ -35,12 +35,6 @@ pub struct TagArgs {
     quiet: bool,
 }
 
-impl From<mirrorball_spherical::Error> for CliError {
-    fn from(e: mirrorball_spherical::Error) -> CliError {
-        CliError::new(e.fault(), e.to_string())
-    }
-}
-
 pub fn run(a: TagArgs) -> Result<(), CliError> {
     let path = Path::new(&a.file);
     let (change, what) = if a.remove {

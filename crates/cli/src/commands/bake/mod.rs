@@ -29,12 +29,6 @@ pub fn run(a: BakeArgs) -> Result<(), CliError> {
     bake(plan)
 }
 
-impl From<mirrorball_bake::Error> for CliError {
-    fn from(e: mirrorball_bake::Error) -> CliError {
-        CliError::new(e.fault, e.message)
-    }
-}
-
 fn bake(mut plan: BakePlan) -> Result<(), CliError> {
     let quiet = plan.quiet;
     let say = |s: String| {
@@ -43,7 +37,10 @@ fn bake(mut plan: BakePlan) -> Result<(), CliError> {
         }
     };
     let t0 = Instant::now();
-    let env = load::read_prepared(&plan.source, &plan.input, plan.quiet)?;
+    let (env, notes) = load::read_prepared(&plan.source, &plan.input)?;
+    if !plan.quiet {
+        notes.iter().for_each(|line| eprintln!("{line}"));
+    }
     plan.bake.check(&env)?;
     plan.bake.fit(&env);
     let size = plan.bake.opts.size;

@@ -43,7 +43,7 @@ impl Plan {
                 "bake needs the input map and the output folder: mirrorball bake IN --for ENGINE OUT-DIR",
             ));
         };
-        let input = InputPlan::new(&a.input_args)?;
+        let input = crate::commands::input_plan(&a.input_args)?;
         let encoding = a
             .encoding
             .as_deref()

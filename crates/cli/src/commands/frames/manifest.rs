@@ -287,7 +287,10 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         let t = Instant::now();
         // A job of one conversion is recorded as a sequence's frame is (`record.rs`).
         let outs = outputs(&args);
-        let stamp = record::stamp(&record::settings(&args), Path::new(&args.input));
+        let stamp = record::stamp(
+            &record::settings(&super::frames_request(&args)?),
+            Path::new(&args.input),
+        );
         if let Some(o) = outs.as_ref().filter(|o| o.iter().all(|p| p.exists())) {
             match made.verdict(&o[0], stamp) {
                 _ if a.frames.overwrite => {}
@@ -395,7 +398,7 @@ mod tests {
         ] {
             let e = parse("m", text, None).unwrap_err();
             assert!(e.message.contains(says), "{text:?}: {}", e.message);
-            assert_eq!(e.code(), 2);
+            assert_eq!(crate::error::exit_code(&e), 2);
         }
     }
 }

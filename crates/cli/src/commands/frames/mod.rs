@@ -9,15 +9,9 @@
 //! - `manifest.rs` — JSON-lines or CSV manifests, each job a `convert` of its own;
 //!   `shard.rs` — `--shard i/n`; `log.rs` — the one JSON line per frame or job.
 
-mod log;
 mod manifest;
-mod packing;
-mod pattern;
-mod pipe;
-mod pipeline;
-mod record;
-mod sequence;
-mod shard;
+
+use mirrorball::frames::{log, pattern, pipe, record, shard, FramesRequest};
 
 use crate::choice::names;
 use crate::error::CliError;
@@ -73,7 +67,9 @@ pub fn route(a: &ConvertArgs) -> Option<Result<(), CliError>> {
             || Pattern::output(&a.output)?.is_some())
     };
     match many() {
-        Ok(true) => Some(sequence::run(a)),
+        Ok(true) => Some(frames_request(a).and_then(|r| {
+            mirrorball::frames::run(&r, &crate::progress::Printer { quiet: a.quiet })
+        })),
         Ok(false) => single_only(a).err().map(Err),
         Err(e) => Some(Err(e)),
     }
@@ -95,4 +91,28 @@ fn single_only(a: &ConvertArgs) -> Result<(), CliError> {
         ))),
         None => Ok(()),
     }
+}
+
+/// `a`'s flags as the library's request of frames.
+pub fn frames_request(a: &ConvertArgs) -> Result<FramesRequest, CliError> {
+    let f = &a.frames;
+    let pix_fmt = |flag: &str, given: &Option<String>| {
+        given
+            .as_deref()
+            .map(|s| crate::choice::parse_flag::<PixFmt>(flag, s))
+            .transpose()
+    };
+    Ok(FramesRequest {
+        convert: super::convert::request(a)?,
+        in_size: f
+            .in_size
+            .as_deref()
+            .map(|s| pipe::parse_size("--in-size", s))
+            .transpose()?,
+        pix_fmt: pix_fmt("--pix-fmt", &f.pix_fmt)?,
+        out_pix_fmt: pix_fmt("--out-pix-fmt", &f.out_pix_fmt)?,
+        shard: f.shard.as_deref().map(shard::Shard::parse).transpose()?,
+        overwrite: f.overwrite,
+        json: f.json,
+    })
 }

@@ -113,7 +113,11 @@ fn say(plan: &Plan, s: String) {
 /// The source, prepared (sanitized unless asked not to), and compressed as `--compress`
 /// says, with its energy report.
 fn read(plan: &Plan) -> Result<(EnvMap, Option<EnergyReport>), CliError> {
-    let mut env = load::read_prepared(&plan.source, &plan.input, plan.quiet)?;
+    let (env, notes) = load::read_prepared(&plan.source, &plan.input)?;
+    if !plan.quiet {
+        notes.iter().for_each(|line| eprintln!("{line}"));
+    }
+    let mut env = env;
     let energy = (plan.compression != Compression::None).then(|| {
         let r = compress(&mut env, plan.compression);
         say(

@@ -50,7 +50,7 @@ pub(super) struct Plan {
 
 impl Plan {
     pub fn new(a: &PrefilterArgs) -> Result<Plan, CliError> {
-        let input = InputPlan::new(&a.input_args)?;
+        let input = crate::commands::input_plan(&a.input_args)?;
         let kind = parse_flag::<LobeKind>("--lobe", &a.lobe)?;
         let to = ProjSpec::parse(&a.to).map_err(|e| bad("--to", e))?;
         let layout = parse_layout("--layout", a.layout.as_deref())?;

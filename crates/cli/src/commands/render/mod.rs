@@ -6,7 +6,7 @@
 //! tone curve, sRGB) or EXR/HDR (linear) `→` diagnostic channels as separate float EXRs
 //! beside the image (`output.rs`).
 
-mod material;
+use mirrorball::materials as material;
 mod output;
 mod plan;
 pub(crate) mod schema;

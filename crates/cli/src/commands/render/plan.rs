@@ -299,7 +299,7 @@ fn flag_pan_blur(a: &RenderArgs) -> Result<Option<f32>, CliError> {
 impl RenderPlan {
     /// The plan of the flags, then of the scene file (if any), checked whole.
     pub fn new(a: &RenderArgs) -> Result<RenderPlan, CliError> {
-        let input = InputPlan::new(&a.input_args)?;
+        let input = crate::commands::input_plan(&a.input_args)?;
         let indexing = parse_mode(&a.mode)?;
         let attach = a
             .attach

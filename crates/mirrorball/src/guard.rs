@@ -5,7 +5,7 @@
 //! `mirrorball_io::check_writable`), and, once the command knows about how many bytes it
 //! writes, its file system has room for them: all before any input is read.
 
-use crate::error::CliError;
+use crate::error::Error;
 use mirrorball_io::Folders;
 use std::path::{Path, PathBuf};
 
@@ -70,16 +70,16 @@ impl Files {
 
     /// Refuses the request when an output is one of the inputs or two outputs are one
     /// file, and refuses an output that cannot be written ([`Files::writable`]).
-    pub fn check(&self) -> Result<(), CliError> {
+    pub fn check(&self) -> Result<(), Error> {
         self.distinct()?;
         self.writable()
     }
 
     /// Refuses an output whose name is a folder, whose folder is missing (beyond what the
     /// command makes) or cannot be written: the message names the output.
-    pub fn writable(&self) -> Result<(), CliError> {
+    pub fn writable(&self) -> Result<(), Error> {
         if let Some((what, name)) = self.names.iter().find(|(_, p)| p.is_dir()) {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "{what} {}: is a folder; give a file name (the files are named from it)",
                 name.display()
             )));
@@ -90,7 +90,7 @@ impl Files {
             let folder = mirrorball_io::output_folder(out);
             if out.is_dir() || seen.insert(folder) {
                 mirrorball_io::check_writable(out, self.folders).map_err(|e| {
-                    CliError::new(
+                    Error::new(
                         e.fault(),
                         format!("{what} {}: {}", e.path().display(), e.problem()),
                     )
@@ -103,7 +103,7 @@ impl Files {
     /// Refuses the job when a file system that would hold outputs has less room than
     /// `bytes`, about what the outputs take in all (each file system is asked for all of
     /// it: outputs are rarely spread over several).
-    pub fn room(&self, bytes: u64) -> Result<(), CliError> {
+    pub fn room(&self, bytes: u64) -> Result<(), Error> {
         let mut seen = std::collections::HashSet::new();
         for (what, out) in &self.outputs {
             if !seen.insert(mirrorball_io::file_system(out)) {
@@ -113,7 +113,7 @@ impl Files {
                 continue;
             };
             if free < bytes {
-                return Err(CliError::system(format!(
+                return Err(Error::system(format!(
                     "{what} {}: the outputs need about {}, but its file system ({}) has {} free; free some space or write elsewhere",
                     out.display(),
                     crate::budget::human(bytes),
@@ -126,11 +126,11 @@ impl Files {
     }
 
     /// No output is an input, no two outputs one file.
-    pub fn distinct(&self) -> Result<(), CliError> {
+    pub fn distinct(&self) -> Result<(), Error> {
         for (what_out, out) in &self.outputs {
             for (what_in, inp) in &self.inputs {
                 if mirrorball_io::same_file(inp, out) {
-                    return Err(CliError::request(format!(
+                    return Err(Error::request(format!(
                         "{}: {what_out} would overwrite {what_in} {} (the same file); choose another name",
                         out.display(),
                         inp.display()
@@ -146,7 +146,7 @@ impl Files {
                     _ => false,
                 } || mirrorball_io::same_file(a, b);
                 if same {
-                    return Err(CliError::request(format!(
+                    return Err(Error::request(format!(
                         "{}: {what_a} and {what_b} ({}) are the same file; give them different names",
                         a.display(),
                         b.display()

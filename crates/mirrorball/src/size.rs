@@ -5,7 +5,7 @@
 //! not fit in memory is refused in the same words once the job's need is known
 //! (`budget::check_size`).
 
-use crate::error::CliError;
+use crate::error::Error;
 use mirrorball_io::{Format, Limits};
 
 /// The values a size may take, and why the largest is the largest.
@@ -30,7 +30,7 @@ impl Bound {
 
     /// `value` when it lies within the bound; otherwise the rule's one message: "--size
     /// -5: outside 1..=16384 (…)".
-    pub fn check(&self, flag: &str, value: i64) -> Result<u32, CliError> {
+    pub fn check(&self, flag: &str, value: i64) -> Result<u32, Error> {
         if value >= self.min as i64 && value <= self.max as i64 {
             return Ok(value as u32);
         }
@@ -38,8 +38,8 @@ impl Bound {
     }
 
     /// The rule's message for `shown`, a value outside the bound as the user gave it.
-    pub fn refusal(&self, flag: &str, shown: &str) -> CliError {
-        CliError::request(format!(
+    pub fn refusal(&self, flag: &str, shown: &str) -> Error {
+        Error::request(format!(
             "{flag} {shown}: outside {}..={} ({})",
             self.min, self.max, self.why
         ))

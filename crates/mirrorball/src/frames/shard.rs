@@ -4,7 +4,7 @@
 //! items is `[i·len/n, (i+1)·len/n)`, so the slices differ in length by at most one and
 //! together hold every item once.
 
-use crate::error::CliError;
+use crate::error::Error;
 use std::ops::Range;
 
 /// A slice of work: `index` of `count`.
@@ -16,8 +16,8 @@ pub struct Shard {
 
 impl Shard {
     /// Parses `I/N`.
-    pub fn parse(s: &str) -> Result<Shard, CliError> {
-        let bad = |why: String| CliError::request(format!("--shard {s}: {why}"));
+    pub fn parse(s: &str) -> Result<Shard, Error> {
+        let bad = |why: String| Error::request(format!("--shard {s}: {why}"));
         let (i, n) = s
             .split_once('/')
             .ok_or_else(|| bad("not I/N (slice I of N, I from 0 to N-1)".into()))?;
@@ -78,7 +78,7 @@ mod tests {
         ] {
             let e = Shard::parse(s).unwrap_err();
             assert!(e.message.contains(says), "{s}: {}", e.message);
-            assert_eq!(e.code(), 2);
+            assert_eq!(e.fault, mirrorball_core::Fault::Request);
         }
     }
 }

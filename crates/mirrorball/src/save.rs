@@ -1,7 +1,7 @@
 //! Writing an environment map: the extension picks the container, the layout packs the
 //! layers, KTX2/DDS cubes get their mip chain.
 
-use crate::error::CliError;
+use crate::error::Error;
 use crate::fit::{self, Report};
 use crate::load::{layer_names, FACE};
 use mirrorball_core::Choice;
@@ -57,7 +57,7 @@ const CONTAINER_FLAGS: &[(&str, TakesFlag)] = &[
 
 /// The output's container, from `out`'s extension: one mirrorball writes (its folder is
 /// `guard::Files`' to check). What the container alone decides, checked before anything is read.
-pub fn check_container(out: &str) -> Result<Format, CliError> {
+pub fn check_container(out: &str) -> Result<Format, Error> {
     let path = Path::new(out);
     let written: Vec<&str> = Format::ALL
         .iter()
@@ -65,13 +65,13 @@ pub fn check_container(out: &str) -> Result<Format, CliError> {
         .map(|f| f.extension())
         .collect();
     let format = Format::from_path(path).ok_or_else(|| {
-        CliError::request(format!(
+        Error::request(format!(
             "{out}: unknown output extension (use {})",
             written.join(" ")
         ))
     })?;
     if !format.is_written() {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{out}: {} is read-only here; write .png",
             format.name()
         )));
@@ -87,7 +87,7 @@ pub fn check_flags(
     format: Format,
     given: &[&str],
     precision: Option<Precision>,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     let container = format!("{} ({})", format.extension(), format.name());
     for (flag, takes) in CONTAINER_FLAGS {
         if given.contains(flag) && !takes(format) {
@@ -96,7 +96,7 @@ pub fn check_flags(
                 .filter(|f| f.is_written() && takes(**f))
                 .map(|f| f.extension())
                 .collect();
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "{out}: {flag} applies to {} outputs, not {container}",
                 which.join(" ")
             )));
@@ -105,7 +105,7 @@ pub fn check_flags(
     match (precision, format.precisions()) {
         (Some(p), takes) if !takes.contains(&p) => {
             let takes: Vec<&str> = takes.iter().map(|p| p.name()).collect();
-            Err(CliError::request(format!(
+            Err(Error::request(format!(
                 "{out}: --precision {} does not apply to {container}, which {}",
                 p.name(),
                 match takes.len() {
@@ -119,16 +119,16 @@ pub fn check_flags(
 }
 
 /// Checks that `out` can hold a map of `kind` before any work starts.
-pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<Format, CliError> {
+pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<Format, Error> {
     let format = check_container(out)?;
     if format.is_cube_container() && kind != ProjectionKind::Cube {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{out}: KTX2 and DDS files are sampled by GPUs as OpenGL/Direct3D cube maps, so they hold --to cube only (not {kind})"
         )));
     }
     let layers = kind.default_projection().layer_count();
     if out.contains(FACE) && (layers == 1 || format.is_cube_container()) {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{out}: {FACE} in the name writes one file per layer, but {}",
             if layers == 1 {
                 format!("a {kind} map has one layer; leave {FACE} out")
@@ -139,13 +139,13 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
     }
     if let Some(l) = layout {
         if !l.fits(layers) {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "--layout {l} needs six faces; a {kind} map has {}",
                 mirrorball_core::count(layers as u64, "layer")
             )));
         }
         if l != Layout::Separate && out.contains(FACE) {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "{out}: {FACE} in the name writes one file per layer, which --layout {l} does not"
             )));
         }
@@ -156,7 +156,7 @@ pub fn check(out: &str, kind: ProjectionKind, layout: Option<Layout>) -> Result<
 /// The folder of `out` made when missing (`Folders::MakeOne` checked it can be): the
 /// folder, when this call made it, marked so that an interrupt removes it again if it is
 /// left empty (`mirrorball_io::made_folder`).
-pub fn make_folder(out: &Path) -> Result<Option<PathBuf>, CliError> {
+pub fn make_folder(out: &Path) -> Result<Option<PathBuf>, Error> {
     let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) else {
         return Ok(None);
     };
@@ -167,7 +167,7 @@ pub fn make_folder(out: &Path) -> Result<Option<PathBuf>, CliError> {
         }
         // Made meanwhile (another shard), or there already.
         Err(_) if dir.is_dir() => Ok(None),
-        Err(e) => Err(CliError::system(format!(
+        Err(e) => Err(Error::system(format!(
             "{}: cannot make the folder: {e}",
             dir.display()
         ))),
@@ -313,7 +313,7 @@ pub fn per_part_path(out: &str, placeholder: &str, part: &str) -> PathBuf {
 }
 
 /// Writes `env` to `out`; returns the files written and what they could not hold.
-pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Saved, CliError> {
+pub fn save(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<Saved, Error> {
     save_eyes(std::slice::from_ref(env), Stereo::Mono, out, opts)
 }
 
@@ -324,18 +324,18 @@ pub fn check_stereo(
     layers: usize,
     stereo: Stereo,
     opts: &SaveOptions,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     if stereo == Stereo::Mono {
         return Ok(());
     }
     let format = Format::from_path(Path::new(out));
     if format.is_some_and(Format::is_cube_container) {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{out}: --stereo {stereo} packs both eyes into one picture, which a KTX2 or DDS cube cannot hold; write .exr .hdr .png or .jpg"
         )));
     }
     if layer_files(out, layers, opts).is_some() {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{out}: --stereo {stereo} packs both eyes into one picture, not one file a layer; give a packed --layout (hcross, c3x2, hstrip, …) and no {FACE}"
         )));
     }
@@ -344,20 +344,20 @@ pub fn check_stereo(
 
 /// The picture of `eyes` (one per eye of `stereo`, each of one projection and size): each
 /// eye packed in `layout`, the eyes joined as `stereo` arranges them.
-pub fn pack_eyes(eyes: &[EnvMap], stereo: Stereo, layout: Layout) -> Result<Image, CliError> {
+pub fn pack_eyes(eyes: &[EnvMap], stereo: Stereo, layout: Layout) -> Result<Image, Error> {
     let n = eyes[0].layers().len();
     let pictures = eyes
         .iter()
         .map(|e| layout.pack(e))
         .collect::<Option<Vec<Image>>>()
         .ok_or_else(|| {
-            CliError::request(format!(
+            Error::request(format!(
                 "layout {layout} does not fit a map of {}",
                 mirrorball_core::count(n as u64, "layer")
             ))
         })?;
     stereo.join(pictures).ok_or_else(|| {
-        CliError::request(format!(
+        Error::request(format!(
             "a {stereo} picture needs {} eye(s) of one size",
             stereo.eyes()
         ))
@@ -372,7 +372,7 @@ pub fn save_eyes(
     stereo: Stereo,
     out: &str,
     opts: &SaveOptions,
-) -> Result<Saved, CliError> {
+) -> Result<Saved, Error> {
     let env = &eyes[0];
     let path = Path::new(out);
     let format = check(out, env.projection().kind(), opts.layout)?;

@@ -3,7 +3,7 @@
 //! (`mirrorball:projection`, `mirrorball:layout`), else what OpenEXR's `envmap` tag says (in
 //! OpenEXR's conventions), else guessed from the picture's shape.
 
-use crate::error::CliError;
+use crate::error::Error;
 use crate::spec::ProjSpec;
 use mirrorball_core::{
     guess, CubeMap, EnvMap, Image, LatLong, Layout, Projection, ProjectionKind, Stereo,
@@ -12,6 +12,19 @@ use mirrorball_core::{
 use mirrorball_io::{openexr, Format, Limits, Loaded};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+
+/// How to read an input: its projection and layout when the caller knows them (else they
+/// are read from the file or guessed), and whether NaN, infinite and negative values are
+/// kept (else set to 0 and counted).
+#[derive(Clone, Debug, Default)]
+pub struct InputPlan {
+    /// The projection, `NAME[:key=value…]` parsed; `None`: recorded in the file or guessed.
+    pub from: Option<ProjSpec>,
+    /// The layout of the layers in the picture; `None`: recorded or guessed.
+    pub layout: Option<mirrorball_core::Layout>,
+    /// Keep NaN, infinite and negative values.
+    pub keep_invalid: bool,
+}
 
 /// The placeholder for per-layer file names.
 pub const FACE: &str = "{face}";
@@ -88,21 +101,13 @@ pub fn zero_invalid<'a>(
     })
 }
 
-/// Reads `input` as `plan` says and prepares it ([`Source::prepare`]), saying what was read
-/// and decided unless `quiet`: the first steps of `prefilter` and `bake`.
-pub fn read_prepared(
-    input: &str,
-    plan: &crate::commands::InputPlan,
-    quiet: bool,
-) -> Result<EnvMap, CliError> {
+/// Reads `input` as `plan` says and prepares it ([`Source::prepare`]): the map, and the
+/// lines saying what was read and decided (the first steps of `prefilter` and `bake`).
+pub fn read_prepared(input: &str, plan: &InputPlan) -> Result<(EnvMap, Vec<String>), Error> {
     let limits = Limits::default();
     let mut src = load(input, plan.from.as_ref(), plan.layout, &limits)?;
-    for line in src.prepare(input, plan.keep_invalid) {
-        if !quiet {
-            eprintln!("{line}");
-        }
-    }
-    Ok(src.env)
+    let notes = src.prepare(input, plan.keep_invalid);
+    Ok((src.env, notes))
 }
 
 /// Reads `input`: one file, or one per layer when the name holds `{face}`.
@@ -111,7 +116,7 @@ pub fn load(
     from: Option<&ProjSpec>,
     layout: Option<Layout>,
     limits: &Limits,
-) -> Result<Source, CliError> {
+) -> Result<Source, Error> {
     load_eyes(input, from, layout, (None, Stereo::Mono), limits)
 }
 
@@ -127,9 +132,9 @@ pub fn load_eyes(
     layout: Option<Layout>,
     (asked, output): (Option<Stereo>, Stereo),
     limits: &Limits,
-) -> Result<Source, CliError> {
+) -> Result<Source, Error> {
     let one_picture = |stereo: Stereo, what: &str| {
-        CliError::request(format!(
+        Error::request(format!(
             "{input}: --in-stereo {stereo} splits one picture into eyes, but {what}"
         ))
     };
@@ -154,7 +159,7 @@ pub fn load_eyes(
     // when nothing else says the projection.
     let recorded = match recorded {
         Some(Err(e)) if from.is_none() => {
-            return Err(CliError::input(format!(
+            return Err(Error::input(format!(
                 "{input}: {e}; say the projection with --from"
             )))
         }
@@ -186,7 +191,7 @@ pub fn load_eyes(
             _ => multi_layer(from)?,
         };
         if proj.layer_count() != 6 {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "{input}: holds six cube faces, which cannot be read as {}",
                 spec.kind
             )));
@@ -199,8 +204,7 @@ pub fn load_eyes(
                 records_other(&proj)
             ),
         };
-        let env =
-            EnvMap::new(proj, layers).map_err(|e| CliError::input(format!("{input}: {e}")))?;
+        let env = EnvMap::new(proj, layers).map_err(|e| Error::input(format!("{input}: {e}")))?;
         return Ok(Source {
             env,
             description,
@@ -213,7 +217,7 @@ pub fn load_eyes(
     let image = layers
         .into_iter()
         .next()
-        .ok_or_else(|| CliError::input(format!("{input}: no image")))?;
+        .ok_or_else(|| Error::input(format!("{input}: no image")))?;
     // OpenEXR's `envmap` tag, when it alone says the projection: its pictures follow
     // OpenEXR's conventions (ImfEnvmap), turned into mirrorball's here.
     let tagged = stereo == Stereo::Mono
@@ -224,7 +228,7 @@ pub fn load_eyes(
     match declared.filter(|_| tagged) {
         Some(ProjectionKind::LatLong) => {
             let env = EnvMap::new(LatLong.into(), vec![openexr::latlong_to_mirrorball(&image)])
-                .map_err(|e| CliError::input(format!("{input}: {e}")))?;
+                .map_err(|e| Error::input(format!("{input}: {e}")))?;
             return Ok(Source {
                 env,
                 description,
@@ -236,9 +240,9 @@ pub fn load_eyes(
         }
         Some(ProjectionKind::Cube) => {
             let faces = openexr::cube_to_faces(&image)
-                .map_err(|e| CliError::input(format!("{input}: {e}")))?;
+                .map_err(|e| Error::input(format!("{input}: {e}")))?;
             let env = EnvMap::new(CubeMap.into(), faces)
-                .map_err(|e| CliError::input(format!("{input}: {e}")))?;
+                .map_err(|e| Error::input(format!("{input}: {e}")))?;
             return Ok(Source {
                 env,
                 description,
@@ -283,11 +287,11 @@ pub fn interpret_eyes(
     recorded: Option<mirrorball_io::MapInfo>,
     declared: Option<ProjectionKind>,
     records_other: impl Fn(&Projection) -> String,
-) -> Result<(EnvMap, Option<EnvMap>, String), CliError> {
+) -> Result<(EnvMap, Option<EnvMap>, String), Error> {
     let (w, h) = (image.width(), image.height());
     let mut pictures = stereo
         .split(image, eyes)
-        .map_err(|e| CliError::request(format!("{input}: --in-stereo {stereo}: {e}")))?
+        .map_err(|e| Error::request(format!("{input}: --in-stereo {stereo}: {e}")))?
         .into_iter();
     let left = pictures.next().expect("a picture has an eye");
     let (env, decided) = interpret(
@@ -335,7 +339,7 @@ pub fn interpret(
     recorded: Option<mirrorball_io::MapInfo>,
     declared: Option<ProjectionKind>,
     records_other: impl Fn(&Projection) -> String,
-) -> Result<(EnvMap, String), CliError> {
+) -> Result<(EnvMap, String), Error> {
     let (w, h) = (image.width(), image.height());
     let (proj, layout, decided) = match (from, layout, recorded) {
         (Some(spec), Some(l), _) => {
@@ -373,7 +377,7 @@ pub fn interpret(
         }
         (None, _, None) => {
             let g = guess(w, h, declared).ok_or_else(|| {
-                CliError::input(format!(
+                Error::input(format!(
                     "{input}: cannot tell the projection of a {w}x{h} picture (2:1 is lat-long, 4:3, 3:4, 6:1 and 1:6 are cube layouts, 1:1 a sphere map); say it with --from"
                 ))
             })?;
@@ -391,7 +395,7 @@ pub fn interpret(
         }
     };
     if layout == Layout::Separate && proj.layer_count() > 1 {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{input}: a {} map has {} layers; give one file per layer with {FACE} in the name, or a packed layout",
             proj.kind(),
             proj.layer_count()
@@ -400,18 +404,18 @@ pub fn interpret(
     check_shape(input, &proj, w, h, layout)?;
     let env = layout
         .unpack_owned(image, proj)
-        .map_err(|e| CliError::input(format!("{input}: {e}")))?;
+        .map_err(|e| Error::input(format!("{input}: {e}")))?;
     Ok((env, decided))
 }
 
 /// The projection `spec` names, for a `w`×`h` picture.
-fn build_from(spec: &ProjSpec, w: u32, h: u32) -> Result<Projection, CliError> {
+fn build_from(spec: &ProjSpec, w: u32, h: u32) -> Result<Projection, Error> {
     spec.build(Some((w, h)))
-        .map_err(|e| CliError::request(format!("--from: {e}")))
+        .map_err(|e| Error::request(format!("--from: {e}")))
 }
 
-fn no_layout(input: &str, w: u32, h: u32, kind: ProjectionKind) -> CliError {
-    CliError::input(format!(
+fn no_layout(input: &str, w: u32, h: u32, kind: ProjectionKind) -> Error {
+    Error::input(format!(
         "{input}: a {w}x{h} picture fits no layout of a {kind} map (six square faces: 4:3 or 3:4 cross, 6:1 or 1:6 strip; two halves: 2:1 or 1:2)"
     ))
 }
@@ -423,14 +427,14 @@ fn check_shape(
     w: u32,
     h: u32,
     layout: Layout,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     if layout != Layout::Separate || proj.layer_count() != 1 {
         return Ok(());
     }
     let (ew, eh) = proj.layer_extent(w);
     let ratio_err = ((h as f64) - (eh as f64)).abs() / eh as f64;
     if proj.kind() != ProjectionKind::Mercator && ratio_err > 0.01 {
-        return Err(CliError::input(format!(
+        return Err(Error::input(format!(
             "{input}: a {} map is {}:{} ({ew}x{eh} for this width) but the picture is {w}x{h}; use --from to read it as another projection",
             proj.name(),
             ew / gcd(ew, eh),
@@ -449,13 +453,13 @@ fn gcd(a: u32, b: u32) -> u32 {
 }
 
 /// The projection of a multi-layer input: as asked, or a cube.
-fn multi_layer(from: Option<&ProjSpec>) -> Result<(ProjSpec, Projection), CliError> {
+fn multi_layer(from: Option<&ProjSpec>) -> Result<(ProjSpec, Projection), Error> {
     let spec = from
         .cloned()
         .unwrap_or_else(|| ProjSpec::of(ProjectionKind::Cube));
     let proj = spec
         .build(None)
-        .map_err(|e| CliError::request(format!("--from: {e}")))?;
+        .map_err(|e| Error::request(format!("--from: {e}")))?;
     Ok((spec, proj))
 }
 
@@ -463,7 +467,7 @@ fn multi_layer(from: Option<&ProjSpec>) -> Result<(ProjSpec, Projection), CliErr
 ///
 /// Without `--from`: the projection the files record (each face file mirrorball writes
 /// records it), else a cube, or a dual paraboloid when only `front`/`back` files exist.
-fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<Source, CliError> {
+fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<Source, Error> {
     let guessed = from.is_none()
         && !Path::new(&input.replace(FACE, "px")).exists()
         && Path::new(&input.replace(FACE, "front")).exists();
@@ -471,14 +475,14 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
         let spec = ProjSpec::of(ProjectionKind::Paraboloid);
         let proj = spec
             .build(None)
-            .map_err(|e| CliError::request(format!("--from: {e}")))?;
+            .map_err(|e| Error::request(format!("--from: {e}")))?;
         (spec, proj)
     } else {
         multi_layer(from)?
     };
     let names = layer_names(proj.layer_count());
     if names.len() < 2 {
-        return Err(CliError::request(format!("{input}: {FACE} files need a projection with several layers (cube, continuous-cube, paraboloid), not {}", spec.kind)));
+        return Err(Error::request(format!("{input}: {FACE} files need a projection with several layers (cube, continuous-cube, paraboloid), not {}", spec.kind)));
     }
     let paths: Vec<PathBuf> = names
         .iter()
@@ -526,9 +530,9 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
             .layers
             .into_iter()
             .next()
-            .ok_or_else(|| CliError::input(format!("{}: no image", p.display())))?;
+            .ok_or_else(|| Error::input(format!("{}: no image", p.display())))?;
         if img.width() != img.height() {
-            return Err(CliError::input(format!(
+            return Err(Error::input(format!(
                 "{}: a face must be square, this one is {}x{}",
                 p.display(),
                 img.width(),
@@ -539,7 +543,7 @@ fn load_layers(input: &str, from: Option<&ProjSpec>, limits: &Limits) -> Result<
     }
     let c = layers.iter().map(|l| l.channels()).max().unwrap_or(3);
     let layers: Vec<Image> = layers.iter().map(|l| l.with_channels(c)).collect();
-    let env = EnvMap::new(proj, layers).map_err(|e| CliError::input(format!("{input}: {e}")))?;
+    let env = EnvMap::new(proj, layers).map_err(|e| Error::input(format!("{input}: {e}")))?;
     Ok(Source {
         env,
         description: format!("{} files", names.len()),

@@ -14,11 +14,10 @@ use super::pipe::{self, PixFmt};
 use super::pipeline::{self, Eyes, Meta, FRAMES_IN_FLIGHT};
 use super::record::{self, Verdict};
 use super::shard::Shard;
-use crate::commands::convert::{times, Plan};
-use crate::error::CliError;
-use crate::progress::with_progress;
-use crate::spec::bad;
-use crate::{budget, load, save, ConvertArgs};
+use crate::convert::{times, ConvertPlan as Plan, ConvertRequest};
+use crate::error::Error;
+use crate::hooks::Hooks;
+use crate::{budget, load, save};
 use mirrorball_core::{
     EnvMap, Image, Layout, Projection, Remap, RemapRows, Stereo, WorldProjection,
 };
@@ -27,6 +26,26 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
+
+/// A conversion of many frames (a pattern of files, or raw frames through `-`), as plain
+/// values.
+#[derive(Clone, Debug, Default)]
+pub struct FramesRequest {
+    /// Each frame's conversion: `input` and `output` are patterns (`%05d`, a glob) or `-`.
+    pub convert: ConvertRequest,
+    /// The size of raw frames on standard input (the whole picture, both eyes of a pair).
+    pub in_size: Option<(u32, u32)>,
+    /// The pixel format of raw frames through `-`.
+    pub pix_fmt: Option<PixFmt>,
+    /// The pixel format of the frames written to standard output, when not `pix_fmt`.
+    pub out_pix_fmt: Option<PixFmt>,
+    /// Only this slice of the frames.
+    pub shard: Option<Shard>,
+    /// Convert frames whose outputs exist again.
+    pub overwrite: bool,
+    /// One JSON line per frame.
+    pub json: bool,
+}
 
 /// Where frames come from.
 enum Input {
@@ -44,12 +63,6 @@ enum Output {
     Pipe(PixFmt),
 }
 
-fn pix_fmt(flag: &str, given: Option<&str>) -> Result<Option<PixFmt>, CliError> {
-    given
-        .map(|s| crate::choice::parse_flag(flag, s))
-        .transpose()
-}
-
 /// `path`'s folder resolved, joined with its name: how two names of one file are told
 /// apart across a sequence without a system call per pair.
 fn resolved(path: &Path, dirs: &mut std::collections::HashMap<PathBuf, PathBuf>) -> PathBuf {
@@ -64,13 +77,14 @@ fn resolved(path: &Path, dirs: &mut std::collections::HashMap<PathBuf, PathBuf>)
     real.join(path.file_name().unwrap_or_default())
 }
 
-pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
-    let f = &a.frames;
-    let shard = f.shard.as_deref().map(Shard::parse).transpose()?;
-    let in_fmt = pix_fmt("--pix-fmt", f.pix_fmt.as_deref())?;
-    let out_fmt = pix_fmt("--out-pix-fmt", f.out_pix_fmt.as_deref())?.or(in_fmt);
+/// Converts the frames `r` names, saying what it does through `hooks`.
+pub fn run(r: &FramesRequest, hooks: &dyn Hooks) -> Result<(), Error> {
+    let a = &r.convert;
+    let shard = r.shard;
+    let in_fmt = r.pix_fmt;
+    let out_fmt = r.out_pix_fmt.or(in_fmt);
     if a.input == a.output && a.input != "-" {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{}: the output pattern is the input pattern, so each frame would overwrite itself; choose another name or folder",
             a.output
         )));
@@ -79,25 +93,23 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
     let mut empty_slice = None;
     let input = if a.input == "-" {
         if shard.is_some() {
-            return Err(CliError::request(
+            return Err(Error::request(
                 "--shard slices frames from files; standard input (-) is one stream, so give each machine its own stream instead",
             ));
         }
-        let (Some(size), Some(fmt)) = (f.in_size.as_deref(), in_fmt) else {
-            return Err(CliError::request(
+        let (Some((w, h)), Some(fmt)) = (r.in_size, in_fmt) else {
+            return Err(Error::request(
                 "input -: raw frames need --in-size WIDTHxHEIGHT and --pix-fmt (rgb24, rgb48le, rgbf32le, gbrpf32le)",
             ));
         };
-        let (w, h) = pipe::parse_size("--in-size", size)?;
-        if let Some(s) = a.in_stereo.as_deref() {
-            crate::choice::parse_flag::<Stereo>("--in-stereo", s)?
-                .eye_extent(w, h)
-                .map_err(|e| CliError::request(format!("--in-size {size}: {e}")))?;
+        if let Some(s) = a.in_stereo {
+            s.eye_extent(w, h)
+                .map_err(|e| Error::request(format!("--in-size {w}x{h}: {e}")))?;
         }
         Input::Pipe { w, h, fmt }
     } else {
-        if f.in_size.is_some() {
-            return Err(CliError::request(format!(
+        if r.in_size.is_some() {
+            return Err(Error::request(format!(
                 "--in-size is the size of raw frames on standard input; {} is read from files, which say their size",
                 a.input
             )));
@@ -120,10 +132,10 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
     };
     let output = if a.output == "-" {
         let fmt = out_fmt.ok_or_else(|| {
-            CliError::request("output -: raw frames need --pix-fmt (or --out-pix-fmt): rgb24, rgb48le, rgbf32le, gbrpf32le")
+            Error::request("output -: raw frames need --pix-fmt (or --out-pix-fmt): rgb24, rgb48le, rgbf32le, gbrpf32le")
         })?;
         if a.precision.is_some() || a.mips || a.compression.is_some() {
-            return Err(CliError::request(
+            return Err(Error::request(
                 "output -: raw frames carry --pix-fmt's precision, no mips and no compression; leave out --precision, --mips and --compression",
             ));
         }
@@ -136,7 +148,7 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
                     Output::File(a.output.clone())
                 }
                 _ => {
-                    return Err(CliError::request(format!(
+                    return Err(Error::request(format!(
                         "{}: many frames need an output pattern with %d or %0Nd (out/%05d.exr), or - for standard output",
                         a.output
                     )))
@@ -168,28 +180,29 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         plan.resample.rotation = plan.resample.rotation.then(plan.orient.rotation());
         plan.orient = mirrorball_core::AxisMap::IDENTITY;
     }
-    let dst: Projection = plan.to.build(None).map_err(|e| bad("--to", e))?;
+    let dst: Projection = plan
+        .to
+        .build(None)
+        .map_err(|e| crate::spec::bad("--to", e))?;
     if matches!(output, Output::Pipe(_))
         && dst.layer_count() > 1
         && plan.save.layout == Some(Layout::Separate)
     {
-        return Err(CliError::request(
+        return Err(Error::request(
             "output -: a raw frame is one picture; give a packed --layout (hcross, vcross, hstrip, vstrip)",
         ));
     }
-    if let Some((at, len)) = empty_slice {
-        if !a.quiet {
-            eprintln!(
-                "--shard {}: frames {at}..{at} of {len}: this slice is empty, nothing to do",
-                f.shard.as_deref().unwrap_or_default()
-            );
-        }
+    if let (Some((at, len)), Some(s)) = (empty_slice, shard) {
+        hooks.note(&format!(
+            "--shard {}/{}: frames {at}..{at} of {len}: this slice is empty, nothing to do",
+            s.index, s.count
+        ));
         return Ok(());
     }
 
     // Frames from files: outputs named, checked against every input, and those done already.
     let log = Log {
-        on: f.json,
+        on: r.json,
         to_stderr: matches!(output, Output::Pipe(_)),
     };
     let outputs_of = |path: &Path| -> Vec<PathBuf> {
@@ -197,7 +210,7 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         save::layer_files(&s, dst.layer_count(), &plan.save)
             .unwrap_or_else(|| vec![path.to_path_buf()])
     };
-    let settings = record::settings(a);
+    let settings = record::settings(r);
     let mut made = record::Made::default();
     let (mut skipped, mut unknown, mut again) = (0u64, 0u64, 0u64);
     let input = match input {
@@ -218,13 +231,13 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
                     .iter()
                     .find(|o| inputs.contains(&resolved(o, &mut dirs)))
                 {
-                    return Err(CliError::request(format!(
+                    return Err(Error::request(format!(
                         "{}: frame {}'s output would overwrite an input frame; choose another name or folder",
                         o.display(),
                         fr.number
                     )));
                 }
-                if !f.overwrite && !outs.is_empty() && outs.iter().all(|o| o.exists()) {
+                if !r.overwrite && !outs.is_empty() && outs.iter().all(|o| o.exists()) {
                     let verdict = made.verdict(&outs[0], record::stamp(&settings, &fr.path));
                     if verdict == Verdict::Other {
                         again += 1;
@@ -242,10 +255,8 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
                 }
                 todo.push(fr);
             }
-            if !a.quiet {
-                for line in record::kept_lines("frame", skipped, unknown, again) {
-                    eprintln!("{line}");
-                }
+            for line in record::kept_lines("frame", skipped, unknown, again) {
+                hooks.note(&line);
             }
             if todo.is_empty() {
                 return Ok(());
@@ -259,7 +270,7 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
         Output::File(s) => MadeFolder::for_output(Path::new(s))?,
         Output::Pipe(_) => MadeFolder(None),
     };
-    convert_frames(a, &plan, dst, input, output, log, skipped)
+    convert_frames(r, hooks, &plan, dst, input, output, log, skipped)
 }
 
 /// The output folder, made for the frames when missing (`save::make_folder`); removed again
@@ -267,7 +278,7 @@ pub fn run(a: &ConvertArgs) -> Result<(), CliError> {
 struct MadeFolder(Option<PathBuf>);
 
 impl MadeFolder {
-    fn for_output(out: &Path) -> Result<MadeFolder, CliError> {
+    fn for_output(out: &Path) -> Result<MadeFolder, Error> {
         save::make_folder(out).map(MadeFolder)
     }
 }
@@ -283,7 +294,7 @@ impl Drop for MadeFolder {
 
 /// Reads frames one after another.
 struct Reader<'a> {
-    a: &'a ConvertArgs,
+    hooks: &'a dyn Hooks,
     plan: &'a Plan,
     input: Input,
     /// Files: the next frame's position; pipe: frames read.
@@ -300,7 +311,7 @@ struct Reader<'a> {
 impl Reader<'_> {
     /// The next raw frame's bytes as they came, into `spare` where one came back: for a
     /// converter that reads them as codes (`PixFmt::codes`). A pipe's only.
-    fn next_codes(&mut self, spare: Option<Vec<u8>>) -> Option<Result<(Meta, Vec<u8>), CliError>> {
+    fn next_codes(&mut self, spare: Option<Vec<u8>>) -> Option<Result<(Meta, Vec<u8>), Error>> {
         let Input::Pipe { w, h, fmt } = self.input else {
             unreachable!("codes are read from a pipe");
         };
@@ -317,7 +328,7 @@ impl Reader<'_> {
         }
     }
 
-    fn next(&mut self, spare: Option<Eyes>) -> Option<Result<(Meta, Eyes), CliError>> {
+    fn next(&mut self, spare: Option<Eyes>) -> Option<Result<(Meta, Eyes), Error>> {
         match &self.input {
             Input::Files(frames) => {
                 let fr = frames.get(self.at)?.clone();
@@ -340,7 +351,7 @@ impl Reader<'_> {
         }
     }
 
-    fn read_file(&mut self, fr: &Frame) -> Result<(Meta, Eyes), CliError> {
+    fn read_file(&mut self, fr: &Frame) -> Result<(Meta, Eyes), Error> {
         let name = fr.path.to_string_lossy().into_owned();
         let mut src = load::load_eyes(
             &name,
@@ -351,14 +362,12 @@ impl Reader<'_> {
         )?;
         self.stereo.get_or_insert(src.stereo);
         let lines = src.prepare(&name, self.plan.input.keep_invalid);
-        if !self.a.quiet {
-            // What was decided, for the first frame; warnings for every frame.
-            lines
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| self.at == 1 || *i > 0)
-                .for_each(|(_, l)| eprintln!("{l}"));
-        }
+        // What was decided, for the first frame; warnings for every frame.
+        lines
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| self.at == 1 || *i > 0)
+            .for_each(|(_, l)| self.hooks.note(l));
         Ok((
             meta(fr.number, name),
             std::iter::once(src.env).chain(src.right).collect(),
@@ -372,7 +381,7 @@ impl Reader<'_> {
         h: u32,
         fmt: PixFmt,
         spare: Option<Eyes>,
-    ) -> Result<(Meta, Eyes), CliError> {
+    ) -> Result<(Meta, Eyes), Error> {
         let name = format!("frame {n} of standard input");
         let stereo = self.plan.in_stereo.unwrap_or_default();
         self.stereo = Some(stereo);
@@ -389,14 +398,14 @@ impl Reader<'_> {
         let mut eyes = match self.decided {
             Some((proj, layout)) => stereo
                 .split(img, reads)
-                .map_err(|e| CliError::request(format!("{name}: {e}")))?
+                .map_err(|e| Error::request(format!("{name}: {e}")))?
                 .into_iter()
                 .map(|eye| {
                     layout
                         .unpack_owned(eye, proj)
-                        .map_err(|e| CliError::input(format!("{name}: {e}")))
+                        .map_err(|e| Error::input(format!("{name}: {e}")))
                 })
-                .collect::<Result<Eyes, CliError>>()?,
+                .collect::<Result<Eyes, Error>>()?,
             None => {
                 let (left, right, decided) = load::interpret_eyes(
                     "-",
@@ -414,21 +423,17 @@ impl Reader<'_> {
                         .map(|l| l.0)
                         .unwrap_or(Layout::Separate),
                 };
-                if !self.a.quiet {
-                    eprintln!(
-                        "reading {w}x{h} {fmt} frames from standard input: {} — {decided}",
-                        left.projection().name()
-                    );
-                }
+                self.hooks.note(&format!(
+                    "reading {w}x{h} {fmt} frames from standard input: {} — {decided}",
+                    left.projection().name()
+                ));
                 self.decided = Some((*left.projection(), layout));
                 std::iter::once(left).chain(right).collect()
             }
         };
         let keep = self.plan.input.keep_invalid;
         if let Some(warning) = load::zero_invalid(&name, &mut eyes, invalid, keep) {
-            if !self.a.quiet {
-                eprintln!("{warning}");
-            }
+            self.hooks.note(&warning);
         }
         Ok((meta(n, name), eyes))
     }
@@ -549,13 +554,13 @@ fn source_rows<'a>(
     (w, h, fmt): (u32, u32, PixFmt),
     m: &Meta,
     src: &'a Source,
-) -> Result<mirrorball_core::RemapRows<'a>, CliError> {
+) -> Result<mirrorball_core::RemapRows<'a>, Error> {
     match src {
         Source::Maps(eyes) => remap.rows(&eyes[0]),
         Source::Codes(c) => {
-            let codes = fmt.codes(c, w, h).ok_or_else(|| {
-                CliError::input(format!("{}: not one {w}x{h} {fmt} frame", m.input))
-            })?;
+            let codes = fmt
+                .codes(c, w, h)
+                .ok_or_else(|| Error::input(format!("{}: not one {w}x{h} {fmt} frame", m.input)))?;
             remap.rows_coded(codes)
         }
     }
@@ -574,21 +579,23 @@ fn meta(number: u64, input: String) -> Meta {
     Meta { number, input }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn convert_frames(
-    a: &ConvertArgs,
+    r: &FramesRequest,
+    hooks: &dyn Hooks,
     plan: &Plan,
     dst: Projection,
     input: Input,
     output: Output,
     log: Log,
     skipped: u64,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     let total = match &input {
         Input::Files(fr) => fr.len() as u64,
         Input::Pipe { .. } => 0,
     };
     let mut reader = Reader {
-        a,
+        hooks,
         plan,
         input,
         at: 0,
@@ -620,9 +627,7 @@ fn convert_frames(
         (first, early.and_then(|e| e.join().ok().flatten()))
     });
     let Some(first) = first else {
-        return Err(CliError::input(
-            "standard input ended before the first frame",
-        ));
+        return Err(Error::input("standard input ended before the first frame"));
     };
     let (meta0, eyes0) = first?;
     let from = reader.stereo.unwrap_or_default();
@@ -676,14 +681,14 @@ fn convert_frames(
         FRAMES_IN_FLIGHT * (source + made) + remap.memory_bytes() as u64 + written,
         "a smaller --size",
     )?;
-    if let (Some((layout, _, fmt)), false) = (&packed, a.quiet) {
+    if let Some((layout, _, fmt)) = &packed {
         let (pw, ph) = if *layout == Layout::Separate {
             (w, h)
         } else {
             layout.extent(dst.layer_count(), w, h)
         };
         let (pw, ph) = plan.stereo.extent(pw, ph);
-        eprintln!(
+        hooks.note(&format!(
             "writing {pw}x{ph} {fmt} frames to standard output: {} {w}x{h}{} ({layout}{})",
             dst.name(),
             times(dst.layer_count()),
@@ -691,7 +696,7 @@ fn convert_frames(
                 Stereo::Mono => String::new(),
                 s => format!(", each eye of a {s} pair"),
             }
-        );
+        ));
     }
     // A raw frame of integer codes that is the source's one layer as it is (no eyes to
     // split, no layout to unpack, no lens overlap to blend) is read by the plan as it came:
@@ -717,7 +722,7 @@ fn convert_frames(
             None => packing.encode_rows(fmt, rows, bytes),
         };
     let t_plan = t0.elapsed();
-    let settings = record::settings(a);
+    let settings = record::settings(r);
 
     let fresh = || -> Eyes {
         (0..plan.stereo.eyes())
@@ -740,7 +745,7 @@ fn convert_frames(
         );
     };
     let mut bytes = Vec::new();
-    let mut put = |m: &Meta, eyes: &Eyes| -> Result<(), CliError> {
+    let mut put = |m: &Meta, eyes: &Eyes| -> Result<(), Error> {
         let t = Instant::now();
         let out: String = match (&output, &packed) {
             (Output::Pipe(_), Some((layout, packing, fmt))) => {
@@ -758,17 +763,20 @@ fn convert_frames(
                 "-".into()
             }
             (Output::Files(p), _) => {
-                save_frame(eyes, &p.path(m.number), plan, &m.input, &settings)?
+                save_frame(eyes, &p.path(m.number), (plan, hooks), &m.input, &settings)?
             }
-            (Output::File(s), _) => save_frame(eyes, Path::new(s), plan, &m.input, &settings)?,
+            (Output::File(s), _) => {
+                save_frame(eyes, Path::new(s), (plan, hooks), &m.input, &settings)?
+            }
             _ => unreachable!("a pipe has its format"),
         };
         logged(m, out, t);
         Ok(())
     };
     let t1 = Instant::now();
-    let done = with_progress("frames", total, a.quiet, |counter| {
-        let done = AtomicU64::new(0);
+    let mut done = None;
+    hooks.progress("frames", total, &mut |counter| {
+        let counted = AtomicU64::new(0);
         let mut next = |spare: Option<Eyes>| first.take().map(Ok).or_else(|| reader.next(spare));
         let mut put_bytes = |m: &Meta, bytes: &Vec<u8>| {
             let t = Instant::now();
@@ -805,7 +813,7 @@ fn convert_frames(
                     },
                     &Vec::new,
                     &mut put_bytes,
-                    &done,
+                    &counted,
                 )
             }
             // Rows made and encoded together: no float copy of the output frame.
@@ -818,7 +826,7 @@ fn convert_frames(
                 },
                 &Vec::new,
                 &mut put_bytes,
-                &done,
+                &counted,
             ),
             _ => pipeline::run(
                 &mut next,
@@ -831,15 +839,15 @@ fn convert_frames(
                     counter.fetch_add(1, Ordering::Relaxed);
                     Ok(())
                 },
-                &done,
+                &counted,
             ),
         };
-        (r, done.load(Ordering::Relaxed))
+        done = Some((r, counted.load(Ordering::Relaxed)));
     });
-    let (result, n) = done;
+    let (result, n) = done.expect("the work ran");
     let secs = t1.elapsed().as_secs_f64();
-    if !a.quiet {
-        eprintln!(
+    {
+        hooks.note(&format!(
             "{} to {} {w}x{h}{} in {secs:.2}s ({:.2} frames/s; planned in {:.2}s){}",
             mirrorball_core::count(n, "frame"),
             dst.name(),
@@ -851,7 +859,7 @@ fn convert_frames(
             } else {
                 String::new()
             }
-        );
+        ));
     }
     result
 }
@@ -861,13 +869,15 @@ fn convert_frames(
 fn save_frame(
     eyes: &[EnvMap],
     path: &Path,
-    plan: &Plan,
+    (plan, hooks): (&Plan, &dyn Hooks),
     input: &str,
     settings: &str,
-) -> Result<String, CliError> {
+) -> Result<String, Error> {
     let s = path.to_string_lossy().into_owned();
     let saved = save::save_eyes(eyes, plan.stereo, &s, &plan.save)?;
-    plan.say_clipped(&s, &saved.report);
+    if let Some(line) = plan.clipped_line(&s, &saved.report) {
+        hooks.note(&line);
+    }
     if let Some(first) = saved.files.first() {
         record::note(first, record::stamp(settings, Path::new(input)))?;
     }

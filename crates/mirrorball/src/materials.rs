@@ -21,7 +21,7 @@ fn keys(kind: MaterialKind) -> &'static [&'static str] {
 /// keys it sets.
 #[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
-pub(super) struct MaterialEntry {
+pub struct MaterialEntry {
     kind: String,
     /// Mirror tint; base colour of fresnel, diffuse and phong-map.
     tint: Option<[f32; 3]>,
@@ -64,7 +64,7 @@ fn spec_number(k: &str, v: &str) -> Result<f32, String> {
 
 /// Parses a `--material` spec, `NAME[:key=value…]` (see [`material_of`] for the keys), with
 /// `--tint` and `--f0` as the defaults of `tint` and `f0`.
-pub(super) fn parse_material(spec: &str, tint: [f32; 3], f0: f32) -> Result<Material, String> {
+pub fn parse_material(spec: &str, tint: [f32; 3], f0: f32) -> Result<Material, String> {
     let mut parts = spec.split(':');
     let mut e = MaterialEntry {
         kind: parts.next().unwrap_or_default().trim().to_string(),
@@ -121,7 +121,7 @@ fn colour(k: &str, c: [f32; 3]) -> Result<[f32; 3], String> {
 
 /// The material a scene file's (or a `--material` spec's) entry describes, every value
 /// checked.
-pub(super) fn material_of(e: &MaterialEntry) -> Result<Material, String> {
+pub fn material_of(e: &MaterialEntry) -> Result<Material, String> {
     let tint = colour("tint", e.tint.unwrap_or([1.0; 3]))?;
     let f0 = e.f0.unwrap_or(0.04);
     if !(0.0..=1.0).contains(&f0) {

@@ -14,8 +14,8 @@
 //! output another tool made, or mirrorball before it kept records) is kept, and the run
 //! says how many, as `--overwrite` converts them too.
 
-use crate::error::CliError;
-use crate::ConvertArgs;
+use super::sequence::FramesRequest;
+use crate::error::Error;
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -23,20 +23,18 @@ use std::path::{Path, PathBuf};
 /// The record's file name in an output folder.
 pub const RECORD: &str = ".mirrorball-frames";
 
-/// The request's settings as one text: `a` less what does not decide an output (the input
-/// and output names, which each line's name and the input's stamp stand for; `--shard`,
-/// `--manifest`, `--overwrite`, `--json`, `--quiet`), with mirrorball's version, so that
-/// another version's outputs are made again.
-pub fn settings(a: &ConvertArgs) -> String {
-    let mut a = a.clone();
-    a.input.clear();
-    a.output.clear();
-    a.quiet = false;
-    a.frames.manifest = None;
-    a.frames.shard = None;
-    a.frames.overwrite = false;
-    a.frames.json = false;
-    format!("mirrorball {} {a:?}", env!("CARGO_PKG_VERSION"))
+/// The request's settings as one text: `r` less what does not decide an output (the input
+/// and output names, which each line's name and the input's stamp stand for; the shard,
+/// `overwrite`, `json`), with mirrorball's version, so that another version's outputs are
+/// made again.
+pub fn settings(r: &FramesRequest) -> String {
+    let mut r = r.clone();
+    r.convert.input.clear();
+    r.convert.output.clear();
+    r.shard = None;
+    r.overwrite = false;
+    r.json = false;
+    format!("mirrorball {} {r:?}", env!("CARGO_PKG_VERSION"))
 }
 
 /// The stamp of an output made with `settings` from the file `input` (its length and
@@ -85,7 +83,7 @@ impl Made {
 }
 
 /// Appends `out`'s line to its folder's record, once `out` is in place.
-pub fn note(out: &Path, stamp: u64) -> Result<(), CliError> {
+pub fn note(out: &Path, stamp: u64) -> Result<(), Error> {
     let (dir, name) = split(out);
     let path = dir.join(RECORD);
     let line = format!("{stamp:016x}\t{name}\n");
@@ -95,7 +93,7 @@ pub fn note(out: &Path, stamp: u64) -> Result<(), CliError> {
         .open(&path)
         .and_then(|mut f| f.write_all(line.as_bytes()))
         .map_err(|e| {
-            CliError::system(format!(
+            Error::system(format!(
                 "{}: cannot record how {name} was made: {e}",
                 path.display()
             ))

@@ -7,7 +7,7 @@
 //! frames numbered 0, 1, 2 … in name order (bytewise). An output pattern is printf only: a
 //! frame's output is the pattern printed with the frame's number.
 
-use crate::error::CliError;
+use crate::error::Error;
 use std::path::{Path, PathBuf};
 
 /// A printf pattern: `dir/prefix%0Wdsuffix`.
@@ -70,9 +70,9 @@ fn split(arg: &str) -> (PathBuf, String) {
 
 /// The printf conversion of `name` (`%d` or `%0Nd`, `%%` for a `%`): `Ok(None)` when it has
 /// none, an error for a `%` that is neither or for two conversions.
-fn printf_parts(arg: &str, name: &str) -> Result<Option<(String, usize, String)>, CliError> {
+fn printf_parts(arg: &str, name: &str) -> Result<Option<(String, usize, String)>, Error> {
     let bad = |why: &str| {
-        CliError::request(format!(
+        Error::request(format!(
             "{arg}: {why} (a frame pattern has one %d or %0Nd, and %% for a %)"
         ))
     };
@@ -126,14 +126,14 @@ fn has_glob(name: &str) -> bool {
 impl Pattern {
     /// The pattern `arg` holds, `None` when it names one file (it has no pattern, or a file
     /// of that very name exists). Patterns in the folder part are refused.
-    pub fn parse(arg: &str) -> Result<Option<Pattern>, CliError> {
+    pub fn parse(arg: &str) -> Result<Option<Pattern>, Error> {
         if arg == "-" || Path::new(arg).is_file() {
             return Ok(None);
         }
         let (dir, name) = split(arg);
         let dir_text = dir.to_string_lossy();
         if printf_parts(arg, &dir_text).ok().flatten().is_some() || has_glob(&dir_text) {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "{arg}: a frame pattern goes in the file name, not in the folder"
             )));
         }
@@ -152,13 +152,13 @@ impl Pattern {
     }
 
     /// An output pattern: printf only.
-    pub fn output(arg: &str) -> Result<Option<Printf>, CliError> {
+    pub fn output(arg: &str) -> Result<Option<Printf>, Error> {
         if arg == "-" {
             return Ok(None);
         }
         let (dir, name) = split(arg);
         if has_glob(&name) {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "{arg}: an output pattern numbers frames with %d or %0Nd; * ? [ ] only match inputs"
             )));
         }
@@ -174,13 +174,13 @@ impl Pattern {
 
     /// The files the pattern matches, in frame order (see the module's documentation);
     /// refused when it matches none.
-    pub fn expand(&self, arg: &str) -> Result<Vec<Frame>, CliError> {
+    pub fn expand(&self, arg: &str) -> Result<Vec<Frame>, Error> {
         let dir = match self {
             Pattern::Printf(p) => &p.dir,
             Pattern::Glob { dir, .. } => dir,
         };
         let entries = std::fs::read_dir(dir).map_err(|e| {
-            CliError::request(format!(
+            Error::request(format!(
                 "{arg}: cannot list the folder {}: {e}",
                 dir.display()
             ))
@@ -216,7 +216,7 @@ impl Pattern {
         };
         frames.sort_by_key(|f| f.number);
         if frames.is_empty() {
-            return Err(CliError::request(format!(
+            return Err(Error::request(format!(
                 "{arg}: the pattern matches no file in {}",
                 dir.display()
             )));

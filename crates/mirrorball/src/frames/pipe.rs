@@ -7,7 +7,7 @@
 
 #[cfg(test)]
 use super::packing::Packing;
-use crate::error::CliError;
+use crate::error::Error;
 use mirrorball_core::color::linear_to_srgb;
 use mirrorball_core::{choice_traits, count_invalid, Choice, Codes, Image};
 use mirrorball_simd::{x8_kernel, F32x8, I32x8, X8};
@@ -155,13 +155,7 @@ impl PixFmt {
     /// Encodes texels (`c` channels each, the first three R, G, B) into `dst`, this
     /// interleaved format's bytes for as many pixels; `table`: the format's sRGB codes.
     #[inline]
-    pub(super) fn encode_texels(
-        self,
-        table: Option<&SrgbTable>,
-        src: &[f32],
-        c: usize,
-        dst: &mut [u8],
-    ) {
+    pub fn encode_texels(self, table: Option<&SrgbTable>, src: &[f32], c: usize, dst: &mut [u8]) {
         let px = self.pixel_bytes();
         // RGB texels are their values in order, each one code: eight at a time, the few
         // left over one by one (the same codes: `SrgbTable::codes_x8`).
@@ -362,13 +356,13 @@ x8_kernel! {
 
 /// Reads one frame of `buf.len()` bytes: `Ok(false)` at the end of the stream before the
 /// frame's first byte, an input error when it ends inside the frame.
-pub fn read_frame(r: &mut impl Read, buf: &mut [u8], frame: u64) -> Result<bool, CliError> {
+pub fn read_frame(r: &mut impl Read, buf: &mut [u8], frame: u64) -> Result<bool, Error> {
     let mut got = 0;
     while got < buf.len() {
         match r.read(&mut buf[got..]) {
             Ok(0) if got == 0 => return Ok(false),
             Ok(0) => {
-                return Err(CliError::input(format!(
+                return Err(Error::input(format!(
                     "standard input ended {got} bytes into frame {frame}, which needs {} (check --in-size and --pix-fmt against the stream)",
                     buf.len()
                 )))
@@ -376,7 +370,7 @@ pub fn read_frame(r: &mut impl Read, buf: &mut [u8], frame: u64) -> Result<bool,
             Ok(k) => got += k,
             Err(e) if e.kind() == ErrorKind::Interrupted => {}
             Err(e) => {
-                return Err(CliError::system(format!(
+                return Err(Error::system(format!(
                     "reading frame {frame} from standard input: {e}"
                 )))
             }
@@ -386,22 +380,22 @@ pub fn read_frame(r: &mut impl Read, buf: &mut [u8], frame: u64) -> Result<bool,
 }
 
 /// Writes one encoded frame; a reader that has gone away is the system's fault, said so.
-pub fn write_frame(w: &mut impl Write, bytes: &[u8], frame: u64) -> Result<(), CliError> {
+pub fn write_frame(w: &mut impl Write, bytes: &[u8], frame: u64) -> Result<(), Error> {
     w.write_all(bytes).and_then(|_| w.flush()).map_err(|e| {
         if e.kind() == ErrorKind::BrokenPipe {
-            CliError::system(format!(
+            Error::system(format!(
                 "standard output was closed by its reader before frame {frame}"
             ))
         } else {
-            CliError::system(format!("writing frame {frame} to standard output: {e}"))
+            Error::system(format!("writing frame {frame} to standard output: {e}"))
         }
     })
 }
 
 /// A `WxH` size.
-pub fn parse_size(flag: &str, s: &str) -> Result<(u32, u32), CliError> {
+pub fn parse_size(flag: &str, s: &str) -> Result<(u32, u32), Error> {
     let bad = || {
-        CliError::request(format!(
+        Error::request(format!(
             "{flag}: '{s}' is not WIDTHxHEIGHT (for example 4096x2048)"
         ))
     };
@@ -411,7 +405,7 @@ pub fn parse_size(flag: &str, s: &str) -> Result<(u32, u32), CliError> {
         h.trim().parse().map_err(|_| bad())?,
     );
     if w == 0 || h == 0 || w > 65536 || h > 65536 {
-        return Err(CliError::request(format!(
+        return Err(Error::request(format!(
             "{flag}: {w}x{h} is outside 1..=65536 on a side"
         )));
     }

@@ -1,7 +1,7 @@
 //! Memory a job will need, estimated before it starts and refused, with a message that says
 //! how much and what to do, when it would not fit (instead of the allocator's abort).
 
-use crate::error::CliError;
+use crate::error::Error;
 use std::sync::OnceLock;
 
 /// `--max-memory`, when given.
@@ -33,7 +33,7 @@ pub const PROCESS: u64 = 10 << 20;
 /// Refuses `what` when it needs more than the limit: `held` bytes it already holds (a
 /// source read into memory) and `more` it will allocate at its peak, besides the process
 /// itself ([`PROCESS`]). `hint` says what to change ("a smaller --size").
-pub fn check(what: &str, held: u64, more: u64, hint: &str) -> Result<(), CliError> {
+pub fn check(what: &str, held: u64, more: u64, hint: &str) -> Result<(), Error> {
     let Some((max, source)) = limit() else {
         return Ok(());
     };
@@ -47,7 +47,7 @@ pub fn check(what: &str, held: u64, more: u64, hint: &str) -> Result<(), CliErro
     if bytes <= max {
         return Ok(());
     }
-    Err(CliError::request(format!(
+    Err(Error::request(format!(
         "{what} needs about {} of memory, more than the {} of {source}; use {hint}, or raise --max-memory",
         human(bytes),
         human(max)
@@ -62,7 +62,7 @@ pub fn check_convert(
     held: u64,
     (scratch, made, written): (u64, u64, u64),
     hint: &str,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     let converting = held.saturating_add(scratch).saturating_add(made);
     let writing = made.saturating_add(written);
     check(
@@ -116,7 +116,7 @@ pub fn check_prefilter(
     working: u64,
     made: u64,
     hint: &str,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     let c = env.channels() as u64;
     let held = f32_texels(
         env.width() as u64 * env.height() as u64 * env.layers().len() as u64,

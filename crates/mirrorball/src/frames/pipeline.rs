@@ -11,7 +11,7 @@
 //! to files or packed), or a raw frame's bytes already encoded (each row encoded as the
 //! `Remap` makes it, so the frame never exists as floats).
 
-use crate::error::CliError;
+use crate::error::Error;
 use mirrorball_core::{EnvMap, Remap, RemapError, Stereo};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender};
@@ -34,12 +34,11 @@ pub type Eyes = Vec<EnvMap>;
 
 /// Reads the next frame (maps, [`Eyes`], or whatever source the converter takes), given a
 /// source frame that has come back for reuse (when one has); `None` at the end.
-pub type Next<'a, S = Eyes> =
-    dyn FnMut(Option<S>) -> Option<Result<(Meta, S), CliError>> + Send + 'a;
+pub type Next<'a, S = Eyes> = dyn FnMut(Option<S>) -> Option<Result<(Meta, S), Error>> + Send + 'a;
 /// Converts a source frame into an output of the writer's kind, reusing its memory.
-pub type Convert<'a, O, S = Eyes> = dyn Fn(&Meta, &S, &mut O) -> Result<(), CliError> + Sync + 'a;
+pub type Convert<'a, O, S = Eyes> = dyn Fn(&Meta, &S, &mut O) -> Result<(), Error> + Sync + 'a;
 /// Writes a converted frame.
-pub type Put<'a, O> = dyn FnMut(&Meta, &O) -> Result<(), CliError> + Send + 'a;
+pub type Put<'a, O> = dyn FnMut(&Meta, &O) -> Result<(), Error> + Send + 'a;
 
 /// Runs the loop until `next` ends or a stage fails; `done` counts the frames written.
 /// `fresh_output` makes an output for the converter to fill (at most
@@ -54,7 +53,7 @@ pub fn run<S: Send, O: Send>(
     fresh_output: &(dyn Fn() -> O + Sync),
     put: &mut Put<'_, O>,
     done: &AtomicU64,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     let (src_tx, src_rx) = sync_channel::<(Meta, S)>(1);
     let (out_tx, out_rx) = sync_channel::<(Meta, O)>(1);
     let (src_back_tx, src_back_rx) = channel::<S>();
@@ -80,7 +79,7 @@ fn read_stage<S>(
     next: &mut Next<'_, S>,
     tx: std::sync::mpsc::SyncSender<(Meta, S)>,
     back: Receiver<S>,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     let mut made = 0;
     loop {
         let spare = match back.try_recv() {
@@ -109,8 +108,8 @@ fn read_stage<S>(
 }
 
 /// The error of a frame the plan was not made for.
-pub fn misfit(meta: &Meta, err: RemapError) -> CliError {
-    CliError::input(format!(
+pub fn misfit(meta: &Meta, err: RemapError) -> Error {
+    Error::input(format!(
         "{}: {err} (every frame must have the first's projection and size)",
         meta.input
     ))
@@ -124,7 +123,7 @@ pub fn convert_eyes(
     meta: &Meta,
     src: &Eyes,
     out: &mut Eyes,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     for e in 0..out.len() {
         let eye = from.source_eye(e);
         if e > 0 && from.source_eye(e - 1) == eye {
@@ -135,7 +134,7 @@ pub fn convert_eyes(
             continue;
         }
         let src_eye = src.get(eye).ok_or_else(|| {
-            CliError::input(format!(
+            Error::input(format!(
                 "{}: {} eye(s), where the first frame had {}",
                 meta.input,
                 src.len(),
@@ -156,7 +155,7 @@ fn convert_stage<S, O>(
     tx: std::sync::mpsc::SyncSender<(Meta, O)>,
     src_back: Sender<S>,
     out_back: Receiver<O>,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     let mut made = 0;
     for (meta, src) in rx {
         let mut out = match out_back.try_recv() {
@@ -184,7 +183,7 @@ fn write_stage<O>(
     rx: Receiver<(Meta, O)>,
     back: Sender<O>,
     done: &AtomicU64,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     for (meta, out) in rx {
         put(&meta, &out)?;
         done.fetch_add(1, Ordering::Relaxed);
