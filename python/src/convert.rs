@@ -61,14 +61,22 @@ pub fn options(
 /// How a source picture is read: its projection text and layout.
 #[derive(Clone, Debug)]
 pub struct Source {
+    /// The argument naming the projection (`src`, or `write`'s `projection`).
+    arg: &'static str,
     spec: ProjectionSpec,
     layout: Option<Layout>,
 }
 
 impl Source {
     pub fn new(src: &str, src_layout: Option<&str>) -> PyResult<Source> {
+        Source::named("src", src, src_layout)
+    }
+
+    /// [`Source::new`] with the projection's argument named `arg`.
+    pub fn named(arg: &'static str, src: &str, src_layout: Option<&str>) -> PyResult<Source> {
         Ok(Source {
-            spec: spec_arg("src", src)?,
+            arg,
+            spec: spec_arg(arg, src)?,
             layout: layout_arg("src_layout", src_layout)?,
         })
     }
@@ -99,15 +107,16 @@ impl Source {
                 )
             })?,
         };
-        let proj = self.spec.build(Some((w, h))).map_err(|e| request("src", e))?;
+        let proj = self.spec.build(Some((w, h))).map_err(|e| request(self.arg, e))?;
         if layout == Layout::Separate && n == 1 && proj.kind() != ProjectionKind::Mercator {
             let (ew, eh) = proj.layer_extent(w);
             if (h as f64 - eh as f64).abs() / eh as f64 > 0.01 {
                 return Err(request(
                     arg,
                     format!(
-                        "a {} map of width {w} is {ew}x{eh}, but the picture is {w}x{h} (H×W×C = {h}×{w}); say another src",
-                        proj.name()
+                        "a {} map of width {w} is {ew}x{eh}, but the picture is {w}x{h} (H×W×C = {h}×{w}); say another {}",
+                        proj.name(),
+                        self.arg
                     ),
                 ));
             }

@@ -30,7 +30,7 @@ def check(written, frames, out):
         got, info = mb.read(w)
         assert info["projection"] == "cube"
         array, _ = mb.read(frames / pathlib.Path(w).name)
-        expected = mb.convert(array, dst="cube", size=32, invalid="zero")
+        expected = mb.convert(array, dst="cube", size=32, invalid="zero", layout="separate")
         assert np.abs(got - expected).max() <= 1e-4 * max(1.0, np.abs(expected).max())
 
 

@@ -144,7 +144,11 @@ def test_write_refusals(tmp, smooth):
         mb.write(tmp / "a.tiff", smooth)
     with pytest.raises(ValueError, match=r"^precision: "):
         mb.write(tmp / "a.png", smooth, precision="half")
-    with pytest.raises(ValueError, match=r"^array: .*six faces"):
+    with pytest.raises(ValueError, match=r"^projection: KTX2 .*holds a cube map"):
         mb.write(tmp / "a.ktx2", smooth)
+    with pytest.raises(ValueError, match=r"^projection: .*latlonk"):
+        mb.write(tmp / "a.exr", smooth, projection="latlonk")
+    with pytest.raises(ValueError, match=r"^mips: "):
+        mb.write(tmp / "a.exr", smooth, projection="latlong", mips=True)
     with pytest.raises(FileNotFoundError):
         mb.write(tmp / "no" / "such" / "folder" / "a.exr", smooth)
