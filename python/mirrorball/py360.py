@@ -190,7 +190,7 @@ def c2e(
 
     def one(a):
         layers = a.reshape((6, n) + a.shape[1:])
-        return _native.convert(layers, src="cube", src_layout="separate", dst="latlong", size=h, linear=linear)
+        return _native.convert(layers, src="cube", src_layout="separate", dst="latlong", size=w, linear=linear)
 
     out = _channels(tall, one, linear)
     return out[..., 0] if squeeze else out
@@ -212,7 +212,7 @@ def _view(fov_deg, u_deg: float, v_deg: float, out_hw, in_rot_deg: float) -> tup
             f"{out_w}-wide view of these fields of view is {want_h} high; give fov_deg=(h_fov, v_fov) "
             f"with tan(v_fov/2)/tan(h_fov/2) = {out_h}/{out_w}"
         )
-    spec = f"perspective:hfov={h_fov!r}:vfov={v_fov!r}:yaw={-float(u_deg)!r}:pitch={float(v_deg)!r}:roll={float(in_rot_deg)!r}"
+    spec = f"perspective:hfov={h_fov!r}:vfov={v_fov!r}:yaw={float(u_deg)!r}:pitch={float(v_deg)!r}:roll={float(in_rot_deg)!r}"
     return spec, out_w
 
 

@@ -8,7 +8,7 @@ use half::f16;
 use mirrorball_core::color::{linear_to_srgb, srgb_to_linear};
 use mirrorball_core::Image;
 use numpy::{
-    Element, PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
+    Element, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
     PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyTypeError;
@@ -186,7 +186,6 @@ pub fn pictures(
             coded::<u16>(obj, c, |v| t[v as usize], |v| v as f32 / 65535.0)?
         }
     };
-    let mut flat = flat;
     if matches!(dtype, Dtype::F32 | Dtype::F16) {
         match invalid {
             Invalid::Keep => {}
@@ -226,9 +225,11 @@ pub fn pictures(
 /// The floats of a float array, in C order (any strides).
 fn floats<T: Element + Copy + Sync>(obj: &Bound<'_, PyAny>, f: fn(T) -> f32) -> PyResult<Vec<f32>> {
     let a: PyReadonlyArrayDyn<'_, T> = obj.extract()?;
-    Ok(match a.as_slice() {
-        Ok(s) => s.par_iter().map(|&v| f(v)).collect(),
-        Err(_) => a.as_array().iter().map(|&v| f(v)).collect(),
+    // `as_slice` takes Fortran order too: C order only, else the logical iteration.
+    let c_order = a.is_c_contiguous();
+    Ok(match a.as_slice().ok().filter(|_| c_order) {
+        Some(s) => s.par_iter().map(|&v| f(v)).collect(),
+        None => a.as_array().iter().map(|&v| f(v)).collect(),
     })
 }
 
@@ -248,8 +249,9 @@ fn coded<T: Element + Copy + Sync>(
             colour(v)
         }
     };
-    Ok(match a.as_slice() {
-        Ok(s) => {
+    let c_order = a.is_c_contiguous();
+    Ok(match a.as_slice().ok().filter(|_| c_order) {
+        Some(s) => {
             let mut out = vec![0f32; s.len()];
             out.par_chunks_mut(c * 4096)
                 .zip(s.par_chunks(c * 4096))
@@ -260,7 +262,7 @@ fn coded<T: Element + Copy + Sync>(
                 });
             out
         }
-        Err(_) => a
+        None => a
             .as_array()
             .iter()
             .enumerate()

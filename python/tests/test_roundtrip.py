@@ -17,7 +17,7 @@ def test_exr_float32_round_trip_is_exact(tmp):
         assert b.dtype == np.float32 and b.shape == a.shape
         assert np.array_equal(a, b)
         assert info["projection"] == "latlong"
-        assert info["decided"] == "recorded in the file"
+        assert info["decided"].endswith("recorded in the file")
 
 
 def test_float16_is_written_half_and_read_back_exactly(tmp):
@@ -35,22 +35,23 @@ def test_png_codes_round_trip_exactly(tmp, dtype):
     mb.write(tmp / "a.png", a)
     b, info = mb.read(tmp / "a.png", dtype=dtype)
     assert np.array_equal(a, b)
-    # Read as floats, codes are sRGB: code 128 of 255 is about 0.2158 linear.
-    f, _ = mb.read(tmp / "a.png")
-    k = np.unravel_index(np.argmax(a == top // 2 + 1), a.shape)
-    expected = ((top // 2 + 1) / top + 0.055) / 1.055
-    assert f[k] == pytest.approx(expected**2.4, rel=1e-4)
+    # Read as floats, codes are sRGB (IEC 61966-2-1's curve).
+    a[0, 0] = [top // 2, top // 4, top]
+    mb.write(tmp / "b.png", a)
+    f, _ = mb.read(tmp / "b.png")
+    expected = [((k / top + 0.055) / 1.055) ** 2.4 for k in a[0, 0]]
+    assert f[0, 0] == pytest.approx(expected, rel=1e-4)
 
 
 def test_linear_codes_are_code_over_max():
     a = np.full((32, 64, 3), 51, np.uint8)
-    f = mb.convert(a, dst="latlong", size=32, linear=True, dtype=np.float32)
+    f = mb.convert(a, dst="latlong", size=64, linear=True, dtype=np.float32)
     assert np.allclose(f, 0.2, atol=1e-6)
-    s = mb.convert(a, dst="latlong", size=32, dtype=np.float32)
+    s = mb.convert(a, dst="latlong", size=64, dtype=np.float32)
     assert np.allclose(s, ((51 / 255 + 0.055) / 1.055) ** 2.4, atol=1e-6)
     # Codes in, the same codes out (a constant map converts to itself).
-    assert np.array_equal(mb.convert(a, dst="latlong", size=32), a)
-    assert np.array_equal(mb.convert(a, dst="latlong", size=32, linear=True), a)
+    assert np.array_equal(mb.convert(a, dst="latlong", size=64), a)
+    assert np.array_equal(mb.convert(a, dst="latlong", size=64, linear=True), a)
 
 
 def test_ktx2_cube_faces_round_trip(tmp, smooth):
@@ -58,15 +59,16 @@ def test_ktx2_cube_faces_round_trip(tmp, smooth):
     assert faces.shape == (6, 16, 16, 3)
     mb.write(tmp / "c.ktx2", faces, projection="cube", precision="float")
     back, info = mb.read(tmp / "c.ktx2")
-    assert back.shape == (6, 16, 16, 3)
+    # KTX2 holds RGBA: alpha 1 comes back.
+    assert back.shape == (6, 16, 16, 4) and np.all(back[..., 3] == 1)
     assert info["projection"] == "cube" and info["layout"] == "separate"
-    assert np.array_equal(back, faces)
+    assert np.array_equal(back[..., :3], faces)
 
 
 def test_cube_round_trip_returns_the_map(smooth):
     cross = mb.convert(smooth, dst="cube", size=64)
     assert cross.shape == (3 * 64, 4 * 64, 3)
-    back = mb.convert(cross, src="cube", dst="latlong", size=128)
+    back = mb.convert(cross, src="cube", dst="latlong", size=256)
     assert back.shape == smooth.shape
     assert np.abs(back - smooth).max() < 0.01
     # The cross's unused cells are black.
@@ -84,8 +86,8 @@ def test_layouts_hold_the_same_faces(smooth):
     assert np.array_equal(cross[n : 2 * n, n : 2 * n], faces[4])
     assert np.array_equal(cross[0:n, n : 2 * n], faces[2])
     # Faces given back as separate layers read the same as the cross.
-    again = mb.convert(faces, src="cube", src_layout="separate", dst="latlong", size=64)
-    assert np.array_equal(again, mb.convert(cross, src="cube", dst="latlong", size=64))
+    again = mb.convert(faces, src="cube", src_layout="separate", dst="latlong", size=128)
+    assert np.array_equal(again, mb.convert(cross, src="cube", dst="latlong", size=128))
 
 
 def test_dtype_is_kept_unless_asked(smooth):
@@ -137,7 +139,7 @@ def test_remap_agrees_with_convert_and_fills_out(smooth):
 
 
 def test_rotation_turns_the_world(smooth):
-    turned = mb.convert(smooth, dst="latlong", size=128, yaw=90)
+    turned = mb.convert(smooth, dst="latlong", size=256, yaw=90)
     # yaw 90 turns the world 90° to the left: a quarter of the width.
     assert np.abs(turned - np.roll(smooth, -64, axis=1)).max() < 1e-3 or np.abs(
         turned - np.roll(smooth, 64, axis=1)
@@ -160,7 +162,7 @@ def test_sh9_of_a_constant_map():
     assert sh.shape == (9, 3)
     # Y00 = 1/(2√π); ∫ 2·Y00 dω = 2·4π/(2√π) = 4√π.
     assert sh[0] == pytest.approx([4 * np.sqrt(np.pi)] * 3, rel=1e-4)
-    assert np.abs(sh[1:]).max() < 1e-4
+    assert np.abs(sh[1:]).max() < 1e-3 * sh[0, 0]
 
 
 def test_threads_setting():
