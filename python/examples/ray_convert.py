@@ -9,6 +9,7 @@ and converts batches of frames; mirrorball releases the GIL and uses the worker'
 """
 
 import argparse
+import os
 import pathlib
 
 import numpy as np
@@ -47,7 +48,15 @@ def convert_folder(in_dir, out_dir, size=512, cpus=2):
     pathlib.Path(out_dir).mkdir(parents=True, exist_ok=True)
     started = not ray.is_initialized()
     if started:
-        ray.init(num_cpus=cpus, include_dashboard=False, log_to_driver=False)
+        # The workers import this module (Converter) by name: its folder on their path.
+        here = str(pathlib.Path(__file__).resolve().parent)
+        path = os.pathsep.join(p for p in (here, os.environ.get("PYTHONPATH")) if p)
+        ray.init(
+            num_cpus=cpus,
+            include_dashboard=False,
+            log_to_driver=False,
+            runtime_env={"env_vars": {"PYTHONPATH": path}},
+        )
     try:
         ds = ray.data.from_items([{"path": p} for p in paths])
         ds = ds.map_batches(
