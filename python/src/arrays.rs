@@ -8,8 +8,7 @@ use half::f16;
 use mirrorball_core::color::{linear_to_srgb, srgb_to_linear};
 use mirrorball_core::Image;
 use numpy::{
-    Element, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
-    PyUntypedArrayMethods,
+    Element, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -160,7 +159,10 @@ pub fn pictures(
         ));
     }
     if shape.contains(&0) {
-        return Err(request(arg, format!("shape {}: the array is empty", dims(&shape))));
+        return Err(request(
+            arg,
+            format!("shape {}: the array is empty", dims(&shape)),
+        ));
     }
     if h > u32::MAX as usize / 2 || w > u32::MAX as usize / 2 {
         return Err(request(arg, format!("shape {}: too large", dims(&shape))));
@@ -322,7 +324,12 @@ fn encode_linear(a: f32, max: f32) -> f32 {
 }
 
 /// Encodes `src` (interleaved, `c` channels) into `out` as `T`.
-pub fn encode_into<T: Send>(src: &[f32], c: usize, out: &mut [T], f: impl Fn(usize, f32) -> T + Sync) {
+pub fn encode_into<T: Send>(
+    src: &[f32],
+    c: usize,
+    out: &mut [T],
+    f: impl Fn(usize, f32) -> T + Sync,
+) {
     out.par_chunks_mut(c * 4096)
         .zip(src.par_chunks(c * 4096))
         .for_each(|(o, s)| {
@@ -394,15 +401,18 @@ pub fn to_numpy<'py>(
             shaped(py, v, shape)
         }
         Dtype::F16 => {
-            let v = py.detach(|| crate::threads::run(|| encode_all(&parts, c, |_, v| f16::from_f32(v))));
+            let v = py
+                .detach(|| crate::threads::run(|| encode_all(&parts, c, |_, v| f16::from_f32(v))));
             shaped(py, v, shape)
         }
         Dtype::U8 => {
-            let v = py.detach(|| crate::threads::run(|| encode_all(&parts, c, encoder_u8(c, linear))));
+            let v =
+                py.detach(|| crate::threads::run(|| encode_all(&parts, c, encoder_u8(c, linear))));
             shaped(py, v, shape)
         }
         Dtype::U16 => {
-            let v = py.detach(|| crate::threads::run(|| encode_all(&parts, c, encoder_u16(c, linear))));
+            let v =
+                py.detach(|| crate::threads::run(|| encode_all(&parts, c, encoder_u16(c, linear))));
             shaped(py, v, shape)
         }
     }

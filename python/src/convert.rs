@@ -35,7 +35,10 @@ pub fn options(
 ) -> PyResult<ResampleOptions> {
     for (name, v) in [("yaw", yaw), ("pitch", pitch), ("roll", roll)] {
         if !v.is_finite() {
-            return Err(request(name, format!("{v} is not a finite number of degrees")));
+            return Err(request(
+                name,
+                format!("{v} is not a finite number of degrees"),
+            ));
         }
     }
     if !exposure.is_finite() || exposure.abs() > 64.0 {
@@ -107,7 +110,10 @@ impl Source {
                 )
             })?,
         };
-        let proj = self.spec.build(Some((w, h))).map_err(|e| request(self.arg, e))?;
+        let proj = self
+            .spec
+            .build(Some((w, h)))
+            .map_err(|e| request(self.arg, e))?;
         if layout == Layout::Separate && n == 1 && proj.kind() != ProjectionKind::Mercator {
             let (ew, eh) = proj.layer_extent(w);
             if (h as f64 - eh as f64).abs() / eh as f64 > 0.01 {
@@ -152,11 +158,7 @@ impl Source {
         }
         pics.images
             .into_iter()
-            .map(|img| {
-                layout
-                    .unpack_owned(img, proj)
-                    .map_err(|e| request(arg, e))
-            })
+            .map(|img| layout.unpack_owned(img, proj).map_err(|e| request(arg, e)))
             .collect()
     }
 
@@ -182,13 +184,21 @@ pub struct Placement {
 }
 
 impl Placement {
-    fn new(dst: Projection, layout: Option<Layout>, (w, h): (u32, u32), c: usize) -> PyResult<Placement> {
+    fn new(
+        dst: Projection,
+        layout: Option<Layout>,
+        (w, h): (u32, u32),
+        c: usize,
+    ) -> PyResult<Placement> {
         let layers = dst.layer_count();
         let layout = layout.unwrap_or_else(|| Layout::default_for(dst.kind()));
         if !layout.fits(layers) {
             return Err(request(
                 "layout",
-                format!("{layout} needs six faces; a {} map has {layers} layers", dst.kind()),
+                format!(
+                    "{layout} needs six faces; a {} map has {layers} layers",
+                    dst.kind()
+                ),
             ));
         }
         Ok(Placement {
@@ -213,7 +223,9 @@ impl Placement {
             }
             return vec![self.layers, self.h, self.w, self.c];
         }
-        let (pw, ph) = self.layout.extent(self.layers, self.w as u32, self.h as u32);
+        let (pw, ph) = self
+            .layout
+            .extent(self.layers, self.w as u32, self.h as u32);
         vec![ph as usize, pw as usize, self.c]
     }
 
@@ -257,7 +269,14 @@ unsafe impl<T: Send> Sync for Dest<T> {}
 
 impl<T: Copy> Dest<T> {
     /// Writes `row` (floats, `c` channels) at `offset`, backwards by texels if `reversed`.
-    fn put(&self, offset: usize, row: &[f32], c: usize, reversed: bool, enc: &(impl Fn(usize, f32) -> T + Sync)) {
+    fn put(
+        &self,
+        offset: usize,
+        row: &[f32],
+        c: usize,
+        reversed: bool,
+        enc: &(impl Fn(usize, f32) -> T + Sync),
+    ) {
         assert!(offset + row.len() <= self.len, "a row past the array's end");
         // SAFETY: in bounds (asserted), and no other writer writes these elements.
         let out = unsafe { std::slice::from_raw_parts_mut(self.ptr.add(offset), row.len()) };
@@ -345,7 +364,8 @@ fn make_map<T: Copy + Send>(
     }
     if !place.by_rows() {
         let env = EnvMap::new(dst, whole).map_err(|e| request("dst", e))?;
-        let picture = run(|| place.layout.pack(&env)).ok_or_else(|| request("layout", "does not fit"))?;
+        let picture =
+            run(|| place.layout.pack(&env)).ok_or_else(|| request("layout", "does not fit"))?;
         run(|| {
             picture
                 .data()
@@ -410,7 +430,9 @@ fn make_all<'py>(
         let item = place.item_len();
         py.detach(|| {
             for i in 0..count {
-                make(i, &mut |rows| make_map(rows, place, dst, &dest, i * item, &enc))?;
+                make(i, &mut |rows| {
+                    make_map(rows, place, dst, &dest, i * item, &enc)
+                })?;
             }
             Ok(())
         })
@@ -421,10 +443,24 @@ fn make_all<'py>(
         Dtype::F16 => typed::<half::f16>(py, &array, count, &place, dst, make, |_, v| {
             half::f16::from_f32(v)
         })?,
-        Dtype::U8 => typed::<u8>(py, &array, count, &place, dst, make, arrays::encoder_u8(c, linear))?,
-        Dtype::U16 => {
-            typed::<u16>(py, &array, count, &place, dst, make, arrays::encoder_u16(c, linear))?
-        }
+        Dtype::U8 => typed::<u8>(
+            py,
+            &array,
+            count,
+            &place,
+            dst,
+            make,
+            arrays::encoder_u8(c, linear),
+        )?,
+        Dtype::U16 => typed::<u16>(
+            py,
+            &array,
+            count,
+            &place,
+            dst,
+            make,
+            arrays::encoder_u16(c, linear),
+        )?,
     }
     Ok(array)
 }
@@ -432,7 +468,9 @@ fn make_all<'py>(
 /// The output projection and its layers' size: `size` as the CLI's `--size` (a cube's face
 /// edge, a lat-long's height…), by default the source's resolution kept.
 fn destination(dst: &str, size: Option<i64>, src: &EnvMap) -> PyResult<(Projection, (u32, u32))> {
-    let dst = spec_arg("dst", dst)?.build(None).map_err(|e| request("dst", e))?;
+    let dst = spec_arg("dst", dst)?
+        .build(None)
+        .map_err(|e| request("dst", e))?;
     let size = match size {
         None => src.natural_size(dst.kind()),
         Some(s) if (1..=65536).contains(&s) => s as u32,
@@ -484,7 +522,9 @@ pub fn convert<'py>(
     let want = arrays::dtype_arg(py, dtype)?;
     let invalid = arrays::invalid_arg(invalid)?;
     // Checked before the array is read.
-    spec_arg("dst", dst)?.build(None).map_err(|e| request("dst", e))?;
+    spec_arg("dst", dst)?
+        .build(None)
+        .map_err(|e| request("dst", e))?;
     let pics = arrays::pictures(array, "array", source.lead(), linear, invalid)?;
     let batched = pics.lead.len() > usize::from(source.separate_layers());
     let (dtype, c) = (want.unwrap_or(pics.dtype), pics.channels());
@@ -495,7 +535,17 @@ pub fn convert<'py>(
         let r = run(|| Resampler::new(&maps[i], dst, extent.0, extent.1, &opts));
         f(&ResamplerRows(r))
     };
-    make_all(py, maps.len(), batched, place, dst, dtype, linear, out, &make)
+    make_all(
+        py,
+        maps.len(),
+        batched,
+        place,
+        dst,
+        dtype,
+        linear,
+        out,
+        &make,
+    )
 }
 
 /// projections()
@@ -565,9 +615,9 @@ impl Remap {
         let (lw, lh) = match l {
             Layout::Separate => (w, h),
             Layout::Cells(cells) => {
-                let n = cells.face_size(w, h).ok_or_else(|| {
-                    request("src_shape", format!("{w}x{h} fits no {l} layout"))
-                })?;
+                let n = cells
+                    .face_size(w, h)
+                    .ok_or_else(|| request("src_shape", format!("{w}x{h} fits no {l} layout")))?;
                 (n, n)
             }
             l => {
@@ -582,11 +632,8 @@ impl Remap {
             }
         };
         let n = proj.layer_count();
-        let probe = EnvMap::new(
-            proj,
-            (0..n).map(|_| Image::new(lw, lh, 3)).collect(),
-        )
-        .map_err(|e| request("src_shape", e))?;
+        let probe = EnvMap::new(proj, (0..n).map(|_| Image::new(lw, lh, 3)).collect())
+            .map_err(|e| request("src_shape", e))?;
         let (dst, extent) = destination(dst, size, &probe)?;
         drop(probe);
         Placement::new(dst, layout, extent, 3)?;
@@ -643,7 +690,17 @@ impl Remap {
             let rows = run(|| plan.rows(&maps[i])).map_err(|e| request("array", e))?;
             f(&RemapRows(rows, row))
         };
-        make_all(py, maps.len(), batched, place, self.dst, dtype, linear, out, &make)
+        make_all(
+            py,
+            maps.len(),
+            batched,
+            place,
+            self.dst,
+            dtype,
+            linear,
+            out,
+            &make,
+        )
     }
 
     /// The shape of one result (without a batch's N), for channels `c`.

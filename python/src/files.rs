@@ -126,9 +126,8 @@ pub fn write(
     let path = path_arg(path)?;
     let text = path_text(&path)?;
     let invalid = arrays::invalid_arg(invalid)?;
-    let format = mirrorball::save::check_container(&text).map_err(|e| {
-        request("path", e.message)
-    })?;
+    let format =
+        mirrorball::save::check_container(&text).map_err(|e| request("path", e.message))?;
     let precision = precision
         .map(|p| p.parse::<Precision>().map_err(|e| request("precision", e)))
         .transpose()?;
@@ -139,7 +138,10 @@ pub fn write(
         ));
     }
     let exr_compression = compression
-        .map(|c| c.parse::<ExrCompression>().map_err(|e| request("compression", e)))
+        .map(|c| {
+            c.parse::<ExrCompression>()
+                .map_err(|e| request("compression", e))
+        })
         .transpose()?
         .unwrap_or_default();
     if compression.is_some() && format != Format::Exr {
@@ -184,7 +186,12 @@ pub fn write(
     };
     let source = Source::named("projection", projection, src_layout)?;
     let layers = source.layers();
-    let separate = layers > 1 && array.getattr("ndim").and_then(|n| n.extract::<usize>()).ok() == Some(4);
+    let separate = layers > 1
+        && array
+            .getattr("ndim")
+            .and_then(|n| n.extract::<usize>())
+            .ok()
+            == Some(4);
     let source = match separate {
         true => Source::named("projection", projection, Some("separate"))?,
         false => source,
@@ -203,7 +210,10 @@ pub fn write(
         keep_invalid: invalid == Invalid::Keep,
     };
     let env = source.maps("array", pics)?.remove(0);
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
+    if let Some(dir) = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
+    {
         let e = std::fs::metadata(dir)
             .err()
             .unwrap_or_else(|| std::io::Error::from(std::io::ErrorKind::NotADirectory));
@@ -212,5 +222,9 @@ pub fn write(
     let saved = py
         .detach(|| run(|| mirrorball::save(&env, &text, &opts)))
         .map_err(lib_error)?;
-    Ok(saved.files.iter().map(|p| p.display().to_string()).collect())
+    Ok(saved
+        .files
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect())
 }

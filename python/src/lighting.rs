@@ -19,7 +19,12 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 
 /// One map from an array argument (no batch).
-fn one_map(array: &Bound<'_, PyAny>, source: &Source, linear: bool, invalid: &str) -> PyResult<EnvMap> {
+fn one_map(
+    array: &Bound<'_, PyAny>,
+    source: &Source,
+    linear: bool,
+    invalid: &str,
+) -> PyResult<EnvMap> {
     let invalid = arrays::invalid_arg(invalid)?;
     let lead = match source.separate_layers() {
         true => 1..=1,
@@ -62,18 +67,25 @@ pub fn prefilter<'py>(
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let source = Source::new(src, src_layout)?;
     let kind = lobe.parse::<LobeKind>().map_err(|e| request("lobe", e))?;
-    let out = spec_arg("dst", dst)?.build(None).map_err(|e| request("dst", e))?;
+    let out = spec_arg("dst", dst)?
+        .build(None)
+        .map_err(|e| request("dst", e))?;
     let mapping = RoughnessMapping::parse(mapping).ok_or_else(|| {
         request(
             "mapping",
-            format!("'{mapping}' is not linear, ue4, filament or a list of roughness values in [0, 1]"),
+            format!(
+                "'{mapping}' is not linear, ue4, filament or a list of roughness values in [0, 1]"
+            ),
         )
     })?;
     let method = irradiance
         .parse::<IrradianceMethod>()
         .map_err(|e| request("irradiance", e))?;
     if samples == 0 || samples > 65536 {
-        return Err(request("samples", format!("{samples} is outside 1..=65536")));
+        return Err(request(
+            "samples",
+            format!("{samples} is outside 1..=65536"),
+        ));
     }
     if let Some(c) = cube_size.filter(|c| !(1..=4096).contains(c)) {
         return Err(request("cube_size", format!("{c} is outside 1..=4096")));
@@ -84,7 +96,10 @@ pub fn prefilter<'py>(
     let layout = crate::convert::layout_arg("layout", layout)?
         .unwrap_or_else(|| Layout::default_for(out.kind()));
     if !layout.fits(out.layer_count()) {
-        return Err(request("layout", format!("{layout} does not fit a {} map", out.kind())));
+        return Err(request(
+            "layout",
+            format!("{layout} does not fit a {} map", out.kind()),
+        ));
     }
     let want = arrays::dtype_arg(py, dtype)?;
     let pics_dtype = array
@@ -114,7 +129,10 @@ pub fn prefilter<'py>(
         if kind != LobeKind::Lambert && r.len() != levels {
             return Err(request(
                 "mapping",
-                format!("lists {} roughness values but the chain has {levels} levels", r.len()),
+                format!(
+                    "lists {} roughness values but the chain has {levels} levels",
+                    r.len()
+                ),
             ));
         }
     }
@@ -124,31 +142,38 @@ pub fn prefilter<'py>(
         cube_size,
         ..Default::default()
     };
-    let chain: Vec<EnvMap> = py.detach(|| {
-        run(|| match kind {
-            LobeKind::Lambert => {
-                let top = match method {
-                    IrradianceMethod::Exact => {
-                        Prefilterer::for_chain(&env, &[Lobe::Lambert], out, size, opts)
-                            .render(&Lobe::Lambert, out, size)
-                    }
-                    IrradianceMethod::Sh => {
-                        let sh9 = sh::project(&env);
-                        irradiance::irradiance_map_sh(&sh9, Window::None, out, size)
-                    }
-                };
-                MipChain::build_levels(&top, MipFilter::Box, levels).into_levels()
-            }
-            _ => Prefilterer::for_chain(&env, &lobes, out, size, opts).render_chain(&lobes, out, size),
-        })
-    });
+    let chain: Vec<EnvMap> =
+        py.detach(|| {
+            run(|| match kind {
+                LobeKind::Lambert => {
+                    let top =
+                        match method {
+                            IrradianceMethod::Exact => {
+                                Prefilterer::for_chain(&env, &[Lobe::Lambert], out, size, opts)
+                                    .render(&Lobe::Lambert, out, size)
+                            }
+                            IrradianceMethod::Sh => {
+                                let sh9 = sh::project(&env);
+                                irradiance::irradiance_map_sh(&sh9, Window::None, out, size)
+                            }
+                        };
+                    MipChain::build_levels(&top, MipFilter::Box, levels).into_levels()
+                }
+                _ => Prefilterer::for_chain(&env, &lobes, out, size, opts)
+                    .render_chain(&lobes, out, size),
+            })
+        });
     let c = env.channels();
     chain
         .iter()
         .map(|level| {
             let (parts, shape) = if layout == Layout::Separate {
                 let parts: Vec<&[f32]> = level.layers().iter().map(|l| l.data()).collect();
-                let mut shape = vec![level.height() as usize, level.width() as usize, level.channels()];
+                let mut shape = vec![
+                    level.height() as usize,
+                    level.width() as usize,
+                    level.channels(),
+                ];
                 if parts.len() > 1 {
                     shape.insert(0, parts.len());
                 }
@@ -162,8 +187,19 @@ pub fn prefilter<'py>(
             let picture = layout
                 .pack(level)
                 .ok_or_else(|| request("layout", "does not fit"))?;
-            let shape = [picture.height() as usize, picture.width() as usize, picture.channels()];
-            arrays::to_numpy(py, &[picture.data()], &shape, picture.channels(), dtype, linear)
+            let shape = [
+                picture.height() as usize,
+                picture.width() as usize,
+                picture.channels(),
+            ];
+            arrays::to_numpy(
+                py,
+                &[picture.data()],
+                &shape,
+                picture.channels(),
+                dtype,
+                linear,
+            )
         })
         .collect()
 }
@@ -236,12 +272,18 @@ pub fn bake(
         None => takes_zstd.then_some(3),
     };
     if samples == 0 || samples > 65536 {
-        return Err(request("samples", format!("{samples} is outside 1..=65536")));
+        return Err(request(
+            "samples",
+            format!("{samples} is outside 1..=65536"),
+        ));
     }
     if out_dir.exists() && !out_dir.is_dir() {
         return Err(request(
             "out_dir",
-            format!("{}: a file; bake writes a folder of files", out_dir.display()),
+            format!(
+                "{}: a file; bake writes a folder of files",
+                out_dir.display()
+            ),
         ));
     }
     let opts = BakeOptions {
