@@ -377,6 +377,11 @@ fn make_map<T: Copy + Send>(
     Ok(())
 }
 
+/// A map's maker: for map `i`, hands its rows (a `Rows`) to the callback that fills the
+/// output from them.
+type MakeMap<'a> =
+    dyn Fn(usize, &mut dyn FnMut(&dyn Rows) -> PyResult<()>) -> PyResult<()> + Sync + 'a;
+
 /// The output array (`out` when given, checked; else a new one) and the maps made into it
 /// by `rows_of(i)` for map `i` of `count`.
 #[allow(clippy::too_many_arguments)]
@@ -389,7 +394,7 @@ fn make_all<'py>(
     dtype: Dtype,
     linear: bool,
     out: Option<&Bound<'py, PyAny>>,
-    make: &(dyn Fn(usize, &mut dyn FnMut(&dyn Rows) -> PyResult<()>) -> PyResult<()> + Sync),
+    make: &MakeMap<'_>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut shape = place.item_shape();
     if batched {
@@ -413,7 +418,7 @@ fn make_all<'py>(
         count: usize,
         place: &Placement,
         dst: Projection,
-        make: &(dyn Fn(usize, &mut dyn FnMut(&dyn Rows) -> PyResult<()>) -> PyResult<()> + Sync),
+        make: &MakeMap<'_>,
         enc: impl Fn(usize, f32) -> T + Sync + Send,
     ) -> PyResult<()> {
         let arr = array.cast::<PyArrayDyn<T>>()?;
