@@ -150,12 +150,12 @@ def main():
         report(f"e2c {name}: {W}x{H} -> 6x{FACE}²", rows, "mirrorball Remap.apply (planned, warm)")
 
         faces = plan.apply(img)
-        cube_plan = mb.Remap((FACE, FACE), src="cube", src_layout="separate", dst="latlong", size=H)
+        cube_plan = mb.Remap((FACE, FACE), src="cube", src_layout="separate", dst="latlong", size=W)
         back = np.empty((H, W, 3), dtype)
         cube_plan.apply(faces, out=back)
         rows = {"mirrorball Remap.apply (planned, warm)": timed(lambda: cube_plan.apply(faces, out=back), a.reps)}
         rows["mirrorball convert (plans each call)"] = timed(
-            lambda: mb.convert(faces, src="cube", src_layout="separate", dst="latlong", size=H), a.reps
+            lambda: mb.convert(faces, src="cube", src_layout="separate", dst="latlong", size=W), a.reps
         )
         py_faces = [np.ascontiguousarray(f) for f in mb.py360._to_py360(faces)]
 

@@ -73,6 +73,18 @@ pub struct Pictures {
 }
 
 impl Pictures {
+    /// The buffer of a single picture's texels back, for [`pictures_into`] to fill again.
+    pub fn spare_of(maps: Vec<mirrorball_core::EnvMap>) -> Vec<f32> {
+        match <[_; 1]>::try_from(maps) {
+            Ok([map]) if map.layers().len() == 1 => map
+                .into_layers()
+                .pop()
+                .map(Image::into_vec)
+                .unwrap_or_default(),
+            _ => Vec::new(),
+        }
+    }
+
     pub fn height(&self) -> u32 {
         self.images[0].height()
     }
@@ -115,6 +127,19 @@ pub fn pictures(
     lead_ok: std::ops::RangeInclusive<usize>,
     linear: bool,
     invalid: Invalid,
+) -> PyResult<Pictures> {
+    pictures_into(obj, arg, lead_ok, linear, invalid, Vec::new())
+}
+
+/// [`pictures`] into `spare` (an earlier call's buffer, from [`Pictures::into_spare`]) when
+/// it is the right length: no allocation and no page faults for the frames of a loop.
+pub fn pictures_into(
+    obj: &Bound<'_, PyAny>,
+    arg: &str,
+    lead_ok: std::ops::RangeInclusive<usize>,
+    linear: bool,
+    invalid: Invalid,
+    spare: Vec<f32>,
 ) -> PyResult<Pictures> {
     let arr = obj.cast::<PyUntypedArray>().map_err(|_| {
         let ty = obj
@@ -176,23 +201,29 @@ pub fn pictures(
             "{arg}: dtype {name}; give {TAKEN} (for example {arg}.astype(np.float32))"
         ))
     })?;
+    let total = count * per;
+    let spare = match spare.len() == total {
+        true => spare,
+        false => Vec::new(),
+    };
+    let mut nonfinite = 0;
     let flat: Vec<f32> = match dtype {
-        Dtype::F32 => floats::<f32>(obj, |v| v)?,
-        Dtype::F16 => floats::<f16>(obj, f16::to_f32)?,
+        Dtype::F32 => floats::<f32>(obj, |v| v, spare, &mut nonfinite)?,
+        Dtype::F16 => floats::<f16>(obj, f16::to_f32, spare, &mut nonfinite)?,
         Dtype::U8 => {
             let (t, a) = (decode8(linear), alpha8());
-            coded::<u8>(obj, c, |v| t[v as usize], |v| a[v as usize])?
+            coded::<u8>(obj, c, |v| t[v as usize], |v| a[v as usize], spare)?
         }
         Dtype::U16 => {
             let t = decode16(linear);
-            coded::<u16>(obj, c, |v| t[v as usize], |v| v as f32 / 65535.0)?
+            coded::<u16>(obj, c, |v| t[v as usize], |v| v as f32 / 65535.0, spare)?
         }
     };
     if matches!(dtype, Dtype::F32 | Dtype::F16) {
         match invalid {
             Invalid::Keep => {}
             Invalid::Raise => {
-                let bad = flat.par_iter().filter(|v| !v.is_finite()).count();
+                let bad = nonfinite;
                 if bad > 0 {
                     return Err(request(
                         arg,
@@ -225,14 +256,43 @@ pub fn pictures(
 }
 
 /// The floats of a float array, in C order (any strides).
-fn floats<T: Element + Copy + Sync>(obj: &Bound<'_, PyAny>, f: fn(T) -> f32) -> PyResult<Vec<f32>> {
+/// The floats of a float array, in C order (any strides), into `out` (reused when it has
+/// the array's length), counting the NaN and infinite ones into `nonfinite` as they are
+/// copied (while in cache).
+fn floats<T: Element + Copy + Sync>(
+    obj: &Bound<'_, PyAny>,
+    f: fn(T) -> f32,
+    mut out: Vec<f32>,
+    nonfinite: &mut usize,
+) -> PyResult<Vec<f32>> {
     let a: PyReadonlyArrayDyn<'_, T> = obj.extract()?;
     // `as_slice` takes Fortran order too: C order only, else the logical iteration.
     let c_order = a.is_c_contiguous();
-    Ok(match a.as_slice().ok().filter(|_| c_order) {
-        Some(s) => s.par_iter().map(|&v| f(v)).collect(),
-        None => a.as_array().iter().map(|&v| f(v)).collect(),
-    })
+    let out = match a.as_slice().ok().filter(|_| c_order) {
+        Some(s) => {
+            if out.len() != s.len() {
+                out = vec![0.0; s.len()];
+            }
+            const BLOCK: usize = 1 << 15;
+            *nonfinite = out
+                .par_chunks_mut(BLOCK)
+                .zip(s.par_chunks(BLOCK))
+                .map(|(d, s)| {
+                    for (d, &v) in d.iter_mut().zip(s) {
+                        *d = f(v);
+                    }
+                    d.iter().filter(|v| !v.is_finite()).count()
+                })
+                .sum();
+            out
+        }
+        None => {
+            let v: Vec<f32> = a.as_array().iter().map(|&v| f(v)).collect();
+            *nonfinite = v.iter().filter(|v| !v.is_finite()).count();
+            v
+        }
+    };
+    Ok(out)
 }
 
 /// The linear values of an integer array of `c` channels, colour through `colour`, alpha
@@ -242,6 +302,7 @@ fn coded<T: Element + Copy + Sync>(
     c: usize,
     colour: impl Fn(T) -> f32 + Sync,
     alpha: impl Fn(T) -> f32 + Sync,
+    out: Vec<f32>,
 ) -> PyResult<Vec<f32>> {
     let a: PyReadonlyArrayDyn<'_, T> = obj.extract()?;
     let decode = |i: usize, v: T| {
@@ -254,7 +315,10 @@ fn coded<T: Element + Copy + Sync>(
     let c_order = a.is_c_contiguous();
     Ok(match a.as_slice().ok().filter(|_| c_order) {
         Some(s) => {
-            let mut out = vec![0f32; s.len()];
+            let mut out = out;
+            if out.len() != s.len() {
+                out = vec![0f32; s.len()];
+            }
             out.par_chunks_mut(c * 4096)
                 .zip(s.par_chunks(c * 4096))
                 .for_each(|(o, s)| {

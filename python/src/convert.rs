@@ -580,6 +580,8 @@ pub struct Remap {
     dst: Projection,
     layout: Option<Layout>,
     extent: (u32, u32),
+    /// The last source's float texels, filled again by the next `apply`.
+    spare: std::sync::Mutex<Vec<f32>>,
 }
 
 #[pymethods]
@@ -652,6 +654,7 @@ impl Remap {
             dst,
             layout,
             extent,
+            spare: std::sync::Mutex::new(Vec::new()),
         })
     }
 
@@ -672,7 +675,9 @@ impl Remap {
     ) -> PyResult<Bound<'py, PyAny>> {
         let want = arrays::dtype_arg(py, dtype)?;
         let invalid: Invalid = arrays::invalid_arg(invalid)?;
-        let pics = arrays::pictures(array, "array", self.source.lead(), linear, invalid)?;
+        let spare = std::mem::take(&mut *self.spare.lock().unwrap_or_else(|e| e.into_inner()));
+        let pics =
+            arrays::pictures_into(array, "array", self.source.lead(), linear, invalid, spare)?;
         if (pics.width(), pics.height()) != self.src_extent {
             return Err(request(
                 "array",
@@ -695,7 +700,7 @@ impl Remap {
             let rows = run(|| plan.rows(&maps[i])).map_err(|e| request("array", e))?;
             f(&RemapRows(rows, row))
         };
-        make_all(
+        let made = make_all(
             py,
             maps.len(),
             batched,
@@ -705,7 +710,9 @@ impl Remap {
             linear,
             out,
             &make,
-        )
+        );
+        *self.spare.lock().unwrap_or_else(|e| e.into_inner()) = Pictures::spare_of(maps);
+        made
     }
 
     /// The shape of one result (without a batch's N), for channels `c`.
