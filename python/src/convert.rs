@@ -287,8 +287,10 @@ impl<T: Copy> Dest<T> {
                 }
             }
         } else {
-            for (i, (o, &v)) in out.iter_mut().zip(row).enumerate() {
-                *o = enc(i % c, v);
+            for (o, s) in out.chunks_exact_mut(c).zip(row.chunks_exact(c)) {
+                for (i, (o, &v)) in o.iter_mut().zip(s).enumerate() {
+                    *o = enc(i, v);
+                }
             }
         }
     }

@@ -172,3 +172,19 @@ def test_threads_setting():
     finally:
         mb.set_threads(None)
     assert mb.get_threads() >= 1
+
+
+def test_srgb8_codes_are_the_nearest(tmp):
+    # Every threshold between codes on the exact curve, a float either side of it, and a
+    # sweep: the codes are io's (the count of thresholds at or below the value).
+    k = np.arange(255) + 0.5
+    c = k / 255
+    t = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
+    near = np.concatenate([t, np.nextafter(t, 0), np.nextafter(t, 2)])
+    sweep = np.linspace(-0.01, 1.01, 300_000, dtype=np.float32)
+    x = np.concatenate([near, sweep, [0, 1, 2, np.float32(2.0**-9)]]).astype(np.float32)
+    x = np.resize(x, (300, 600, 3))  # 2:1, read as a lat-long
+    mb.write(tmp / "x.exr", x)
+    codes, _ = mb.read(tmp / "x.exr", dtype=np.uint8)
+    expected = np.searchsorted(t, x, side="right").astype(np.uint8)
+    assert np.array_equal(codes, expected)
