@@ -133,8 +133,8 @@ impl Source {
     /// The maps of `pics`: each picture (or each group of layers) one map.
     pub fn maps(&self, arg: &str, pics: Pictures) -> PyResult<Vec<EnvMap>> {
         let (w, h) = (pics.width(), pics.height());
-        let (proj, layout) = self.shape(arg, w, h)?;
         if self.separate_layers() {
+            let (proj, _) = self.shape(arg, w, h)?;
             let n = self.layers();
             if pics.lead.last() != Some(&n) {
                 return Err(request(
@@ -156,9 +156,28 @@ impl Source {
             }
             return Ok(maps);
         }
+        // Each picture read as the CLI reads a picture with --from (and --in-layout): the
+        // library's `interpret` (the layout judged by the shape, the shape checked, the
+        // layers unpacked), its messages naming this call's arguments.
+        let named = |e: mirrorball::Error| {
+            let m = e.message.replace("use --from to", "say another src to");
+            crate::errors::by_fault(e.fault, m.replace("--from", self.arg))
+        };
         pics.images
             .into_iter()
-            .map(|img| layout.unpack_owned(img, proj).map_err(|e| request(arg, e)))
+            .map(|img| {
+                mirrorball::load::interpret(
+                    arg,
+                    img,
+                    Some(&self.spec),
+                    self.layout,
+                    None,
+                    None,
+                    |_| String::new(),
+                )
+                .map(|(env, _)| env)
+                .map_err(named)
+            })
             .collect()
     }
 

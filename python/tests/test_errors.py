@@ -26,10 +26,10 @@ def test_wrong_shape_names_the_array(smooth):
     with pytest.raises(ValueError, match=r"array: shape 128×256×2: 2 channels"):
         mb.convert(smooth[..., :2])
     # A lat-long is 2:1.
-    with pytest.raises(ValueError, match=r"array: a latlong map of width 256 is 256x128"):
+    with pytest.raises(mb.InputError, match=r"array: a latlong map is 2:1 \(256x128 for this width\) but the picture is 256x100"):
         mb.convert(smooth[:100])
     # No cube layout is 2:1 ... but a 4:3 picture read as a cube is.
-    with pytest.raises(ValueError, match=r"array: a 256x128 picture fits no layout of a cube map"):
+    with pytest.raises(mb.InputError, match=r"array: a 256x128 picture fits no layout of a cube map"):
         mb.convert(smooth, src="cube")
     with pytest.raises(ValueError, match="array"):
         mb.convert(np.zeros((2, 2, 3, 3, 3, 3), np.float32))
