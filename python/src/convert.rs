@@ -492,7 +492,7 @@ fn make_all<'py>(
 }
 
 /// The output projection and its layers' size: `size` as the CLI's `--size` (a cube's face
-/// edge, a lat-long's height…), by default the source's resolution kept.
+/// edge, a lat-long's width…), by default the source's resolution kept.
 fn destination(dst: &str, size: Option<i64>, src: &EnvMap) -> PyResult<(Projection, (u32, u32))> {
     let dst = spec_arg("dst", dst)?
         .build(None)
@@ -505,15 +505,12 @@ fn destination(dst: &str, size: Option<i64>, src: &EnvMap) -> PyResult<(Projecti
     Ok((dst, dst.layer_extent(size)))
 }
 
-/// convert(array, src="latlong", dst="cube", size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8, dtype=None, linear=False, invalid="raise", out=None)
-/// --
-///
 /// Converts an environment map (H×W×C, or a batch N×H×W×C) from projection `src` to `dst`
 /// with mirrorball's antialiasing: the CLI's `mirrorball convert`, bit for bit.
 ///
 /// `src`, `dst`: projection texts as the CLI's --from/--to take them
 /// (`NAME[:key=value…]`: "latlong", "cube", "fisheye:fov=190:lens=equisolid").
-/// `size`: as --size (a cube's face edge, a lat-long's height); default: the source's
+/// `size`: as --size (a cube's face edge, a lat-long's width); default: the source's
 /// resolution kept. `layout`: how a multi-layer output is packed ("hcross" by default for
 /// cubes, "separate" gives L×H×W×C, also "vcross", "hstrip", "vstrip", "c3x2", "eac").
 /// `src_layout`: how the source's layers are packed (default: judged by its shape;
@@ -574,18 +571,12 @@ pub fn convert<'py>(
     )
 }
 
-/// projections()
-/// --
-///
 /// The projection names `src` and `dst` take (canonical names; aliases are accepted too).
 #[pyfunction]
 pub fn projections() -> Vec<String> {
     ProjectionKind::all().map(|k| k.to_string()).collect()
 }
 
-/// Remap(src_shape, src="latlong", dst="cube", size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8)
-/// --
-///
 /// A conversion planned once for sources of one shape and applied to many arrays or
 /// batches (core's `Remap`: what cv2.remap's precomputed maps are, with mirrorball's
 /// antialiasing in the plan). Results agree with `convert` to about 1e-5 relative.
@@ -679,9 +670,6 @@ impl Remap {
         })
     }
 
-    /// apply(array, out=None, *, dtype=None, linear=False, invalid="raise")
-    /// --
-    ///
     /// Converts `array` (the plan's source shape, or a batch N×…) into a new array, or into
     /// `out` (C-contiguous, the result's shape and dtype) and returns it.
     #[pyo3(signature = (array, out=None, *, dtype=None, linear=false, invalid="raise"))]

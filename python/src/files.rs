@@ -38,9 +38,6 @@ fn path_text(path: &Path) -> PyResult<String> {
         .ok_or_else(|| request("path", format!("{}: not valid UTF-8", path.display())))
 }
 
-/// read(path, *, src=None, src_layout=None, dtype=None, linear=False)
-/// --
-///
 /// Reads an environment map (OpenEXR, Radiance HDR, PNG, JPEG, WebP, KTX2, DDS; one file a
 /// layer with "{face}" in the name) as the CLI reads it, and returns `(array, info)`. The
 /// array is the map's layers: H×W×C for one-layer projections, L×H×W×C otherwise (a cube's
@@ -92,9 +89,6 @@ pub fn read<'py>(
     Ok((array, info))
 }
 
-/// write(path, array, *, projection=None, layout=None, precision=None, compression=None, quality=92, mips=False, src_layout=None, linear=False, invalid="raise")
-/// --
-///
 /// Writes a map to `path` as the CLI's `convert` writes its output (the extension picks the
 /// container), atomically, and returns the files written. With `projection` (the text
 /// `convert` takes) the array is a map of it: H×W×C (layers packed in one picture are

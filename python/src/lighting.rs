@@ -34,9 +34,6 @@ fn one_map(
     Ok(source.maps("array", pics)?.remove(0))
 }
 
-/// prefilter(array, lobe, *, src="latlong", dst="cube", size=None, levels=None, mapping="linear", samples=128, cube_size=None, irradiance="exact", layout=None, src_layout=None, dtype=None, linear=False, invalid="raise")
-/// --
-///
 /// Prefiltered lighting as a mip chain: the CLI's `mirrorball prefilter`, bit for bit, one
 /// array per level (laid out by `layout` as `convert` does: "hcross" for cubes by default,
 /// "separate" for L×H×W×C). `lobe`: "lambert" (irradiance E/π), "phong" or "ggx".
@@ -204,9 +201,6 @@ pub fn prefilter<'py>(
         .collect()
 }
 
-/// sh9(array, *, src="latlong", src_layout=None, linear=False, invalid="raise")
-/// --
-///
 /// The radiance's nine spherical-harmonic coefficients (orthonormal real basis, world axes:
 /// mirrorball_filter::sh), as a 9×3 float64 array, index l(l + 1) + m.
 #[pyfunction]
@@ -226,9 +220,6 @@ pub fn sh9<'py>(
     Ok(PyArray1::from_vec(py, flat).reshape([9, 3])?.into_any())
 }
 
-/// bake(array, engine, out_dir, *, src="latlong", size=256, encoding=None, effort="basic", zstd=None, background_size=None, samples=128, source="", overwrite=False, src_layout=None, linear=False, invalid="raise")
-/// --
-///
 /// Image-based lighting baked for `engine` ("bevy", "three", "babylon", "gltf",
 /// "filament", "unity", "unreal", "ktx2") into the folder `out_dir`: the CLI's
 /// `mirrorball bake`, bit for bit (give `source` the name the CLI was given: it is recorded

@@ -19,9 +19,6 @@ pub fn run<T: Send>(f: impl FnOnce() -> T + Send) -> T {
     }
 }
 
-/// set_threads(n=None)
-/// --
-///
 /// Sets how many threads mirrorball's calls use: `n` ≥ 1, or None for one per core.
 #[pyfunction]
 #[pyo3(signature = (n=None))]
@@ -46,9 +43,6 @@ pub fn set_threads(n: Option<i64>) -> PyResult<()> {
     Ok(())
 }
 
-/// get_threads()
-/// --
-///
 /// How many threads mirrorball's calls use.
 #[pyfunction]
 pub fn get_threads() -> usize {
