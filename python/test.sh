@@ -2,7 +2,7 @@
 # Builds the Python package from this checkout and runs its tests:
 #   python/test.sh            # a venv at python/.venv (or $MIRRORBALL_VENV), pinned requirements
 # The venv is made from python/requirements-dev.txt (pip, from PyPI), the package built and
-# installed with maturin (release build, into $CARGO_TARGET_DIR if set), the CLI built for
+# installed with maturin (a debug build unless MIRRORBALL_PY_RELEASE=1, into $CARGO_TARGET_DIR if set), the CLI built for
 # the byte-for-byte tests (MIRRORBALL_BIN, else $CARGO_TARGET_DIR/debug/mirrorball), then
 # pytest runs python/tests. Extra arguments go to pytest.
 set -euo pipefail
@@ -21,6 +21,10 @@ if [ -z "${MIRRORBALL_BIN:-}" ]; then
     cargo build --quiet -p mirrorball-cli --manifest-path "$root/Cargo.toml"
     export MIRRORBALL_BIN="$target/debug/mirrorball"
 fi
-(cd "$here" && VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop --release --quiet)
+# A debug build by default (it shares the workspace's debug artifacts, so after `cargo test`
+# only PyO3 and this crate compile); MIRRORBALL_PY_RELEASE=1 for an optimised one (benches).
+profile=()
+[ "${MIRRORBALL_PY_RELEASE:-0}" = 1 ] && profile=(--release)
+(cd "$here" && VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop "${profile[@]}" --quiet)
 cd "$here"
 exec "$venv/bin/python" -m pytest -q "$@"

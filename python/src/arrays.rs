@@ -3,9 +3,9 @@
 //! not. 8- and 16-bit codes are sRGB as the CLI reads PNG (io's own tables), or linear
 //! (`linear=True`: code/255 or code/65535); alpha is always linear.
 
+use mirrorball::frames::pipe::SrgbTable;
 use crate::errors::request;
 use half::f16;
-use mirrorball_core::color::{linear_to_srgb, srgb_to_linear};
 use mirrorball_core::Image;
 use numpy::{
     Element, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
@@ -357,52 +357,16 @@ fn decode16(linear: bool) -> &'static [f32] {
     }
 }
 
-/// Linear light to the nearest 8-bit sRGB code, clamped to [0, 1], NaN 0: the rule io's PNG
-/// writer follows (the code is how many of the thresholds halfway between codes, on the
-/// exact curve, are at or below the value). Fast and exact: a table gives the code at the
-/// start of each of 2¹² pieces per octave above 2⁻⁹ (a piece spans under 0.02 of a code),
-/// and the thresholds after it are stepped over; below 2⁻⁹, a search of the thresholds.
+/// Linear light to the nearest 8-bit sRGB code, clamped to [0, 1], NaN 0: io's PNG rule,
+/// through the library's fast table that gives its codes exactly (`SrgbTable`, what raw
+/// video frames use).
 fn encode8_srgb(l: f32) -> u8 {
-    const FROM: u32 = 0x3b00_0000; // 2⁻⁹
-    const SHIFT: u32 = 11;
-    struct Enc {
-        thresholds: Vec<f32>,
-        start: Vec<u8>,
-    }
-    static ENC: OnceLock<Enc> = OnceLock::new();
-    let e = ENC.get_or_init(|| {
-        let thresholds: Vec<f32> = (0..255)
-            .map(|k| srgb_to_linear((k as f64 + 0.5) / 255.0) as f32)
-            .collect();
-        let pieces = (1.0f32.to_bits() - FROM) >> SHIFT;
-        let start = (0..pieces)
-            .map(|k| {
-                let at = f32::from_bits(FROM + (k << SHIFT));
-                thresholds.partition_point(|&x| x <= at) as u8
-            })
-            .collect();
-        Enc { thresholds, start }
-    });
-    if l.is_nan() || l <= f32::from_bits(FROM) {
-        return e.thresholds.partition_point(|&x| x <= l) as u8;
-    }
-    if l >= 1.0 {
-        return 255;
-    }
-    let mut c = e.start[((l.to_bits() - FROM) >> SHIFT) as usize] as usize;
-    while c < 255 && l >= e.thresholds[c] {
-        c += 1;
-    }
-    c as u8
+    SrgbTable::get(255.0).code8(l) as u8
 }
 
-/// Linear light to the nearest 16-bit sRGB code, as io's PNG writer.
+/// Linear light to the nearest 16-bit sRGB code, as io's PNG writer (the same table).
 fn encode16_srgb(l: f32) -> u16 {
-    if l > 0.0 {
-        (linear_to_srgb(l.min(1.0) as f64) * 65535.0 + 0.5) as u16
-    } else {
-        0
-    }
+    SrgbTable::get(65535.0).code16(l) as u16
 }
 
 /// A linear value (alpha, or a colour with `linear=True`) to an integer of `max`.

@@ -172,6 +172,7 @@ pub fn write(
             exr_compression,
             jpeg_quality: quality as u8,
             declared: None,
+            note: None,
         };
         let picture = pics.images.into_iter().next().expect("one picture");
         py.detach(|| run(|| mirrorball::io::write_image(&path, &picture, &opts)))
@@ -199,6 +200,7 @@ pub fn write(
             exr_compression,
             jpeg_quality: quality as u8,
             declared: None,
+            note: None,
         },
         mips,
         keep_invalid: invalid == Invalid::Keep,
