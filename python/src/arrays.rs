@@ -3,9 +3,9 @@
 //! not. 8- and 16-bit codes are sRGB as the CLI reads PNG (io's own tables), or linear
 //! (`linear=True`: code/255 or code/65535); alpha is always linear.
 
-use mirrorball::frames::pipe::SrgbTable;
 use crate::errors::request;
 use half::f16;
+use mirrorball::frames::pipe::SrgbTable;
 use mirrorball_core::Image;
 use numpy::{
     Element, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
