@@ -145,6 +145,9 @@ pub struct Converter {
     stereo: Stereo,
     /// The output frame's width and height.
     pub out_extent: (u32, u32),
+    /// How much U and V as made are reduced (2×2 means for 4:2:0) to their planes' size:
+    /// none where the layout halves with them.
+    chroma_shift: (u32, u32),
     /// What was decided about the input (its projection, layout and eyes), for people.
     pub said: String,
 }
@@ -216,19 +219,28 @@ impl Converter {
                 layer.0, layer.1, format.name
             )));
         }
-        let clayer = (layer.0 >> sx, layer.1 >> sy);
         let picture = target
             .stereo
             .extent_of(packed_extent(target.layout, layers, layer));
-        let cpicture = target
-            .stereo
-            .extent_of(packed_extent(target.layout, layers, clayer));
-        if cpicture != (picture.0 >> sx, picture.1 >> sy) || picture.0 % 2 + picture.1 % 2 > 0 {
+        if !(even(picture.0, sx) && even(picture.1, sy)) {
             return Err(Error::request(format!(
                 "--size: a {}x{} picture does not hold {} with even sizes: give another --size",
                 picture.0, picture.1, format.name
             )));
         }
+        // The colour planes' layers at their own size where the layout halves with them;
+        // else (EAC's fixed border) made at the picture's size and halved.
+        let mut clayer = (layer.0 >> sx, layer.1 >> sy);
+        let halves = target
+            .stereo
+            .extent_of(packed_extent(target.layout, layers, clayer))
+            == (picture.0 >> sx, picture.1 >> sy);
+        let chroma_shift = if halves {
+            (0, 0)
+        } else {
+            clayer = layer;
+            (sx, sy)
+        };
         let plan = |src: &EnvMap, out: (u32, u32), k: usize| PlanePlan {
             remap: Remap::with_extent(
                 *src.projection(),
@@ -256,6 +268,7 @@ impl Converter {
             layout: target.layout,
             stereo: target.stereo,
             out_extent: picture,
+            chroma_shift,
             said,
         })
     }
@@ -298,6 +311,10 @@ impl Converter {
                     .join(pictures)
                     .ok_or_else(|| Error::input("the eyes differ in size"))?
             };
+            let picture = match (k, self.chroma_shift) {
+                (0, _) | (_, (0, 0)) => picture,
+                (_, shift) => reduce(&picture, shift),
+            };
             out.extent[k] = (picture.width(), picture.height());
             out.data[k] = self.write_plane(&picture, plan.neutral);
         }
@@ -337,6 +354,30 @@ impl Converter {
         }
         out
     }
+}
+
+/// A one-channel picture reduced by `(sx, sy)` halvings: each texel the mean of its block.
+fn reduce(img: &Image, (sx, sy): (u32, u32)) -> Image {
+    let (w, h) = (img.width() >> sx, img.height() >> sy);
+    let (bw, bh) = (1usize << sx, 1usize << sy);
+    let src = img.data();
+    let sw = img.width() as usize;
+    let mut out = Image::new(w, h, 1);
+    let k = 1.0 / (bw * bh) as f32;
+    out.data_mut()
+        .par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, o) in row.iter_mut().enumerate() {
+                let mut sum = 0.0;
+                for dy in 0..bh {
+                    let r = &src[(y * bh + dy) * sw + x * bw..][..bw];
+                    sum += r.iter().sum::<f32>();
+                }
+                *o = sum * k;
+            }
+        });
+    out
 }
 
 /// The picture extent of `eye` in an arrangement of eyes.

@@ -237,7 +237,15 @@ fn raw_frames(path: &Path, filter: Option<&str>) -> Vec<u8> {
         cmd.args(["-vf", f]);
     }
     let out = cmd
-        .args(["-f", "rawvideo", "-pix_fmt", "yuv420p", "-"])
+        .args([
+            "-fps_mode",
+            "passthrough",
+            "-f",
+            "rawvideo",
+            "-pix_fmt",
+            "yuv420p",
+            "-",
+        ])
         .output()
         .unwrap();
     assert!(
@@ -339,16 +347,16 @@ fn bad_inputs_are_refused_and_leave_nothing() {
         "-f",
         "lavfi",
         "-i",
-        "testsrc2=size=255x127:rate=30:duration=0.2",
+        "testsrc2=size=256x128:rate=30:duration=0.2",
+        "-vf",
+        "scale=255:127",
         "-c:v",
         "ffv1",
         "-pix_fmt",
         "yuv420p",
         odd.to_str().unwrap(),
     ]);
-    refused(
-        &request(&odd, &d.join("o3.mp4"), "cube"),
-        Fault::Input,
-        "odd size",
-    );
+    let mut r = request(&odd, &d.join("o3.mp4"), "cube");
+    r.convert.input_plan.from = Some(ProjSpec::parse("latlong").unwrap());
+    refused(&r, Fault::Input, "odd size");
 }
