@@ -18,4 +18,5 @@ mod roundtrip;
 mod safety;
 mod util;
 mod v360;
+mod video;
 mod zoneplate;
