@@ -110,6 +110,19 @@ pub fn route(a: &ConvertArgs) -> Option<Result<(), CliError>> {
     if is_video(&a.input) || is_video(&a.output) {
         return Some(video(a));
     }
+    let f = &a.frames;
+    let encoder = [
+        ("--codec", f.codec.is_some()),
+        ("--crf", f.crf.is_some()),
+        ("--preset", f.preset.is_some()),
+    ];
+    if let Some((flag, _)) = encoder.iter().find(|(_, g)| *g) {
+        return Some(Err(CliError::request(format!(
+            "{flag} is for video files ({}); {} is not one",
+            VIDEO.join(", "),
+            a.output
+        ))));
+    }
     let many = || -> Result<bool, CliError> {
         Ok(a.input == "-"
             || a.output == "-"
@@ -133,9 +146,6 @@ fn single_only(a: &ConvertArgs) -> Result<(), CliError> {
         ("--pix-fmt", f.pix_fmt.is_some()),
         ("--out-pix-fmt", f.out_pix_fmt.is_some()),
         ("--shard", f.shard.is_some()),
-        ("--codec", f.codec.is_some()),
-        ("--crf", f.crf.is_some()),
-        ("--preset", f.preset.is_some()),
     ];
     match given.iter().find(|(_, g)| *g) {
         Some((flag, _)) => Err(CliError::request(format!(
