@@ -565,7 +565,7 @@ impl Writer {
                     let (w, h) = planes.extent[0];
                     let mut f = frame::Video::new(self.pix, w, h);
                     for k in 0..3 {
-                        let (pw, ph) = planes.extent[k];
+                        let (_, ph) = planes.extent[k];
                         let row = planes.data[k].len() / ph.max(1) as usize;
                         let stride = f.stride(k);
                         let dst = f.data_mut(k);
@@ -573,7 +573,6 @@ impl Writer {
                             dst[y * stride..y * stride + row]
                                 .copy_from_slice(&planes.data[k][y * row..(y + 1) * row]);
                         }
-                        let _ = pw;
                     }
                     let pts = pts.or(self.last.map(|t| t + self.step)).unwrap_or(0);
                     self.last = Some(pts);

@@ -219,9 +219,8 @@ impl Converter {
                 layer.0, layer.1, format.name
             )));
         }
-        let picture = target
-            .stereo
-            .extent_of(packed_extent(target.layout, layers, layer));
+        let packed = packed_extent(target.layout, layers, layer);
+        let picture = target.stereo.extent(packed.0, packed.1);
         if !(even(picture.0, sx) && even(picture.1, sy)) {
             return Err(Error::request(format!(
                 "--size: a {}x{} picture does not hold {} with even sizes: give another --size",
@@ -231,10 +230,9 @@ impl Converter {
         // The colour planes' layers at their own size where the layout halves with them;
         // else (EAC's fixed border) made at the picture's size and halved.
         let mut clayer = (layer.0 >> sx, layer.1 >> sy);
-        let halves = target
-            .stereo
-            .extent_of(packed_extent(target.layout, layers, clayer))
-            == (picture.0 >> sx, picture.1 >> sy);
+        let cpacked = packed_extent(target.layout, layers, clayer);
+        let halves =
+            target.stereo.extent(cpacked.0, cpacked.1) == (picture.0 >> sx, picture.1 >> sy);
         let chroma_shift = if halves {
             (0, 0)
         } else {
@@ -273,7 +271,7 @@ impl Converter {
         })
     }
 
-    /// The input frame's extent this plan takes.
+    /// The pixel format of the frames, in and out.
     pub fn format(&self) -> PlaneFormat {
         self.format
     }
@@ -378,17 +376,6 @@ fn reduce(img: &Image, (sx, sy): (u32, u32)) -> Image {
             }
         });
     out
-}
-
-/// The picture extent of `eye` in an arrangement of eyes.
-trait ExtentOf {
-    fn extent_of(self, eye: (u32, u32)) -> (u32, u32);
-}
-
-impl ExtentOf for Stereo {
-    fn extent_of(self, (w, h): (u32, u32)) -> (u32, u32) {
-        self.extent(w, h)
-    }
 }
 
 #[cfg(test)]
