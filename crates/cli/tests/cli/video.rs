@@ -4,9 +4,11 @@
 //! inputs: `crates/video/tests`.)
 
 use crate::util::{files, run, stderr};
+#[cfg(feature = "video")]
 use std::path::Path;
 
 /// A 30 fps testsrc2 lat-long of `size` and `seconds`, with a sine track.
+#[cfg(feature = "video")]
 fn make_video(path: &Path, size: &str, seconds: u32) {
     let status = std::process::Command::new("ffmpeg")
         .args(["-y", "-v", "error", "-nostdin", "-f", "lavfi", "-i"])
