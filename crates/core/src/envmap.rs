@@ -464,6 +464,7 @@ pub(crate) fn bilinear(
     out: &mut [f32],
 ) {
     match (layers[layer].channels(), out.len()) {
+        (1, 1) => bilinear_n::<1>(proj, layers, layer, uv, out),
         (3, 3) => bilinear_n::<3>(proj, layers, layer, uv, out),
         (4, 4) => bilinear_n::<4>(proj, layers, layer, uv, out),
         (4, 3) => {

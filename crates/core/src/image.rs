@@ -19,12 +19,15 @@ pub struct Image {
 }
 
 impl Image {
-    /// A black image. `channels` must be 3 (RGB) or 4 (RGBA).
+    /// A black image. `channels` must be 3 (RGB) or 4 (RGBA), or 1 for one plane of a
+    /// planar picture (a YUV frame's Y, U or V), which [`Remap`](crate::Remap), layouts and
+    /// stereo pairs convert and arrange alone.
     ///
     /// # Panics
-    /// If `channels` is not 3 or 4. Callers validating user input use [`Image::from_vec`].
+    /// If `channels` is not 1, 3 or 4. Callers validating user input use
+    /// [`Image::from_vec`].
     pub fn new(width: u32, height: u32, channels: usize) -> Image {
-        assert!(channels == 3 || channels == 4, "channels must be 3 or 4");
+        assert!(matches!(channels, 1 | 3 | 4), "channels must be 1, 3 or 4");
         let len = width as usize * height as usize * channels;
         Image {
             width,
@@ -208,7 +211,7 @@ impl Image {
     {
         use rayon::prelude::*;
         use std::mem::MaybeUninit;
-        assert!(channels == 3 || channels == 4, "channels must be 3 or 4");
+        assert!(matches!(channels, 1 | 3 | 4), "channels must be 1, 3 or 4");
         let row_len = width as usize * channels;
         let len = row_len * height as usize;
         let mut data: Vec<f32> = Vec::with_capacity(len);

@@ -524,7 +524,7 @@ impl Remap {
         let scale = self.job.scale;
         if scale != 1.0 {
             for px in row.chunks_exact_mut(C) {
-                for v in &mut px[..3] {
+                for v in &mut px[..C.min(3)] {
                     *v *= scale;
                 }
             }
@@ -614,6 +614,7 @@ impl<'a> RemapRows<'a> {
         }
         let base = Base::Floats(&planes);
         match self.c {
+            1 => self.remap.fill_row::<1>(&self.pyr, base, layer, y, row),
             3 => self.remap.fill_row::<3>(&self.pyr, base, layer, y, row),
             _ => self.remap.fill_row::<4>(&self.pyr, base, layer, y, row),
         }
@@ -1003,6 +1004,48 @@ fn push_bilinear(
 #[cfg(test)]
 mod tests {
     use super::quantize_fraction;
+    use crate::{EnvMap, Image, ProjectionKind, Remap, ResampleOptions};
+
+    /// A one-channel source (one plane of a YUV frame) is converted as the first channel of
+    /// a three-channel one holding the same values, antialiasing (integrated texels, the
+    /// mip levels they read) and seams included.
+    #[test]
+    fn one_channel_planes_convert_as_the_first_channel() {
+        let (ll, cube) = (
+            ProjectionKind::LatLong.default_projection(),
+            ProjectionKind::Cube.default_projection(),
+        );
+        let (w, h) = (96u32, 48u32);
+        let value = |i: usize| ((i * 37 + i / 7) % 251) as f32;
+        let mut one = Image::new(w, h, 1);
+        let mut three = Image::new(w, h, 3);
+        for (i, v) in one.data_mut().iter_mut().enumerate() {
+            *v = value(i);
+        }
+        for (i, t) in three.data_mut().chunks_exact_mut(3).enumerate() {
+            t.copy_from_slice(&[value(i), 1.0, 2.0]);
+        }
+        let (one, three) = (
+            EnvMap::new(ll, vec![one]).unwrap(),
+            EnvMap::new(ll, vec![three]).unwrap(),
+        );
+        // A small cube integrates many source texels each; a large one reads bilinearly.
+        for size in [5, 64] {
+            let plan = Remap::new(ll, (w, h), 1, cube, size, &ResampleOptions::default());
+            assert!(size > 5 || plan.tap_count() > 0, "integrated texels tested");
+            let (a, b) = (plan.apply(&one).unwrap(), plan.apply(&three).unwrap());
+            assert_eq!(a.channels(), 1);
+            for (la, lb) in a.layers().iter().zip(b.layers()) {
+                for (x, t) in la.data().iter().zip(lb.data().chunks_exact(3)) {
+                    assert!(
+                        (x - t[0]).abs() <= 1e-4 * t[0].abs().max(1.0),
+                        "{x} {}",
+                        t[0]
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn fractions_quantize_as_round_does() {

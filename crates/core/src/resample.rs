@@ -365,7 +365,10 @@ fn block_weights(proj: &Projection, layer: usize, w: u32, h: u32) -> Vec<[f32; 4
 fn downsample_into(img: &Image, weights: &[[f32; 4]], out: &mut Image) {
     let (w, h, c) = (img.width(), img.height(), img.channels());
     let data = img.data();
-    if c == 3 {
+    if c == 1 {
+        // One plane of a planar picture (a YUV frame's Y, U or V), each converted alone.
+        downsample_texels((w, h), |i| [data[i]], weights, out)
+    } else if c == 3 {
         downsample_texels(
             (w, h),
             |i| [data[3 * i], data[3 * i + 1], data[3 * i + 2]],

@@ -265,6 +265,47 @@ where
     Ok(staged)
 }
 
+/// Runs `work` with the name of a scratch file beside `path` (`.NAME.PART.PID.tmp`) for
+/// a writer that opens files by name (FFmpeg's muxers), registered as every temporary file
+/// is: removed when `work` ends, whatever it returns, and by [`interrupted`] (Ctrl-C). What
+/// `work` made there lands only if it copies it into place itself ([`atomic_write`]).
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// let out = dir.path().join("movie.mp4");
+/// let kept = mirrorball_io::with_scratch(&out, "mux", |scratch| {
+///     std::fs::write(scratch, b"frames").unwrap();
+///     Ok::<_, mirrorball_io::Error>(std::fs::read(scratch).unwrap())
+/// })
+/// .unwrap();
+/// assert_eq!(kept, b"frames");
+/// assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0); // nothing left
+/// ```
+pub fn with_scratch<T, E: From<Error>>(
+    path: &Path,
+    part: &str,
+    work: impl FnOnce(&Path) -> Result<T, E>,
+) -> Result<T, E> {
+    let target = write_through(path);
+    remove_leftovers(&target);
+    let name = target
+        .file_name()
+        .map(|n| format!("{}.{part}", n.to_string_lossy()))
+        .unwrap_or_else(|| part.to_string());
+    let tmp = temp_path(&target.with_file_name(name), std::process::id());
+    {
+        let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            return Err(Error::request(path, "interrupted".into()).into());
+        }
+        pending.push(tmp.clone());
+    }
+    let done = work(&tmp);
+    let _ = std::fs::remove_file(&tmp);
+    forget_pending(&tmp);
+    done
+}
+
 fn forget_pending(tmp: &Path) {
     let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
     if let Some(i) = pending.iter().position(|p| p == tmp) {

@@ -46,7 +46,8 @@ mod sh_file;
 pub use alloc::HugePages;
 pub use apng::write_apng;
 pub use atomic::{
-    atomic_write, interrupted, keep_folder, made_folder, removed_leftovers, write_together,
+    atomic_write, interrupted, keep_folder, made_folder, removed_leftovers, with_scratch,
+    write_together,
 };
 pub use babylon_env::{read_babylon_env, write_babylon_env, BabylonEnv};
 pub use dds_io::write_dds;

@@ -19,4 +19,5 @@ mod safety;
 mod tables;
 mod util;
 mod v360;
+mod video;
 mod zoneplate;

@@ -52,6 +52,53 @@ pub struct FramesArgs {
     /// on standard error when standard output carries frames.
     #[arg(long)]
     pub json: bool,
+    /// Video files (.mp4 .m4v .mov .mkv .webm; built with `--features video`): the encoder,
+    /// by FFmpeg's name as -c:v takes it: libx264 (the default; libvpx-vp9 for .webm),
+    /// libx265, libvpx-vp9, libaom-av1, …
+    #[arg(long, value_name = "ENCODER")]
+    pub codec: Option<String>,
+    /// Video files: the encoder's constant rate factor, as -crf (libx264's default 23).
+    #[arg(long, value_name = "N")]
+    pub crf: Option<u32>,
+    /// Video files: the encoder's preset, as -preset (libx264: ultrafast … veryslow).
+    #[arg(long, value_name = "NAME")]
+    pub preset: Option<String>,
+}
+
+/// Video file extensions (`mirrorball_video::EXTENSIONS`, known without the feature too).
+const VIDEO: &[&str] = &["mp4", "m4v", "mov", "mkv", "webm"];
+
+/// Whether `path` names a video file.
+fn is_video(path: &str) -> bool {
+    std::path::Path::new(path)
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| VIDEO.contains(&e.to_ascii_lowercase().as_str()))
+}
+
+/// Converts a video file (the `video` feature).
+#[cfg(feature = "video")]
+fn video(a: &ConvertArgs) -> Result<(), CliError> {
+    let r = mirrorball_video::VideoRequest {
+        convert: super::convert::request(a)?,
+        codec: a.frames.codec.clone(),
+        crf: a.frames.crf,
+        preset: a.frames.preset.clone(),
+    };
+    mirrorball_video::run(&r, &crate::progress::Printer { quiet: a.quiet })
+}
+
+/// Says how to get video files: this binary was built without them.
+#[cfg(not(feature = "video"))]
+fn video(a: &ConvertArgs) -> Result<(), CliError> {
+    Err(CliError::request(format!(
+        "{} {}: video files need mirrorball built with its `video` feature, on the system's \
+         FFmpeg libraries: `apt-get install libavcodec-dev libavformat-dev libavutil-dev pkg-config \
+         clang libclang-dev` \
+         then `cargo install --path crates/cli --features video`; or pipe raw frames \
+         (`ffmpeg -i in.mp4 -f rawvideo -pix_fmt rgb24 - | mirrorball convert - …`)",
+        a.input, a.output
+    )))
 }
 
 /// Runs `a` here when it is a sequence, a pipe or a manifest; `None` when it is a plain
@@ -59,6 +106,22 @@ pub struct FramesArgs {
 pub fn route(a: &ConvertArgs) -> Option<Result<(), CliError>> {
     if a.frames.manifest.is_some() {
         return Some(manifest::run(a));
+    }
+    if is_video(&a.input) || is_video(&a.output) {
+        return Some(video(a));
+    }
+    let f = &a.frames;
+    let encoder = [
+        ("--codec", f.codec.is_some()),
+        ("--crf", f.crf.is_some()),
+        ("--preset", f.preset.is_some()),
+    ];
+    if let Some((flag, _)) = encoder.iter().find(|(_, g)| *g) {
+        return Some(Err(CliError::request(format!(
+            "{flag} is for video files ({}); {} is not one",
+            VIDEO.join(", "),
+            a.output
+        ))));
     }
     let many = || -> Result<bool, CliError> {
         Ok(a.input == "-"
