@@ -4,10 +4,11 @@
 //! want of a margin, one that does not fit is refused before it starts) and at most 1.5×.
 //! Each run peaks at a few hundred MB, where the job's maps dominate the process's own.
 //!
-//! A test binary of its own: a child's `ru_maxrss` starts at the resident memory of the
-//! process it was spawned from (the kernel counts the memory it leaves at `exec`), so the
-//! spawning process must stay well under every child's peak, which the other tests'
-//! in-process maps do not let it (this one's, mostly its own mapped binary, is about 100 MB).
+//! A test binary of its own: a child's `ru_maxrss` is the larger of its own peak and the
+//! resident memory of the process it was spawned from (the kernel counts the memory it
+//! leaves at `exec`), so a child's measured peak is its own only when it is above this
+//! process's peak, which the other tests' in-process maps would not let it be (this one's,
+//! mostly its own mapped binary, is about 100 MB).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -179,10 +180,10 @@ fn estimates_hold_to_the_measured_peak() {
         std::fs::create_dir(p("frames")).unwrap();
     }
     println!("{}", table.join("\n"));
-    // A child's peak starts at what it inherits of this process (see the module's note):
-    // it is the child's own only while this process stays well under every child's.
+    // A child's peak is the larger of its own and what it inherits of this process (see the
+    // module's note): above this process's peak, it is the child's own.
     assert!(
-        own_peak() < least_peak / 2,
+        own_peak() < least_peak,
         "the test process peaked at {} MB, a child at {} MB: the children's peaks may be this process's",
         own_peak() / 1_000_000,
         least_peak / 1_000_000
