@@ -127,11 +127,9 @@ fn map_text(input: &str, src: &load::Source, panorama: Option<&str>) -> String {
 }
 
 /// The extension of `input`, lowercase.
-fn extension(input: &str) -> Option<String> {
-    Path::new(input)
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
+pub fn extension(input: &str) -> Option<String> {
+    let ext = Path::new(input).extension()?;
+    Some(ext.to_string_lossy().to_ascii_lowercase())
 }
 
 /// What a PNG's or JPEG's GPano XMP says: `None` for other files and for pictures

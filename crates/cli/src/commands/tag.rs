@@ -89,15 +89,12 @@ pub fn run(a: TagArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `input`'s extension, in lower case.
-fn extension(input: &str) -> Option<String> {
-    let ext = Path::new(input).extension()?;
-    Some(ext.to_string_lossy().to_ascii_lowercase())
-}
-
 /// Whether `info` should read `input` as a video (by its extension).
 pub fn is_movie(input: &str) -> bool {
-    matches!(extension(input).as_deref(), Some("mp4" | "mov" | "m4v"))
+    matches!(
+        mirrorball::info::extension(input).as_deref(),
+        Some("mp4" | "mov" | "m4v")
+    )
 }
 
 /// `info` of a video: each video track's spherical metadata and how mirrorball reads it.
