@@ -5,7 +5,7 @@
 
 use crate::errors::request;
 use half::f16;
-use mirrorball::frames::pipe::SrgbTable;
+use mirrorball::frames::pipe::{PixFmt, SrgbTable};
 use mirrorball_core::Image;
 use numpy::{
     Element, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
@@ -73,16 +73,13 @@ pub struct Pictures {
 }
 
 impl Pictures {
-    /// The buffer of a single picture's texels back, for [`pictures_into`] to fill again.
-    pub fn spare_of(maps: Vec<mirrorball_core::EnvMap>) -> Vec<f32> {
-        match <[_; 1]>::try_from(maps) {
-            Ok([map]) if map.layers().len() == 1 => map
-                .into_layers()
-                .pop()
-                .map(Image::into_vec)
-                .unwrap_or_default(),
-            _ => Vec::new(),
-        }
+    /// The buffers of the maps' layers back (each picture's texels), for
+    /// [`pictures_into`] to fill again.
+    pub fn spare_of(maps: Vec<mirrorball_core::EnvMap>) -> Vec<Vec<f32>> {
+        maps.into_iter()
+            .flat_map(|m| m.into_layers())
+            .map(Image::into_vec)
+            .collect()
     }
 
     pub fn height(&self) -> u32 {
@@ -131,15 +128,15 @@ pub fn pictures(
     pictures_into(obj, arg, lead_ok, linear, invalid, Vec::new())
 }
 
-/// [`pictures`] into `spare` (an earlier call's buffer, from [`Pictures::into_spare`]) when
-/// it is the right length: no allocation and no page faults for the frames of a loop.
+/// [`pictures`] into `spare` (an earlier call's buffers, from [`Pictures::spare_of`]) where
+/// they are the right length: no allocation and no page faults for the frames of a loop.
 pub fn pictures_into(
     obj: &Bound<'_, PyAny>,
     arg: &str,
     lead_ok: std::ops::RangeInclusive<usize>,
     linear: bool,
     invalid: Invalid,
-    spare: Vec<f32>,
+    spare: Vec<Vec<f32>>,
 ) -> PyResult<Pictures> {
     let arr = obj.cast::<PyUntypedArray>().map_err(|_| {
         let ty = obj
@@ -201,47 +198,44 @@ pub fn pictures_into(
             "{arg}: dtype {name}; give {TAKEN} (for example {arg}.astype(np.float32))"
         ))
     })?;
-    let total = count * per;
-    let spare = match spare.len() == total {
-        true => spare,
-        false => Vec::new(),
-    };
+    // One buffer a picture, an earlier call's where it has the length.
+    let mut bufs = spare;
+    bufs.truncate(count);
+    for b in &mut bufs {
+        if b.len() != per {
+            *b = vec![0.0; per];
+        }
+    }
+    bufs.resize_with(count, || vec![0.0; per]);
     let mut nonfinite = 0;
-    let flat: Vec<f32> = match dtype {
-        Dtype::F32 => floats::<f32>(obj, |v| v, spare, &mut nonfinite)?,
-        Dtype::F16 => floats::<f16>(obj, f16::to_f32, spare, &mut nonfinite)?,
+    match dtype {
+        Dtype::F32 => nonfinite = floats::<f32>(obj, |v| v, &mut bufs)?,
+        Dtype::F16 => nonfinite = floats::<f16>(obj, f16::to_f32, &mut bufs)?,
         Dtype::U8 => {
             let (t, a) = (decode8(linear), alpha8());
-            coded::<u8>(obj, c, |v| t[v as usize], |v| a[v as usize], spare)?
+            coded::<u8>(obj, c, |v| t[v as usize], |v| a[v as usize], &mut bufs)?
         }
         Dtype::U16 => {
             let t = decode16(linear);
-            coded::<u16>(obj, c, |v| t[v as usize], |v| v as f32 / 65535.0, spare)?
+            coded::<u16>(obj, c, |v| t[v as usize], |v| v as f32 / 65535.0, &mut bufs)?
         }
     };
     if matches!(dtype, Dtype::F32 | Dtype::F16) {
         match invalid {
             Invalid::Keep => {}
             Invalid::Raise => {
-                let bad = nonfinite;
-                if bad > 0 {
-                    return Err(request(
-                        arg,
-                        format!("{bad} NaN or infinite values (invalid='zero' sets them to 0, as the CLI does; invalid='keep' keeps them)"),
-                    ));
+                if nonfinite > 0 {
+                    return Err(nonfinite_error(arg, nonfinite));
                 }
             }
             // Core's rule, after the pictures are made.
             Invalid::Zero => {}
         }
     }
-    let images = if count == 1 {
-        vec![Image::from_vec(w as u32, h as u32, c, flat).expect("checked shape")]
-    } else {
-        flat.chunks_exact(per)
-            .map(|p| Image::from_vec(w as u32, h as u32, c, p.to_vec()).expect("checked shape"))
-            .collect()
-    };
+    let images: Vec<Image> = bufs
+        .into_iter()
+        .map(|v| Image::from_vec(w as u32, h as u32, c, v).expect("checked shape"))
+        .collect();
     let mut images = images;
     if invalid == Invalid::Zero {
         images.par_iter_mut().for_each(|img| {
@@ -255,89 +249,93 @@ pub fn pictures_into(
     })
 }
 
-/// The floats of a float array, in C order (any strides).
-/// The floats of a float array, in C order (any strides), into `out` (reused when it has
-/// the array's length), counting the NaN and infinite ones into `nonfinite` as they are
-/// copied (while in cache).
+/// `invalid='raise'` refusing an array holding `bad` NaN or infinite values.
+pub fn nonfinite_error(arg: &str, bad: usize) -> PyErr {
+    request(
+        arg,
+        format!("{bad} NaN or infinite values (invalid='zero' sets them to 0, as the CLI does; invalid='keep' keeps them)"),
+    )
+}
+
+/// Copies a float array's values, in C order (any strides), into `bufs` (one picture's
+/// texels each, in order), returning how many are NaN or infinite (counted as they are
+/// copied, while in cache).
 fn floats<T: Element + Copy + Sync>(
     obj: &Bound<'_, PyAny>,
     f: fn(T) -> f32,
-    mut out: Vec<f32>,
-    nonfinite: &mut usize,
-) -> PyResult<Vec<f32>> {
+    bufs: &mut [Vec<f32>],
+) -> PyResult<usize> {
     let a: PyReadonlyArrayDyn<'_, T> = obj.extract()?;
-    // `as_slice` takes Fortran order too: C order only, else the logical iteration.
-    let c_order = a.is_c_contiguous();
-    let out = match a.as_slice().ok().filter(|_| c_order) {
-        Some(s) => {
-            if out.len() != s.len() {
-                out = vec![0.0; s.len()];
-            }
-            const BLOCK: usize = 1 << 15;
-            *nonfinite = out
-                .par_chunks_mut(BLOCK)
-                .zip(s.par_chunks(BLOCK))
-                .map(|(d, s)| {
-                    for (d, &v) in d.iter_mut().zip(s) {
-                        *d = f(v);
-                    }
-                    d.iter().filter(|v| !v.is_finite()).count()
-                })
-                .sum();
-            out
+    fill(&a, bufs, 1 << 15, |d, s| {
+        for (d, &v) in d.iter_mut().zip(s) {
+            *d = f(v);
         }
-        None => {
-            let v: Vec<f32> = a.as_array().iter().map(|&v| f(v)).collect();
-            *nonfinite = v.iter().filter(|v| !v.is_finite()).count();
-            v
-        }
-    };
-    Ok(out)
+        d.iter().filter(|v| !v.is_finite()).count()
+    })
 }
 
 /// The linear values of an integer array of `c` channels, colour through `colour`, alpha
-/// through `alpha`.
+/// through `alpha`, into `bufs` (one picture's texels each, in order).
 fn coded<T: Element + Copy + Sync>(
     obj: &Bound<'_, PyAny>,
     c: usize,
     colour: impl Fn(T) -> f32 + Sync,
     alpha: impl Fn(T) -> f32 + Sync,
-    out: Vec<f32>,
-) -> PyResult<Vec<f32>> {
+    bufs: &mut [Vec<f32>],
+) -> PyResult<()> {
     let a: PyReadonlyArrayDyn<'_, T> = obj.extract()?;
-    let decode = |i: usize, v: T| {
-        if c == 4 && i % 4 == 3 {
-            alpha(v)
-        } else {
-            colour(v)
+    fill(&a, bufs, c * 4096, |d, s| {
+        for (i, (d, &v)) in d.iter_mut().zip(s).enumerate() {
+            *d = if c == 4 && i % 4 == 3 {
+                alpha(v)
+            } else {
+                colour(v)
+            };
         }
-    };
-    let c_order = a.is_c_contiguous();
-    Ok(match a.as_slice().ok().filter(|_| c_order) {
-        Some(s) => {
-            let mut out = out;
-            if out.len() != s.len() {
-                out = vec![0f32; s.len()];
-            }
-            out.par_chunks_mut(c * 4096)
-                .zip(s.par_chunks(c * 4096))
-                .for_each(|(o, s)| {
-                    for (i, (o, &v)) in o.iter_mut().zip(s).enumerate() {
-                        *o = decode(i, v);
-                    }
-                });
-            out
-        }
-        None => a
-            .as_array()
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| decode(i, v))
-            .collect(),
-    })
+        0
+    })?;
+    Ok(())
 }
 
-fn decode8(linear: bool) -> &'static [f32] {
+/// Fills `bufs` (consecutive parts of the array's C order) from `a` through `block(dst,
+/// src)` in parallel blocks of `block_len` (a whole number of texels), summing what the
+/// blocks return; an array not in C order is read by its logical iteration.
+fn fill<T: Element + Copy + Sync>(
+    a: &PyReadonlyArrayDyn<'_, T>,
+    bufs: &mut [Vec<f32>],
+    block_len: usize,
+    block: impl Fn(&mut [f32], &[T]) -> usize + Sync,
+) -> PyResult<usize> {
+    // `as_slice` takes Fortran order too: C order only, else the logical iteration.
+    if let Some(s) = a.as_slice().ok().filter(|_| a.is_c_contiguous()) {
+        let mut at = 0;
+        let mut sum = 0;
+        for b in bufs.iter_mut() {
+            let part = &s[at..at + b.len()];
+            at += b.len();
+            sum += b
+                .par_chunks_mut(block_len)
+                .zip(part.par_chunks(block_len))
+                .map(|(d, s)| block(d, s))
+                .sum::<usize>();
+        }
+        return Ok(sum);
+    }
+    let arr = a.as_array();
+    let mut values = arr.iter();
+    let mut sum = 0;
+    let mut scratch = Vec::with_capacity(block_len);
+    for b in bufs.iter_mut() {
+        for d in b.chunks_mut(block_len) {
+            scratch.clear();
+            scratch.extend(values.by_ref().take(d.len()).copied());
+            sum += block(d, &scratch);
+        }
+    }
+    Ok(sum)
+}
+
+pub fn decode8(linear: bool) -> &'static [f32] {
     static LINEAR: OnceLock<Vec<f32>> = OnceLock::new();
     match linear {
         false => &mirrorball_io::srgb8_to_linear()[..],
@@ -349,7 +347,7 @@ fn alpha8() -> &'static [f32] {
     decode8(true)
 }
 
-fn decode16(linear: bool) -> &'static [f32] {
+pub fn decode16(linear: bool) -> &'static [f32] {
     static LINEAR: OnceLock<Vec<f32>> = OnceLock::new();
     match linear {
         false => mirrorball_io::srgb16_to_linear(),
@@ -378,42 +376,92 @@ fn encode_linear(a: f32, max: f32) -> f32 {
     }
 }
 
-/// Encodes `src` (interleaved, `c` channels) into `out` as `T`.
-pub fn encode_into<T: Send>(
-    src: &[f32],
-    c: usize,
-    out: &mut [T],
-    f: impl Fn(usize, f32) -> T + Sync,
-) {
-    out.par_chunks_mut(c * 4096)
-        .zip(src.par_chunks(c * 4096))
-        .for_each(|(o, s)| {
-            for (o, s) in o.chunks_exact_mut(c).zip(s.chunks_exact(c)) {
-                for (i, (o, &v)) in o.iter_mut().zip(s).enumerate() {
-                    *o = f(i, v);
-                }
-            }
-        });
+/// An output element type: how a row of linear floats becomes its elements.
+pub trait OutElem: Element + Copy + Default + Send + Sync {
+    /// Encodes `src` (texels of `c` channels, the fourth alpha) into `out` (as many
+    /// elements): floats as they are, integers as the module documents.
+    fn encode_row(src: &[f32], c: usize, linear: bool, out: &mut [Self]);
+    /// `out` as floats where the element is `f32` (rows are then made straight into it).
+    fn floats(_out: &mut [Self]) -> Option<&mut [f32]> {
+        None
+    }
 }
 
-/// The texels `src` (interleaved, `c` channels) as a flat vector of `dtype`.
-fn encode_all<T: Send + Default + Clone>(
-    src: &[&[f32]],
-    c: usize,
-    f: impl Fn(usize, f32) -> T + Sync,
-) -> Vec<T> {
+impl OutElem for f32 {
+    fn encode_row(src: &[f32], _: usize, _: bool, out: &mut [f32]) {
+        out.copy_from_slice(src);
+    }
+    fn floats(out: &mut [f32]) -> Option<&mut [f32]> {
+        Some(out)
+    }
+}
+
+impl OutElem for f16 {
+    fn encode_row(src: &[f32], _: usize, _: bool, out: &mut [f16]) {
+        for (o, &v) in out.iter_mut().zip(src) {
+            *o = f16::from_f32(v);
+        }
+    }
+}
+
+impl OutElem for u8 {
+    fn encode_row(src: &[f32], c: usize, linear: bool, out: &mut [u8]) {
+        if c == 3 && !linear {
+            // RGB sRGB codes: the library's raw-frame encoder (eight lanes, io's codes).
+            return PixFmt::Rgb24.encode_texels(Some(SrgbTable::get(255.0)), src, 3, out);
+        }
+        if c == 3 {
+            // Linear codes: each value rounded, a loop the compiler vectorises.
+            for (o, &v) in out.iter_mut().zip(src) {
+                *o = (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+            }
+            return;
+        }
+        per_value(src, c, out, encoder_u8(c, linear))
+    }
+}
+
+impl OutElem for u16 {
+    fn encode_row(src: &[f32], c: usize, linear: bool, out: &mut [u16]) {
+        if c == 3 && !linear && cfg!(target_endian = "little") {
+            // SAFETY: the elements' bytes, written as little-endian codes, which on this
+            // target are the `u16`s themselves; `u8` has no alignment.
+            let bytes = unsafe {
+                std::slice::from_raw_parts_mut(out.as_mut_ptr().cast::<u8>(), out.len() * 2)
+            };
+            let table = SrgbTable::get(65535.0);
+            return PixFmt::Rgb48le.encode_texels(Some(table), src, 3, bytes);
+        }
+        per_value(src, c, out, encoder_u16(c, linear))
+    }
+}
+
+/// Each value of `src` (texels of `c` channels) through `f(channel, value)`.
+fn per_value<T>(src: &[f32], c: usize, out: &mut [T], f: impl Fn(usize, f32) -> T) {
+    for (o, s) in out.chunks_exact_mut(c).zip(src.chunks_exact(c)) {
+        for (i, (o, &v)) in o.iter_mut().zip(s).enumerate() {
+            *o = f(i, v);
+        }
+    }
+}
+
+/// The texels `src` (interleaved, `c` channels) as a flat vector of `T`, in parallel blocks.
+fn encode_all<T: OutElem>(src: &[&[f32]], c: usize, linear: bool) -> Vec<T> {
     let total: usize = src.iter().map(|s| s.len()).sum();
     let mut out = vec![T::default(); total];
     let mut at = 0;
     for s in src {
-        encode_into(s, c, &mut out[at..at + s.len()], &f);
+        out[at..at + s.len()]
+            .par_chunks_mut(c * 4096)
+            .zip(s.par_chunks(c * 4096))
+            .for_each(|(o, s)| T::encode_row(s, c, linear, o));
         at += s.len();
     }
     out
 }
 
 /// The per-channel encoder of `dtype`.
-pub fn encoder_u8(c: usize, linear: bool) -> impl Fn(usize, f32) -> u8 + Sync {
+fn encoder_u8(c: usize, linear: bool) -> impl Fn(usize, f32) -> u8 + Sync {
     move |ch, v| {
         if linear || (c == 4 && ch == 3) {
             encode_linear(v, 255.0) as u8
@@ -423,7 +471,7 @@ pub fn encoder_u8(c: usize, linear: bool) -> impl Fn(usize, f32) -> u8 + Sync {
     }
 }
 
-pub fn encoder_u16(c: usize, linear: bool) -> impl Fn(usize, f32) -> u16 + Sync {
+fn encoder_u16(c: usize, linear: bool) -> impl Fn(usize, f32) -> u16 + Sync {
     move |ch, v| {
         if linear || (c == 4 && ch == 3) {
             encode_linear(v, 65535.0) as u16
@@ -451,27 +499,21 @@ pub fn to_numpy<'py>(
         let a = PyArray1::from_vec(py, v);
         Ok(a.reshape(shape)?.into_any())
     }
-    let parts: Vec<&[f32]> = parts.to_vec();
+    fn typed<'py, T: OutElem>(
+        py: Python<'py>,
+        parts: &[&[f32]],
+        shape: &[usize],
+        c: usize,
+        linear: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let v = py.detach(|| crate::threads::run(|| encode_all::<T>(parts, c, linear)));
+        shaped(py, v, shape)
+    }
     match dtype {
-        Dtype::F32 => {
-            let v = py.detach(|| crate::threads::run(|| encode_all(&parts, c, |_, v| v)));
-            shaped(py, v, shape)
-        }
-        Dtype::F16 => {
-            let v = py
-                .detach(|| crate::threads::run(|| encode_all(&parts, c, |_, v| f16::from_f32(v))));
-            shaped(py, v, shape)
-        }
-        Dtype::U8 => {
-            let v =
-                py.detach(|| crate::threads::run(|| encode_all(&parts, c, encoder_u8(c, linear))));
-            shaped(py, v, shape)
-        }
-        Dtype::U16 => {
-            let v =
-                py.detach(|| crate::threads::run(|| encode_all(&parts, c, encoder_u16(c, linear))));
-            shaped(py, v, shape)
-        }
+        Dtype::F32 => typed::<f32>(py, parts, shape, c, linear),
+        Dtype::F16 => typed::<f16>(py, parts, shape, c, linear),
+        Dtype::U8 => typed::<u8>(py, parts, shape, c, linear),
+        Dtype::U16 => typed::<u16>(py, parts, shape, c, linear),
     }
 }
 

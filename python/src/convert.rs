@@ -3,15 +3,18 @@
 //! arrays or batches, into `out=`). The work runs with the GIL released, in bands of rows,
 //! and Python's signal handlers run between bands (Ctrl-C stops a long call).
 
-use crate::arrays::{self, Dtype, Invalid, Pictures};
+use crate::arrays::{self, Dtype, Invalid, OutElem, Pictures};
 use crate::errors::request;
 use crate::threads::run;
 use mirrorball_core::projection::ProjectionSpec;
 use mirrorball_core::{
-    Choice, EnvMap, Image, Layout, Projection, ProjectionKind, ResampleOptions, Resampler,
+    Choice, Codes, EnvMap, Image, Layout, Projection, ProjectionKind, ResampleOptions, Resampler,
     Rotation, WorldProjection,
 };
-use numpy::{Element, PyArrayDyn, PyArrayMethods};
+use numpy::{
+    PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -286,32 +289,36 @@ struct Dest<T> {
 unsafe impl<T: Send> Send for Dest<T> {}
 unsafe impl<T: Send> Sync for Dest<T> {}
 
-impl<T: Copy> Dest<T> {
-    /// Writes `row` (floats, `c` channels) at `offset`, backwards by texels if `reversed`.
-    fn put(
-        &self,
-        offset: usize,
-        row: &[f32],
-        c: usize,
-        reversed: bool,
-        enc: &(impl Fn(usize, f32) -> T + Sync),
-    ) {
-        assert!(offset + row.len() <= self.len, "a row past the array's end");
-        // SAFETY: in bounds (asserted), and no other writer writes these elements.
-        let out = unsafe { std::slice::from_raw_parts_mut(self.ptr.add(offset), row.len()) };
+impl<T: OutElem> Dest<T> {
+    /// The `len` elements at `offset`, for one writer.
+    ///
+    /// # Safety
+    /// No other writer may hold elements of `offset..offset + len` at the same time.
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn part(&self, offset: usize, len: usize) -> &mut [T] {
+        assert!(offset + len <= self.len, "a row past the array's end");
+        // SAFETY: in bounds (asserted); the caller's writers are disjoint.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(offset), len) }
+    }
+
+    /// Writes `row` (floats, `c` channels) at `offset`, backwards by texels if `reversed`
+    /// (`row` is then turned in place).
+    fn put(&self, offset: usize, row: &mut [f32], c: usize, reversed: bool, linear: bool) {
         if reversed {
-            for (o, s) in out.chunks_exact_mut(c).zip(row.chunks_exact(c).rev()) {
-                for (i, (o, &v)) in o.iter_mut().zip(s).enumerate() {
-                    *o = enc(i, v);
-                }
-            }
-        } else {
-            for (o, s) in out.chunks_exact_mut(c).zip(row.chunks_exact(c)) {
-                for (i, (o, &v)) in o.iter_mut().zip(s).enumerate() {
-                    *o = enc(i, v);
-                }
-            }
+            reverse_texels(row, c);
         }
+        // SAFETY: every row of the output is written by one writer (`make_map`).
+        let out = unsafe { self.part(offset, row.len()) };
+        T::encode_row(row, c, linear, out);
+    }
+}
+
+/// Turns a row of texels of `c` channels end for end.
+fn reverse_texels(row: &mut [f32], c: usize) {
+    let n = row.len() / c;
+    for i in 0..n / 2 {
+        let (a, b) = row.split_at_mut((n - 1 - i) * c);
+        a[i * c..(i + 1) * c].swap_with_slice(&mut b[..c]);
     }
 }
 
@@ -327,6 +334,10 @@ fn check_signals() -> PyResult<()> {
 trait Rows: Sync {
     /// Makes rows `y0 ..` of `layer` into `band` (whole rows).
     fn rows(&self, layer: usize, y0: usize, band: &mut [f32]);
+    /// The plan's rows, where each row can be made alone (straight into the output).
+    fn planned(&self) -> Option<&mirrorball_core::RemapRows<'_>> {
+        None
+    }
 }
 
 struct ResamplerRows<'a>(Resampler<'a>);
@@ -345,21 +356,50 @@ impl Rows for RemapRows<'_> {
             .enumerate()
             .for_each(|(i, row)| self.0.row_into(layer, y0 + i, row));
     }
+    fn planned(&self) -> Option<&mirrorball_core::RemapRows<'_>> {
+        Some(&self.0)
+    }
 }
 
 /// Makes every row of one map through `rows` into `dest` at `base` (its first element),
 /// band by band, checking signals between bands (on the calling thread: Python runs its
-/// handlers on the main thread only). Packed v360 cells are made whole, then packed.
-fn make_map<T: Copy + Send>(
+/// handlers on the main thread only). A plan's rows are made one by one on all threads,
+/// each encoded into the array while in cache (a float row made straight into it); packed
+/// v360 cells are made whole, then packed.
+fn make_map<T: OutElem>(
     rows: &dyn Rows,
     place: &Placement,
     dst: Projection,
     dest: &Dest<T>,
     base: usize,
-    enc: &(impl Fn(usize, f32) -> T + Sync),
+    linear: bool,
 ) -> PyResult<()> {
     let (w, h, c) = (place.w, place.h, place.c);
     let band = BAND_ROWS.max(h / 8).min(h);
+    if let (Some(planned), true) = (rows.planned(), place.by_rows()) {
+        for layer in 0..place.layers {
+            for y0 in (0..h).step_by(band) {
+                let ys = y0..(y0 + band).min(h);
+                run(|| {
+                    ys.into_par_iter().for_each_init(Vec::new, |buf, y| {
+                        let (at, reversed) = place.row_at(layer, y);
+                        if !reversed {
+                            // SAFETY: row `y` of `layer` is this writer's alone.
+                            let out = unsafe { dest.part(base + at, w * c) };
+                            if let Some(out) = T::floats(out) {
+                                return planned.row_into(layer, y, out);
+                            }
+                        }
+                        buf.resize(w * c, 0.0);
+                        planned.row_into(layer, y, buf);
+                        dest.put(base + at, buf, c, reversed, linear);
+                    })
+                });
+                check_signals()?;
+            }
+        }
+        return Ok(());
+    }
     let mut buf = vec![0f32; band * w * c];
     let mut whole: Vec<Image> = Vec::new();
     for layer in 0..place.layers {
@@ -372,9 +412,9 @@ fn make_map<T: Copy + Send>(
             match img.as_mut() {
                 Some(img) => img.data_mut()[y0 * w * c..(y0 + n) * w * c].copy_from_slice(part),
                 None => run(|| {
-                    part.par_chunks(w * c).enumerate().for_each(|(i, row)| {
+                    part.par_chunks_mut(w * c).enumerate().for_each(|(i, row)| {
                         let (at, reversed) = place.row_at(layer, y0 + i);
-                        dest.put(base + at, row, c, reversed, enc);
+                        dest.put(base + at, row, c, reversed, linear);
                     })
                 }),
             }
@@ -385,14 +425,15 @@ fn make_map<T: Copy + Send>(
     }
     if !place.by_rows() {
         let env = EnvMap::new(dst, whole).map_err(|e| request("dst", e))?;
-        let picture =
+        let mut picture =
             run(|| place.layout.pack(&env)).ok_or_else(|| request("layout", "does not fit"))?;
+        let row = picture.width() as usize * c;
         run(|| {
             picture
-                .data()
-                .par_chunks(picture.width() as usize * c)
+                .data_mut()
+                .par_chunks_mut(row)
                 .enumerate()
-                .for_each(|(y, row)| dest.put(base + y * row.len(), row, c, false, enc))
+                .for_each(|(y, r)| dest.put(base + y * row, r, c, false, linear))
         });
     }
     Ok(())
@@ -433,14 +474,14 @@ fn make_all<'py>(
             Dtype::U16 => PyArrayDyn::<u16>::zeros(py, shape.clone(), false).into_any(),
         },
     };
-    fn typed<T: Element + Copy + Send>(
+    fn typed<T: OutElem>(
         py: Python<'_>,
         array: &Bound<'_, PyAny>,
         count: usize,
         place: &Placement,
         dst: Projection,
         make: &MakeMap<'_>,
-        enc: impl Fn(usize, f32) -> T + Sync + Send,
+        linear: bool,
     ) -> PyResult<()> {
         let arr = array.cast::<PyArrayDyn<T>>()?;
         let mut rw = arr
@@ -457,36 +498,17 @@ fn make_all<'py>(
         py.detach(|| {
             for i in 0..count {
                 make(i, &mut |rows| {
-                    make_map(rows, place, dst, &dest, i * item, &enc)
+                    make_map(rows, place, dst, &dest, i * item, linear)
                 })?;
             }
             Ok(())
         })
     }
-    let c = place.c;
     match dtype {
-        Dtype::F32 => typed::<f32>(py, &array, count, &place, dst, make, |_, v| v)?,
-        Dtype::F16 => typed::<half::f16>(py, &array, count, &place, dst, make, |_, v| {
-            half::f16::from_f32(v)
-        })?,
-        Dtype::U8 => typed::<u8>(
-            py,
-            &array,
-            count,
-            &place,
-            dst,
-            make,
-            arrays::encoder_u8(c, linear),
-        )?,
-        Dtype::U16 => typed::<u16>(
-            py,
-            &array,
-            count,
-            &place,
-            dst,
-            make,
-            arrays::encoder_u16(c, linear),
-        )?,
+        Dtype::F32 => typed::<f32>(py, &array, count, &place, dst, make, linear)?,
+        Dtype::F16 => typed::<half::f16>(py, &array, count, &place, dst, make, linear)?,
+        Dtype::U8 => typed::<u8>(py, &array, count, &place, dst, make, linear)?,
+        Dtype::U16 => typed::<u16>(py, &array, count, &place, dst, make, linear)?,
     }
     Ok(array)
 }
@@ -589,11 +611,14 @@ pub struct Remap {
     source: Source,
     /// The source picture's width and height.
     src_extent: (u32, u32),
+    /// Whether each source picture is the projection's one layer as it is (no layout to
+    /// unpack).
+    one_picture: bool,
     dst: Projection,
     layout: Option<Layout>,
     extent: (u32, u32),
     /// The last source's float texels, filled again by the next `apply`.
-    spare: std::sync::Mutex<Vec<f32>>,
+    spare: std::sync::Mutex<Vec<Vec<f32>>>,
 }
 
 #[pymethods]
@@ -663,6 +688,7 @@ impl Remap {
             plan: Arc::new(plan),
             source,
             src_extent: (w, h),
+            one_picture: n == 1 && l == Layout::Separate,
             dst,
             layout,
             extent,
@@ -684,6 +710,9 @@ impl Remap {
     ) -> PyResult<Bound<'py, PyAny>> {
         let want = arrays::dtype_arg(py, dtype)?;
         let invalid: Invalid = arrays::invalid_arg(invalid)?;
+        if let Some(made) = self.apply_in_place(py, array, out, want, linear, invalid)? {
+            return Ok(made);
+        }
         let spare = std::mem::take(&mut *self.spare.lock().unwrap_or_else(|e| e.into_inner()));
         let pics =
             arrays::pictures_into(array, "array", self.source.lead(), linear, invalid, spare)?;
@@ -755,6 +784,135 @@ impl Remap {
             self.extent.0,
             self.extent.1,
             self.dst.layer_count()
+        )
+    }
+}
+
+impl Remap {
+    /// [`Remap::apply`] reading the array where it lies, with no float copy of it: for a
+    /// plan whose source is one picture read as it is (a lat-long, a fisheye…), and an RGB
+    /// array (or batch) of uint8, uint16 or float32, C-contiguous, in the machine's byte
+    /// order. The rows are core's coded rows, the same bits as the copied source's (core's
+    /// test); `None` where the array is not such (the caller copies it), or where floats
+    /// hold values `invalid='zero'` must change.
+    fn apply_in_place<'py>(
+        &self,
+        py: Python<'py>,
+        array: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+        want: Option<Dtype>,
+        linear: bool,
+        invalid: Invalid,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
+        if !self.one_picture || !self.plan.takes_codes() {
+            return Ok(None);
+        }
+        let Ok(arr) = array.cast::<PyUntypedArray>() else {
+            return Ok(None);
+        };
+        let shape = arr.shape().to_vec();
+        let (w, h) = (self.src_extent.0 as usize, self.src_extent.1 as usize);
+        let nd = shape.len();
+        let fits = (nd == 3 || nd == 4)
+            && shape[nd - 3..] == [h, w, 3]
+            && !shape.contains(&0)
+            && arr.is_c_contiguous()
+            && arr.dtype().is_native_byteorder() != Some(false);
+        if !fits {
+            return Ok(None);
+        }
+        let name: String = arr.dtype().getattr("name")?.extract()?;
+        let (count, batched) = (if nd == 4 { shape[0] } else { 1 }, nd == 4);
+        let per = w * h * 3;
+        let extent = self.src_extent;
+        match name.as_str() {
+            "uint8" => {
+                let a: PyReadonlyArrayDyn<'_, u8> = array.extract()?;
+                let s = a.as_slice()?;
+                let table = arrays::decode8(linear);
+                self.apply_codes(
+                    py,
+                    (count, batched),
+                    want.unwrap_or(Dtype::U8),
+                    linear,
+                    out,
+                    &|i| Codes::u8(&s[i * per..(i + 1) * per], table, extent).ok(),
+                )
+                .map(Some)
+            }
+            "uint16" if cfg!(target_endian = "little") => {
+                let a: PyReadonlyArrayDyn<'_, u16> = array.extract()?;
+                let s = a.as_slice()?;
+                // SAFETY: the elements' bytes, read only while `a` is borrowed; on this
+                // target they are the little-endian codes `Codes::u16le` reads.
+                let bytes =
+                    unsafe { std::slice::from_raw_parts(s.as_ptr().cast::<u8>(), s.len() * 2) };
+                let table = arrays::decode16(linear);
+                self.apply_codes(
+                    py,
+                    (count, batched),
+                    want.unwrap_or(Dtype::U16),
+                    linear,
+                    out,
+                    &|i| Codes::u16le(&bytes[i * per * 2..(i + 1) * per * 2], table, extent).ok(),
+                )
+                .map(Some)
+            }
+            "float32" => {
+                let a: PyReadonlyArrayDyn<'_, f32> = array.extract()?;
+                let s = a.as_slice()?;
+                // What `invalid` asks of the values, checked on all threads first.
+                let bad = |f: fn(&[f32]) -> usize| {
+                    py.detach(|| run(|| s.par_chunks(1 << 15).map(f).sum::<usize>()))
+                };
+                match invalid {
+                    Invalid::Keep => {}
+                    Invalid::Raise => {
+                        let n = bad(|b| b.iter().filter(|v| !v.is_finite()).count());
+                        if n > 0 {
+                            return Err(arrays::nonfinite_error("array", n));
+                        }
+                    }
+                    Invalid::Zero => {
+                        if bad(|b| mirrorball_core::count_invalid(b, false) as usize) > 0 {
+                            return Ok(None);
+                        }
+                    }
+                }
+                self.apply_codes(
+                    py,
+                    (count, batched),
+                    want.unwrap_or(Dtype::F32),
+                    linear,
+                    out,
+                    &|i| Codes::f32(&s[i * per..(i + 1) * per], extent).ok(),
+                )
+                .map(Some)
+            }
+            _ => Ok(None),
+        }
+    }
+
+    /// The plan applied to `count` sources given as codes (`codes(i)`: source `i`), into
+    /// a new array of `dtype` or `out`.
+    fn apply_codes<'py, 'c>(
+        &self,
+        py: Python<'py>,
+        (count, batched): (usize, bool),
+        dtype: Dtype,
+        linear: bool,
+        out: Option<&Bound<'py, PyAny>>,
+        codes: &(dyn Fn(usize) -> Option<Codes<'c>> + Sync),
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let place = Placement::new(self.dst, self.layout, self.extent, 3)?;
+        let (plan, row) = (&self.plan, self.extent.0 as usize * 3);
+        let make = |i: usize, f: &mut dyn FnMut(&dyn Rows) -> PyResult<()>| {
+            let c = codes(i).ok_or_else(|| request("array", "not the plan's source shape"))?;
+            let rows = plan.rows_coded(c).map_err(|e| request("array", e))?;
+            f(&RemapRows(rows, row))
+        };
+        make_all(
+            py, count, batched, place, self.dst, dtype, linear, out, &make,
         )
     }
 }

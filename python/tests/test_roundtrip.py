@@ -188,3 +188,54 @@ def test_srgb8_codes_are_the_nearest(tmp):
     codes, _ = mb.read(tmp / "x.exr", dtype=np.uint8)
     expected = np.searchsorted(t, x, side="right").astype(np.uint8)
     assert np.array_equal(codes, expected)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.uint8, np.uint16])
+@pytest.mark.parametrize("layout", ["separate", "cross", "vcross", "c3x2"])
+def test_remap_reads_arrays_in_place_to_the_same_bits(dtype, layout):
+    """A C-contiguous RGB array is read where it lies (no float copy); a strided view of
+    the same values is copied first. Both must give the same bits, for every dtype, a
+    batch, and layouts made by rows, turned cells and packed ones; a wide-range float map
+    (a sun past what a half float holds, tiny values) shrunk so that taps read mip levels."""
+    rng = np.random.default_rng(3)
+    if dtype == np.float32:
+        src = (rng.random((2, 128, 256, 3), np.float32) * 2.0) ** 6
+        src[0, 5, 7] = 2e5
+    else:
+        top = np.iinfo(dtype).max
+        src = rng.integers(0, top + 1, (2, 128, 256, 3)).astype(dtype)
+    plan = mb.Remap(src.shape[1:], dst="cube", size=20, layout=layout, yaw=17)
+    strided = np.zeros((2, 128, 256, 4), dtype)
+    strided[..., :3] = src
+    view = strided[..., :3]
+    assert src.flags.c_contiguous and not view.flags.c_contiguous
+    for out_dtype in [None, np.float32, np.uint8, np.uint16, np.float16]:
+        kw = {} if out_dtype is None else {"dtype": out_dtype}
+        fast, slow = plan.apply(src, **kw), plan.apply(view, **kw)
+        assert fast.dtype == slow.dtype and fast.shape == slow.shape
+        assert np.array_equal(fast.view(np.uint8), slow.view(np.uint8)), (out_dtype, layout)
+        single = plan.apply(src[1], **kw)
+        assert np.array_equal(single.view(np.uint8), fast[1].view(np.uint8))
+    if dtype == np.uint8:
+        lin_fast, lin_slow = plan.apply(src, linear=True), plan.apply(view, linear=True)
+        assert np.array_equal(lin_fast, lin_slow)
+
+
+def test_remap_in_place_keeps_the_invalid_rules(smooth):
+    plan = mb.Remap(smooth.shape, dst="cube", size=16, layout="separate")
+    bad = smooth.copy()
+    bad[3, 4, 1] = np.nan
+    bad[9, 9, 0] = -1.0
+    with pytest.raises(ValueError, match="1 NaN or infinite"):
+        plan.apply(bad)
+    # invalid='zero': the NaN and the negative set to 0 first, as convert does.
+    zeroed = bad.copy()
+    zeroed[3, 4, 1] = 0.0
+    zeroed[9, 9, 0] = 0.0
+    assert np.array_equal(plan.apply(bad, invalid="zero"), plan.apply(zeroed))
+    kept = plan.apply(bad, invalid="keep")
+    assert np.isnan(kept).any()
+    # The source is never written, and an output that is the input is refused.
+    before = bad.copy()
+    plan.apply(bad, invalid="zero")
+    assert np.array_equal(before, bad, equal_nan=True)

@@ -1,6 +1,7 @@
-//! [`Codes`]: a layer of integer-coded RGB texels read through a table of linear values, as
-//! a raw video frame arrives (ffmpeg's `rgb24` and `rgb48le`), so that a planned
-//! [`Remap`](crate::Remap) reads the frame as it is, with no float copy of it
+//! [`Codes`]: a layer of RGB texels held as the caller has them: integer codes read through
+//! a table of linear values, as a raw video frame arrives (ffmpeg's `rgb24` and `rgb48le`),
+//! or `f32` values borrowed from the caller (a numpy array), so that a planned
+//! [`Remap`](crate::Remap) reads the layer as it is, with no float copy of it
 //! ([`Remap::rows_coded`](crate::Remap::rows_coded)).
 //!
 //! Every read goes through the table, so a texel read here is, to the bit, the texel of the
@@ -11,15 +12,29 @@
 use crate::Image;
 use rayon::prelude::*;
 
-/// One layer of `width`×`height` texels, R, G, B interleaved, each channel one integer code:
-/// one byte, or two bytes little-endian; a code `k` is the linear value `table[k]`.
+/// One layer of `width`×`height` texels, R, G, B interleaved, each channel one integer code
+/// (one byte, or two bytes little-endian; a code `k` is the linear value `table[k]`) or one
+/// `f32` read as it is.
 #[derive(Clone, Copy, Debug)]
 pub struct Codes<'a> {
     bytes: &'a [u8],
     table: &'a [f32],
-    wide: bool,
+    /// The texels as floats, for [`CodeKind::Float`] (empty otherwise).
+    floats: &'a [f32],
+    kind: CodeKind,
     width: u32,
     height: u32,
+}
+
+/// How [`Codes`] hold a channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CodeKind {
+    /// One byte through a table of 256 values.
+    Narrow,
+    /// Two bytes, little-endian, through a table of 65536 values.
+    Wide,
+    /// One `f32`, its own value.
+    Float,
 }
 
 /// Why bytes cannot be read as [`Codes`]: the caller's mistake.
@@ -79,6 +94,31 @@ impl<'a> Codes<'a> {
         Codes::new(bytes, table, true, (width, height))
     }
 
+    /// Floats (`rgbf32`, a float32 array): `floats` holds `width × height × 3` values,
+    /// each read as it is (no table). The conversion reads the caller's floats where a
+    /// float image of them would be copied first: the same bits either way.
+    pub fn f32(floats: &'a [f32], (width, height): (u32, u32)) -> Result<Codes<'a>, CodesError> {
+        let expected = width as usize * height as usize * 3;
+        if floats.len() != expected {
+            return Err(CodesError::Length {
+                expected: expected * 4,
+                found: floats.len() * 4,
+            });
+        }
+        // SAFETY: the bytes of the floats, read only, for as long as the floats are
+        // borrowed; `u8` has no alignment and every byte is a valid `u8`.
+        let bytes =
+            unsafe { std::slice::from_raw_parts(floats.as_ptr().cast::<u8>(), floats.len() * 4) };
+        Ok(Codes {
+            bytes,
+            table: &[],
+            floats,
+            kind: CodeKind::Float,
+            width,
+            height,
+        })
+    }
+
     fn new(
         bytes: &'a [u8],
         table: &'a [f32],
@@ -103,7 +143,12 @@ impl<'a> Codes<'a> {
         Ok(Codes {
             bytes,
             table,
-            wide,
+            floats: &[],
+            kind: if wide {
+                CodeKind::Wide
+            } else {
+                CodeKind::Narrow
+            },
             width,
             height,
         })
@@ -114,9 +159,14 @@ impl<'a> Codes<'a> {
         (self.width, self.height)
     }
 
-    /// Whether each code is two bytes.
-    pub(crate) fn wide(&self) -> bool {
-        self.wide
+    /// How a channel is held.
+    pub(crate) fn kind(&self) -> CodeKind {
+        self.kind
+    }
+
+    /// The texels as floats ([`CodeKind::Float`]; empty for integer codes).
+    pub(crate) fn floats(&self) -> &'a [f32] {
+        self.floats
     }
 
     /// The codes' bytes.
@@ -135,10 +185,10 @@ impl<'a> Codes<'a> {
     /// If `i` is outside the layer.
     #[inline(always)]
     pub fn texel(&self, i: usize) -> [f32; 3] {
-        if self.wide {
-            Wide::texel(self.bytes, Wide::table(self.table), i)
-        } else {
-            Narrow::texel(self.bytes, Narrow::table(self.table), i)
+        match self.kind {
+            CodeKind::Wide => Wide::texel(self.bytes, Wide::table(self.table), i),
+            CodeKind::Narrow => Narrow::texel(self.bytes, Narrow::table(self.table), i),
+            CodeKind::Float => Float::texel(self.bytes, (), i),
         }
     }
 
@@ -180,6 +230,20 @@ pub(crate) trait CodeWidth {
 pub(crate) struct Narrow;
 /// Two bytes a channel, little-endian.
 pub(crate) struct Wide;
+/// One `f32` a channel, in the machine's byte order (the bytes of a `&[f32]`).
+pub(crate) struct Float;
+
+impl CodeWidth for Float {
+    const TEXEL_BYTES: usize = 12;
+    type Table<'t> = ();
+    fn table(_: &[f32]) {}
+    #[inline(always)]
+    fn texel(bytes: &[u8], _: (), i: usize) -> [f32; 3] {
+        let b = &bytes[12 * i..12 * i + 12];
+        let k = |j: usize| f32::from_ne_bytes([b[j], b[j + 1], b[j + 2], b[j + 3]]);
+        [k(0), k(4), k(8)]
+    }
+}
 
 impl CodeWidth for Narrow {
     const TEXEL_BYTES: usize = 3;
@@ -224,6 +288,11 @@ mod tests {
         let bytes = [0x01u8, 0x02, 0xff, 0xff, 0, 0];
         let c = Codes::u16le(&bytes, &t16, (1, 1)).unwrap();
         assert_eq!(c.texel(0), [513.0, 65535.0, 0.0]);
+        let floats = [1.5f32, -2.0, f32::NAN, 0.25, 1e30, 7.0];
+        let c = Codes::f32(&floats, (2, 1)).unwrap();
+        assert_eq!(c.texel(1), [0.25, 1e30, 7.0]);
+        assert!(c.texel(0)[2].is_nan());
+        assert_eq!(c.to_image().data()[..2], [1.5, -2.0]);
     }
 
     #[test]
@@ -241,6 +310,13 @@ mod tests {
             CodesError::Table {
                 expected: 65536,
                 found: 256
+            }
+        );
+        assert_eq!(
+            Codes::f32(&[0.0; 5], (2, 1)).unwrap_err(),
+            CodesError::Length {
+                expected: 24,
+                found: 20
             }
         );
         // A layer whose byte count overflows nothing: 0×0 holds no codes.

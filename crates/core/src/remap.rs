@@ -17,7 +17,7 @@
 //! Memory: 8 bytes per output texel, plus 16 bytes per tap of the few texels that are
 //! integrated or straddle a seam (a 6×1024² cube from a 4096×2048 lat-long: about 60 MB).
 
-use crate::codes::{CodeWidth, Narrow, Wide};
+use crate::codes::{CodeKind, CodeWidth, Float, Narrow, Wide};
 use crate::envmap::{bilinear_blend, bilinear_mix, lerp4, seam_taps};
 use crate::projection::{Projection, WorldProjection};
 use crate::resample::{Job, PointScratch, Pyramid, PyramidPlan, RowScratch};
@@ -494,12 +494,24 @@ impl Remap {
             Base::Floats(planes) => {
                 gather_row::<C>(entries, planes, self.src_layers == 1, sw * C, row)
             }
-            Base::Codes(c) if c.wide() => {
-                gather_row_codes::<Wide>(entries, c.bytes(), Wide::table(c.table()), sw, row)
-            }
-            Base::Codes(c) => {
-                gather_row_codes::<Narrow>(entries, c.bytes(), Narrow::table(c.table()), sw, row)
-            }
+            Base::Codes(c) => match c.kind() {
+                CodeKind::Wide => {
+                    gather_row_codes::<Wide>(entries, c.bytes(), Wide::table(c.table()), sw, row)
+                }
+                CodeKind::Narrow => gather_row_codes::<Narrow>(
+                    entries,
+                    c.bytes(),
+                    Narrow::table(c.table()),
+                    sw,
+                    row,
+                ),
+                // The caller's floats are the float path's layer: its gather, its bits.
+                CodeKind::Float => {
+                    let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
+                    planes[0] = c.floats();
+                    gather_row::<3>(entries, &planes, true, sw * 3, row)
+                }
+            },
         }
         let ((g0, t0), (g1, _)) = (starts[y], starts[y + 1]);
         let mut k = t0 as usize;
@@ -512,10 +524,18 @@ impl Remap {
             match base {
                 Base::Codes(c) if g.level == 0 => {
                     let n = c.extent().0 as usize * c.extent().1 as usize;
-                    if c.wide() {
-                        sum_taps_codes::<Wide>(group, c.bytes(), Wide::table(c.table()), n, o)
-                    } else {
-                        sum_taps_codes::<Narrow>(group, c.bytes(), Narrow::table(c.table()), n, o)
+                    match c.kind() {
+                        CodeKind::Wide => {
+                            sum_taps_codes::<Wide>(group, c.bytes(), Wide::table(c.table()), n, o)
+                        }
+                        CodeKind::Narrow => sum_taps_codes::<Narrow>(
+                            group,
+                            c.bytes(),
+                            Narrow::table(c.table()),
+                            n,
+                            o,
+                        ),
+                        CodeKind::Float => sum_taps_codes::<Float>(group, c.bytes(), (), n, o),
                     }
                 }
                 _ => sum_taps::<C>(group, pyr.level(g.level as usize), o),

@@ -15,7 +15,7 @@
 //!
 //! The work runs in parallel over rows with rayon and allocates nothing per texel.
 
-use crate::codes::{CodeWidth, Narrow, Wide};
+use crate::codes::{CodeKind, CodeWidth, Narrow, Wide};
 use crate::envmap::{bilinear32, bilinear32_quad, bilinear_corner, bilinear_corner4, lerp_quad};
 use crate::projection::{DirRun, Lookup, Projection, WorldProjection};
 use crate::{Codes, EnvMap, Image};
@@ -254,14 +254,25 @@ impl<'a> Pyramid<'a> {
                 let out = &mut next[layer];
                 match (prev, codes) {
                     (Some(p), _) => downsample_into(&p[layer], wts, out),
-                    (None, Some(cd)) if cd.wide() => {
-                        let t = Wide::table(cd.table());
-                        downsample_texels((w, h), |i| Wide::texel(cd.bytes(), t, i), wts, out)
-                    }
-                    (None, Some(cd)) => {
-                        let t = Narrow::table(cd.table());
-                        downsample_texels((w, h), |i| Narrow::texel(cd.bytes(), t, i), wts, out)
-                    }
+                    (None, Some(cd)) => match cd.kind() {
+                        CodeKind::Wide => {
+                            let t = Wide::table(cd.table());
+                            downsample_texels((w, h), |i| Wide::texel(cd.bytes(), t, i), wts, out)
+                        }
+                        CodeKind::Narrow => {
+                            let t = Narrow::table(cd.table());
+                            downsample_texels((w, h), |i| Narrow::texel(cd.bytes(), t, i), wts, out)
+                        }
+                        CodeKind::Float => {
+                            let f = cd.floats();
+                            downsample_texels(
+                                (w, h),
+                                |i| [f[3 * i], f[3 * i + 1], f[3 * i + 2]],
+                                wts,
+                                out,
+                            )
+                        }
+                    },
                     (None, None) => downsample_into(&base[layer], wts, out),
                 }
             }

@@ -495,9 +495,10 @@ fn a_resampler_refuses_a_buffer_of_the_wrong_size() {
     r.layer_into(0, &mut Image::new(8, 9, 3));
 }
 
-/// A source given as 8- or 16-bit codes (`Remap::rows_coded`) converts to the same bits as
-/// the float map their table decodes them into, through every path of the plan: bilinear
-/// lookups, seam taps, integrated texels on the base and on mip levels, exposure.
+/// A source given as 8- or 16-bit codes or as borrowed floats (`Remap::rows_coded`)
+/// converts to the same bits as the float map their table decodes them into (the floats
+/// themselves), through every path of the plan: bilinear lookups, seam taps, integrated
+/// texels on the base and on mip levels, exposure.
 #[test]
 fn a_coded_source_converts_to_the_bits_of_its_decoded_map() {
     use mirrorball_core::color::srgb_to_linear;
@@ -520,6 +521,19 @@ fn a_coded_source_converts_to_the_bits_of_its_decoded_map() {
     };
     let narrow: Vec<u8> = (0..sw * sh * 3).map(|_| byte()).collect();
     let wide: Vec<u8> = (0..sw * sh * 6).map(|_| byte()).collect();
+    // Floats over a wide range: a sun past what a half float holds, negatives, tiny values.
+    let floats: Vec<f32> = wide
+        .chunks_exact(2)
+        .map(|b| {
+            let v = u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0;
+            match b[0] % 8 {
+                0 => v * 2e5,
+                1 => -v,
+                2 => v * 1e-6,
+                _ => v,
+            }
+        })
+        .collect();
     let opts = ResampleOptions {
         exposure: 0.5,
         rotation: Rotation::from_euler_deg(20.0, 10.0, 0.0),
@@ -533,6 +547,7 @@ fn a_coded_source_converts_to_the_bits_of_its_decoded_map() {
     for (codes, what) in [
         (Codes::u8(&narrow, &t8, (sw, sh)).unwrap(), "8-bit"),
         (Codes::u16le(&wide, &t16, (sw, sh)).unwrap(), "16-bit"),
+        (Codes::f32(&floats, (sw, sh)).unwrap(), "f32"),
     ] {
         let decoded = EnvMap::new(ll, vec![codes.to_image()]).unwrap();
         for (dst, size) in dsts {
@@ -553,7 +568,7 @@ fn a_coded_source_converts_to_the_bits_of_its_decoded_map() {
                         b.iter().map(|v| v.to_bits()).collect(),
                     );
                     assert_eq!(ab, bb, "{what} {dst:?} {size}: layer {layer} row {y}");
-                    nonzero += a.iter().filter(|v| **v > 0.0).count();
+                    nonzero += a.iter().filter(|v| **v != 0.0).count();
                 }
             }
             assert!(
