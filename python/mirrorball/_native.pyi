@@ -37,13 +37,17 @@ def convert(
     roll: float = 0.0,
     exposure: float = 0.0,
     max_samples: int = 8,
+    outside: Optional[str] = None,
     dtype: DTypeLike = None,
     linear: bool = False,
     invalid: str = "raise",
     out: Optional[Array] = None,
 ) -> Array:
     """Converts an environment map (H×W×C or N×H×W×C) from ``src`` to ``dst``, antialiased:
-    the CLI's ``mirrorball convert``, bit for bit."""
+    the CLI's ``mirrorball convert``, bit for bit. ``outside``: what texels outside the
+    output's covered part hold, ``"black"`` or ``"rim"`` (the CLI's ``--outside``; default:
+    black for fisheye, dual fisheye, Hammer and sinusoidal, the rim's value for sphere,
+    angular and paraboloid maps)."""
 
 class Remap:
     """A conversion planned once for sources of one shape, applied to many arrays."""
@@ -62,6 +66,7 @@ class Remap:
         roll: float = 0.0,
         exposure: float = 0.0,
         max_samples: int = 8,
+        outside: Optional[str] = None,
     ) -> None: ...
     def apply(
         self,

@@ -8,8 +8,8 @@ use crate::errors::request;
 use crate::threads::run;
 use mirrorball_core::projection::ProjectionSpec;
 use mirrorball_core::{
-    Choice, Codes, EnvMap, Image, Layout, Projection, ProjectionKind, ResampleOptions, Resampler,
-    Rotation, WorldProjection,
+    Choice, Codes, EnvMap, Image, Layout, Outside, Projection, ProjectionKind, ResampleOptions,
+    Resampler, Rotation, WorldProjection,
 };
 use numpy::{
     PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
@@ -30,12 +30,16 @@ pub fn layout_arg(arg: &str, text: Option<&str>) -> PyResult<Option<Layout>> {
         .transpose()
 }
 
-/// The rotation, exposure and antialiasing arguments as core's options.
+/// The rotation, exposure, antialiasing and `outside` arguments as core's options.
 pub fn options(
     (yaw, pitch, roll): (f64, f64, f64),
     exposure: f32,
     max_samples: u32,
+    outside: Option<&str>,
 ) -> PyResult<ResampleOptions> {
+    let outside = outside
+        .map(|o| o.parse::<Outside>().map_err(|e| request("outside", e)))
+        .transpose()?;
     for (name, v) in [("yaw", yaw), ("pitch", pitch), ("roll", roll)] {
         if !v.is_finite() {
             return Err(request(
@@ -60,6 +64,7 @@ pub fn options(
         rotation: Rotation::from_euler_deg(yaw, pitch, roll),
         exposure,
         max_samples,
+        outside,
         ..Default::default()
     })
 }
@@ -537,11 +542,14 @@ fn destination(dst: &str, size: Option<i64>, src: &EnvMap) -> PyResult<(Projecti
 /// cubes, "separate" gives L×H×W×C, also "vcross", "hstrip", "vstrip", "c3x2", "eac").
 /// `src_layout`: how the source's layers are packed (default: judged by its shape;
 /// "separate" takes L×H×W×C). `yaw`/`pitch`/`roll` (degrees) turn the world as the CLI's
-/// flags. `dtype`: the result's (default: the input's). uint8/uint16 arrays are sRGB codes,
+/// flags. `outside`: what texels outside the output's covered part hold, "black" or "rim"
+/// (the CLI's --outside; default: black for fisheye, dual fisheye, Hammer and sinusoidal,
+/// the rim's value for sphere, angular and paraboloid maps). `dtype`: the result's
+/// (default: the input's). uint8/uint16 arrays are sRGB codes,
 /// as the CLI reads PNG; `linear=True` reads and writes them as linear codes. `invalid`:
 /// NaN and infinite values "raise" (default), are set to "zero" (as the CLI), or "keep".
 #[pyfunction]
-#[pyo3(signature = (array, src="latlong", dst="cube", size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8, dtype=None, linear=false, invalid="raise", out=None))]
+#[pyo3(signature = (array, src="latlong", dst="cube", size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8, outside=None, dtype=None, linear=false, invalid="raise", out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn convert<'py>(
     py: Python<'py>,
@@ -556,13 +564,14 @@ pub fn convert<'py>(
     roll: f64,
     exposure: f32,
     max_samples: u32,
+    outside: Option<&str>,
     dtype: Option<&Bound<'py, PyAny>>,
     linear: bool,
     invalid: &str,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let source = Source::new(src, src_layout)?;
-    let opts = options((yaw, pitch, roll), exposure, max_samples)?;
+    let opts = options((yaw, pitch, roll), exposure, max_samples, outside)?;
     let layout = layout_arg("layout", layout)?;
     let want = arrays::dtype_arg(py, dtype)?;
     let invalid = arrays::invalid_arg(invalid)?;
@@ -624,7 +633,7 @@ pub struct Remap {
 #[pymethods]
 impl Remap {
     #[new]
-    #[pyo3(signature = (src_shape, src="latlong", dst="cube", size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8))]
+    #[pyo3(signature = (src_shape, src="latlong", dst="cube", size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8, outside=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -639,9 +648,10 @@ impl Remap {
         roll: f64,
         exposure: f32,
         max_samples: u32,
+        outside: Option<&str>,
     ) -> PyResult<Remap> {
         let source = Source::new(src, src_layout)?;
-        let opts = options((yaw, pitch, roll), exposure, max_samples)?;
+        let opts = options((yaw, pitch, roll), exposure, max_samples, outside)?;
         let layout = layout_arg("layout", layout)?;
         let (h, w) = match src_shape[..] {
             [h, w] | [h, w, 3] | [h, w, 4] if h > 0 && w > 0 && h <= 1 << 20 && w <= 1 << 20 => {

@@ -5,7 +5,9 @@
 //! (512×256), log-domain PSNR over the directions the projection covers, at two sizes: the
 //! same texel budget as the source (131,072 texels), and four times that.
 use mirrorball_core::metrics::log_psnr_where;
-use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions, WorldProjection};
+use mirrorball_core::{
+    resample, EnvMap, Outside, ProjectionKind, ResampleOptions, WorldProjection,
+};
 
 /// Edge giving about `budget` texels in total.
 fn edge_for_budget(kind: ProjectionKind, budget: f64) -> u32 {
@@ -31,7 +33,12 @@ fn main() {
             let mut cells = Vec::new();
             for k in [1.0, 4.0] {
                 let e = edge_for_budget(kind, budget * k);
-                let out = resample(&src, p, e, &ResampleOptions::default());
+                // Outside a disk or an outline: the rim's value (the test's rule).
+                let forward = ResampleOptions {
+                    outside: Some(Outside::Rim),
+                    ..ResampleOptions::default()
+                };
+                let out = resample(&src, p, e, &forward);
                 let back = resample(
                     &out,
                     *src.projection(),

@@ -186,6 +186,12 @@ pub struct ConvertArgs {
         value_parser = clap::value_parser!(u32).range(1..=16)
     )]
     max_samples: u32,
+    /// What the output's texels outside its picture's covered part hold: black (zero
+    /// alpha), or the rim's value (so that filtering near the rim never darkens). Default:
+    /// black for fisheye, dual fisheye, Hammer and sinusoidal (as v360), the rim for the
+    /// sphere, angular and paraboloid maps a renderer samples
+    #[arg(long, value_parser = names::<mirrorball_core::Outside>())]
+    outside: Option<String>,
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,

@@ -51,7 +51,8 @@ pub use projection::{
 pub use projection::{DualFisheye, FisheyeLens, LensModel};
 pub use remap::{Remap, RemapError, RemapRows};
 pub use resample::{
-    resample, resample_memory, resample_to_extent, Axis, ResampleOptions, Resampler, Rotation,
+    resample, resample_memory, resample_to_extent, Axis, Outside, ResampleOptions, Resampler,
+    Rotation,
 };
 
 pub use glam;

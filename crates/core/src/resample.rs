@@ -147,7 +147,30 @@ pub struct ResampleOptions {
     /// What each finished row adds to [`progress`](Self::progress): 1 (rows) by default;
     /// a bar that counts work in other units gives a row's cost.
     pub progress_unit: u64,
+    /// What the output's texels outside its covered domain hold; `None`: the output
+    /// projection's rule ([`ProjectionKind::outside`](crate::ProjectionKind::outside)).
+    pub outside: Option<Outside>,
 }
+
+/// What an output's texels outside the projection's covered domain hold: the corners of a
+/// disk map, the outside of a world map's outline, a fisheye's surround.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Outside {
+    /// The nearest covered point's value, so that filtering near the rim never pulls in
+    /// black: for maps a renderer samples (sphere, angular and paraboloid maps).
+    Rim,
+    /// Zero (and zero alpha): for pictures people look at and cameras' frames (fisheye,
+    /// dual fisheye, Hammer, sinusoidal), as FFmpeg's `v360` and dome masters leave them.
+    Black,
+}
+
+impl crate::Choice for Outside {
+    const NAMES: &'static [(Self, &'static [&'static str])] = &[
+        (Outside::Rim, &["rim", "extend", "nearest"]),
+        (Outside::Black, &["black", "zero", "transparent"]),
+    ];
+}
+crate::choice_traits!(Outside);
 
 impl Default for ResampleOptions {
     fn default() -> Self {
@@ -157,6 +180,7 @@ impl Default for ResampleOptions {
             max_samples: 8,
             progress: None,
             progress_unit: 1,
+            outside: None,
         }
     }
 }
@@ -833,6 +857,8 @@ pub(crate) struct Job {
     pub(crate) scale: f32,
     pub(crate) w: u32,
     pub(crate) h: u32,
+    /// Texels outside the output's covered domain are left zero ([`Outside::Black`]).
+    black: bool,
 }
 
 impl Job {
@@ -857,6 +883,19 @@ impl Job {
             density: &mut s.dens,
         };
         dst.span_dirs_f32(layer, y as u32, self.w, self.h, 0, run);
+        if self.black {
+            // A texel given the rim's direction (density 0) whose centre lies outside the
+            // domain has no direction of its own: it stays black.
+            let v = (y as f64 + 0.5) / self.h as f64;
+            for (x, d) in s.dens.iter_mut().enumerate() {
+                if *d == 0.0 {
+                    let uv = glam::DVec2::new((x as f64 + 0.5) / self.w as f64, v);
+                    if dst.nearest_covered(layer, uv) != uv {
+                        *d = -1.0;
+                    }
+                }
+            }
+        }
         if self.rotate {
             let m = self.rot.to_source.as_mat3();
             for ((x, y), z) in s.xs.iter_mut().zip(&mut s.ys).zip(&mut s.zs) {
@@ -1236,6 +1275,7 @@ impl Job {
             scale: 2f32.powf(opts.exposure),
             w,
             h,
+            black: opts.outside.unwrap_or(dst.kind().outside()) == Outside::Black,
         }
     }
 }

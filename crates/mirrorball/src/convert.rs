@@ -59,6 +59,8 @@ pub struct ConvertRequest {
     pub mips: bool,
     /// The most integration points per texel side (1..=16).
     pub max_samples: u32,
+    /// What texels outside the output's covered domain hold; `None`: the projection's rule.
+    pub outside: Option<mirrorball_core::Outside>,
 }
 
 impl Default for ConvertRequest {
@@ -82,6 +84,7 @@ impl Default for ConvertRequest {
             compression: None,
             mips: false,
             max_samples: ResampleOptions::default().max_samples,
+            outside: None,
         }
     }
 }
@@ -207,8 +210,8 @@ impl ConvertPlan {
                 rotation,
                 exposure: r.exposure,
                 max_samples: r.max_samples,
-                progress: None,
-                progress_unit: 1,
+                outside: r.outside,
+                ..ResampleOptions::default()
             },
             orient,
             in_stereo: r.in_stereo,

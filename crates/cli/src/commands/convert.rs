@@ -62,6 +62,7 @@ pub(crate) fn request(a: &ConvertArgs) -> Result<ConvertRequest, CliError> {
         compression: parse("--compression", &a.compression)?,
         mips: a.mips,
         max_samples: a.max_samples,
+        outside: parse("--outside", &a.outside)?,
     })
 }
 

@@ -439,3 +439,48 @@ fn compare_scores_the_common_coverage_with_json_and_a_difference_picture() {
     let o = run(&["compare", c, f, "--diff", c]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// A fisheye's corners are black by default (as v360 leaves them), the rim's value with
+/// `--outside rim`; a sphere map's are the rim's by default; a name that is no choice is
+/// refused with the choices, before any file is written.
+#[test]
+fn outside_the_circle_is_black_or_the_rim() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = asset("venice.exr");
+    let corner = |to: &str, extra: &[&str]| {
+        let out = dir.path().join("out.exr");
+        let mut args = vec!["convert", src.to_str().unwrap(), out.to_str().unwrap()];
+        args.extend(["--to", to, "--size", "64", "--quiet"]);
+        args.extend(extra);
+        ok(&args);
+        let map = mirrorball_io::read(&out, &Default::default()).unwrap();
+        let img = &map.layers[0];
+        (img.get(0, 0)[..3].to_vec(), img.get(32, 32)[..3].to_vec())
+    };
+    let (c, centre) = corner("fisheye", &[]);
+    assert_eq!(c, [0.0; 3]);
+    assert!(centre.iter().any(|v| *v > 0.0));
+    let (c, _) = corner("fisheye", &["--outside", "rim"]);
+    assert!(c.iter().any(|v| *v > 0.0), "{c:?}");
+    let (c, _) = corner("sphere", &[]);
+    assert!(c.iter().any(|v| *v > 0.0), "{c:?}");
+    let (c, _) = corner("sphere", &["--outside", "black"]);
+    assert_eq!(c, [0.0; 3]);
+    let out = dir.path().join("bad.exr");
+    let o = run(&[
+        "convert",
+        src.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--to",
+        "fisheye",
+        "--outside",
+        "purple",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("black") && stderr(&o).contains("rim"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+}

@@ -4,7 +4,9 @@
 //! (`cargo run --release -p mirrorball-cli --example quality` prints them).
 use crate::util::asset;
 use mirrorball_core::metrics::log_psnr_where;
-use mirrorball_core::{resample, EnvMap, ProjectionKind, ResampleOptions, WorldProjection};
+use mirrorball_core::{
+    resample, EnvMap, Outside, ProjectionKind, ResampleOptions, WorldProjection,
+};
 
 fn edge_for_budget(kind: ProjectionKind, budget: f64) -> u32 {
     let p = kind.default_projection();
@@ -79,12 +81,14 @@ fn round_trip_quality_does_not_drop() {
         let sizes = RECORDED.iter().map(|r| (1.0, r));
         for (times, (kind, floors)) in sizes.chain(RECORDED_4X.iter().map(|r| (4.0, r))) {
             let p = kind.default_projection();
-            let out = resample(
-                &src,
-                p,
-                edge_for_budget(*kind, budget * times),
-                &ResampleOptions::default(),
-            );
+            // The projection's own quality: texels outside a disk or an outline filled from
+            // the rim, as for a map a renderer samples, so that reading back near the rim
+            // measures the projection, not the black surround a camera's frame has.
+            let forward = ResampleOptions {
+                outside: Some(Outside::Rim),
+                ..ResampleOptions::default()
+            };
+            let out = resample(&src, p, edge_for_budget(*kind, budget * times), &forward);
             let back = resample(
                 &out,
                 *src.projection(),

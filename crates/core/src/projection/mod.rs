@@ -284,6 +284,22 @@ macro_rules! projections {
                 }
             }
 
+            /// What an output's texels outside the covered domain hold unless asked
+            /// otherwise: black for cameras' frames and pictures people look at (fisheye,
+            /// dual fisheye, Hammer, sinusoidal: v360's rule), the rim's value for the maps
+            /// a renderer samples (sphere, angular, paraboloid), which filtering near the
+            /// rim must not darken. Projections covering their whole picture never have
+            /// such texels.
+            pub fn outside(self) -> crate::Outside {
+                match self {
+                    ProjectionKind::Fisheye
+                    | ProjectionKind::DualFisheye
+                    | ProjectionKind::Hammer
+                    | ProjectionKind::Sinusoidal => crate::Outside::Black,
+                    _ => crate::Outside::Rim,
+                }
+            }
+
             /// The projection with its documented default parameters.
             pub fn default_projection(self) -> Projection {
                 match self {

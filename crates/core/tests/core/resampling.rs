@@ -51,9 +51,15 @@ fn rel_rms_where(e: &EnvMap, f: impl Fn(DVec3) -> [f32; 4], keep: impl Fn(DVec3)
 #[test]
 fn every_projection_converts_a_smooth_environment_accurately() {
     let src = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 512, 3, smooth);
+    // Outside a disk or an outline, the rim's value: reading back near the rim then
+    // measures the projection, not a camera frame's black surround.
+    let rim = ResampleOptions {
+        outside: Some(mirrorball_core::Outside::Rim),
+        ..ResampleOptions::default()
+    };
     for kind in ProjectionKind::ALL {
         let dst = kind.default_projection();
-        let out = resample(&src, dst, 128, &ResampleOptions::default());
+        let out = resample(&src, dst, 128, &rim);
         let e = rel_rms(&out, smooth);
         eprintln!("{kind}: {e:.2e}");
         assert!(e < 4e-3, "{kind}: relative RMS {e}");
@@ -745,4 +751,90 @@ fn sample_texels_is_env_maps_sample() {
             );
         }
     }
+}
+
+/// Texels outside an output's covered domain are black for cameras' frames and pictures
+/// (fisheye, dual fisheye, Hammer, sinusoidal), the rim's value for the maps a renderer
+/// samples (sphere, angular, paraboloid), and either when asked; the plan does as the
+/// resampler does, texel for texel, and the inside is the same either way.
+#[test]
+fn outside_the_covered_domain_is_black_or_the_rim_as_the_projection_or_caller_says() {
+    use mirrorball_core::{Outside, Remap};
+    let ll = ProjectionKind::LatLong.default_projection();
+    let src = EnvMap::from_fn(ll, 64, 4, |d| [2.0 + d.x as f32, 1.5, 1.0, 1.0]);
+    for kind in ProjectionKind::ALL {
+        let dst = kind.default_projection();
+        for asked in [None, Some(Outside::Rim), Some(Outside::Black)] {
+            let opts = ResampleOptions {
+                outside: asked,
+                ..ResampleOptions::default()
+            };
+            let out = resample(&src, dst, 32, &opts);
+            let plan = Remap::new(ll, (64, 32), 1, dst, 32, &opts)
+                .apply(&src)
+                .unwrap();
+            let black = asked.unwrap_or(kind.outside()) == Outside::Black;
+            let (mut outside, mut inside) = (0, 0);
+            for (layer, (img, planned)) in out.layers().iter().zip(plan.layers()).enumerate() {
+                let (w, h) = (img.width(), img.height());
+                for y in 0..h {
+                    for x in 0..w {
+                        let v = img.get(x, y);
+                        let p = planned.get(x, y);
+                        let uv = glam::DVec2::new(
+                            (x as f64 + 0.5) / w as f64,
+                            (y as f64 + 0.5) / h as f64,
+                        );
+                        if dst.nearest_covered(layer, uv) == uv {
+                            inside += 1;
+                            assert!(
+                                v[1] > 1.4,
+                                "{kind:?} {asked:?}: inside texel ({x}, {y}) {v:?}"
+                            );
+                        } else {
+                            outside += 1;
+                            if black {
+                                assert_eq!(v, &[0.0; 4], "{kind:?} {asked:?}: ({x}, {y})");
+                            } else {
+                                assert!(
+                                    v[1] > 1.4 && v[3] > 0.99,
+                                    "{kind:?} {asked:?}: ({x}, {y}) {v:?}"
+                                );
+                            }
+                        }
+                        for c in 0..4 {
+                            assert!(
+                                (v[c] - p[c]).abs() <= 1e-4 * v[c].abs().max(1.0),
+                                "{kind:?} {asked:?} plan ({x}, {y})"
+                            );
+                        }
+                    }
+                }
+            }
+            assert!(inside > 0, "{kind:?}");
+            if matches!(kind, ProjectionKind::Fisheye | ProjectionKind::Sphere) {
+                assert!(outside > 0, "{kind:?}: no texel outside to test");
+            }
+        }
+    }
+    // The rule as the table gives it.
+    for (kind, black) in [
+        (ProjectionKind::Fisheye, true),
+        (ProjectionKind::DualFisheye, true),
+        (ProjectionKind::Hammer, true),
+        (ProjectionKind::Sinusoidal, true),
+        (ProjectionKind::Sphere, false),
+        (ProjectionKind::Angular, false),
+        (ProjectionKind::Paraboloid, false),
+    ] {
+        assert_eq!(kind.outside() == Outside::Black, black, "{kind:?}");
+    }
+    // A fisheye's corners are outside: the test above saw black there.
+    let fe = resample(
+        &src,
+        ProjectionKind::Fisheye.default_projection(),
+        32,
+        &ResampleOptions::default(),
+    );
+    assert_eq!(fe.layers()[0].get(0, 0), &[0.0; 4]);
 }
