@@ -322,6 +322,22 @@ fn write_png(
     })
 }
 
+/// Writes `w`×`h` 8-bit grey samples (a mask: 255 where a pixel counts, 0 where not) as a
+/// one-channel PNG, stored as given (no transfer function), through the atomic writes.
+pub fn write_grey_png(path: &Path, (w, h): (u32, u32), samples: &[u8]) -> Result<(), Error> {
+    if samples.len() != w as usize * h as usize {
+        return Err(Error::request(
+            path,
+            format!("{} grey samples for a {w}×{h} picture", samples.len()),
+        ));
+    }
+    crate::atomic::land(stage(path, |out| {
+        PngEncoder::new(out)
+            .write_image(samples, w, h, ExtendedColorType::L8)
+            .map_err(|e| encode_error(path, "PNG", e))
+    })?)
+}
+
 /// The GPano XMP packet of a lat-long or VR180 picture of `w`×`h` texels (none for other
 /// projections and for stereo pairs): 360° viewers show such photos as panoramas.
 fn panorama_xmp(info: &crate::MapInfo, w: u32, h: u32) -> Option<String> {

@@ -1,0 +1,606 @@
+//! Rigs of pinhole views for photogrammetry and Gaussian splatting (`mirrorball views IN
+//! OUT-DIR`): a panorama cut into perspective views, each antialiased as every conversion
+//! is (core's `Remap` from the panorama's projection to a rectilinear `View`), with the
+//! camera files COLMAP and nerfstudio read ([`cameras`]) and masks of what the panorama
+//! does not cover.
+//!
+//! `ViewsRequest → ViewsPlan (rig, fields of view, sizes, container, folder and every file
+//! checked: nothing read yet) → read the panorama (and --mask, the same size) → each
+//! view's size and camera → memory and room checked → per view: its plan, its picture,
+//! its mask → every file lands together (io::write_together)`.
+//!
+//! What OUT-DIR holds (`FRAME` the input's file stem, `EXT` the views' container):
+//! - `images/VIEW/FRAME.EXT`: the views, one folder per view, as COLMAP's rig
+//!   configuration takes them (each camera its own image prefix);
+//! - `masks/VIEW/FRAME.EXT.png`: 8-bit grey, 255 where the pixel's direction is covered by
+//!   the panorama (and white in `--mask`), 0 elsewhere; COLMAP's `mask_path` naming.
+//!   Written for every view when one of them is not all valid, or with `--masks`;
+//! - `sparse/0/`: the COLMAP text model, `rig_config.json`, `transforms.json`.
+
+pub mod cameras;
+pub mod rig;
+
+use crate::budget;
+use crate::error::Error;
+use crate::guard::Files;
+use crate::hooks::Hooks;
+use crate::load::{self, InputPlan};
+use crate::spec::ProjSpec;
+use cameras::{Pinhole, Shot};
+use mirrorball_core::glam::DVec2;
+use mirrorball_core::{EnvMap, Projection, Remap, ResampleOptions, View, WorldProjection};
+use mirrorball_io::{Folders, Format, WriteOptions};
+pub use rig::{ViewSpec, PRESETS};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What to cut, as plain values: the command line's `views` flags.
+#[derive(Clone, Debug)]
+pub struct ViewsRequest {
+    /// The panorama (any projection mirrorball reads).
+    pub input: String,
+    /// The folder to write into (made if missing; its parent must exist).
+    pub out_dir: String,
+    /// How to read the input.
+    pub input_plan: InputPlan,
+    /// A preset's name ([`PRESETS`]) or a `.json` file of views.
+    pub rig: String,
+    /// `--size W[xH]`: each view's width (where the rig gives none) and height (where the
+    /// view sets neither its height nor its vertical field of view).
+    pub size: Option<(i64, Option<i64>)>,
+    /// The views' container: `png`, `jpg` or `exr`.
+    pub format: String,
+    /// Write every view's mask even when all its pixels are valid.
+    pub masks: bool,
+    /// A mask drawn on the panorama (white: valid), the panorama's size.
+    pub mask: Option<String>,
+    /// The most integration points per texel side (1..=16).
+    pub max_samples: u32,
+}
+
+impl ViewsRequest {
+    /// The command line's defaults for cutting `input` into `out_dir`.
+    pub fn new(input: &str, out_dir: &str) -> ViewsRequest {
+        ViewsRequest {
+            input: input.into(),
+            out_dir: out_dir.into(),
+            input_plan: InputPlan::default(),
+            rig: "cube".into(),
+            size: None,
+            format: "png".into(),
+            masks: false,
+            mask: None,
+            max_samples: ResampleOptions::default().max_samples,
+        }
+    }
+}
+
+/// `--size`'s text, `W` or `WxH`, as numbers (checked against the container's bound in the
+/// plan).
+pub fn parse_size(s: &str) -> Result<(i64, Option<i64>), String> {
+    let s = s.trim();
+    match s.split_once(['x', 'X', '×']) {
+        Some((w, h)) => Ok((crate::size::parse(w)?, Some(crate::size::parse(h)?))),
+        None => Ok((crate::size::parse(s)?, None)),
+    }
+}
+
+/// A view, checked: its aim and fields, its size where known before the panorama is read.
+#[derive(Clone, Debug)]
+struct Planned {
+    spec: ViewSpec,
+    width: Option<u32>,
+    height: Option<u32>,
+}
+
+/// A cut, checked before any file is read.
+pub struct ViewsPlan {
+    input: String,
+    input_plan: InputPlan,
+    rig: String,
+    views: Vec<Planned>,
+    format: Format,
+    ext: &'static str,
+    dir: PathBuf,
+    frame: String,
+    mask: Option<String>,
+    masks: bool,
+    max_samples: u32,
+    bound: crate::size::Bound,
+    files: Files,
+}
+
+impl ViewsPlan {
+    /// Checks `r`: the rig, each view's fields of view and size, the container, OUT-DIR and
+    /// every file written.
+    pub fn new(r: &ViewsRequest) -> Result<ViewsPlan, Error> {
+        let views = rig::resolve(&r.rig)?;
+        let (format, ext) = match r.format.to_ascii_lowercase().as_str() {
+            "png" => (Format::Png, "png"),
+            "jpg" | "jpeg" => (Format::Jpeg, "jpg"),
+            "exr" => (Format::Exr, "exr"),
+            other => {
+                return Err(Error::request(format!(
+                    "--format: unknown '{other}' (png, jpg, exr)"
+                )))
+            }
+        };
+        if !(1..=16).contains(&r.max_samples) {
+            return Err(Error::request(format!(
+                "--max-samples: {} is outside 1..=16",
+                r.max_samples
+            )));
+        }
+        let bound =
+            crate::size::pictures(format, &format!("a .{ext} view"), |s| (s as u64, s as u64));
+        let size = r
+            .size
+            .map(|(w, h)| {
+                Ok::<_, Error>((
+                    bound.check("--size", w)?,
+                    h.map(|h| bound.check("--size", h)).transpose()?,
+                ))
+            })
+            .transpose()?;
+        let planned = views
+            .into_iter()
+            .map(|v| plan_view(v, size, &bound))
+            .collect::<Result<Vec<_>, _>>()?;
+        let dir = PathBuf::from(&r.out_dir);
+        check_dir(&dir)?;
+        let frame = frame_name(&r.input);
+        let mut files = Files::new();
+        files
+            .making(Folders::MakeAll)
+            .input_arg("the input", &r.input);
+        if let Some(m) = &r.mask {
+            files.input("--mask", m);
+        }
+        let mut plan = ViewsPlan {
+            input: r.input.clone(),
+            input_plan: r.input_plan.clone(),
+            rig: r.rig.clone(),
+            views: planned,
+            format,
+            ext,
+            dir,
+            frame,
+            mask: r.mask.clone(),
+            masks: r.masks,
+            max_samples: r.max_samples,
+            bound,
+            files: Files::new(),
+        };
+        for v in &plan.views {
+            files.output("a view", plan.image_path(&v.spec.name));
+            files.output("a mask", plan.mask_path(&v.spec.name));
+        }
+        for name in TEXT_FILES {
+            files.output("a camera file", plan.dir.join(name));
+        }
+        files.check()?;
+        plan.files = files;
+        Ok(plan)
+    }
+
+    /// The picture of view `name`, relative to `images/`.
+    fn image_name(&self, name: &str) -> String {
+        format!("{name}/{}.{}", self.frame, self.ext)
+    }
+
+    /// The mask of view `name`, relative to OUT-DIR.
+    fn mask_name(&self, name: &str) -> String {
+        format!("masks/{}.png", self.image_name(name))
+    }
+
+    fn image_path(&self, name: &str) -> PathBuf {
+        self.dir.join("images").join(self.image_name(name))
+    }
+
+    fn mask_path(&self, name: &str) -> PathBuf {
+        self.dir.join(self.mask_name(name))
+    }
+
+    /// The rig's cameras for a panorama `env`: each view's size (from `--size`, the view,
+    /// else the panorama's resolution) and fields of view.
+    fn cameras(&self, env: &EnvMap) -> Result<Vec<(View, Pinhole)>, Error> {
+        let p = env.projection();
+        let texels = env.width() as f64 * env.height() as f64 * env.layers().len() as f64;
+        // Texels per radian: the panorama's, were they spread evenly over what it covers.
+        let per_radian = (texels / p.covered_solid_angle()).sqrt();
+        self.views
+            .iter()
+            .map(|v| {
+                let s = &v.spec;
+                let t = (0.5 * s.fov.to_radians()).tan();
+                let w = match v.width {
+                    Some(w) => w,
+                    None => {
+                        let w = (2.0 * t * per_radian).round().max(16.0);
+                        self.bound
+                            .check(&format!("view '{}': its width", s.name), w as i64)?
+                    }
+                };
+                let (h, vfov) = match (v.height, s.vfov) {
+                    (Some(h), Some(vfov)) => (h, vfov),
+                    (Some(h), None) => (h, fov_of(t * h as f64 / w as f64)),
+                    (None, Some(vfov)) => {
+                        let tv = (0.5 * vfov.to_radians()).tan();
+                        let h = (w as f64 * tv / t).round().max(1.0) as i64;
+                        (
+                            self.bound
+                                .check(&format!("view '{}': its height", s.name), h)?,
+                            vfov,
+                        )
+                    }
+                    (None, None) => (w, s.fov),
+                };
+                let view =
+                    View::perspective(s.fov, vfov, s.yaw, s.pitch, s.roll).ok_or_else(|| {
+                        Error::request(format!(
+                            "view '{}': a pinhole view of {}°×{vfov}° cannot be drawn",
+                            s.name, s.fov
+                        ))
+                    })?;
+                let cam = Pinhole::new(
+                    &s.name,
+                    (w, h),
+                    (s.fov, vfov),
+                    View::frame_of(s.yaw, s.pitch, s.roll),
+                );
+                Ok((view, cam))
+            })
+            .collect()
+    }
+}
+
+/// The camera files, relative to OUT-DIR.
+const TEXT_FILES: [&str; 7] = [
+    "sparse/0/cameras.txt",
+    "sparse/0/images.txt",
+    "sparse/0/points3D.txt",
+    "sparse/0/rigs.txt",
+    "sparse/0/frames.txt",
+    "rig_config.json",
+    "transforms.json",
+];
+
+/// The field of view, degrees, whose half-angle's tangent is `t`.
+fn fov_of(t: f64) -> f64 {
+    2.0 * t.atan().to_degrees()
+}
+
+/// A rig's view checked: finite angles, fields of view a pinhole draws, sizes within the
+/// container's bound; `--size` (`size`) where the view gives none.
+fn plan_view(
+    spec: ViewSpec,
+    size: Option<(u32, Option<u32>)>,
+    bound: &crate::size::Bound,
+) -> Result<Planned, Error> {
+    let name = &spec.name;
+    for (what, v) in [
+        ("yaw", spec.yaw),
+        ("pitch", spec.pitch),
+        ("roll", spec.roll),
+    ] {
+        if !v.is_finite() {
+            return Err(Error::request(format!(
+                "view '{name}': {what} {v} is not finite"
+            )));
+        }
+    }
+    let fovs = View::hfov_range(0.0);
+    for (what, v) in [("fov", Some(spec.fov)), ("vfov", spec.vfov)] {
+        if let Some(v) = v.filter(|v| !fovs.contains(*v)) {
+            return Err(Error::request(format!(
+                "view '{name}': {what} {v}°: a pinhole view's field of view lies in (0°, 180°)"
+            )));
+        }
+    }
+    let width = match spec.width {
+        Some(w) => Some(bound.check(&format!("view '{name}': width"), w)?),
+        None => size.map(|s| s.0),
+    };
+    let height = match (spec.height, spec.vfov) {
+        (Some(h), _) => Some(bound.check(&format!("view '{name}': height"), h)?),
+        (None, None) if spec.width.is_none() => size.and_then(|s| s.1),
+        _ => None,
+    };
+    if let (None, Some(h)) = (width, height) {
+        return Err(Error::request(format!(
+            "view '{name}': a height ({h}) needs a width (the view's, or --size's)"
+        )));
+    }
+    Ok(Planned {
+        spec,
+        width,
+        height,
+    })
+}
+
+/// OUT-DIR: a folder or nothing yet, in a folder that exists.
+fn check_dir(dir: &Path) -> Result<(), Error> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(Error::request(format!(
+            "{}: OUT-DIR is a file; views writes a folder of files (give a folder's name)",
+            dir.display()
+        )));
+    }
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(p) = parent.filter(|p| !dir.exists() && !p.is_dir()) {
+        return Err(Error::request(format!(
+            "{}: the folder {} does not exist (views makes OUT-DIR, not the folders above it)",
+            dir.display(),
+            p.display()
+        )));
+    }
+    Ok(())
+}
+
+/// The frame's name in each view's folder: the input's file stem (`{face}` left out).
+fn frame_name(input: &str) -> String {
+    let stem = Path::new(&input.replace(load::FACE, ""))
+        .file_stem()
+        .map(|s| {
+            s.to_string_lossy()
+                .trim_matches(['_', '-', '.'])
+                .to_string()
+        })
+        .unwrap_or_default();
+    let plain: String = stem
+        .chars()
+        .map(
+            |c| match c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                true => c,
+                false => '_',
+            },
+        )
+        .collect();
+    match plain.is_empty() {
+        true => "frame".into(),
+        false => plain,
+    }
+}
+
+/// Where each pixel of `view` (`w`×`h`) is valid: its centre's direction covered by
+/// `source` (255) or not (0).
+fn coverage(view: &View, (w, h): (u32, u32), source: &Projection) -> Vec<u8> {
+    use rayon::prelude::*;
+    let mut out = vec![0u8; w as usize * h as usize];
+    out.par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, m) in row.iter_mut().enumerate() {
+                let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                let covered = view
+                    .uv_to_dir(0, uv)
+                    .is_some_and(|d| source.dir_to_uv(d).is_some());
+                *m = if covered { 255 } else { 0 };
+            }
+        });
+    out
+}
+
+/// Reads `--mask` as a map of the panorama's projection and layout, refused unless it is
+/// the panorama's size.
+fn read_mask(plan: &ViewsPlan, path: &str, env: &EnvMap) -> Result<EnvMap, Error> {
+    let from = ProjSpec::parse(&env.projection().to_string())
+        .map_err(|e| Error::request(format!("--mask: {e}")))?;
+    let limits = mirrorball_io::Limits::default();
+    let shape = |m: &EnvMap| {
+        let layers = match m.layers().len() {
+            1 => String::new(),
+            n => format!("x{n}"),
+        };
+        format!("{}x{}{layers}", m.width(), m.height())
+    };
+    let m = load::load(path, Some(&from), plan.input_plan.layout, &limits)
+        .map_err(|e| e.context("--mask"))?
+        .env;
+    if (m.width(), m.height(), m.layers().len()) != (env.width(), env.height(), env.layers().len())
+    {
+        return Err(Error::input(format!(
+            "--mask {path}: {}, the panorama is {}: a mask is drawn on the panorama, the same size",
+            shape(&m),
+            shape(env)
+        )));
+    }
+    Ok(m)
+}
+
+/// What [`run`] wrote.
+pub struct Written {
+    /// Every file, in the order written.
+    pub files: Vec<PathBuf>,
+    /// The views' cameras.
+    pub cameras: Vec<Pinhole>,
+    /// Whether masks were written.
+    pub masks: bool,
+}
+
+/// Cuts the panorama into the rig's views and writes them with their camera files, saying
+/// what it does through `hooks`.
+pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
+    let t0 = Instant::now();
+    let (env, notes) = load::read_prepared(&plan.input, &plan.input_plan)?;
+    notes.iter().for_each(|l| hooks.note(l));
+    let user_mask = plan
+        .mask
+        .as_deref()
+        .map(|m| read_mask(plan, m, &env))
+        .transpose()?;
+    let rig = plan.cameras(&env)?;
+    let src = *env.projection();
+    let c = env.channels() as u64;
+    // Held: the panorama (and the mask). Per view: its plan (8 bytes a texel, and taps), its
+    // picture and the mask's, and the masks kept until the end.
+    let held = budget::f32_texels(
+        env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
+        c,
+    ) * if user_mask.is_some() { 2 } else { 1 };
+    let texels = |cam: &Pinhole| cam.size.0 as u64 * cam.size.1 as u64;
+    let most = rig.iter().map(|(_, cam)| texels(cam)).max().unwrap_or(0);
+    let all: u64 = rig.iter().map(|(_, cam)| texels(cam)).sum();
+    budget::check(
+        &format!("{} views", rig.len()),
+        held,
+        most * (16 + 2 * 4 * c) + all,
+        "a smaller --size",
+    )?;
+    let bytes: u64 = rig
+        .iter()
+        .map(|(_, cam)| plan.format.bytes_estimate(texels(cam), 3, None) + texels(cam))
+        .sum();
+    plan.files.room(bytes)?;
+    let rows: u64 = rig.iter().map(|(_, cam)| cam.size.1 as u64).sum();
+    let t1 = Instant::now();
+    let write = WriteOptions {
+        precision: None,
+        exr_compression: Default::default(),
+        jpeg_quality: 92,
+        declared: None,
+        note: None,
+    };
+    let mut done = None;
+    hooks.progress("views", rows, &mut |counter| {
+        let opts = ResampleOptions {
+            max_samples: plan.max_samples,
+            progress: Some(counter),
+            ..Default::default()
+        };
+        done = Some(mirrorball_io::write_together(|| {
+            let mut masks = Vec::with_capacity(rig.len());
+            for (view, cam) in &rig {
+                let dst = Projection::View(*view);
+                let remap = Remap::with_extent(
+                    src,
+                    (env.width(), env.height()),
+                    env.layers().len(),
+                    dst,
+                    cam.size,
+                    &opts,
+                );
+                let out = remap.apply(&env).map_err(|e| {
+                    mirrorball_io::Error::request(Path::new(&plan.input), e.to_string())
+                })?;
+                let mut mask = coverage(view, cam.size, &src);
+                if let Some(m) = &user_mask {
+                    let drawn = remap.apply(m).map_err(|e| {
+                        mirrorball_io::Error::request(Path::new(&plan.input), e.to_string())
+                    })?;
+                    let img = &drawn.layers()[0];
+                    for (v, px) in mask.iter_mut().zip(img.data().chunks_exact(img.channels())) {
+                        if px[0] < 0.5 {
+                            *v = 0;
+                        }
+                    }
+                }
+                drop(remap);
+                mirrorball_io::write_image(&plan.image_path(&cam.name), &out.layers()[0], &write)?;
+                masks.push(mask);
+            }
+            let with_masks = plan.masks || masks.iter().any(|m| m.iter().any(|&v| v == 0));
+            if with_masks {
+                for ((_, cam), m) in rig.iter().zip(&masks) {
+                    mirrorball_io::write_grey_png(&plan.mask_path(&cam.name), cam.size, m)?;
+                }
+            }
+            write_cameras(plan, &rig, with_masks)?;
+            Ok(with_masks)
+        }));
+    });
+    let (with_masks, files) = done.expect("the work ran")?;
+    hooks.note(&format!(
+        "wrote {} views of {}, {}{} and the camera files in {} (read {:.2}s, views {:.2}s)",
+        rig.len(),
+        plan.input,
+        rig.iter()
+            .map(|(_, c)| format!("{}x{}", c.size.0, c.size.1))
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect::<Vec<_>>()
+            .join(", "),
+        if with_masks { ", their masks" } else { "" },
+        plan.dir.display(),
+        (t1 - t0).as_secs_f64(),
+        t1.elapsed().as_secs_f64()
+    ));
+    Ok(Written {
+        files,
+        cameras: rig.into_iter().map(|(_, c)| c).collect(),
+        masks: with_masks,
+    })
+}
+
+/// Writes the COLMAP model, the rig configuration and `transforms.json` (inside the
+/// caller's `write_together`).
+fn write_cameras(
+    plan: &ViewsPlan,
+    rig: &[(View, Pinhole)],
+    with_masks: bool,
+) -> Result<(), mirrorball_io::Error> {
+    let cams: Vec<Pinhole> = rig.iter().map(|(_, c)| c.clone()).collect();
+    let names: Vec<(String, String)> = cams
+        .iter()
+        .map(|c| (plan.image_name(&c.name), plan.mask_name(&c.name)))
+        .collect();
+    let shots: Vec<Shot> = names
+        .iter()
+        .enumerate()
+        .map(|(i, (image, mask))| Shot {
+            camera: i,
+            name: image,
+            mask: with_masks.then_some(mask.as_str()),
+        })
+        .collect();
+    let extra = serde_json::json!({
+        "source": plan.input,
+        "rig": plan.rig,
+    });
+    let texts = [
+        cameras::cameras_txt(&cams),
+        cameras::images_txt(&cams, &shots),
+        cameras::points3d_txt(),
+        cameras::rigs_txt(&cams),
+        cameras::frames_txt(&cams, &shots),
+        cameras::rig_config_json(&cams),
+        cameras::transforms_json(&cams, &shots, Some(extra)),
+    ];
+    for (name, text) in TEXT_FILES.iter().zip(texts) {
+        let path = plan.dir.join(name);
+        mirrorball_io::atomic_write(&path, |w| {
+            std::io::Write::write_all(w, text.as_bytes())
+                .map_err(|e| mirrorball_io::Error::io(&path, e))
+        })?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("640"), Ok((640, None)));
+        assert_eq!(parse_size("640x480"), Ok((640, Some(480))));
+        assert!(parse_size("640x").is_err());
+        assert_eq!(frame_name("dir/pano{face}.exr"), "pano");
+        assert_eq!(frame_name("a b.png"), "a_b");
+    }
+
+    #[test]
+    fn bad_views_are_refused_before_any_work() {
+        let mut r = ViewsRequest::new("missing.exr", "out");
+        r.rig = "nope".into();
+        assert!(ViewsPlan::new(&r).is_err());
+        let bound = crate::size::pictures(Format::Png, "a view", |s| (s as u64, s as u64));
+        let mut v = rig::resolve("cube").unwrap().remove(0);
+        v.fov = 180.0;
+        let e = plan_view(v.clone(), None, &bound).unwrap_err();
+        assert!(e.message.contains("(0°, 180°)"), "{}", e.message);
+        v.fov = 90.0;
+        v.width = Some(0);
+        assert!(plan_view(v, None, &bound).is_err());
+    }
+}
