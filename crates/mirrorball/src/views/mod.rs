@@ -29,7 +29,7 @@ use crate::spec::ProjSpec;
 use cameras::{Pinhole, Shot};
 use mirrorball_core::glam::DVec2;
 use mirrorball_core::{EnvMap, Projection, Remap, ResampleOptions, View, WorldProjection};
-use mirrorball_io::{Folders, Format, WriteOptions};
+use mirrorball_io::{Folders, Format, Precision, WriteOptions};
 pub use rig::{ViewSpec, PRESETS};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -48,7 +48,7 @@ pub struct ViewsRequest {
     /// `--size W[xH]`: each view's width (where the rig gives none) and height (where the
     /// view sets neither its height nor its vertical field of view).
     pub size: Option<(i64, Option<i64>)>,
-    /// The views' container: `png`, `jpg` or `exr`.
+    /// The views' container: `png` (8-bit), `png16` (16-bit PNG), `jpg` or `exr` (half).
     pub format: String,
     /// Write every view's mask even when all its pixels are valid.
     pub masks: bool,
@@ -101,6 +101,7 @@ pub struct ViewsPlan {
     views: Vec<Planned>,
     format: Format,
     ext: &'static str,
+    precision: Option<Precision>,
     dir: PathBuf,
     frame: String,
     mask: Option<String>,
@@ -115,13 +116,14 @@ impl ViewsPlan {
     /// every file written.
     pub fn new(r: &ViewsRequest) -> Result<ViewsPlan, Error> {
         let views = rig::resolve(&r.rig)?;
-        let (format, ext) = match r.format.to_ascii_lowercase().as_str() {
-            "png" => (Format::Png, "png"),
-            "jpg" | "jpeg" => (Format::Jpeg, "jpg"),
-            "exr" => (Format::Exr, "exr"),
+        let (format, ext, precision) = match r.format.to_ascii_lowercase().as_str() {
+            "png" => (Format::Png, "png", None),
+            "png16" => (Format::Png, "png", Some(Precision::U16)),
+            "jpg" | "jpeg" => (Format::Jpeg, "jpg", None),
+            "exr" => (Format::Exr, "exr", None),
             other => {
                 return Err(Error::request(format!(
-                    "--format: unknown '{other}' (png, jpg, exr)"
+                    "--format: unknown '{other}' (png, png16, jpg, exr)"
                 )))
             }
         };
@@ -163,6 +165,7 @@ impl ViewsPlan {
             views: planned,
             format,
             ext,
+            precision,
             dir,
             frame,
             mask: r.mask.clone(),
@@ -455,12 +458,18 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
     let rows: u64 = rig.iter().map(|(_, cam)| cam.size.1 as u64).sum();
     let t1 = Instant::now();
     let write = WriteOptions {
-        precision: None,
+        precision: plan.precision,
         exr_compression: Default::default(),
         jpeg_quality: 92,
         declared: None,
         note: None,
     };
+    let mut wanted: Vec<PathBuf> = Vec::new();
+    for (_, cam) in &rig {
+        wanted.push(plan.image_path(&cam.name));
+    }
+    wanted.extend(TEXT_FILES.iter().map(|n| plan.dir.join(n)));
+    let mut made = make_folders(&wanted)?;
     let mut done = None;
     hooks.progress("views", rows, &mut |counter| {
         let opts = ResampleOptions {
@@ -501,6 +510,9 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
             }
             let with_masks = plan.masks || masks.iter().any(|m| m.iter().any(|&v| v == 0));
             if with_masks {
+                let paths: Vec<PathBuf> =
+                    rig.iter().map(|(_, c)| plan.mask_path(&c.name)).collect();
+                made.extend(make_folders(&paths)?);
                 for ((_, cam), m) in rig.iter().zip(&masks) {
                     mirrorball_io::write_grey_png(&plan.mask_path(&cam.name), cam.size, m)?;
                 }
@@ -509,7 +521,19 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
             Ok(with_masks)
         }));
     });
-    let (with_masks, files) = done.expect("the work ran")?;
+    let done = done.expect("the work ran");
+    // Folders made for files that did not land are removed again (when left empty).
+    for dir in made.iter().rev() {
+        match (&done, dir.exists()) {
+            (Ok(_), _) => mirrorball_io::keep_folder(dir),
+            (Err(_), true) => {
+                let _ = std::fs::remove_dir(dir);
+                mirrorball_io::keep_folder(dir);
+            }
+            (Err(_), false) => mirrorball_io::keep_folder(dir),
+        }
+    }
+    let (with_masks, files) = done?;
     hooks.note(&format!(
         "wrote {} views of {}, {}{} and the camera files in {} (read {:.2}s, views {:.2}s)",
         rig.len(),
@@ -530,6 +554,28 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
         cameras: rig.into_iter().map(|(_, c)| c).collect(),
         masks: with_masks,
     })
+}
+
+/// Makes the folders `files` need that are missing, outermost first, each marked so that an
+/// interrupt removes it again when left empty (`mirrorball_io::made_folder`); the folders
+/// made, in the order made.
+fn make_folders(files: &[PathBuf]) -> Result<Vec<PathBuf>, mirrorball_io::Error> {
+    let mut made = Vec::new();
+    for f in files {
+        let mut missing: Vec<&Path> = f
+            .ancestors()
+            .skip(1)
+            .filter(|d| !d.as_os_str().is_empty())
+            .take_while(|d| !d.is_dir())
+            .collect();
+        missing.reverse();
+        for d in missing {
+            std::fs::create_dir(d).map_err(|e| mirrorball_io::Error::io(d, e))?;
+            mirrorball_io::made_folder(d);
+            made.push(d.to_path_buf());
+        }
+    }
+    Ok(made)
 }
 
 /// Writes the COLMAP model, the rig configuration and `transforms.json` (inside the
