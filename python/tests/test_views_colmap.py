@@ -49,6 +49,20 @@ def pixel_grid(w, h):
     return np.stack([x.ravel() + 0.5, y.ravel() + 0.5], -1).astype(np.float64)
 
 
+# The panorama's texel: pi / 512 rad. Its first and last rows lie half a texel from the
+# poles and span every longitude, so within a few degrees of a pole a lookup is off by up to
+# half a texel (2.6e-3 rad measured at the pole, 1.1e-4 beyond 5 degrees); elsewhere what
+# the views' filter leaves of a smooth field is far less than a texel.
+HALF_TEXEL = 0.5 * np.pi / 512
+
+
+def check_errors(err, world_mb):
+    """The worst error anywhere (within half a texel), and away from the poles."""
+    unit = world_mb / np.linalg.norm(world_mb, axis=-1, keepdims=True)
+    away = np.abs(unit[:, 1]) < np.cos(np.deg2rad(5))
+    return err.max(), err[away].max(initial=0.0)
+
+
 def angles(a, b):
     a = a / np.linalg.norm(a, axis=-1, keepdims=True)
     b = b / np.linalg.norm(b, axis=-1, keepdims=True)
@@ -77,7 +91,7 @@ def test_colmap_rays_are_the_pixels_directions(rig):
     assert rec.num_images() == 8 and rec.num_cameras() == 8 and rec.num_points3D() == 0
     # The rig as the model holds it: one rig, one frame holding every view.
     assert rec.num_rigs() == 1 and rec.num_frames() == 1
-    worst = 0.0
+    worst = np.zeros(2)
     for image in rec.images.values():
         cam = rec.cameras[image.camera_id]
         assert cam.model == pycolmap.CameraModelId.PINHOLE
@@ -87,12 +101,10 @@ def test_colmap_rays_are_the_pixels_directions(rig):
         rays = np.concatenate([cam.cam_from_img(xy), np.ones((len(xy), 1))], -1)
         pose = image.cam_from_world()
         assert np.allclose(pose.translation, 0.0)
-        world = rays @ pose.rotation.matrix()  # R^T applied to each row
-        err = angles(world @ COLMAP_TO_MB.T, seen)
-        worst = max(worst, err.max())
-    # A 1024-wide panorama: a texel is 6e-3 rad; what the views' filter leaves is far less.
-    print(f"COLMAP rays vs pixels: worst {worst:.2e} rad")
-    assert worst < 2e-3
+        world = rays @ pose.rotation.matrix() @ COLMAP_TO_MB.T  # R^T applied to each row
+        worst = np.maximum(worst, check_errors(angles(world, seen), world))
+    print(f"COLMAP rays vs pixels: worst {worst[0]:.2e} rad, {worst[1]:.2e} rad 5 degrees from the poles")
+    assert worst[0] < HALF_TEXEL and worst[1] < 2e-4
 
 
 def test_rig_config_reads_and_matches_the_model(rig):
@@ -119,7 +131,7 @@ def test_nerfstudio_rays_are_the_pixels_directions(rig):
     t = json.loads((rig / "transforms.json").read_text())
     assert t["camera_model"] == "PINHOLE"
     assert len(t["frames"]) == 8
-    worst = 0.0
+    worst = np.zeros(2)
     for f in t["frames"]:
         assert "mask_path" not in f  # a lat-long covers every direction
         seen, w, h = view_directions(rig, f["file_path"].removeprefix("images/"))
@@ -131,11 +143,10 @@ def test_nerfstudio_rays_are_the_pixels_directions(rig):
         )
         c2w = np.array(f["transform_matrix"])
         assert np.allclose(c2w[3], [0, 0, 0, 1]) and np.allclose(c2w[:3, 3], 0)
-        world = d @ c2w[:3, :3].T
-        err = angles(world @ NS_TO_MB.T, seen)
-        worst = max(worst, err.max())
-    print(f"nerfstudio rays vs pixels: worst {worst:.2e} rad")
-    assert worst < 2e-3
+        world = d @ c2w[:3, :3].T @ NS_TO_MB.T
+        worst = np.maximum(worst, check_errors(angles(world, seen), world))
+    print(f"nerfstudio rays vs pixels: worst {worst[0]:.2e} rad, {worst[1]:.2e} rad 5 degrees from the poles")
+    assert worst[0] < HALF_TEXEL and worst[1] < 2e-4
 
 
 def test_fisheye_masks_are_its_coverage(cli, tmp):
