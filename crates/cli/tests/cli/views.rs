@@ -33,9 +33,12 @@ fn direction_panorama(dir: &Path, size: u32) -> String {
 /// A camera of `cameras.txt`: width, height, fx, fy, cx, cy.
 type Camera = (u32, u32, f64, f64, f64, f64);
 
+/// An image of `images.txt`: name, camera id, `cam_from_world` rotation and translation.
+type Posed = (String, u32, DMat3, DVec3);
+
 /// `cameras.txt` and `images.txt` of `sparse`, read as COLMAP's text format says: cameras
 /// by id, and per image name its camera id and `cam_from_world` rotation.
-fn read_model(sparse: &Path) -> (HashMap<u32, Camera>, Vec<(String, u32, DMat3, DVec3)>) {
+fn read_model(sparse: &Path) -> (HashMap<u32, Camera>, Vec<Posed>) {
     let text = std::fs::read_to_string(sparse.join("cameras.txt")).unwrap();
     let mut cams = HashMap::new();
     for line in text
@@ -420,4 +423,60 @@ fn views_bad_requests_are_refused_before_any_work() {
             "{help}"
         );
     }
+}
+
+#[test]
+fn views_of_a_sequence_share_one_rig() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("seq");
+    std::fs::create_dir(&seq).unwrap();
+    let ll = ProjectionKind::LatLong.default_projection();
+    for (n, size) in [(1, 32), (2, 32), (3, 16)] {
+        let env = EnvMap::from_fn(ll, size, 3, |d| {
+            [d.x.abs() as f32 * n as f32, 0.5, 0.5, 1.0]
+        });
+        let path = seq.join(format!("frame_{n:04}.exr"));
+        mirrorball_io::write_image(&path, &env.layers()[0], &Default::default()).unwrap();
+    }
+    // The third frame is smaller: refused when reached, nothing written.
+    let pattern = seq.join("frame_%04d.exr");
+    let out = dir.path().join("out");
+    let o = run(&[
+        "views",
+        pattern.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--size",
+        "8",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("frame_0003.exr"), "{}", stderr(&o));
+    assert!(!out.exists(), "{:?}", files(&out));
+    std::fs::remove_file(seq.join("frame_0003.exr")).unwrap();
+    ok(&[
+        "views",
+        pattern.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--size",
+        "8",
+        "-q",
+    ]);
+    let listed = files(&out);
+    for view in ["front", "right", "back", "left", "up", "down"] {
+        for n in [1, 2] {
+            let f = format!("images/{view}/frame_{n:04}.png");
+            assert!(listed.contains(&f), "{f}: {listed:?}");
+        }
+    }
+    let (cams, images) = read_model(&out.join("sparse/0"));
+    assert_eq!((cams.len(), images.len()), (6, 12));
+    // Frame 2's images: the same cameras and poses as frame 1's.
+    for i in 0..6 {
+        assert_eq!(images[i].1, images[i + 6].1);
+        assert_eq!(images[i].2, images[i + 6].2);
+        assert!(images[i + 6].0.ends_with("frame_0002.png"));
+    }
+    let frames = std::fs::read_to_string(out.join("sparse/0/frames.txt")).unwrap();
+    let lines: Vec<&str> = frames.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(lines.len(), 2);
+    assert!(lines[1].ends_with("CAMERA 6 12"), "{}", lines[1]);
 }

@@ -22,6 +22,7 @@ pub mod rig;
 
 use crate::budget;
 use crate::error::Error;
+use crate::frames::pattern::Pattern;
 use crate::guard::Files;
 use crate::hooks::Hooks;
 use crate::load::{self, InputPlan};
@@ -103,7 +104,8 @@ pub struct ViewsPlan {
     ext: &'static str,
     precision: Option<Precision>,
     dir: PathBuf,
-    frame: String,
+    /// Each panorama (one, or a sequence's frames) and its name in the views' folders.
+    frames: Vec<(String, String)>,
     mask: Option<String>,
     masks: bool,
     max_samples: u32,
@@ -150,11 +152,30 @@ impl ViewsPlan {
             .collect::<Result<Vec<_>, _>>()?;
         let dir = PathBuf::from(&r.out_dir);
         check_dir(&dir)?;
-        let frame = frame_name(&r.input);
+        let frames: Vec<(String, String)> = match Pattern::parse(&r.input)? {
+            Some(p) => p
+                .expand(&r.input)?
+                .into_iter()
+                .map(|f| {
+                    let path = f.path.to_string_lossy().into_owned();
+                    let name = frame_name(&path);
+                    (path, name)
+                })
+                .collect(),
+            None => vec![(r.input.clone(), frame_name(&r.input))],
+        };
+        let mut names = std::collections::HashSet::new();
+        if let Some((path, name)) = frames.iter().find(|(_, n)| !names.insert(n.clone())) {
+            return Err(Error::request(format!(
+                "{}: {path} is another frame named {name} (frames are named by their file stems)",
+                r.input
+            )));
+        }
         let mut files = Files::new();
-        files
-            .making(Folders::MakeAll)
-            .input_arg("the input", &r.input);
+        files.making(Folders::MakeAll);
+        for (path, _) in &frames {
+            files.input_arg("the input", path);
+        }
         if let Some(m) = &r.mask {
             files.input("--mask", m);
         }
@@ -167,16 +188,18 @@ impl ViewsPlan {
             ext,
             precision,
             dir,
-            frame,
+            frames,
             mask: r.mask.clone(),
             masks: r.masks,
             max_samples: r.max_samples,
             bound,
             files: Files::new(),
         };
-        for v in &plan.views {
-            files.output("a view", plan.image_path(&v.spec.name));
-            files.output("a mask", plan.mask_path(&v.spec.name));
+        for (_, frame) in &plan.frames {
+            for v in &plan.views {
+                files.output("a view", plan.image_path(&v.spec.name, frame));
+                files.output("a mask", plan.mask_path(&v.spec.name, frame));
+            }
         }
         for name in TEXT_FILES {
             files.output("a camera file", plan.dir.join(name));
@@ -187,21 +210,21 @@ impl ViewsPlan {
     }
 
     /// The picture of view `name`, relative to `images/`.
-    fn image_name(&self, name: &str) -> String {
-        format!("{name}/{}.{}", self.frame, self.ext)
+    fn image_name(&self, name: &str, frame: &str) -> String {
+        format!("{name}/{frame}.{}", self.ext)
     }
 
     /// The mask of view `name`, relative to OUT-DIR.
-    fn mask_name(&self, name: &str) -> String {
-        format!("masks/{}.png", self.image_name(name))
+    fn mask_name(&self, name: &str, frame: &str) -> String {
+        format!("masks/{}.png", self.image_name(name, frame))
     }
 
-    fn image_path(&self, name: &str) -> PathBuf {
-        self.dir.join("images").join(self.image_name(name))
+    fn image_path(&self, name: &str, frame: &str) -> PathBuf {
+        self.dir.join("images").join(self.image_name(name, frame))
     }
 
-    fn mask_path(&self, name: &str) -> PathBuf {
-        self.dir.join(self.mask_name(name))
+    fn mask_path(&self, name: &str, frame: &str) -> PathBuf {
+        self.dir.join(self.mask_name(name, frame))
     }
 
     /// The rig's cameras for a panorama `env`: each view's size (from `--size`, the view,
@@ -425,7 +448,8 @@ pub struct Written {
 /// what it does through `hooks`.
 pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
     let t0 = Instant::now();
-    let (env, notes) = load::read_prepared(&plan.input, &plan.input_plan)?;
+    let first = &plan.frames[0].0;
+    let (env, notes) = load::read_prepared(first, &plan.input_plan)?;
     notes.iter().for_each(|l| hooks.note(l));
     let user_mask = plan
         .mask
@@ -434,11 +458,12 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
         .transpose()?;
     let rig = plan.cameras(&env)?;
     let src = *env.projection();
+    let src_shape = (env.width(), env.height(), env.layers().len());
     let c = env.channels() as u64;
-    // Held: the panorama (and the mask). Per view: its plan (8 bytes a texel, and taps), its
-    // picture and the mask's, and the masks kept until the end.
+    // Held: a panorama (and the mask), each view's plan (8 bytes a texel, and taps) and
+    // mask, and one view's picture.
     let held = budget::f32_texels(
-        env.width() as u64 * env.height() as u64 * env.layers().len() as u64,
+        env.width() as u64 * env.height() as u64 * src_shape.2 as u64,
         c,
     ) * if user_mask.is_some() { 2 } else { 1 };
     let texels = |cam: &Pinhole| cam.size.0 as u64 * cam.size.1 as u64;
@@ -447,15 +472,15 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
     budget::check(
         &format!("{} views", rig.len()),
         held,
-        most * (16 + 2 * 4 * c) + all,
+        all * 17 + most * 4 * c * 2,
         "a smaller --size",
     )?;
+    let frames = plan.frames.len() as u64;
     let bytes: u64 = rig
         .iter()
         .map(|(_, cam)| plan.format.bytes_estimate(texels(cam), 3, None) + texels(cam))
         .sum();
-    plan.files.room(bytes)?;
-    let rows: u64 = rig.iter().map(|(_, cam)| cam.size.1 as u64).sum();
+    plan.files.room(bytes * frames)?;
     let t1 = Instant::now();
     let write = WriteOptions {
         precision: plan.precision,
@@ -466,37 +491,41 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
     };
     let mut wanted: Vec<PathBuf> = Vec::new();
     for (_, cam) in &rig {
-        wanted.push(plan.image_path(&cam.name));
+        wanted.push(plan.image_path(&cam.name, &plan.frames[0].1));
     }
     wanted.extend(TEXT_FILES.iter().map(|n| plan.dir.join(n)));
     let mut made = make_folders(&wanted)?;
+    let opts = ResampleOptions {
+        max_samples: plan.max_samples,
+        ..Default::default()
+    };
+    let mut env = Some(env);
     let mut done = None;
-    hooks.progress("views", rows, &mut |counter| {
-        let opts = ResampleOptions {
-            max_samples: plan.max_samples,
-            progress: Some(counter),
-            ..Default::default()
-        };
+    // Progress in views: each view's plan, then each view of each frame.
+    let total = rig.len() as u64 * (frames + 1);
+    hooks.progress("views", total, &mut |counter| {
+        let tick = || counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let mut env = env.take().expect("the work runs once");
         done = Some(mirrorball_io::write_together(|| {
+            let bad = |path: &str, e: String| mirrorball_io::Error::input(Path::new(path), e);
+            // One plan per view, made once; each view's mask with it.
+            let mut plans = Vec::with_capacity(rig.len());
             let mut masks = Vec::with_capacity(rig.len());
             for (view, cam) in &rig {
                 let dst = Projection::View(*view);
                 let remap = Remap::with_extent(
                     src,
-                    (env.width(), env.height()),
-                    env.layers().len(),
+                    (src_shape.0, src_shape.1),
+                    src_shape.2,
                     dst,
                     cam.size,
                     &opts,
                 );
-                let out = remap.apply(&env).map_err(|e| {
-                    mirrorball_io::Error::request(Path::new(&plan.input), e.to_string())
-                })?;
                 let mut mask = coverage(view, cam.size, &src);
                 if let Some(m) = &user_mask {
-                    let drawn = remap.apply(m).map_err(|e| {
-                        mirrorball_io::Error::request(Path::new(&plan.input), e.to_string())
-                    })?;
+                    let drawn = remap
+                        .apply(m)
+                        .map_err(|e| bad(plan.mask.as_deref().unwrap_or(""), e.to_string()))?;
                     let img = &drawn.layers()[0];
                     for (v, px) in mask.iter_mut().zip(img.data().chunks_exact(img.channels())) {
                         if px[0] < 0.5 {
@@ -504,17 +533,31 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
                         }
                     }
                 }
-                drop(remap);
-                mirrorball_io::write_image(&plan.image_path(&cam.name), &out.layers()[0], &write)?;
+                plans.push(remap);
                 masks.push(mask);
+                tick();
             }
-            let with_masks = plan.masks || masks.iter().any(|m| m.iter().any(|&v| v == 0));
-            if with_masks {
-                let paths: Vec<PathBuf> =
-                    rig.iter().map(|(_, c)| plan.mask_path(&c.name)).collect();
-                made.extend(make_folders(&paths)?);
-                for ((_, cam), m) in rig.iter().zip(&masks) {
-                    mirrorball_io::write_grey_png(&plan.mask_path(&cam.name), cam.size, m)?;
+            let with_masks = plan.masks || masks.iter().any(|m| m.contains(&0));
+            for (f, (path, frame)) in plan.frames.iter().enumerate() {
+                if f > 0 {
+                    let (next, notes) = load::read_prepared(path, &plan.input_plan)
+                        .map_err(|e| bad(path, e.message))?;
+                    notes.iter().for_each(|l| hooks.note(l));
+                    env = next;
+                }
+                for ((_, cam), remap) in rig.iter().zip(&plans) {
+                    let out = remap.apply(&env).map_err(|e| bad(path, e.to_string()))?;
+                    let image = plan.image_path(&cam.name, frame);
+                    made.extend(make_folders(std::slice::from_ref(&image))?);
+                    mirrorball_io::write_image(&image, &out.layers()[0], &write)?;
+                    tick();
+                }
+                if with_masks {
+                    for ((_, cam), m) in rig.iter().zip(&masks) {
+                        let path = plan.mask_path(&cam.name, frame);
+                        made.extend(make_folders(std::slice::from_ref(&path))?);
+                        mirrorball_io::write_grey_png(&path, cam.size, m)?;
+                    }
                 }
             }
             write_cameras(plan, &rig, with_masks)?;
@@ -524,26 +567,25 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
     let done = done.expect("the work ran");
     // Folders made for files that did not land are removed again (when left empty).
     for dir in made.iter().rev() {
-        match (&done, dir.exists()) {
-            (Ok(_), _) => mirrorball_io::keep_folder(dir),
-            (Err(_), true) => {
-                let _ = std::fs::remove_dir(dir);
-                mirrorball_io::keep_folder(dir);
-            }
-            (Err(_), false) => mirrorball_io::keep_folder(dir),
+        if done.is_err() {
+            let _ = std::fs::remove_dir(dir);
         }
+        mirrorball_io::keep_folder(dir);
     }
     let (with_masks, files) = done?;
+    let sizes: std::collections::BTreeSet<String> = rig
+        .iter()
+        .map(|(_, c)| format!("{}x{}", c.size.0, c.size.1))
+        .collect();
     hooks.note(&format!(
-        "wrote {} views of {}, {}{} and the camera files in {} (read {:.2}s, views {:.2}s)",
+        "wrote {} views of {}{}, {}{} and the camera files in {} (read {:.2}s, views {:.2}s)",
         rig.len(),
         plan.input,
-        rig.iter()
-            .map(|(_, c)| format!("{}x{}", c.size.0, c.size.1))
-            .collect::<std::collections::BTreeSet<_>>()
-            .into_iter()
-            .collect::<Vec<_>>()
-            .join(", "),
+        match frames {
+            1 => String::new(),
+            n => format!(" ({n} frames, each frame's rig at the same pose: the views' poses within it are exact)"),
+        },
+        sizes.into_iter().collect::<Vec<_>>().join(", "),
         if with_masks { ", their masks" } else { "" },
         plan.dir.display(),
         (t1 - t0).as_secs_f64(),
@@ -586,15 +628,23 @@ fn write_cameras(
     with_masks: bool,
 ) -> Result<(), mirrorball_io::Error> {
     let cams: Vec<Pinhole> = rig.iter().map(|(_, c)| c.clone()).collect();
-    let names: Vec<(String, String)> = cams
+    let names: Vec<(usize, String, String)> = plan
+        .frames
         .iter()
-        .map(|c| (plan.image_name(&c.name), plan.mask_name(&c.name)))
+        .flat_map(|(_, frame)| {
+            cams.iter().enumerate().map(move |(i, c)| {
+                (
+                    i,
+                    plan.image_name(&c.name, frame),
+                    plan.mask_name(&c.name, frame),
+                )
+            })
+        })
         .collect();
     let shots: Vec<Shot> = names
         .iter()
-        .enumerate()
-        .map(|(i, (image, mask))| Shot {
-            camera: i,
+        .map(|(i, image, mask)| Shot {
+            camera: *i,
             name: image,
             mask: with_masks.then_some(mask.as_str()),
         })
