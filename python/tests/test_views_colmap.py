@@ -178,3 +178,40 @@ def test_fisheye_masks_are_its_coverage(cli, tmp):
         assert np.array_equal(valid[clear], covered[clear]), image.name
         counts += np.bincount(valid.astype(int), minlength=2)
     assert counts.min() > 1000, counts
+
+
+def test_exif_time_and_place_are_carried(cli, tmp):
+    """A JPEG panorama's capture time and GPS fields, read back by Pillow from every JPEG
+    view, and recorded in transforms.json for PNG views."""
+    Image = pytest.importorskip("PIL.Image")
+    from PIL import ExifTags
+
+    pano = tmp / "pano.jpg"
+    rgb = (direction_latlong(64, 128) * 255 + 0.5).astype(np.uint8)
+    exif = Image.Exif()
+    exif.get_ifd(ExifTags.IFD.Exif)[ExifTags.Base.DateTimeOriginal] = "2024:05:01 12:34:56"
+    gps = exif.get_ifd(ExifTags.IFD.GPSInfo)
+    gps[ExifTags.GPS.GPSLatitudeRef] = "S"
+    gps[ExifTags.GPS.GPSLatitude] = (33.0, 30.0, 0.0)
+    gps[ExifTags.GPS.GPSLongitudeRef] = "E"
+    gps[ExifTags.GPS.GPSLongitude] = (151.0, 12.0, 36.0)
+    Image.fromarray(rgb).save(pano, exif=exif)
+
+    out = tmp / "jpg"
+    cli("views", pano, out, "--size", 32, "--format", "jpg", "--quiet")
+    for view in ["front", "right", "back", "left", "up", "down"]:
+        with Image.open(out / "images" / view / "pano.jpg") as im:
+            e = im.getexif()
+            assert e.get_ifd(ExifTags.IFD.Exif)[ExifTags.Base.DateTimeOriginal] == "2024:05:01 12:34:56"
+            g = e.get_ifd(ExifTags.IFD.GPSInfo)
+            assert g[ExifTags.GPS.GPSLatitudeRef] == "S"
+            assert [float(v) for v in g[ExifTags.GPS.GPSLatitude]] == [33.0, 30.0, 0.0]
+            assert [float(v) for v in g[ExifTags.GPS.GPSLongitude]] == [151.0, 12.0, 36.0]
+            assert im.size == (32, 32)
+
+    out = tmp / "png"
+    cli("views", pano, out, "--size", 32, "--quiet")
+    record = json.loads((out / "transforms.json").read_text())["mirrorball"]["exif"]["pano"]
+    assert record["DateTimeOriginal"] == "2024:05:01 12:34:56"
+    assert record["latitude"] == pytest.approx(-33.5)
+    assert record["longitude"] == pytest.approx(151.21)

@@ -15,7 +15,8 @@ fn rig_help() -> String {
 
 #[derive(Args, Debug)]
 pub struct ViewsArgs {
-    /// The panorama (any projection mirrorball reads; `{face}` reads one file per layer).
+    /// The panorama (any projection mirrorball reads; `{face}` reads one file per layer), or
+    /// a sequence: a pattern (in/%05d.exr, 'in/*.jpg'), one rig over every frame.
     input: String,
     /// The folder to write into (made if missing; its parent must exist): images/VIEW/,
     /// masks/VIEW/, sparse/0/ (COLMAP), rig_config.json, transforms.json (nerfstudio).

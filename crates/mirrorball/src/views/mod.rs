@@ -4,12 +4,20 @@
 //! camera files COLMAP and nerfstudio read ([`cameras`]) and masks of what the panorama
 //! does not cover.
 //!
-//! `ViewsRequest → ViewsPlan (rig, fields of view, sizes, container, folder and every file
-//! checked: nothing read yet) → read the panorama (and --mask, the same size) → each
-//! view's size and camera → memory and room checked → per view: its plan, its picture,
-//! its mask → every file lands together (io::write_together)`.
+//! `ViewsRequest → ViewsPlan (rig, fields of view, sizes, container, folder, a sequence's
+//! frames and every file checked: nothing read yet) → read the (first) panorama (and
+//! --mask, the same size) → each view's size and camera → memory and room checked → per
+//! view: its plan and its mask, made once → per frame: read, each view's picture from its
+//! plan, the masks → every file lands together (io::write_together)`.
 //!
-//! What OUT-DIR holds (`FRAME` the input's file stem, `EXT` the views' container):
+//! A sequence (`frames/%04d.exr`, `'frames/*.jpg'`: `frames::pattern`) is one rig: each
+//! frame's views are its images in `frames.txt` and `transforms.json`, every frame's rig at
+//! the same pose (the poses within the rig are exact; where a moving camera stood is for
+//! the mapper to find, with `rig_config.json`). A source's capture time and GPS fields
+//! ([`metadata`]) go into each JPEG view's EXIF and into `transforms.json`
+//! (`mirrorball.exif`, per frame).
+//!
+//! What OUT-DIR holds (`FRAME` each panorama's file stem, `EXT` the views' container):
 //! - `images/VIEW/FRAME.EXT`: the views, one folder per view, as COLMAP's rig
 //!   configuration takes them (each camera its own image prefix);
 //! - `masks/VIEW/FRAME.EXT.png`: 8-bit grey, 255 where the pixel's direction is covered by
@@ -18,6 +26,7 @@
 //! - `sparse/0/`: the COLMAP text model, `rig_config.json`, `transforms.json`.
 
 pub mod cameras;
+pub mod metadata;
 pub mod rig;
 
 use crate::budget;
@@ -38,7 +47,8 @@ use std::time::Instant;
 /// What to cut, as plain values: the command line's `views` flags.
 #[derive(Clone, Debug)]
 pub struct ViewsRequest {
-    /// The panorama (any projection mirrorball reads).
+    /// The panorama (any projection mirrorball reads), or a sequence's pattern (printf
+    /// `%04d` or a glob, in the file name).
     pub input: String,
     /// The folder to write into (made if missing; its parent must exist).
     pub out_dir: String,
@@ -538,6 +548,7 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
                 tick();
             }
             let with_masks = plan.masks || masks.iter().any(|m| m.contains(&0));
+            let mut exif = Vec::new();
             for (f, (path, frame)) in plan.frames.iter().enumerate() {
                 if f > 0 {
                     let (next, notes) = load::read_prepared(path, &plan.input_plan)
@@ -545,11 +556,27 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
                     notes.iter().for_each(|l| hooks.note(l));
                     env = next;
                 }
+                let carried = metadata::read(Path::new(path));
+                let app1 = carried
+                    .as_ref()
+                    .filter(|_| plan.format == Format::Jpeg)
+                    .and_then(metadata::Carried::app1);
+                if let Some(c) = &carried {
+                    exif.push((frame.clone(), c.json()));
+                }
                 for ((_, cam), remap) in rig.iter().zip(&plans) {
                     let out = remap.apply(&env).map_err(|e| bad(path, e.to_string()))?;
                     let image = plan.image_path(&cam.name, frame);
                     made.extend(make_folders(std::slice::from_ref(&image))?);
-                    mirrorball_io::write_image(&image, &out.layers()[0], &write)?;
+                    match &app1 {
+                        Some(seg) => mirrorball_io::write_jpeg_with_segments(
+                            &image,
+                            &out.layers()[0],
+                            write.jpeg_quality,
+                            seg,
+                        )?,
+                        None => mirrorball_io::write_image(&image, &out.layers()[0], &write)?,
+                    }
                     tick();
                 }
                 if with_masks {
@@ -560,7 +587,7 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
                     }
                 }
             }
-            write_cameras(plan, &rig, with_masks)?;
+            write_cameras(plan, &rig, with_masks, exif)?;
             Ok(with_masks)
         }));
     });
@@ -626,6 +653,7 @@ fn write_cameras(
     plan: &ViewsPlan,
     rig: &[(View, Pinhole)],
     with_masks: bool,
+    exif: Vec<(String, serde_json::Value)>,
 ) -> Result<(), mirrorball_io::Error> {
     let cams: Vec<Pinhole> = rig.iter().map(|(_, c)| c.clone()).collect();
     let names: Vec<(usize, String, String)> = plan
@@ -649,10 +677,13 @@ fn write_cameras(
             mask: with_masks.then_some(mask.as_str()),
         })
         .collect();
-    let extra = serde_json::json!({
+    let mut extra = serde_json::json!({
         "source": plan.input,
         "rig": plan.rig,
     });
+    if !exif.is_empty() {
+        extra["exif"] = serde_json::Value::Object(exif.into_iter().collect());
+    }
     let texts = [
         cameras::cameras_txt(&cams),
         cameras::images_txt(&cams, &shots),
