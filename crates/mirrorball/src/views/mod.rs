@@ -454,28 +454,19 @@ pub struct Written {
     pub masks: bool,
 }
 
-/// Cuts the panorama into the rig's views and writes them with their camera files, saying
-/// what it does through `hooks`.
-pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
-    let t0 = Instant::now();
-    let first = &plan.frames[0].0;
-    let (env, notes) = load::read_prepared(first, &plan.input_plan)?;
-    notes.iter().for_each(|l| hooks.note(l));
-    let user_mask = plan
-        .mask
-        .as_deref()
-        .map(|m| read_mask(plan, m, &env))
-        .transpose()?;
-    let rig = plan.cameras(&env)?;
-    let src = *env.projection();
-    let src_shape = (env.width(), env.height(), env.layers().len());
+/// Refuses the job when it would not fit in memory (a panorama, and the mask when
+/// `masked`; each view's plan (8 bytes a texel, and taps) and mask, and one view's picture)
+/// or on the disk (every frame's views and masks).
+fn check_resources(
+    plan: &ViewsPlan,
+    env: &EnvMap,
+    rig: &[(View, Pinhole)],
+    masked: bool,
+) -> Result<(), Error> {
     let c = env.channels() as u64;
-    // Held: a panorama (and the mask), each view's plan (8 bytes a texel, and taps) and
-    // mask, and one view's picture.
-    let held = budget::f32_texels(
-        env.width() as u64 * env.height() as u64 * src_shape.2 as u64,
-        c,
-    ) * if user_mask.is_some() { 2 } else { 1 };
+    let layers = env.layers().len() as u64;
+    let held = budget::f32_texels(env.width() as u64 * env.height() as u64 * layers, c)
+        * if masked { 2 } else { 1 };
     let texels = |cam: &Pinhole| cam.size.0 as u64 * cam.size.1 as u64;
     let most = rig.iter().map(|(_, cam)| texels(cam)).max().unwrap_or(0);
     let all: u64 = rig.iter().map(|(_, cam)| texels(cam)).sum();
@@ -485,106 +476,145 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
         all * 17 + most * 4 * c * 2,
         "a smaller --size",
     )?;
-    let frames = plan.frames.len() as u64;
     let bytes: u64 = rig
         .iter()
         .map(|(_, cam)| plan.format.bytes_estimate(texels(cam), 3, None) + texels(cam))
         .sum();
-    plan.files.room(bytes * frames)?;
-    let t1 = Instant::now();
-    let write = WriteOptions {
-        precision: plan.precision,
-        exr_compression: Default::default(),
-        jpeg_quality: 92,
-        declared: None,
-        note: None,
-    };
-    let mut wanted: Vec<PathBuf> = Vec::new();
-    for (_, cam) in &rig {
-        wanted.push(plan.image_path(&cam.name, &plan.frames[0].1));
-    }
-    wanted.extend(TEXT_FILES.iter().map(|n| plan.dir.join(n)));
-    let mut made = make_folders(&wanted)?;
+    plan.files.room(bytes * plan.frames.len() as u64)
+}
+
+/// A reading error of `path` as io's, for the writes' set.
+fn input_error(path: &str, problem: String) -> mirrorball_io::Error {
+    mirrorball_io::Error::input(Path::new(path), problem)
+}
+
+/// Each view's plan from a panorama of `src` (`shape`: width, height, layers) and its mask
+/// (the coverage, less what `user_mask` blacks out), each counted by `tick`.
+fn plan_views(
+    plan: &ViewsPlan,
+    rig: &[(View, Pinhole)],
+    (src, shape): (Projection, (u32, u32, usize)),
+    user_mask: Option<&EnvMap>,
+    tick: &dyn Fn(),
+) -> Result<(Vec<Remap>, Vec<Vec<u8>>), mirrorball_io::Error> {
     let opts = ResampleOptions {
         max_samples: plan.max_samples,
         ..Default::default()
     };
+    let (mut plans, mut masks) = (Vec::new(), Vec::new());
+    for (view, cam) in rig {
+        let dst = Projection::View(*view);
+        let remap = Remap::with_extent(src, (shape.0, shape.1), shape.2, dst, cam.size, &opts);
+        let mut mask = coverage(view, cam.size, &src);
+        if let Some(m) = user_mask {
+            let name = plan.mask.as_deref().unwrap_or_default();
+            let drawn = remap
+                .apply(m)
+                .map_err(|e| input_error(name, e.to_string()))?;
+            let img = &drawn.layers()[0];
+            for (v, px) in mask.iter_mut().zip(img.data().chunks_exact(img.channels())) {
+                if px[0] < 0.5 {
+                    *v = 0;
+                }
+            }
+        }
+        plans.push(remap);
+        masks.push(mask);
+        tick();
+    }
+    Ok((plans, masks))
+}
+
+/// Writes the views of one panorama `env` (the file `path`, named `frame` in the views'
+/// folders) by their `plans`, with the EXIF it carries in JPEG views, each counted by
+/// `tick`; the folders made go to `made`. Returns the EXIF carried, for transforms.json.
+fn write_frame(
+    plan: &ViewsPlan,
+    (rig, plans): (&[(View, Pinhole)], &[Remap]),
+    (env, path, frame): (&EnvMap, &str, &str),
+    made: &mut Vec<PathBuf>,
+    tick: &dyn Fn(),
+) -> Result<Option<serde_json::Value>, mirrorball_io::Error> {
+    let write = WriteOptions {
+        precision: plan.precision,
+        jpeg_quality: 92,
+        ..Default::default()
+    };
+    let carried = metadata::read(Path::new(path));
+    let app1 = carried
+        .as_ref()
+        .filter(|_| plan.format == Format::Jpeg)
+        .and_then(metadata::Carried::app1);
+    for ((_, cam), remap) in rig.iter().zip(plans) {
+        let out = remap
+            .apply(env)
+            .map_err(|e| input_error(path, e.to_string()))?;
+        let image = plan.image_path(&cam.name, frame);
+        made.extend(make_folders(std::slice::from_ref(&image))?);
+        let picture = &out.layers()[0];
+        match &app1 {
+            Some(seg) => {
+                mirrorball_io::write_jpeg_with_segments(&image, picture, write.jpeg_quality, seg)?
+            }
+            None => mirrorball_io::write_image(&image, picture, &write)?,
+        }
+        tick();
+    }
+    Ok(carried.map(|c| c.json()))
+}
+
+/// Cuts the panorama (or each frame of the sequence) into the rig's views and writes them
+/// with their masks and camera files, every file landing together, saying what it does
+/// through `hooks`.
+pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
+    let t0 = Instant::now();
+    let (env, notes) = load::read_prepared(&plan.frames[0].0, &plan.input_plan)?;
+    notes.iter().for_each(|l| hooks.note(l));
+    let user_mask = plan
+        .mask
+        .as_deref()
+        .map(|m| read_mask(plan, m, &env))
+        .transpose()?;
+    let rig = plan.cameras(&env)?;
+    check_resources(plan, &env, &rig, user_mask.is_some())?;
+    let source = (
+        *env.projection(),
+        (env.width(), env.height(), env.layers().len()),
+    );
+    let t1 = Instant::now();
+    let mut wanted: Vec<PathBuf> = rig
+        .iter()
+        .map(|(_, cam)| plan.image_path(&cam.name, &plan.frames[0].1))
+        .collect();
+    wanted.extend(TEXT_FILES.iter().map(|n| plan.dir.join(n)));
+    let mut made = make_folders(&wanted)?;
     let mut env = Some(env);
     let mut done = None;
     // Progress in views: each view's plan, then each view of each frame.
-    let total = rig.len() as u64 * (frames + 1);
+    let total = rig.len() as u64 * (plan.frames.len() as u64 + 1);
     hooks.progress("views", total, &mut |counter| {
-        let tick = || counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let tick = || {
+            counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        };
         let mut env = env.take().expect("the work runs once");
         done = Some(mirrorball_io::write_together(|| {
-            let bad = |path: &str, e: String| mirrorball_io::Error::input(Path::new(path), e);
-            // One plan per view, made once; each view's mask with it.
-            let mut plans = Vec::with_capacity(rig.len());
-            let mut masks = Vec::with_capacity(rig.len());
-            for (view, cam) in &rig {
-                let dst = Projection::View(*view);
-                let remap = Remap::with_extent(
-                    src,
-                    (src_shape.0, src_shape.1),
-                    src_shape.2,
-                    dst,
-                    cam.size,
-                    &opts,
-                );
-                let mut mask = coverage(view, cam.size, &src);
-                if let Some(m) = &user_mask {
-                    let drawn = remap
-                        .apply(m)
-                        .map_err(|e| bad(plan.mask.as_deref().unwrap_or(""), e.to_string()))?;
-                    let img = &drawn.layers()[0];
-                    for (v, px) in mask.iter_mut().zip(img.data().chunks_exact(img.channels())) {
-                        if px[0] < 0.5 {
-                            *v = 0;
-                        }
-                    }
-                }
-                plans.push(remap);
-                masks.push(mask);
-                tick();
-            }
+            let (plans, masks) = plan_views(plan, &rig, source, user_mask.as_ref(), &tick)?;
             let with_masks = plan.masks || masks.iter().any(|m| m.contains(&0));
             let mut exif = Vec::new();
             for (f, (path, frame)) in plan.frames.iter().enumerate() {
                 if f > 0 {
                     let (next, notes) = load::read_prepared(path, &plan.input_plan)
-                        .map_err(|e| bad(path, e.message))?;
+                        .map_err(|e| input_error(path, e.message))?;
                     notes.iter().for_each(|l| hooks.note(l));
                     env = next;
                 }
-                let carried = metadata::read(Path::new(path));
-                let app1 = carried
-                    .as_ref()
-                    .filter(|_| plan.format == Format::Jpeg)
-                    .and_then(metadata::Carried::app1);
-                if let Some(c) = &carried {
-                    exif.push((frame.clone(), c.json()));
-                }
-                for ((_, cam), remap) in rig.iter().zip(&plans) {
-                    let out = remap.apply(&env).map_err(|e| bad(path, e.to_string()))?;
-                    let image = plan.image_path(&cam.name, frame);
-                    made.extend(make_folders(std::slice::from_ref(&image))?);
-                    match &app1 {
-                        Some(seg) => mirrorball_io::write_jpeg_with_segments(
-                            &image,
-                            &out.layers()[0],
-                            write.jpeg_quality,
-                            seg,
-                        )?,
-                        None => mirrorball_io::write_image(&image, &out.layers()[0], &write)?,
-                    }
-                    tick();
-                }
-                if with_masks {
-                    for ((_, cam), m) in rig.iter().zip(&masks) {
-                        let path = plan.mask_path(&cam.name, frame);
-                        made.extend(make_folders(std::slice::from_ref(&path))?);
-                        mirrorball_io::write_grey_png(&path, cam.size, m)?;
-                    }
+                let carried =
+                    write_frame(plan, (&rig, &plans), (&env, path, frame), &mut made, &tick)?;
+                exif.extend(carried.map(|c| (frame.clone(), c)));
+                for ((_, cam), m) in rig.iter().zip(&masks).filter(|_| with_masks) {
+                    let path = plan.mask_path(&cam.name, frame);
+                    made.extend(make_folders(std::slice::from_ref(&path))?);
+                    mirrorball_io::write_grey_png(&path, cam.size, m)?;
                 }
             }
             write_cameras(plan, &rig, with_masks, exif)?;
@@ -600,29 +630,41 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
         mirrorball_io::keep_folder(dir);
     }
     let (with_masks, files) = done?;
-    let sizes: std::collections::BTreeSet<String> = rig
-        .iter()
-        .map(|(_, c)| format!("{}x{}", c.size.0, c.size.1))
-        .collect();
-    hooks.note(&format!(
-        "wrote {} views of {}{}, {}{} and the camera files in {} (read {:.2}s, views {:.2}s)",
-        rig.len(),
-        plan.input,
-        match frames {
-            1 => String::new(),
-            n => format!(" ({n} frames, each frame's rig at the same pose: the views' poses within it are exact)"),
-        },
-        sizes.into_iter().collect::<Vec<_>>().join(", "),
-        if with_masks { ", their masks" } else { "" },
-        plan.dir.display(),
-        (t1 - t0).as_secs_f64(),
-        t1.elapsed().as_secs_f64()
-    ));
+    hooks.note(&summary(plan, &rig, with_masks, (t1 - t0, t1.elapsed())));
     Ok(Written {
         files,
         cameras: rig.into_iter().map(|(_, c)| c).collect(),
         masks: with_masks,
     })
+}
+
+/// The line saying what [`run`] wrote, and how long reading and the views took.
+fn summary(
+    plan: &ViewsPlan,
+    rig: &[(View, Pinhole)],
+    with_masks: bool,
+    (read, views): (std::time::Duration, std::time::Duration),
+) -> String {
+    let sizes: std::collections::BTreeSet<String> = rig
+        .iter()
+        .map(|(_, c)| format!("{}x{}", c.size.0, c.size.1))
+        .collect();
+    format!(
+        "wrote {} views of {}{}, {}{} and the camera files in {} (read {:.2}s, views {:.2}s)",
+        rig.len(),
+        plan.input,
+        match plan.frames.len() {
+            1 => String::new(),
+            n => format!(
+                " ({n} frames, each frame's rig at the same pose: the views' poses within it are exact)"
+            ),
+        },
+        sizes.into_iter().collect::<Vec<_>>().join(", "),
+        if with_masks { ", their masks" } else { "" },
+        plan.dir.display(),
+        read.as_secs_f64(),
+        views.as_secs_f64()
+    )
 }
 
 /// Makes the folders `files` need that are missing, outermost first, each marked so that an
