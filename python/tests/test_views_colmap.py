@@ -215,3 +215,33 @@ def test_exif_time_and_place_are_carried(cli, tmp):
     assert record["DateTimeOriginal"] == "2024:05:01 12:34:56"
     assert record["latitude"] == pytest.approx(-33.5)
     assert record["longitude"] == pytest.approx(151.21)
+
+
+def test_colmap_applies_the_rig_to_a_database(rig, tmp):
+    """COLMAP's own step of rig-aware mapping: the views imported one camera per folder,
+    then `apply_rig_config` makes them one rig (the first view its reference) and one frame,
+    each sensor posed as the model poses its camera."""
+    db_path = tmp / "database.db"
+    pycolmap.Database.open(str(db_path)).close()
+    pycolmap.import_images(str(db_path), str(rig / "images"), camera_mode=pycolmap.CameraMode.PER_FOLDER)
+    configs = pycolmap.read_rig_config(str(rig / "rig_config.json"))
+    rec = pycolmap.Reconstruction(str(rig / "sparse" / "0"))
+    posed = {im.name: im.cam_from_world().rotation.matrix() for im in rec.images.values()}
+    with pycolmap.Database.open(str(db_path)) as db:
+        pycolmap.apply_rig_config(configs, db)
+        rigs, frames = db.read_all_rigs(), db.read_all_frames()
+        assert len(rigs) == 1 and len(frames) == 1
+        images = {im.camera_id: im.name for im in db.read_all_images()}
+        assert len(images) == 8 and len(frames[0].data_ids) == 8
+        cameras = {c.camera_id: c for c in db.read_all_cameras()}
+    r = rigs[0]
+    ref = images[r.ref_sensor_id.id]
+    assert ref.startswith(configs[0].cameras[0].image_prefix)
+    assert len(list(r.non_ref_sensors)) == 7
+    for sensor in r.non_ref_sensors:
+        name = images[sensor.id]
+        expected = posed[name] @ posed[ref].T
+        assert np.allclose(r.sensor_from_rig(sensor).rotation.matrix(), expected, atol=1e-9), name
+        model = rec.cameras[rec.find_image_with_name(name).camera_id]
+        assert cameras[sensor.id].model == pycolmap.CameraModelId.PINHOLE
+        assert np.allclose(cameras[sensor.id].params, model.params)
