@@ -245,3 +245,36 @@ def test_colmap_applies_the_rig_to_a_database(rig, tmp):
         model = rec.cameras[rec.find_image_with_name(name).camera_id]
         assert cameras[sensor.id].model == pycolmap.CameraModelId.PINHOLE
         assert np.allclose(cameras[sensor.id].params, model.params)
+
+
+def test_fisheye_views_are_colmaps_opencv_fisheye(cli, tmp):
+    """Fisheye views (equidistant, OPENCV_FISHEYE with k = 0): pycolmap's own fisheye model
+    gives each pixel inside the disk the direction the pixel holds."""
+    pano = tmp / "pano.png"
+    write_png16(pano, direction_latlong(512, 1024).astype(np.float64))
+    rig_file = tmp / "rig.json"
+    rig_file.write_text(json.dumps({"views": [
+        {"name": "front", "model": "fisheye", "fov": 170},
+        {"name": "back", "model": "fisheye", "yaw": 180, "pitch": 20, "roll": 10, "fov": 140},
+    ]}))
+    out = tmp / "out"
+    cli("views", pano, out, "--rig", rig_file, "--size", 160, "--format", "png16", "--quiet")
+    rec = pycolmap.Reconstruction(str(out / "sparse" / "0"))
+    fovs = {"front": 170.0, "back": 140.0}
+    worst = np.zeros(2)
+    for image in rec.images.values():
+        cam = rec.cameras[image.camera_id]
+        assert cam.model == pycolmap.CameraModelId.OPENCV_FISHEYE
+        seen, w, h = view_directions(out, image.name)
+        xy = pixel_grid(w, h)
+        # Inside the disk, less a pixel at its rim (where the picture's filter reaches out).
+        r = np.hypot(xy[:, 0] - cam.principal_point_x, xy[:, 1] - cam.principal_point_y)
+        inside = r < 0.5 * w - 1.0
+        rays = np.concatenate([cam.cam_from_img(xy[inside]), np.ones((inside.sum(), 1))], -1)
+        world = rays @ image.cam_from_world().rotation.matrix() @ COLMAP_TO_MB.T
+        worst = np.maximum(worst, check_errors(angles(world, seen[inside]), world))
+        mask = cv2.imread(str(out / "masks" / f"{image.name}.png"), cv2.IMREAD_UNCHANGED)
+        assert mask.ravel()[r > 0.5 * w + 1.0].max() == 0 and mask.ravel()[inside].min() == 255
+        assert np.isclose(cam.focal_length_x, 0.5 * w / np.deg2rad(0.5 * fovs[image.name.split("/")[0]]))
+    print(f"OPENCV_FISHEYE rays vs pixels: worst {worst[0]:.2e} rad, {worst[1]:.2e} rad 5 degrees from the poles")
+    assert worst[0] < HALF_TEXEL and worst[1] < 5e-4

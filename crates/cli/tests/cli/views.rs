@@ -46,7 +46,7 @@ fn read_model(sparse: &Path) -> (HashMap<u32, Camera>, Vec<Posed>) {
         .filter(|l| !l.starts_with('#') && !l.is_empty())
     {
         let f: Vec<&str> = line.split_whitespace().collect();
-        assert_eq!(f[1], "PINHOLE", "{line}");
+        assert!(["PINHOLE", "OPENCV_FISHEYE"].contains(&f[1]), "{line}");
         let n = |i: usize| f[i].parse::<f64>().unwrap();
         cams.insert(
             f[0].parse().unwrap(),
@@ -140,6 +140,8 @@ fn views_cut_a_panorama_into_a_rig_with_camera_files() {
 
     let (cams, images) = read_model(&out.join("sparse/0"));
     assert_eq!(images.len(), 3);
+    let text = std::fs::read_to_string(out.join("sparse/0/cameras.txt")).unwrap();
+    assert_eq!(text.matches(" PINHOLE ").count(), 3, "{text}");
     // The views as the rig file gives them, through mirrorball's own projection code.
     let specs = [
         ("a", 90.0, None, 0.0, 0.0, 0.0),
@@ -479,4 +481,106 @@ fn views_of_a_sequence_share_one_rig() {
     let lines: Vec<&str> = frames.lines().filter(|l| !l.starts_with('#')).collect();
     assert_eq!(lines.len(), 2);
     assert!(lines[1].ends_with("CAMERA 6 12"), "{}", lines[1]);
+}
+
+#[test]
+fn views_fisheye_rigs_are_opencv_fisheye_cameras() {
+    let dir = tempfile::tempdir().unwrap();
+    let pano = direction_panorama(dir.path(), 256);
+    let rig = dir.path().join("rig.json");
+    std::fs::write(
+        &rig,
+        r#"{"views": [
+            {"name": "f", "model": "fisheye", "fov": 170},
+            {"name": "b", "model": "fisheye", "yaw": 180, "pitch": 10, "roll": 20, "fov": 120, "width": 48}
+        ]}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    ok(&[
+        "views",
+        &pano,
+        out.to_str().unwrap(),
+        "--rig",
+        rig.to_str().unwrap(),
+        "--size",
+        "64",
+        "--format",
+        "exr",
+        "-q",
+    ]);
+    let cameras = std::fs::read_to_string(out.join("sparse/0/cameras.txt")).unwrap();
+    let lines: Vec<&str> = cameras.lines().filter(|l| !l.starts_with('#')).collect();
+    let (_, images) = read_model(&out.join("sparse/0"));
+    let mut worst = 0f64;
+    for (line, (name, _, r, _)) in lines.iter().zip(&images) {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(&f[1..4], ["OPENCV_FISHEYE", f[2], f[2]], "square: {line}");
+        assert_eq!(&f[8..], ["0", "0", "0", "0"]);
+        let n = |i: usize| f[i].parse::<f64>().unwrap();
+        let (w, fx, fy, cx, cy) = (n(2) as u32, n(4), n(5), n(6), n(7));
+        let picture = mirrorball_io::read(&out.join("images").join(name), &Default::default())
+            .unwrap()
+            .layers
+            .remove(0);
+        for y in 0..w {
+            for x in 0..w {
+                // OpenCV's fisheye with k = 0: the distance from the centre is θ.
+                let (a, b) = ((x as f64 + 0.5 - cx) / fx, (y as f64 + 0.5 - cy) / fy);
+                let theta = a.hypot(b);
+                if theta >= 0.5 * f64::to_radians(if name.starts_with('f') { 170.0 } else { 120.0 })
+                {
+                    continue; // outside the disk: masked
+                }
+                let s = if theta > 0.0 {
+                    theta.sin() / theta
+                } else {
+                    1.0
+                };
+                let cam = DVec3::new(a * s, b * s, theta.cos());
+                let wc = r.transpose() * cam;
+                let ray = DVec3::new(wc.x, -wc.y, -wc.z);
+                let p = picture.get(x, y);
+                let seen = DVec3::new(
+                    2.0 * p[0] as f64 - 1.0,
+                    2.0 * p[1] as f64 - 1.0,
+                    2.0 * p[2] as f64 - 1.0,
+                );
+                worst = worst.max(seen.normalize().angle_between(ray));
+            }
+        }
+    }
+    assert!(
+        worst < 0.03,
+        "fisheye pixels are {worst} rad from OpenCV's fisheye rays"
+    );
+    // The disk's outside is masked in every view.
+    let m = mirrorball_io::read(&out.join("masks/f/pano.exr.png"), &Default::default()).unwrap();
+    let m = &m.layers[0];
+    assert_eq!((m.get(0, 0)[0], m.get(32, 32)[0]), (0.0, 1.0));
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("transforms.json")).unwrap())
+            .unwrap();
+    assert_eq!(t["camera_model"], "OPENCV_FISHEYE");
+    assert_eq!(t["frames"][0]["k4"], 0.0);
+    // Mixed models, or a fisheye given a height: refused.
+    let mixed = dir.path().join("mixed.json");
+    std::fs::write(
+        &mixed,
+        r#"{"views": [{"name": "a", "fov": 90}, {"name": "b", "model": "fisheye", "fov": 170}]}"#,
+    )
+    .unwrap();
+    let o = run(&[
+        "views",
+        &pano,
+        dir.path().join("o2").to_str().unwrap(),
+        "--rig",
+        mixed.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("all pinhole or all fisheye"),
+        "{}",
+        stderr(&o)
+    );
 }

@@ -28,12 +28,34 @@ const TO_NERFSTUDIO: DMat3 = DMat3::from_cols(DVec3::X, DVec3::Z, DVec3::NEG_Y);
 /// `applied_transform`): rows `(x, z, −y)`.
 const COLMAP_TO_NERFSTUDIO: DMat3 = DMat3::from_cols(DVec3::X, DVec3::NEG_Z, DVec3::Y);
 
-/// One pinhole camera of the rig: the picture's size and intrinsics in COLMAP's pixel
-/// convention, and its orientation.
+/// How a camera of the rig draws: a pinhole (COLMAP's and nerfstudio's `PINHOLE`), or an
+/// equidistant fisheye (`OPENCV_FISHEYE` with `k1..k4 = 0`: a pixel's distance from the
+/// centre over the focal length is its angle from the axis, as core's `Fisheye` with the
+/// equidistant lens draws).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Model {
+    Pinhole,
+    Fisheye,
+}
+
+impl Model {
+    /// The model's name in COLMAP and nerfstudio.
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Pinhole => "PINHOLE",
+            Model::Fisheye => "OPENCV_FISHEYE",
+        }
+    }
+}
+
+/// One camera of the rig: the picture's size and intrinsics in COLMAP's pixel convention,
+/// and its orientation.
 #[derive(Clone, Debug)]
-pub struct Pinhole {
+pub struct Camera {
     /// The view's name (its folder).
     pub name: String,
+    /// How it draws.
+    pub model: Model,
     /// Picture width and height.
     pub size: (u32, u32),
     /// Focal lengths in pixels.
@@ -45,12 +67,13 @@ pub struct Pinhole {
     pub frame: DMat3,
 }
 
-impl Pinhole {
+impl Camera {
     /// A camera `size` pixels with fields of view `hfov`, `vfov` (degrees) aimed by
     /// `frame`: the focal length at which the picture's edges are the fields' edges.
-    pub fn new(name: &str, (w, h): (u32, u32), (hfov, vfov): (f64, f64), frame: DMat3) -> Pinhole {
-        Pinhole {
+    pub fn new(name: &str, (w, h): (u32, u32), (hfov, vfov): (f64, f64), frame: DMat3) -> Camera {
+        Camera {
             name: name.to_string(),
+            model: Model::Pinhole,
             size: (w, h),
             focal: (
                 w as f64 / (2.0 * (0.5 * hfov.to_radians()).tan()),
@@ -59,6 +82,29 @@ impl Pinhole {
             centre: (0.5 * w as f64, 0.5 * h as f64),
             frame,
         }
+    }
+
+    /// An equidistant fisheye `size`² pixels whose disk, the picture's inscribed circle,
+    /// spans `fov` degrees, aimed by `frame`: focal length `(size/2)/θ_max`.
+    pub fn fisheye(name: &str, size: u32, fov: f64, frame: DMat3) -> Camera {
+        let f = 0.5 * size as f64 / (0.5 * fov.to_radians());
+        Camera {
+            name: name.to_string(),
+            model: Model::Fisheye,
+            size: (size, size),
+            focal: (f, f),
+            centre: (0.5 * size as f64, 0.5 * size as f64),
+            frame,
+        }
+    }
+
+    /// COLMAP's parameters of the camera: `fx fy cx cy`, and `k1..k4` (0) for a fisheye.
+    pub fn params(&self) -> Vec<f64> {
+        let mut p = vec![self.focal.0, self.focal.1, self.centre.0, self.centre.1];
+        if self.model == Model::Fisheye {
+            p.extend([0.0; 4]);
+        }
+        p
     }
 
     /// COLMAP's `cam_from_world` rotation (its world and camera axes).
@@ -74,11 +120,23 @@ impl Pinhole {
     /// The world direction (mirrorball's axes) of the ray through pixel position `(px, py)`
     /// (COLMAP's convention: pixel `(x, y)`'s centre is `(x + ½, y + ½)`).
     pub fn ray(&self, px: f64, py: f64) -> DVec3 {
-        let cam = DVec3::new(
+        let (x, y) = (
             (px - self.centre.0) / self.focal.0,
             (py - self.centre.1) / self.focal.1,
-            1.0,
         );
+        let cam = match self.model {
+            Model::Pinhole => DVec3::new(x, y, 1.0),
+            Model::Fisheye => {
+                // Equidistant: the distance from the centre is the angle from the axis.
+                let theta = x.hypot(y);
+                let s = if theta > 0.0 {
+                    theta.sin() / theta
+                } else {
+                    1.0
+                };
+                DVec3::new(x * s, y * s, theta.cos())
+            }
+        };
         (TO_COLMAP * self.colmap_cam_from_world().transpose() * cam).normalize()
     }
 }
@@ -109,24 +167,23 @@ pub struct Shot<'a> {
     pub mask: Option<&'a str>,
 }
 
-/// `cameras.txt`: one PINHOLE camera per view, ids from 1.
-pub fn cameras_txt(rig: &[Pinhole]) -> String {
+/// `cameras.txt`: one camera per view (PINHOLE or OPENCV_FISHEYE), ids from 1.
+pub fn cameras_txt(rig: &[Camera]) -> String {
     let mut s = String::from(
         "# Camera list with one line of data per camera:\n\
          #   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n",
     );
     let _ = writeln!(s, "# Number of cameras: {}", rig.len());
     for (i, c) in rig.iter().enumerate() {
+        let params: Vec<String> = c.params().into_iter().map(num).collect();
         let _ = writeln!(
             s,
-            "{} PINHOLE {} {} {} {} {} {}",
+            "{} {} {} {} {}",
             i + 1,
+            c.model.name(),
             c.size.0,
             c.size.1,
-            num(c.focal.0),
-            num(c.focal.1),
-            num(c.centre.0),
-            num(c.centre.1)
+            params.join(" ")
         );
     }
     s
@@ -134,7 +191,7 @@ pub fn cameras_txt(rig: &[Pinhole]) -> String {
 
 /// `images.txt`: each shot's `cam_from_world` (translation 0), its camera and name, and an
 /// empty line of 2D points; image ids from 1 in `shots`' order.
-pub fn images_txt(rig: &[Pinhole], shots: &[Shot]) -> String {
+pub fn images_txt(rig: &[Camera], shots: &[Shot]) -> String {
     let mut s = String::from(
         "# Image list with two lines of data per image:\n\
          #   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n\
@@ -171,13 +228,13 @@ pub fn points3d_txt() -> String {
 }
 
 /// `cam_from_rig` of camera `i`: the rig's frame is camera 0's.
-fn cam_from_rig(rig: &[Pinhole], i: usize) -> DMat3 {
+fn cam_from_rig(rig: &[Camera], i: usize) -> DMat3 {
     rig[i].colmap_cam_from_world() * rig[0].colmap_cam_from_world().transpose()
 }
 
 /// `rigs.txt`: one rig, camera 1 its reference sensor, each other camera's
 /// `sensor_from_rig` (translation 0).
-pub fn rigs_txt(rig: &[Pinhole]) -> String {
+pub fn rigs_txt(rig: &[Camera]) -> String {
     let mut s = String::from(
         "# Rig calib list with one line of data per calib:\n\
          #   RIG_ID, NUM_SENSORS, REF_SENSOR_TYPE, REF_SENSOR_ID, SENSORS[] as (SENSOR_TYPE, SENSOR_ID, HAS_POSE, [QW, QX, QY, QZ, TX, TY, TZ])\n\
@@ -202,7 +259,7 @@ pub fn rigs_txt(rig: &[Pinhole]) -> String {
 
 /// `frames.txt`: one frame per panorama (`shots` in runs of the rig's length), its
 /// `rig_from_world` the reference camera's `cam_from_world`, holding its images.
-pub fn frames_txt(rig: &[Pinhole], shots: &[Shot]) -> String {
+pub fn frames_txt(rig: &[Camera], shots: &[Shot]) -> String {
     let frames = shots.len() / rig.len().max(1);
     let mut s = String::from(
         "# Frame list with one line of data per frame:\n\
@@ -231,16 +288,16 @@ pub fn frames_txt(rig: &[Pinhole], shots: &[Shot]) -> String {
 
 /// `rig_config.json`: one rig, each camera's image prefix (`NAME/`), camera 0 the
 /// reference sensor, the others' `cam_from_rig` rotation `[w, x, y, z]` and translation
-/// 0, and each camera's PINHOLE parameters.
-pub fn rig_config_json(rig: &[Pinhole]) -> String {
+/// 0, and each camera's model and parameters.
+pub fn rig_config_json(rig: &[Camera]) -> String {
     let cameras: Vec<serde_json::Value> = rig
         .iter()
         .enumerate()
         .map(|(i, c)| {
             let mut cam = serde_json::json!({
                 "image_prefix": format!("{}/", c.name),
-                "camera_model_name": "PINHOLE",
-                "camera_params": [c.focal.0, c.focal.1, c.centre.0, c.centre.1],
+                "camera_model_name": c.model.name(),
+                "camera_params": c.params(),
             });
             if i == 0 {
                 cam["ref_sensor"] = true.into();
@@ -258,14 +315,11 @@ pub fn rig_config_json(rig: &[Pinhole]) -> String {
     s
 }
 
-/// `transforms.json` for nerfstudio: per frame its camera's intrinsics (`PINHOLE`), the
+/// `transforms.json` for nerfstudio: per frame its camera's intrinsics (the rig's one
+/// model, `PINHOLE` or `OPENCV_FISHEYE` with `k1..k4` 0), the
 /// picture (`images/NAME`), its mask when written, and the camera-to-world matrix;
 /// `extra` (EXIF and the like) added at the top level.
-pub fn transforms_json(
-    rig: &[Pinhole],
-    shots: &[Shot],
-    extra: Option<serde_json::Value>,
-) -> String {
+pub fn transforms_json(rig: &[Camera], shots: &[Shot], extra: Option<serde_json::Value>) -> String {
     let frames: Vec<serde_json::Value> = shots
         .iter()
         .map(|shot| {
@@ -283,9 +337,14 @@ pub fn transforms_json(
                 "cy": c.centre.1,
                 "w": c.size.0,
                 "h": c.size.1,
-                "camera_model": "PINHOLE",
+                "camera_model": c.model.name(),
                 "transform_matrix": [row(0), row(1), row(2), [0.0, 0.0, 0.0, 1.0]],
             });
+            if c.model == Model::Fisheye {
+                for k in ["k1", "k2", "k3", "k4"] {
+                    f[k] = 0.0.into();
+                }
+            }
             if let Some(m) = shot.mask {
                 f["mask_path"] = m.into();
             }
@@ -297,8 +356,9 @@ pub fn transforms_json(
         let v = a.row(i);
         vec![v.x, v.y, v.z, 0.0]
     };
+    let model = rig.first().map_or(Model::Pinhole, |c| c.model);
     let mut doc = serde_json::json!({
-        "camera_model": "PINHOLE",
+        "camera_model": model.name(),
         "frames": frames,
         "applied_transform": [row(0), row(1), row(2)],
     });
@@ -317,7 +377,7 @@ mod tests {
 
     #[test]
     fn the_front_view_is_colmaps_world() {
-        let c = Pinhole::new(
+        let c = Camera::new(
             "front",
             (64, 64),
             (90.0, 90.0),
@@ -336,13 +396,40 @@ mod tests {
     }
 
     #[test]
+    fn fisheye_rays_are_cores_equidistant_fisheye() {
+        use mirrorball_core::{Fisheye, Frame, Lens};
+        let m = View::frame_of(30.0, -10.0, 5.0);
+        let lens = Fisheye::new(
+            Frame {
+                right: m * DVec3::X,
+                up: m * DVec3::Y,
+                forward: m * DVec3::NEG_Z,
+            },
+            Lens::Equidistant,
+            150.0,
+        )
+        .unwrap();
+        let c = Camera::fisheye("f", 64, 150.0, m);
+        assert_eq!(c.params().len(), 8);
+        for (x, y) in [(0, 31), (31, 31), (32, 5), (50, 40), (63, 32)] {
+            let uv =
+                mirrorball_core::glam::DVec2::new((x as f64 + 0.5) / 64.0, (y as f64 + 0.5) / 64.0);
+            let Some(d) = lens.uv_to_dir(0, uv) else {
+                continue;
+            };
+            let r = c.ray(x as f64 + 0.5, y as f64 + 0.5);
+            assert!((d - r).length() < 1e-12, "({x}, {y}): {d} {r}");
+        }
+    }
+
+    #[test]
     fn rays_are_the_views_directions() {
         for (yaw, pitch, roll) in [(0.0, 0.0, 0.0), (37.0, -20.0, 15.0), (200.0, 89.0, -70.0)] {
             let (w, h) = (40u32, 30u32);
             let hfov = 100.0f64;
             let vfov = 2.0 * ((0.5 * hfov.to_radians()).tan() * h as f64 / w as f64).atan();
             let v = View::perspective(hfov, vfov.to_degrees(), yaw, pitch, roll).unwrap();
-            let c = Pinhole::new(
+            let c = Camera::new(
                 "v",
                 (w, h),
                 (hfov, vfov.to_degrees()),

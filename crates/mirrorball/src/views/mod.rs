@@ -36,9 +36,12 @@ use crate::guard::Files;
 use crate::hooks::Hooks;
 use crate::load::{self, InputPlan};
 use crate::spec::ProjSpec;
-use cameras::{Pinhole, Shot};
+use cameras::{Camera, Model, Shot};
 use mirrorball_core::glam::DVec2;
-use mirrorball_core::{EnvMap, Projection, Remap, ResampleOptions, View, WorldProjection};
+use mirrorball_core::glam::DVec3;
+use mirrorball_core::{
+    EnvMap, Fisheye, Frame, Lens, Projection, Remap, ResampleOptions, View, WorldProjection,
+};
 use mirrorball_io::{Folders, Format, Precision, WriteOptions};
 pub use rig::{ViewSpec, PRESETS};
 use std::path::{Path, PathBuf};
@@ -156,6 +159,15 @@ impl ViewsPlan {
                 ))
             })
             .transpose()?;
+        if let Some(v) = views.iter().find(|v| v.model != views[0].model) {
+            return Err(Error::request(format!(
+                "--rig {}: view '{}' is {} and view '{}' is not: a rig's views are all pinhole or all fisheye (nerfstudio reads one camera model a file)",
+                r.rig,
+                v.name,
+                v.model.name(),
+                views[0].name
+            )));
+        }
         let planned = views
             .into_iter()
             .map(|v| plan_view(v, size, &bound))
@@ -239,7 +251,7 @@ impl ViewsPlan {
 
     /// The rig's cameras for a panorama `env`: each view's size (from `--size`, the view,
     /// else the panorama's resolution) and fields of view.
-    fn cameras(&self, env: &EnvMap) -> Result<Vec<(View, Pinhole)>, Error> {
+    fn cameras(&self, env: &EnvMap) -> Result<Vec<(Projection, Camera)>, Error> {
         let p = env.projection();
         let texels = env.width() as f64 * env.height() as f64 * env.layers().len() as f64;
         // Texels per radian: the panorama's, were they spread evenly over what it covers.
@@ -249,14 +261,40 @@ impl ViewsPlan {
             .map(|v| {
                 let s = &v.spec;
                 let t = (0.5 * s.fov.to_radians()).tan();
+                // The picture's half-width over the focal length: the plane's, or (a
+                // fisheye's) the rim's angle.
+                let half = match s.model {
+                    Model::Pinhole => t,
+                    Model::Fisheye => 0.5 * s.fov.to_radians(),
+                };
                 let w = match v.width {
                     Some(w) => w,
                     None => {
-                        let w = (2.0 * t * per_radian).round().max(16.0);
+                        let w = (2.0 * half * per_radian).round().max(16.0);
                         self.bound
                             .check(&format!("view '{}': its width", s.name), w as i64)?
                     }
                 };
+                let frame = View::frame_of(s.yaw, s.pitch, s.roll);
+                if s.model == Model::Fisheye {
+                    let lens = Fisheye::new(
+                        Frame {
+                            right: frame * DVec3::X,
+                            up: frame * DVec3::Y,
+                            forward: frame * DVec3::NEG_Z,
+                        },
+                        Lens::Equidistant,
+                        s.fov,
+                    )
+                    .ok_or_else(|| {
+                        Error::request(format!(
+                            "view '{}': a fisheye of {}° cannot be drawn",
+                            s.name, s.fov
+                        ))
+                    })?;
+                    let cam = Camera::fisheye(&s.name, w, s.fov, frame);
+                    return Ok((Projection::Fisheye(lens), cam));
+                }
                 let (h, vfov) = match (v.height, s.vfov) {
                     (Some(h), Some(vfov)) => (h, vfov),
                     (Some(h), None) => (h, fov_of(t * h as f64 / w as f64)),
@@ -278,13 +316,8 @@ impl ViewsPlan {
                             s.name, s.fov
                         ))
                     })?;
-                let cam = Pinhole::new(
-                    &s.name,
-                    (w, h),
-                    (s.fov, vfov),
-                    View::frame_of(s.yaw, s.pitch, s.roll),
-                );
-                Ok((view, cam))
+                let cam = Camera::new(&s.name, (w, h), (s.fov, vfov), frame);
+                Ok((Projection::View(view), cam))
             })
             .collect()
     }
@@ -325,13 +358,24 @@ fn plan_view(
             )));
         }
     }
+    // A pinhole's plane, and the fisheye model's too (OPENCV_FISHEYE's rays lie in front
+    // of the camera): (0°, 180°).
     let fovs = View::hfov_range(0.0);
+    let kind = match spec.model {
+        Model::Pinhole => "pinhole",
+        Model::Fisheye => "fisheye",
+    };
     for (what, v) in [("fov", Some(spec.fov)), ("vfov", spec.vfov)] {
         if let Some(v) = v.filter(|v| !fovs.contains(*v)) {
             return Err(Error::request(format!(
-                "view '{name}': {what} {v}°: a pinhole view's field of view lies in (0°, 180°)"
+                "view '{name}': {what} {v}°: a {kind} view's field of view lies in (0°, 180°)"
             )));
         }
+    }
+    if spec.model == Model::Fisheye && (spec.vfov.is_some() || spec.height.is_some()) {
+        return Err(Error::request(format!(
+            "view '{name}': a fisheye view is square, its disk fov across: give its width, not vfov or height"
+        )));
     }
     let width = match spec.width {
         Some(w) => Some(bound.check(&format!("view '{name}': width"), w)?),
@@ -339,7 +383,9 @@ fn plan_view(
     };
     let height = match (spec.height, spec.vfov) {
         (Some(h), _) => Some(bound.check(&format!("view '{name}': height"), h)?),
-        (None, None) if spec.width.is_none() => size.and_then(|s| s.1),
+        (None, None) if spec.width.is_none() && spec.model == Model::Pinhole => {
+            size.and_then(|s| s.1)
+        }
         _ => None,
     };
     if let (None, Some(h)) = (width, height) {
@@ -400,7 +446,7 @@ fn frame_name(input: &str) -> String {
 
 /// Where each pixel of `view` (`w`×`h`) is valid: its centre's direction covered by
 /// `source` (255) or not (0).
-fn coverage(view: &View, (w, h): (u32, u32), source: &Projection) -> Vec<u8> {
+fn coverage(view: &Projection, (w, h): (u32, u32), source: &Projection) -> Vec<u8> {
     use rayon::prelude::*;
     let mut out = vec![0u8; w as usize * h as usize];
     out.par_chunks_mut(w as usize)
@@ -449,7 +495,7 @@ pub struct Written {
     /// Every file, in the order written.
     pub files: Vec<PathBuf>,
     /// The views' cameras.
-    pub cameras: Vec<Pinhole>,
+    pub cameras: Vec<Camera>,
     /// Whether masks were written.
     pub masks: bool,
 }
@@ -460,14 +506,14 @@ pub struct Written {
 fn check_resources(
     plan: &ViewsPlan,
     env: &EnvMap,
-    rig: &[(View, Pinhole)],
+    rig: &[(Projection, Camera)],
     masked: bool,
 ) -> Result<(), Error> {
     let c = env.channels() as u64;
     let layers = env.layers().len() as u64;
     let held = budget::f32_texels(env.width() as u64 * env.height() as u64 * layers, c)
         * if masked { 2 } else { 1 };
-    let texels = |cam: &Pinhole| cam.size.0 as u64 * cam.size.1 as u64;
+    let texels = |cam: &Camera| cam.size.0 as u64 * cam.size.1 as u64;
     let most = rig.iter().map(|(_, cam)| texels(cam)).max().unwrap_or(0);
     let all: u64 = rig.iter().map(|(_, cam)| texels(cam)).sum();
     budget::check(
@@ -492,7 +538,7 @@ fn input_error(path: &str, problem: String) -> mirrorball_io::Error {
 /// (the coverage, less what `user_mask` blacks out), each counted by `tick`.
 fn plan_views(
     plan: &ViewsPlan,
-    rig: &[(View, Pinhole)],
+    rig: &[(Projection, Camera)],
     (src, shape): (Projection, (u32, u32, usize)),
     user_mask: Option<&EnvMap>,
     tick: &dyn Fn(),
@@ -503,7 +549,7 @@ fn plan_views(
     };
     let (mut plans, mut masks) = (Vec::new(), Vec::new());
     for (view, cam) in rig {
-        let dst = Projection::View(*view);
+        let dst = *view;
         let remap = Remap::with_extent(src, (shape.0, shape.1), shape.2, dst, cam.size, &opts);
         let mut mask = coverage(view, cam.size, &src);
         if let Some(m) = user_mask {
@@ -530,7 +576,7 @@ fn plan_views(
 /// `tick`; the folders made go to `made`. Returns the EXIF carried, for transforms.json.
 fn write_frame(
     plan: &ViewsPlan,
-    (rig, plans): (&[(View, Pinhole)], &[Remap]),
+    (rig, plans): (&[(Projection, Camera)], &[Remap]),
     (env, path, frame): (&EnvMap, &str, &str),
     made: &mut Vec<PathBuf>,
     tick: &dyn Fn(),
@@ -641,7 +687,7 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
 /// The line saying what [`run`] wrote, and how long reading and the views took.
 fn summary(
     plan: &ViewsPlan,
-    rig: &[(View, Pinhole)],
+    rig: &[(Projection, Camera)],
     with_masks: bool,
     (read, views): (std::time::Duration, std::time::Duration),
 ) -> String {
@@ -693,11 +739,11 @@ fn make_folders(files: &[PathBuf]) -> Result<Vec<PathBuf>, mirrorball_io::Error>
 /// caller's `write_together`).
 fn write_cameras(
     plan: &ViewsPlan,
-    rig: &[(View, Pinhole)],
+    rig: &[(Projection, Camera)],
     with_masks: bool,
     exif: Vec<(String, serde_json::Value)>,
 ) -> Result<(), mirrorball_io::Error> {
-    let cams: Vec<Pinhole> = rig.iter().map(|(_, c)| c.clone()).collect();
+    let cams: Vec<Camera> = rig.iter().map(|(_, c)| c.clone()).collect();
     let names: Vec<(usize, String, String)> = plan
         .frames
         .iter()

@@ -4,6 +4,7 @@
 //! Angles are degrees and aim a view as `convert --to perspective` does
 //! (`mirrorball_core::View::frame_of`): yaw to the right, pitch up, roll about the view axis.
 
+use super::cameras::Model;
 use crate::error::Error;
 use serde::Deserialize;
 use std::collections::HashSet;
@@ -20,7 +21,10 @@ pub struct ViewSpec {
     pub pitch: f64,
     /// Degrees about the view axis.
     pub roll: f64,
-    /// The horizontal field of view, degrees, in `(0, 180)`.
+    /// How it draws: a pinhole, or an equidistant fisheye (square, its disk the picture's
+    /// inscribed circle, `fov` across).
+    pub model: Model,
+    /// The horizontal field of view, degrees, in `(0, 180)` (a fisheye's disk's).
     pub fov: f64,
     /// The vertical field of view, degrees; `None`: from the picture's shape (square
     /// pixels), a square picture when its height is not given either.
@@ -38,6 +42,7 @@ impl ViewSpec {
             yaw,
             pitch,
             roll: 0.0,
+            model: Model::Pinhole,
             fov,
             vfov: None,
             width: None,
@@ -113,8 +118,9 @@ fn ring(n: u32) -> Vec<ViewSpec> {
 pub fn help() -> String {
     let mut s = String::from(
         "The rig: a name below, or a JSON file of views \
-         ({\"views\": [{\"name\", \"yaw\", \"pitch\", \"roll\", \"fov\", \"vfov\", \"width\", \"height\"}]}; \
-         name and fov required, angles in degrees).\nNames:\n",
+         ({\"views\": [{\"name\", \"yaw\", \"pitch\", \"roll\", \"fov\", \"vfov\", \"width\", \"height\", \
+         \"model\"}]}; name and fov required, angles in degrees; model pinhole, or fisheye: \
+         equidistant, square, OPENCV_FISHEYE for COLMAP and nerfstudio).\nNames:\n",
     );
     for p in PRESETS {
         s.push_str(&format!("  {:<8} {}\n", p.name, p.about));
@@ -176,10 +182,21 @@ struct ViewEntry {
     pitch: f64,
     #[serde(default)]
     roll: f64,
+    #[serde(default)]
+    model: ModelName,
     fov: f64,
     vfov: Option<f64>,
     width: Option<i64>,
     height: Option<i64>,
+}
+
+/// A rig file's camera model.
+#[derive(Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum ModelName {
+    #[default]
+    Pinhole,
+    Fisheye,
 }
 
 /// The rig `--rig` names: a preset, else a JSON file (`.json`).
@@ -214,6 +231,10 @@ pub fn resolve(rig: &str) -> Result<Vec<ViewSpec>, Error> {
             yaw: v.yaw,
             pitch: v.pitch,
             roll: v.roll,
+            model: match v.model {
+                ModelName::Pinhole => Model::Pinhole,
+                ModelName::Fisheye => Model::Fisheye,
+            },
             fov: v.fov,
             vfov: v.vfov,
             width: v.width,
