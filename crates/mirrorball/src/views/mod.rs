@@ -1,6 +1,7 @@
 //! Rigs of pinhole views for photogrammetry and Gaussian splatting (`mirrorball views IN
 //! OUT-DIR`): a panorama cut into perspective views, each antialiased as every conversion
-//! is (core's `Remap` from the panorama's projection to a rectilinear `View`), with the
+//! is (core's `Remap` from the panorama's projection to a rectilinear `View`, or to an
+//! equidistant `Fisheye` for a rig of fisheye views), with the
 //! camera files COLMAP and nerfstudio read ([`cameras`]) and masks of what the panorama
 //! does not cover.
 //!
