@@ -194,7 +194,7 @@ fn views_cut_a_panorama_into_a_rig_with_camera_files() {
         worst < 1e-4,
         "COLMAP's rays are {worst} rad from mirrorball's"
     );
-    // A 256-texel-high lat-long: a texel is 0.012 rad; half of one at the poles, and far less
+    // A 256×128 lat-long: a texel is 0.025 rad; half of one at the poles, and far less
     // elsewhere, is what the filter and half-float pixels leave (7.4e-4 rad measured).
     assert!(
         worst_px < 3e-3,
