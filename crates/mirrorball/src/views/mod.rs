@@ -1,9 +1,8 @@
 //! Rigs of pinhole views for photogrammetry and Gaussian splatting (`mirrorball views IN
 //! OUT-DIR`): a panorama cut into perspective views, each antialiased as every conversion
 //! is (core's `Remap` from the panorama's projection to a rectilinear `View`, or to an
-//! equidistant `Fisheye` for a rig of fisheye views), with the
-//! camera files COLMAP and nerfstudio read ([`cameras`]) and masks of what the panorama
-//! does not cover.
+//! equidistant `Fisheye` for a rig of fisheye views), with the camera files COLMAP and
+//! nerfstudio read ([`cameras`]) and masks of what the panorama does not cover.
 //!
 //! `ViewsRequest → ViewsPlan (rig, fields of view, sizes, container, folder, a sequence's
 //! frames and every file checked: nothing read yet) → read the (first) panorama (and
@@ -38,8 +37,7 @@ use crate::hooks::Hooks;
 use crate::load::{self, InputPlan};
 use crate::spec::ProjSpec;
 use cameras::{Camera, Model, Shot};
-use mirrorball_core::glam::DVec2;
-use mirrorball_core::glam::DVec3;
+use mirrorball_core::glam::{DVec2, DVec3};
 use mirrorball_core::{
     EnvMap, Fisheye, Frame, Lens, Projection, Remap, ResampleOptions, View, WorldProjection,
 };
