@@ -122,10 +122,11 @@ pub fn help() -> String {
          \"model\"}]}; name and fov required, angles in degrees; model pinhole, or fisheye: \
          equidistant, square, OPENCV_FISHEYE for COLMAP and nerfstudio).\nNames:\n",
     );
-    for p in PRESETS {
-        s.push_str(&format!("  {:<8} {}\n", p.name, p.about));
-    }
-    s
+    let lines: Vec<String> = PRESETS
+        .iter()
+        .map(|p| format!("  {:<8} {}", p.name, p.about))
+        .collect();
+    s + &lines.join("\n")
 }
 
 /// The views of the preset `name` (`ring8`), or `None` when no preset has that name.
