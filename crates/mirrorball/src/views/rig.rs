@@ -116,7 +116,7 @@ fn ring(n: u32) -> Vec<ViewSpec> {
 
 /// `--rig`'s help: each preset on a line.
 pub fn help() -> String {
-    let mut s = String::from(
+    let s = String::from(
         "The rig: a name below, or a JSON file of views \
          ({\"views\": [{\"name\", \"yaw\", \"pitch\", \"roll\", \"fov\", \"vfov\", \"width\", \"height\", \
          \"model\"}]}; name and fov required, angles in degrees; model pinhole, or fisheye: \
