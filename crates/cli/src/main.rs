@@ -66,6 +66,10 @@ enum Command {
     /// Add, replace or remove the 360° metadata of an MP4/MOV without re-encoding: Spherical
     /// Video V2 (st3d, sv3d), optionally V1's XML; `info FILE.mp4` shows what a video has.
     Tag(commands::tag::TagArgs),
+    /// Cut a panorama into a rig of pinhole views for photogrammetry and Gaussian
+    /// splatting, with the camera files COLMAP (a text model, rig_config.json) and
+    /// nerfstudio (transforms.json) read, and masks of what the panorama does not cover.
+    Views(commands::views::ViewsArgs),
 }
 
 /// `--from`'s long help: the names from core's table of projections, then the keys.
@@ -633,6 +637,7 @@ fn main() -> ExitCode {
         Command::Render(a) => commands::render::run(*a),
         Command::Studio(a) => commands::studio::run(a),
         Command::Tag(a) => commands::tag::run(a),
+        Command::Views(a) => commands::views::run(a),
     };
     if !quiet {
         for f in mirrorball_io::removed_leftovers() {

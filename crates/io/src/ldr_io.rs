@@ -322,6 +322,58 @@ fn write_png(
     })
 }
 
+/// Writes `w`×`h` 8-bit grey samples (a mask: 255 where a pixel counts, 0 where not) as a
+/// one-channel PNG, stored as given (no transfer function), through the atomic writes.
+pub fn write_grey_png(path: &Path, (w, h): (u32, u32), samples: &[u8]) -> Result<(), Error> {
+    if samples.len() != w as usize * h as usize {
+        return Err(Error::request(
+            path,
+            format!("{} grey samples for a {w}×{h} picture", samples.len()),
+        ));
+    }
+    crate::atomic::land(stage(path, |out| {
+        PngEncoder::new(out)
+            .write_image(samples, w, h, ExtendedColorType::L8)
+            .map_err(|e| encode_error(path, "PNG", e))
+    })?)
+}
+
+/// Writes `image` as an 8-bit RGB JPEG at `quality` (92 when 0, at most 100) with
+/// `segments` (complete JPEG marker segments, such as an EXIF `APP1`) placed after the
+/// encoder's own header segments (SOI and JFIF's `APP0`), through the atomic writes.
+pub fn write_jpeg_with_segments(
+    path: &Path,
+    image: &Image,
+    quality: u8,
+    segments: &[u8],
+) -> Result<(), Error> {
+    check_writable_size(path, image)?;
+    let (w, h) = (image.width(), image.height());
+    if w > u16::MAX as u32 || h > u16::MAX as u32 {
+        return Err(Error::request(
+            path,
+            format!("JPEG images are at most 65535 texels wide and high; this one is {w}×{h}"),
+        ));
+    }
+    let quality = match quality {
+        0 => DEFAULT_JPEG_QUALITY,
+        q => q.min(100),
+    };
+    let mut jpeg = Vec::new();
+    JpegEncoder::new_with_quality(&mut jpeg, quality)
+        .write_image(&encode_u8(image, 3), w, h, ExtendedColorType::Rgb8)
+        .map_err(|e| encode_error(path, "JPEG", e))?;
+    // After SOI, and after APP0 (JFIF) when the encoder wrote one first.
+    let mut at = 2;
+    if jpeg.len() > 6 && jpeg[2] == 0xFF && jpeg[3] == 0xE0 {
+        at = 4 + u16::from_be_bytes([jpeg[4], jpeg[5]]) as usize;
+    }
+    jpeg.splice(at..at, segments.iter().copied());
+    crate::atomic::land(stage(path, |out| {
+        std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
+    })?)
+}
+
 /// The GPano XMP packet of a lat-long or VR180 picture of `w`×`h` texels (none for other
 /// projections and for stereo pairs): 360° viewers show such photos as panoramas.
 fn panorama_xmp(info: &crate::MapInfo, w: u32, h: u32) -> Option<String> {

@@ -59,7 +59,9 @@ pub use ktx1_io::{filament_sh_text, write_ktx1};
 pub use ktx2_io::{write_ktx2, zstd_work, CubeWrite};
 /// sRGB encoding's one home: 8-bit codes by the thresholds between codes, 16-bit codes.
 pub use ldr_io::{encode16 as srgb16_code, encode8 as srgb8_code, thresholds8 as srgb8_thresholds};
-pub use ldr_io::{lut16 as srgb16_to_linear, lut8 as srgb8_to_linear};
+pub use ldr_io::{
+    lut16 as srgb16_to_linear, lut8 as srgb8_to_linear, write_grey_png, write_jpeg_with_segments,
+};
 pub use meta_text::read_xmp;
 pub use mirrorball_encode::{Clipped, Effort, Encoding, Range, Storage};
 pub use output::OutputSet;

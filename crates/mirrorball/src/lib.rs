@@ -40,6 +40,10 @@
 //!   [`prefilter::Plan`]; [`prefilter::run`] reads, prefilters and writes the chain, its SH9
 //!   JSON, preview and BRDF table.
 //!
+//! - [`views`]: a [`views::ViewsRequest`] becomes a checked [`views::ViewsPlan`];
+//!   [`views::run`] cuts a panorama into a rig of pinhole views and writes them with the
+//!   camera files COLMAP and nerfstudio read, and masks of what the panorama covers.
+//!
 //! Long jobs tell their caller what they do through [`Hooks`] (lines for people, progress);
 //! [`Quiet`] says nothing.
 //!
@@ -65,6 +69,7 @@ pub mod render;
 pub mod save;
 pub mod size;
 pub mod spec;
+pub mod views;
 
 pub use error::Error;
 pub use hooks::{Hooks, Quiet};

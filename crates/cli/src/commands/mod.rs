@@ -10,6 +10,7 @@ pub mod prefilter;
 pub mod render;
 pub mod studio;
 pub mod tag;
+pub mod views;
 
 use crate::error::CliError;
 use crate::spec::{bad, ProjSpec};

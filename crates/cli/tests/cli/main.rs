@@ -20,4 +20,5 @@ mod tables;
 mod util;
 mod v360;
 mod video;
+mod views;
 mod zoneplate;

@@ -1,0 +1,820 @@
+//! Rigs of pinhole views for photogrammetry and Gaussian splatting (`mirrorball views IN
+//! OUT-DIR`): a panorama cut into perspective views, each antialiased as every conversion
+//! is (core's `Remap` from the panorama's projection to a rectilinear `View`, or to an
+//! equidistant `Fisheye` for a rig of fisheye views), with the camera files COLMAP and
+//! nerfstudio read ([`cameras`]) and masks of what the panorama does not cover.
+//!
+//! `ViewsRequest → ViewsPlan (rig, fields of view, sizes, container, folder, a sequence's
+//! frames and every file checked: nothing read yet) → read the (first) panorama (and
+//! --mask, the same size) → each view's size and camera → memory and room checked → per
+//! view: its plan and its mask, made once → per frame: read, each view's picture from its
+//! plan, the masks → every file lands together (io::write_together)`.
+//!
+//! A sequence (`frames/%04d.exr`, `'frames/*.jpg'`: `frames::pattern`) is one rig: each
+//! frame's views are its images in `frames.txt` and `transforms.json`, every frame's rig at
+//! the same pose (the poses within the rig are exact; where a moving camera stood is for
+//! the mapper to find, with `rig_config.json`). A source's capture time and GPS fields
+//! ([`metadata`]) go into each JPEG view's EXIF and into `transforms.json`
+//! (`mirrorball.exif`, per frame).
+//!
+//! What OUT-DIR holds (`FRAME` each panorama's file stem, `EXT` the views' container):
+//! - `images/VIEW/FRAME.EXT`: the views, one folder per view, as COLMAP's rig
+//!   configuration takes them (each camera its own image prefix);
+//! - `masks/VIEW/FRAME.EXT.png`: 8-bit grey, 255 where the pixel's direction is covered by
+//!   the panorama (and white in `--mask`), 0 elsewhere; COLMAP's `mask_path` naming.
+//!   Written for every view when one of them is not all valid, or with `--masks`;
+//! - `sparse/0/`: the COLMAP text model, `rig_config.json`, `transforms.json`.
+
+pub mod cameras;
+pub mod metadata;
+pub mod rig;
+
+use crate::budget;
+use crate::error::Error;
+use crate::frames::pattern::Pattern;
+use crate::guard::Files;
+use crate::hooks::Hooks;
+use crate::load::{self, InputPlan};
+use crate::spec::ProjSpec;
+use cameras::{Camera, Model, Shot};
+use mirrorball_core::glam::{DVec2, DVec3};
+use mirrorball_core::{
+    EnvMap, Fisheye, Frame, Lens, Projection, Remap, ResampleOptions, View, WorldProjection,
+};
+use mirrorball_io::{Folders, Format, Precision, WriteOptions};
+pub use rig::{ViewSpec, PRESETS};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What to cut, as plain values: the command line's `views` flags.
+#[derive(Clone, Debug)]
+pub struct ViewsRequest {
+    /// The panorama (any projection mirrorball reads), or a sequence's pattern (printf
+    /// `%04d` or a glob, in the file name).
+    pub input: String,
+    /// The folder to write into (made if missing; its parent must exist).
+    pub out_dir: String,
+    /// How to read the input.
+    pub input_plan: InputPlan,
+    /// A preset's name ([`PRESETS`]) or a `.json` file of views.
+    pub rig: String,
+    /// `--size W[xH]`: each view's width (where the rig gives none) and height (where the
+    /// view sets neither its height nor its vertical field of view).
+    pub size: Option<(i64, Option<i64>)>,
+    /// The views' container: `png` (8-bit), `png16` (16-bit PNG), `jpg` or `exr` (half).
+    pub format: String,
+    /// Write every view's mask even when all its pixels are valid.
+    pub masks: bool,
+    /// A mask drawn on the panorama (white: valid), the panorama's size.
+    pub mask: Option<String>,
+    /// The most integration points per texel side (1..=16).
+    pub max_samples: u32,
+}
+
+impl ViewsRequest {
+    /// The command line's defaults for cutting `input` into `out_dir`.
+    pub fn new(input: &str, out_dir: &str) -> ViewsRequest {
+        ViewsRequest {
+            input: input.into(),
+            out_dir: out_dir.into(),
+            input_plan: InputPlan::default(),
+            rig: "cube".into(),
+            size: None,
+            format: "png".into(),
+            masks: false,
+            mask: None,
+            max_samples: ResampleOptions::default().max_samples,
+        }
+    }
+}
+
+/// `--size`'s text, `W` or `WxH`, as numbers (checked against the container's bound in the
+/// plan).
+pub fn parse_size(s: &str) -> Result<(i64, Option<i64>), String> {
+    let s = s.trim();
+    match s.split_once(['x', 'X', '×']) {
+        Some((w, h)) => Ok((crate::size::parse(w)?, Some(crate::size::parse(h)?))),
+        None => Ok((crate::size::parse(s)?, None)),
+    }
+}
+
+/// A view, checked: its aim and fields, its size where known before the panorama is read.
+#[derive(Clone, Debug)]
+struct Planned {
+    spec: ViewSpec,
+    width: Option<u32>,
+    height: Option<u32>,
+}
+
+/// A cut, checked before any file is read.
+pub struct ViewsPlan {
+    input: String,
+    input_plan: InputPlan,
+    rig: String,
+    views: Vec<Planned>,
+    format: Format,
+    ext: &'static str,
+    precision: Option<Precision>,
+    dir: PathBuf,
+    /// Each panorama (one, or a sequence's frames) and its name in the views' folders.
+    frames: Vec<(String, String)>,
+    mask: Option<String>,
+    masks: bool,
+    max_samples: u32,
+    bound: crate::size::Bound,
+    files: Files,
+}
+
+impl ViewsPlan {
+    /// Checks `r`: the rig, each view's fields of view and size, the container, OUT-DIR and
+    /// every file written.
+    pub fn new(r: &ViewsRequest) -> Result<ViewsPlan, Error> {
+        let views = rig::resolve(&r.rig)?;
+        let (format, ext, precision) = match r.format.to_ascii_lowercase().as_str() {
+            "png" => (Format::Png, "png", None),
+            "png16" => (Format::Png, "png", Some(Precision::U16)),
+            "jpg" | "jpeg" => (Format::Jpeg, "jpg", None),
+            "exr" => (Format::Exr, "exr", None),
+            other => {
+                return Err(Error::request(format!(
+                    "--format: unknown '{other}' (png, png16, jpg, exr)"
+                )))
+            }
+        };
+        if !(1..=16).contains(&r.max_samples) {
+            return Err(Error::request(format!(
+                "--max-samples: {} is outside 1..=16",
+                r.max_samples
+            )));
+        }
+        let bound =
+            crate::size::pictures(format, &format!("a .{ext} view"), |s| (s as u64, s as u64));
+        let size = r
+            .size
+            .map(|(w, h)| {
+                Ok::<_, Error>((
+                    bound.check("--size", w)?,
+                    h.map(|h| bound.check("--size", h)).transpose()?,
+                ))
+            })
+            .transpose()?;
+        if let Some(v) = views.iter().find(|v| v.model != views[0].model) {
+            return Err(Error::request(format!(
+                "--rig {}: view '{}' is {} and view '{}' is not: a rig's views are all pinhole or all fisheye (nerfstudio reads one camera model a file)",
+                r.rig,
+                v.name,
+                v.model.name(),
+                views[0].name
+            )));
+        }
+        let planned = views
+            .into_iter()
+            .map(|v| plan_view(v, size, &bound))
+            .collect::<Result<Vec<_>, _>>()?;
+        let dir = PathBuf::from(&r.out_dir);
+        check_dir(&dir)?;
+        let frames: Vec<(String, String)> = match Pattern::parse(&r.input)? {
+            Some(p) => p
+                .expand(&r.input)?
+                .into_iter()
+                .map(|f| {
+                    let path = f.path.to_string_lossy().into_owned();
+                    let name = frame_name(&path);
+                    (path, name)
+                })
+                .collect(),
+            None => vec![(r.input.clone(), frame_name(&r.input))],
+        };
+        let mut names = std::collections::HashSet::new();
+        if let Some((path, name)) = frames.iter().find(|(_, n)| !names.insert(n.clone())) {
+            return Err(Error::request(format!(
+                "{}: {path} is another frame named {name} (frames are named by their file stems)",
+                r.input
+            )));
+        }
+        let mut files = Files::new();
+        files.making(Folders::MakeAll);
+        for (path, _) in &frames {
+            files.input_arg("the input", path);
+        }
+        if let Some(m) = &r.mask {
+            files.input("--mask", m);
+        }
+        let mut plan = ViewsPlan {
+            input: r.input.clone(),
+            input_plan: r.input_plan.clone(),
+            rig: r.rig.clone(),
+            views: planned,
+            format,
+            ext,
+            precision,
+            dir,
+            frames,
+            mask: r.mask.clone(),
+            masks: r.masks,
+            max_samples: r.max_samples,
+            bound,
+            files: Files::new(),
+        };
+        for (_, frame) in &plan.frames {
+            for v in &plan.views {
+                files.output("a view", plan.image_path(&v.spec.name, frame));
+                files.output("a mask", plan.mask_path(&v.spec.name, frame));
+            }
+        }
+        for name in TEXT_FILES {
+            files.output("a camera file", plan.dir.join(name));
+        }
+        files.check()?;
+        plan.files = files;
+        Ok(plan)
+    }
+
+    /// The picture of view `name`, relative to `images/`.
+    fn image_name(&self, name: &str, frame: &str) -> String {
+        format!("{name}/{frame}.{}", self.ext)
+    }
+
+    /// The mask of view `name`, relative to OUT-DIR.
+    fn mask_name(&self, name: &str, frame: &str) -> String {
+        format!("masks/{}.png", self.image_name(name, frame))
+    }
+
+    fn image_path(&self, name: &str, frame: &str) -> PathBuf {
+        self.dir.join("images").join(self.image_name(name, frame))
+    }
+
+    fn mask_path(&self, name: &str, frame: &str) -> PathBuf {
+        self.dir.join(self.mask_name(name, frame))
+    }
+
+    /// The rig's cameras for a panorama `env`: each view's size (from `--size`, the view,
+    /// else the panorama's resolution) and fields of view.
+    fn cameras(&self, env: &EnvMap) -> Result<Vec<(Projection, Camera)>, Error> {
+        let p = env.projection();
+        let texels = env.width() as f64 * env.height() as f64 * env.layers().len() as f64;
+        // Texels per radian: the panorama's, were they spread evenly over what it covers.
+        let per_radian = (texels / p.covered_solid_angle()).sqrt();
+        self.views
+            .iter()
+            .map(|v| {
+                let s = &v.spec;
+                let t = (0.5 * s.fov.to_radians()).tan();
+                // The picture's half-width over the focal length: the plane's, or (a
+                // fisheye's) the rim's angle.
+                let half = match s.model {
+                    Model::Pinhole => t,
+                    Model::Fisheye => 0.5 * s.fov.to_radians(),
+                };
+                let w = match v.width {
+                    Some(w) => w,
+                    None => {
+                        let w = (2.0 * half * per_radian).round().max(16.0);
+                        self.bound
+                            .check(&format!("view '{}': its width", s.name), w as i64)?
+                    }
+                };
+                let frame = View::frame_of(s.yaw, s.pitch, s.roll);
+                if s.model == Model::Fisheye {
+                    let lens = Fisheye::new(
+                        Frame {
+                            right: frame * DVec3::X,
+                            up: frame * DVec3::Y,
+                            forward: frame * DVec3::NEG_Z,
+                        },
+                        Lens::Equidistant,
+                        s.fov,
+                    )
+                    .ok_or_else(|| {
+                        Error::request(format!(
+                            "view '{}': a fisheye of {}° cannot be drawn",
+                            s.name, s.fov
+                        ))
+                    })?;
+                    let cam = Camera::fisheye(&s.name, w, s.fov, frame);
+                    return Ok((Projection::Fisheye(lens), cam));
+                }
+                let (h, vfov) = match (v.height, s.vfov) {
+                    (Some(h), Some(vfov)) => (h, vfov),
+                    (Some(h), None) => (h, fov_of(t * h as f64 / w as f64)),
+                    (None, Some(vfov)) => {
+                        let tv = (0.5 * vfov.to_radians()).tan();
+                        let h = (w as f64 * tv / t).round().max(1.0) as i64;
+                        (
+                            self.bound
+                                .check(&format!("view '{}': its height", s.name), h)?,
+                            vfov,
+                        )
+                    }
+                    (None, None) => (w, s.fov),
+                };
+                let view =
+                    View::perspective(s.fov, vfov, s.yaw, s.pitch, s.roll).ok_or_else(|| {
+                        Error::request(format!(
+                            "view '{}': a pinhole view of {}°×{vfov}° cannot be drawn",
+                            s.name, s.fov
+                        ))
+                    })?;
+                let cam = Camera::new(&s.name, (w, h), (s.fov, vfov), frame);
+                Ok((Projection::View(view), cam))
+            })
+            .collect()
+    }
+}
+
+/// The camera files, relative to OUT-DIR.
+const TEXT_FILES: [&str; 7] = [
+    "sparse/0/cameras.txt",
+    "sparse/0/images.txt",
+    "sparse/0/points3D.txt",
+    "sparse/0/rigs.txt",
+    "sparse/0/frames.txt",
+    "rig_config.json",
+    "transforms.json",
+];
+
+/// The field of view, degrees, whose half-angle's tangent is `t`.
+fn fov_of(t: f64) -> f64 {
+    2.0 * t.atan().to_degrees()
+}
+
+/// A rig's view checked: finite angles, fields of view a pinhole draws, sizes within the
+/// container's bound; `--size` (`size`) where the view gives none.
+fn plan_view(
+    spec: ViewSpec,
+    size: Option<(u32, Option<u32>)>,
+    bound: &crate::size::Bound,
+) -> Result<Planned, Error> {
+    let name = &spec.name;
+    for (what, v) in [
+        ("yaw", spec.yaw),
+        ("pitch", spec.pitch),
+        ("roll", spec.roll),
+    ] {
+        if !v.is_finite() {
+            return Err(Error::request(format!(
+                "view '{name}': {what} {v} is not finite"
+            )));
+        }
+    }
+    // A pinhole's plane, and the fisheye model's too (OPENCV_FISHEYE's rays lie in front
+    // of the camera): (0°, 180°).
+    let fovs = View::hfov_range(0.0);
+    let kind = match spec.model {
+        Model::Pinhole => "pinhole",
+        Model::Fisheye => "fisheye",
+    };
+    for (what, v) in [("fov", Some(spec.fov)), ("vfov", spec.vfov)] {
+        if let Some(v) = v.filter(|v| !fovs.contains(*v)) {
+            return Err(Error::request(format!(
+                "view '{name}': {what} {v}°: a {kind} view's field of view lies in (0°, 180°)"
+            )));
+        }
+    }
+    if spec.model == Model::Fisheye && (spec.vfov.is_some() || spec.height.is_some()) {
+        return Err(Error::request(format!(
+            "view '{name}': a fisheye view is square, its disk fov across: give its width, not vfov or height"
+        )));
+    }
+    let width = match spec.width {
+        Some(w) => Some(bound.check(&format!("view '{name}': width"), w)?),
+        None => size.map(|s| s.0),
+    };
+    let height = match (spec.height, spec.vfov) {
+        (Some(h), _) => Some(bound.check(&format!("view '{name}': height"), h)?),
+        (None, None) if spec.width.is_none() && spec.model == Model::Pinhole => {
+            size.and_then(|s| s.1)
+        }
+        _ => None,
+    };
+    if let (None, Some(h)) = (width, height) {
+        return Err(Error::request(format!(
+            "view '{name}': a height ({h}) needs a width (the view's, or --size's)"
+        )));
+    }
+    Ok(Planned {
+        spec,
+        width,
+        height,
+    })
+}
+
+/// OUT-DIR: a folder or nothing yet, in a folder that exists.
+fn check_dir(dir: &Path) -> Result<(), Error> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(Error::request(format!(
+            "{}: OUT-DIR is a file; views writes a folder of files (give a folder's name)",
+            dir.display()
+        )));
+    }
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(p) = parent.filter(|p| !dir.exists() && !p.is_dir()) {
+        return Err(Error::request(format!(
+            "{}: the folder {} does not exist (views makes OUT-DIR, not the folders above it)",
+            dir.display(),
+            p.display()
+        )));
+    }
+    Ok(())
+}
+
+/// The frame's name in each view's folder: the input's file stem (`{face}` left out).
+fn frame_name(input: &str) -> String {
+    let stem = Path::new(&input.replace(load::FACE, ""))
+        .file_stem()
+        .map(|s| {
+            s.to_string_lossy()
+                .trim_matches(['_', '-', '.'])
+                .to_string()
+        })
+        .unwrap_or_default();
+    let plain: String = stem
+        .chars()
+        .map(
+            |c| match c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                true => c,
+                false => '_',
+            },
+        )
+        .collect();
+    match plain.is_empty() {
+        true => "frame".into(),
+        false => plain,
+    }
+}
+
+/// Where each pixel of `view` (`w`×`h`) is valid: its centre's direction covered by
+/// `source` (255) or not (0).
+fn coverage(view: &Projection, (w, h): (u32, u32), source: &Projection) -> Vec<u8> {
+    use rayon::prelude::*;
+    let mut out = vec![0u8; w as usize * h as usize];
+    out.par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, m) in row.iter_mut().enumerate() {
+                let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                let covered = view
+                    .uv_to_dir(0, uv)
+                    .is_some_and(|d| source.dir_to_uv(d).is_some());
+                *m = if covered { 255 } else { 0 };
+            }
+        });
+    out
+}
+
+/// Reads `--mask` as a map of the panorama's projection and layout, refused unless it is
+/// the panorama's size.
+fn read_mask(plan: &ViewsPlan, path: &str, env: &EnvMap) -> Result<EnvMap, Error> {
+    let from = ProjSpec::parse(&env.projection().to_string())
+        .map_err(|e| Error::request(format!("--mask: {e}")))?;
+    let limits = mirrorball_io::Limits::default();
+    let shape = |m: &EnvMap| {
+        let layers = match m.layers().len() {
+            1 => String::new(),
+            n => format!("x{n}"),
+        };
+        format!("{}x{}{layers}", m.width(), m.height())
+    };
+    let m = load::load(path, Some(&from), plan.input_plan.layout, &limits)
+        .map_err(|e| e.context("--mask"))?
+        .env;
+    if (m.width(), m.height(), m.layers().len()) != (env.width(), env.height(), env.layers().len())
+    {
+        return Err(Error::input(format!(
+            "--mask {path}: {}, the panorama is {}: a mask is drawn on the panorama, the same size",
+            shape(&m),
+            shape(env)
+        )));
+    }
+    Ok(m)
+}
+
+/// What [`run`] wrote.
+pub struct Written {
+    /// Every file, in the order written.
+    pub files: Vec<PathBuf>,
+    /// The views' cameras.
+    pub cameras: Vec<Camera>,
+    /// Whether masks were written.
+    pub masks: bool,
+}
+
+/// Refuses the job when it would not fit in memory (a panorama, and the mask when
+/// `masked`; each view's plan (8 bytes a texel, and taps) and mask, and one view's picture)
+/// or on the disk (every frame's views and masks).
+fn check_resources(
+    plan: &ViewsPlan,
+    env: &EnvMap,
+    rig: &[(Projection, Camera)],
+    masked: bool,
+) -> Result<(), Error> {
+    let c = env.channels() as u64;
+    let layers = env.layers().len() as u64;
+    let held = budget::f32_texels(env.width() as u64 * env.height() as u64 * layers, c)
+        * if masked { 2 } else { 1 };
+    let texels = |cam: &Camera| cam.size.0 as u64 * cam.size.1 as u64;
+    let most = rig.iter().map(|(_, cam)| texels(cam)).max().unwrap_or(0);
+    let all: u64 = rig.iter().map(|(_, cam)| texels(cam)).sum();
+    budget::check(
+        &format!("{} views", rig.len()),
+        held,
+        all * 17 + most * 4 * c * 2,
+        "a smaller --size",
+    )?;
+    let bytes: u64 = rig
+        .iter()
+        .map(|(_, cam)| plan.format.bytes_estimate(texels(cam), 3, None) + texels(cam))
+        .sum();
+    plan.files.room(bytes * plan.frames.len() as u64)
+}
+
+/// A reading error of `path` as io's, for the writes' set.
+fn input_error(path: &str, problem: String) -> mirrorball_io::Error {
+    mirrorball_io::Error::input(Path::new(path), problem)
+}
+
+/// Each view's plan from a panorama of `src` (`shape`: width, height, layers) and its mask
+/// (the coverage, less what `user_mask` blacks out), each counted by `tick`.
+fn plan_views(
+    plan: &ViewsPlan,
+    rig: &[(Projection, Camera)],
+    (src, shape): (Projection, (u32, u32, usize)),
+    user_mask: Option<&EnvMap>,
+    tick: &dyn Fn(),
+) -> Result<(Vec<Remap>, Vec<Vec<u8>>), mirrorball_io::Error> {
+    let opts = ResampleOptions {
+        max_samples: plan.max_samples,
+        ..Default::default()
+    };
+    let (mut plans, mut masks) = (Vec::new(), Vec::new());
+    for (view, cam) in rig {
+        let dst = *view;
+        let remap = Remap::with_extent(src, (shape.0, shape.1), shape.2, dst, cam.size, &opts);
+        let mut mask = coverage(view, cam.size, &src);
+        if let Some(m) = user_mask {
+            let name = plan.mask.as_deref().unwrap_or_default();
+            let drawn = remap
+                .apply(m)
+                .map_err(|e| input_error(name, e.to_string()))?;
+            let img = &drawn.layers()[0];
+            for (v, px) in mask.iter_mut().zip(img.data().chunks_exact(img.channels())) {
+                if px[0] < 0.5 {
+                    *v = 0;
+                }
+            }
+        }
+        plans.push(remap);
+        masks.push(mask);
+        tick();
+    }
+    Ok((plans, masks))
+}
+
+/// Writes the views of one panorama `env` (the file `path`, named `frame` in the views'
+/// folders) by their `plans`, with the EXIF it carries in JPEG views, each counted by
+/// `tick`; the folders made go to `made`. Returns the EXIF carried, for transforms.json.
+fn write_frame(
+    plan: &ViewsPlan,
+    (rig, plans): (&[(Projection, Camera)], &[Remap]),
+    (env, path, frame): (&EnvMap, &str, &str),
+    made: &mut Vec<PathBuf>,
+    tick: &dyn Fn(),
+) -> Result<Option<serde_json::Value>, mirrorball_io::Error> {
+    let write = WriteOptions {
+        precision: plan.precision,
+        jpeg_quality: 92,
+        ..Default::default()
+    };
+    let carried = metadata::read(Path::new(path));
+    let app1 = carried
+        .as_ref()
+        .filter(|_| plan.format == Format::Jpeg)
+        .and_then(metadata::Carried::app1);
+    for ((_, cam), remap) in rig.iter().zip(plans) {
+        let out = remap
+            .apply(env)
+            .map_err(|e| input_error(path, e.to_string()))?;
+        let image = plan.image_path(&cam.name, frame);
+        made.extend(make_folders(std::slice::from_ref(&image))?);
+        let picture = &out.layers()[0];
+        match &app1 {
+            Some(seg) => {
+                mirrorball_io::write_jpeg_with_segments(&image, picture, write.jpeg_quality, seg)?
+            }
+            None => mirrorball_io::write_image(&image, picture, &write)?,
+        }
+        tick();
+    }
+    Ok(carried.map(|c| c.json()))
+}
+
+/// Cuts the panorama (or each frame of the sequence) into the rig's views and writes them
+/// with their masks and camera files, every file landing together, saying what it does
+/// through `hooks`.
+pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
+    let t0 = Instant::now();
+    let (env, notes) = load::read_prepared(&plan.frames[0].0, &plan.input_plan)?;
+    notes.iter().for_each(|l| hooks.note(l));
+    let user_mask = plan
+        .mask
+        .as_deref()
+        .map(|m| read_mask(plan, m, &env))
+        .transpose()?;
+    let rig = plan.cameras(&env)?;
+    check_resources(plan, &env, &rig, user_mask.is_some())?;
+    let source = (
+        *env.projection(),
+        (env.width(), env.height(), env.layers().len()),
+    );
+    let t1 = Instant::now();
+    let mut wanted: Vec<PathBuf> = rig
+        .iter()
+        .map(|(_, cam)| plan.image_path(&cam.name, &plan.frames[0].1))
+        .collect();
+    wanted.extend(TEXT_FILES.iter().map(|n| plan.dir.join(n)));
+    let mut made = make_folders(&wanted)?;
+    let mut env = Some(env);
+    let mut done = None;
+    // Progress in views: each view's plan, then each view of each frame.
+    let total = rig.len() as u64 * (plan.frames.len() as u64 + 1);
+    hooks.progress("views", total, &mut |counter| {
+        let tick = || {
+            counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        };
+        let mut env = env.take().expect("the work runs once");
+        done = Some(mirrorball_io::write_together(|| {
+            let (plans, masks) = plan_views(plan, &rig, source, user_mask.as_ref(), &tick)?;
+            let with_masks = plan.masks || masks.iter().any(|m| m.contains(&0));
+            let mut exif = Vec::new();
+            for (f, (path, frame)) in plan.frames.iter().enumerate() {
+                if f > 0 {
+                    let (next, notes) = load::read_prepared(path, &plan.input_plan)
+                        .map_err(|e| input_error(path, e.message))?;
+                    notes.iter().for_each(|l| hooks.note(l));
+                    env = next;
+                }
+                let carried =
+                    write_frame(plan, (&rig, &plans), (&env, path, frame), &mut made, &tick)?;
+                exif.extend(carried.map(|c| (frame.clone(), c)));
+                for ((_, cam), m) in rig.iter().zip(&masks).filter(|_| with_masks) {
+                    let path = plan.mask_path(&cam.name, frame);
+                    made.extend(make_folders(std::slice::from_ref(&path))?);
+                    mirrorball_io::write_grey_png(&path, cam.size, m)?;
+                }
+            }
+            write_cameras(plan, &rig, with_masks, exif)?;
+            Ok(with_masks)
+        }));
+    });
+    let done = done.expect("the work ran");
+    // Folders made for files that did not land are removed again (when left empty).
+    for dir in made.iter().rev() {
+        if done.is_err() {
+            let _ = std::fs::remove_dir(dir);
+        }
+        mirrorball_io::keep_folder(dir);
+    }
+    let (with_masks, files) = done?;
+    hooks.note(&summary(plan, &rig, with_masks, (t1 - t0, t1.elapsed())));
+    Ok(Written {
+        files,
+        cameras: rig.into_iter().map(|(_, c)| c).collect(),
+        masks: with_masks,
+    })
+}
+
+/// The line saying what [`run`] wrote, and how long reading and the views took.
+fn summary(
+    plan: &ViewsPlan,
+    rig: &[(Projection, Camera)],
+    with_masks: bool,
+    (read, views): (std::time::Duration, std::time::Duration),
+) -> String {
+    let sizes: std::collections::BTreeSet<String> = rig
+        .iter()
+        .map(|(_, c)| format!("{}x{}", c.size.0, c.size.1))
+        .collect();
+    format!(
+        "wrote {} views of {}{}, {}{} and the camera files in {} (read {:.2}s, views {:.2}s)",
+        rig.len(),
+        plan.input,
+        match plan.frames.len() {
+            1 => String::new(),
+            n => format!(
+                " ({n} frames, each frame's rig at the same pose: the views' poses within it are exact)"
+            ),
+        },
+        sizes.into_iter().collect::<Vec<_>>().join(", "),
+        if with_masks { ", their masks" } else { "" },
+        plan.dir.display(),
+        read.as_secs_f64(),
+        views.as_secs_f64()
+    )
+}
+
+/// Makes the folders `files` need that are missing, outermost first, each marked so that an
+/// interrupt removes it again when left empty (`mirrorball_io::made_folder`); the folders
+/// made, in the order made.
+fn make_folders(files: &[PathBuf]) -> Result<Vec<PathBuf>, mirrorball_io::Error> {
+    let mut made = Vec::new();
+    for f in files {
+        let mut missing: Vec<&Path> = f
+            .ancestors()
+            .skip(1)
+            .filter(|d| !d.as_os_str().is_empty())
+            .take_while(|d| !d.is_dir())
+            .collect();
+        missing.reverse();
+        for d in missing {
+            std::fs::create_dir(d).map_err(|e| mirrorball_io::Error::io(d, e))?;
+            mirrorball_io::made_folder(d);
+            made.push(d.to_path_buf());
+        }
+    }
+    Ok(made)
+}
+
+/// Writes the COLMAP model, the rig configuration and `transforms.json` (inside the
+/// caller's `write_together`).
+fn write_cameras(
+    plan: &ViewsPlan,
+    rig: &[(Projection, Camera)],
+    with_masks: bool,
+    exif: Vec<(String, serde_json::Value)>,
+) -> Result<(), mirrorball_io::Error> {
+    let cams: Vec<Camera> = rig.iter().map(|(_, c)| c.clone()).collect();
+    let names: Vec<(usize, String, String)> = plan
+        .frames
+        .iter()
+        .flat_map(|(_, frame)| {
+            cams.iter().enumerate().map(move |(i, c)| {
+                (
+                    i,
+                    plan.image_name(&c.name, frame),
+                    plan.mask_name(&c.name, frame),
+                )
+            })
+        })
+        .collect();
+    let shots: Vec<Shot> = names
+        .iter()
+        .map(|(i, image, mask)| Shot {
+            camera: *i,
+            name: image,
+            mask: with_masks.then_some(mask.as_str()),
+        })
+        .collect();
+    let mut extra = serde_json::json!({
+        "source": plan.input,
+        "rig": plan.rig,
+    });
+    if !exif.is_empty() {
+        extra["exif"] = serde_json::Value::Object(exif.into_iter().collect());
+    }
+    let texts = [
+        cameras::cameras_txt(&cams),
+        cameras::images_txt(&cams, &shots),
+        cameras::points3d_txt(),
+        cameras::rigs_txt(&cams),
+        cameras::frames_txt(&cams, &shots),
+        cameras::rig_config_json(&cams),
+        cameras::transforms_json(&cams, &shots, Some(extra)),
+    ];
+    for (name, text) in TEXT_FILES.iter().zip(texts) {
+        let path = plan.dir.join(name);
+        mirrorball_io::atomic_write(&path, |w| {
+            std::io::Write::write_all(w, text.as_bytes())
+                .map_err(|e| mirrorball_io::Error::io(&path, e))
+        })?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("640"), Ok((640, None)));
+        assert_eq!(parse_size("640x480"), Ok((640, Some(480))));
+        assert!(parse_size("640x").is_err());
+        assert_eq!(frame_name("dir/pano{face}.exr"), "pano");
+        assert_eq!(frame_name("a b.png"), "a_b");
+    }
+
+    #[test]
+    fn bad_views_are_refused_before_any_work() {
+        let mut r = ViewsRequest::new("missing.exr", "out");
+        r.rig = "nope".into();
+        assert!(ViewsPlan::new(&r).is_err());
+        let bound = crate::size::pictures(Format::Png, "a view", |s| (s as u64, s as u64));
+        let mut v = rig::resolve("cube").unwrap().remove(0);
+        v.fov = 180.0;
+        let e = plan_view(v.clone(), None, &bound).unwrap_err();
+        assert!(e.message.contains("(0°, 180°)"), "{}", e.message);
+        v.fov = 90.0;
+        v.width = Some(0);
+        assert!(plan_view(v, None, &bound).is_err());
+    }
+}
