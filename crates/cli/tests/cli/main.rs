@@ -21,4 +21,5 @@ mod util;
 mod v360;
 mod video;
 mod views;
+mod views_quality;
 mod zoneplate;

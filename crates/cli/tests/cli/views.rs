@@ -31,14 +31,14 @@ fn direction_panorama(dir: &Path, size: u32) -> String {
 }
 
 /// A camera of `cameras.txt`: width, height, fx, fy, cx, cy.
-type Camera = (u32, u32, f64, f64, f64, f64);
+pub(crate) type Camera = (u32, u32, f64, f64, f64, f64);
 
 /// An image of `images.txt`: name, camera id, `cam_from_world` rotation and translation.
-type Posed = (String, u32, DMat3, DVec3);
+pub(crate) type Posed = (String, u32, DMat3, DVec3);
 
 /// `cameras.txt` and `images.txt` of `sparse`, read as COLMAP's text format says: cameras
 /// by id, and per image name its camera id and `cam_from_world` rotation.
-fn read_model(sparse: &Path) -> (HashMap<u32, Camera>, Vec<Posed>) {
+pub(crate) fn read_model(sparse: &Path) -> (HashMap<u32, Camera>, Vec<Posed>) {
     let text = std::fs::read_to_string(sparse.join("cameras.txt")).unwrap();
     let mut cams = HashMap::new();
     for line in text
@@ -84,7 +84,7 @@ fn read_model(sparse: &Path) -> (HashMap<u32, Camera>, Vec<Posed>) {
 /// The mirrorball world direction of COLMAP's ray through pixel position `(px, py)` of a
 /// camera `cam` posed `cam_from_world`: `R^T K^-1 (px, py, 1)`, COLMAP's world being
 /// mirrorball's `(x, −y, −z)`.
-fn colmap_ray(cam: &Camera, cam_from_world: DMat3, px: f64, py: f64) -> DVec3 {
+pub(crate) fn colmap_ray(cam: &Camera, cam_from_world: DMat3, px: f64, py: f64) -> DVec3 {
     let k_inv = DVec3::new((px - cam.4) / cam.2, (py - cam.5) / cam.3, 1.0);
     let w = cam_from_world.transpose() * k_inv;
     DVec3::new(w.x, -w.y, -w.z).normalize()
