@@ -7,8 +7,9 @@
 //! `ViewsRequest → ViewsPlan (rig, fields of view, sizes, container, folder, a sequence's
 //! frames and every file checked: nothing read yet) → read the (first) panorama (and
 //! --mask, the same size) → each view's size and camera → memory and room checked → per
-//! view: its plan and its mask, made once → per frame: read, each view's picture from its
-//! plan, the masks → every file lands together (io::write_together)`.
+//! view: its plan and its mask, made once → per frame: each view's picture from its plan,
+//! the masks, while the next frame is read → every file lands together
+//! (io::write_together)`.
 //!
 //! A sequence (`frames/%04d.exr`, `'frames/*.jpg'`: `frames::pattern`) is one rig: each
 //! frame's views are its images in `frames.txt` and `transforms.json`, every frame's rig at
@@ -499,8 +500,8 @@ pub struct Written {
     pub masks: bool,
 }
 
-/// Refuses the job when it would not fit in memory (a panorama, and the mask when
-/// `masked`; each view's plan (8 bytes a texel, and taps) and mask, and one view's picture)
+/// Refuses the job when it would not fit in memory (a panorama, two for a sequence, and
+/// the mask when `masked`; each view's plan (8 bytes a texel, and taps) and mask, and one view's picture)
 /// or on the disk (every frame's views and masks).
 fn check_resources(
     plan: &ViewsPlan,
@@ -510,8 +511,10 @@ fn check_resources(
 ) -> Result<(), Error> {
     let c = env.channels() as u64;
     let layers = env.layers().len() as u64;
+    // A sequence holds two frames: the next one is read while this one's views are made.
+    let frames = plan.frames.len().min(2) as u64;
     let held = budget::f32_texels(env.width() as u64 * env.height() as u64 * layers, c)
-        * if masked { 2 } else { 1 };
+        * (frames + u64::from(masked));
     let texels = |cam: &Camera| cam.size.0 as u64 * cam.size.1 as u64;
     let most = rig.iter().map(|(_, cam)| texels(cam)).max().unwrap_or(0);
     let all: u64 = rig.iter().map(|(_, cam)| texels(cam)).sum();
@@ -646,22 +649,34 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
             let (plans, masks) = plan_views(plan, &rig, source, user_mask.as_ref(), &tick)?;
             let with_masks = plan.masks || masks.iter().any(|m| m.contains(&0));
             let mut exif = Vec::new();
-            for (f, (path, frame)) in plan.frames.iter().enumerate() {
-                if f > 0 {
-                    let (next, notes) = load::read_prepared(path, &plan.input_plan)
-                        .map_err(|e| input_error(path, e.message))?;
-                    notes.iter().for_each(|l| hooks.note(l));
-                    env = next;
+            // A sequence's next frame is read on its own thread while this one's views are
+            // made and encoded (the files are written on this thread, which gathers them).
+            std::thread::scope(|s| {
+                type Read = Result<(EnvMap, Vec<String>), Error>;
+                let mut next: Option<std::thread::ScopedJoinHandle<Read>> = None;
+                for (f, (path, frame)) in plan.frames.iter().enumerate() {
+                    if let Some(reading) = next.take() {
+                        let (read, notes) = reading
+                            .join()
+                            .unwrap_or_else(|e| std::panic::resume_unwind(e))
+                            .map_err(|e| input_error(path, e.message))?;
+                        notes.iter().for_each(|l| hooks.note(l));
+                        env = read;
+                    }
+                    if let Some((after, _)) = plan.frames.get(f + 1) {
+                        next = Some(s.spawn(|| load::read_prepared(after, &plan.input_plan)));
+                    }
+                    let carried =
+                        write_frame(plan, (&rig, &plans), (&env, path, frame), &mut made, &tick)?;
+                    exif.extend(carried.map(|c| (frame.clone(), c)));
+                    for ((_, cam), m) in rig.iter().zip(&masks).filter(|_| with_masks) {
+                        let path = plan.mask_path(&cam.name, frame);
+                        made.extend(make_folders(std::slice::from_ref(&path))?);
+                        mirrorball_io::write_grey_png(&path, cam.size, m)?;
+                    }
                 }
-                let carried =
-                    write_frame(plan, (&rig, &plans), (&env, path, frame), &mut made, &tick)?;
-                exif.extend(carried.map(|c| (frame.clone(), c)));
-                for ((_, cam), m) in rig.iter().zip(&masks).filter(|_| with_masks) {
-                    let path = plan.mask_path(&cam.name, frame);
-                    made.extend(make_folders(std::slice::from_ref(&path))?);
-                    mirrorball_io::write_grey_png(&path, cam.size, m)?;
-                }
-            }
+                Ok::<_, mirrorball_io::Error>(())
+            })?;
             write_cameras(plan, &rig, with_masks, exif)?;
             Ok(with_masks)
         }));
