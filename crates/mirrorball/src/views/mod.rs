@@ -449,6 +449,8 @@ fn frame_name(input: &str) -> String {
 fn coverage(view: &Projection, (w, h): (u32, u32), source: &Projection) -> Vec<u8> {
     use rayon::prelude::*;
     let mut out = vec![0u8; w as usize * h as usize];
+    // A lat-long covers every direction: only the view's own outline is looked up.
+    let everywhere = matches!(source, Projection::LatLong(_));
     out.par_chunks_mut(w as usize)
         .enumerate()
         .for_each(|(y, row)| {
@@ -456,7 +458,7 @@ fn coverage(view: &Projection, (w, h): (u32, u32), source: &Projection) -> Vec<u
                 let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
                 let covered = view
                     .uv_to_dir(0, uv)
-                    .is_some_and(|d| source.dir_to_uv(d).is_some());
+                    .is_some_and(|d| everywhere || source.dir_to_uv(d).is_some());
                 *m = if covered { 255 } else { 0 };
             }
         });
