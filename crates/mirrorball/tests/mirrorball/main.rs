@@ -1,0 +1,2 @@
+//! The mirrorball library's integration tests: one binary, one module per concern.
+mod bytes;
