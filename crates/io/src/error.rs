@@ -81,6 +81,10 @@ impl Error {
     pub fn path(&self) -> &Path {
         &self.path
     }
+    /// The kind of the I/O error behind it, if one is (a full disk: `StorageFull`).
+    pub fn io_kind(&self) -> Option<std::io::ErrorKind> {
+        self.source.as_ref().map(std::io::Error::kind)
+    }
     /// What went wrong, without the file name.
     pub fn problem(&self) -> &str {
         &self.problem
