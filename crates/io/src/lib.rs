@@ -126,7 +126,7 @@ impl MapInfo {
         w: u32,
         h: u32,
     ) -> Result<MapInfo, String> {
-        let unreadable = |key: &str, text: &str, e: String| {
+        let unreadable = |key: &str, text: &str, e: &dyn std::fmt::Display| {
             format!("records {key} = '{text}', which cannot be read ({e})")
         };
         let text = layout.unwrap_or_default();
@@ -135,22 +135,22 @@ impl MapInfo {
                 let stereo = s
                     .trim()
                     .parse::<Stereo>()
-                    .map_err(|e| unreadable(LAYOUT_KEY, text, e.to_string()))?;
+                    .map_err(|e| unreadable(LAYOUT_KEY, text, &e))?;
                 (stereo, Some(l))
             }
             None => (Stereo::Mono, layout),
         };
         let (w, h) = stereo
             .eye_extent(w, h)
-            .map_err(|e| unreadable(LAYOUT_KEY, text, e))?;
+            .map_err(|e| unreadable(LAYOUT_KEY, text, &e))?;
         let projection = ProjectionSpec::parse(projection)
             .and_then(|s| s.build(Some((w, h))))
-            .map_err(|e| unreadable(PROJECTION_KEY, projection, e))?;
+            .map_err(|e| unreadable(PROJECTION_KEY, projection, &e))?;
         let layout = layout
             .map(|l| {
                 l.trim()
                     .parse::<Layout>()
-                    .map_err(|e| unreadable(LAYOUT_KEY, l, e))
+                    .map_err(|e| unreadable(LAYOUT_KEY, l, &e))
             })
             .transpose()?;
         Ok(MapInfo {

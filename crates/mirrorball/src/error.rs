@@ -51,6 +51,12 @@ impl Error {
     }
 }
 
+impl From<mirrorball_core::Error> for Error {
+    fn from(e: mirrorball_core::Error) -> Error {
+        Error::new(e.fault, e.message)
+    }
+}
+
 impl From<mirrorball_io::Error> for Error {
     fn from(e: mirrorball_io::Error) -> Error {
         Error {
