@@ -164,7 +164,7 @@ impl Staged {
         let tmp = self.tmp.take().expect("a staged file is committed once");
         let done = std::fs::rename(&tmp, &self.target).map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
-            Error::io(&self.path, e)
+            Error::io_write(&self.path, e)
         });
         forget_pending(&tmp);
         done
@@ -245,7 +245,7 @@ where
         if INTERRUPTED.load(Ordering::SeqCst) {
             return Err(Error::request(path, "interrupted".into()));
         }
-        let file = File::create(&tmp).map_err(|e| Error::io(path, e))?;
+        let file = File::create(&tmp).map_err(|e| Error::io_write(path, e))?;
         pending.push(tmp.clone());
         file
     };
@@ -257,10 +257,10 @@ where
     };
     let mut w = BufWriter::with_capacity(1 << 20, file);
     write(&mut w)?;
-    w.flush().map_err(|e| Error::io(path, e))?;
+    w.flush().map_err(|e| Error::io_write(path, e))?;
     let file = w
         .into_inner()
-        .map_err(|e| Error::io(path, e.into_error()))?;
+        .map_err(|e| Error::io_write(path, e.into_error()))?;
     drop(file);
     Ok(staged)
 }
