@@ -63,11 +63,20 @@ pub fn run(a: StudioArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::new(e.fault, e.message))
 }
 
-/// The library's error as the studio's, `shown` (a path of this process's own) called
-/// `name` in its message: whose fault it is and the I/O error's kind kept, so the page is
-/// answered by cause.
+/// The library's error as the studio's: whose fault it is and the I/O error's kind kept,
+/// so the page is answered by cause.
+fn as_studio(e: CliError) -> StudioError {
+    let kind = e.io_kind();
+    StudioError::new(e.fault, e.message).with_io_kind(kind)
+}
+
+/// [`as_studio`], `shown` (a path of this process's own) called `name` in the message.
 fn studio_error(e: CliError, shown: &str, name: &str) -> StudioError {
-    StudioError::new(e.fault, e.message.replace(shown, name)).with_io_kind(e.io_kind())
+    let message = e.message.replace(shown, name);
+    StudioError {
+        message,
+        ..as_studio(e)
+    }
 }
 
 fn is_scene(p: &Path) -> bool {
@@ -290,7 +299,7 @@ fn is_mesh(p: &Path) -> bool {
 impl Host for CliHost {
     fn open(&self, path: &Path) -> Result<Opened, StudioError> {
         if is_scene(path) {
-            let v = scene_view(Some(path)).map_err(|e| studio_error(e, "", ""))?;
+            let v = scene_view(Some(path)).map_err(as_studio)?;
             return Ok(Opened::Scene(Box::new(v)));
         }
         if is_mesh(path) {
@@ -346,8 +355,7 @@ impl Host for CliHost {
     }
 
     fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, StudioError> {
-        // Made as `convert` and `prefilter` make their outputs: a map in memory, the chain
-        // in a folder of its own, read back for the page and the folder removed.
+        // Made in memory as `convert` and `prefilter` make their outputs.
         let file = format!("export.{format}");
         let (bytes, report) = match what {
             Export::Map(map) => {
@@ -357,23 +365,11 @@ impl Host for CliHost {
                     mips: false,
                     keep_invalid: false,
                 };
-                save::to_bytes(map, &file, &opts).map_err(|e| studio_error(e, "", ""))?
+                save::to_bytes(map, &file, &opts).map_err(as_studio)?
             }
             Export::Chain(chain) => {
-                let dir =
-                    private_dir("export").map_err(|e| e.context("cannot write the export"))?;
-                let path = dir.join(&file);
-                let shown = path.display().to_string();
-                let written =
-                    outputs::write_cube_chain(&path, chain, &WriteOptions::default(), false)
-                        .map_err(|e| studio_error(e, &shown, &file))
-                        .and_then(|report| {
-                            std::fs::read(&path)
-                                .map(|bytes| (bytes, report))
-                                .map_err(|e| StudioError::io("cannot read the export back", &e))
-                        });
-                let _ = std::fs::remove_dir_all(&dir);
-                written?
+                outputs::cube_chain_bytes(&file, chain, &WriteOptions::default(), false)
+                    .map_err(as_studio)?
             }
         };
         // Said on the server's terminal: the page downloads the file as it is.
@@ -381,5 +377,60 @@ impl Host for CliHost {
             eprintln!("{line}");
         }
         Ok(bytes)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mirrorball::core::{EnvMap, Image, ProjectionKind};
+    use mirrorball_core::Fault;
+
+    fn exr() -> Vec<u8> {
+        let p = ProjectionKind::LatLong.default_projection();
+        let env = EnvMap::new(p, vec![Image::new(16, 8, 3)]).unwrap();
+        let opts = SaveOptions {
+            layout: None,
+            write: WriteOptions::default(),
+            mips: false,
+            keep_invalid: false,
+        };
+        save::to_bytes(&env, "sky.exr", &opts).unwrap().0
+    }
+
+    #[test]
+    fn uploads_are_read_from_memory_and_refused_by_cause() {
+        let bytes = exr();
+        match CliHost.upload("sky.exr", &bytes, &[]) {
+            Ok(Opened::Environment { name, map }) => {
+                assert_eq!(name, "sky.exr");
+                assert_eq!((map.width(), map.height()), (16, 8));
+            }
+            Ok(_) => panic!("not an environment"),
+            Err(e) => panic!("{e}"),
+        }
+        let e = CliHost.upload("cut.exr", &bytes[..60], &[]).err().unwrap();
+        assert_eq!((e.fault, e.status().as_u16()), (Fault::Input, 422), "{e}");
+        assert!(e.message.starts_with("cut.exr"), "{e}");
+        let e = CliHost.upload("notes.txt", b"hello", &[]).err().unwrap();
+        assert_eq!(e.status(), 400, "{e}");
+    }
+
+    #[test]
+    fn exports_are_made_in_memory() {
+        let p = ProjectionKind::Cube.default_projection();
+        let cube = EnvMap::new(p, (0..6).map(|_| Image::new(8, 8, 3)).collect()).unwrap();
+        let bytes = CliHost.export(Export::Map(&cube), "ktx2").unwrap();
+        assert_eq!(&bytes[1..7], b"KTX 20");
+        let half = EnvMap::new(p, (0..6).map(|_| Image::new(4, 4, 3)).collect()).unwrap();
+        let bytes = CliHost
+            .export(Export::Chain(&[cube.clone(), half]), "dds")
+            .unwrap();
+        assert_eq!(&bytes[..4], b"DDS ");
+        // A lat-long is no cube: the request's fault.
+        let ll = ProjectionKind::LatLong.default_projection();
+        let flat = EnvMap::new(ll, vec![Image::new(16, 8, 3)]).unwrap();
+        let e = CliHost.export(Export::Map(&flat), "dds").unwrap_err();
+        assert_eq!(e.status(), 400, "{e}");
     }
 }
