@@ -518,7 +518,7 @@ fn openexr_tagged(
         ProjectionKind::Cube => Some((
             EnvMap::new(
                 CubeMap.into(),
-                openexr::cube_to_faces(image).map_err(|e| bad(&e))?,
+                openexr::cube_to_faces(image, Path::new(input))?,
             )
             .map_err(|e| bad(&e))?,
             "the file is tagged envmap=cube: OpenEXR's vertical strip of faces, read into OpenGL's faces (--from cube --layout vstrip reads the picture as mirrorball's strip)",
