@@ -333,7 +333,7 @@ pub fn write_grey_png(path: &Path, (w, h): (u32, u32), samples: &[u8]) -> Result
             format!("{} grey samples for a {w}×{h} picture", samples.len()),
         ));
     }
-    crate::atomic::land(stage(path, |out| {
+    crate::atomic::land(crate::atomic::stage(path, |out| {
         PngEncoder::new(out)
             .write_image(samples, w, h, ExtendedColorType::L8)
             .map_err(|e| encode_error(path, "PNG", e))
@@ -371,7 +371,7 @@ pub fn write_jpeg_with_segments(
         at = 4 + u16::from_be_bytes([jpeg[4], jpeg[5]]) as usize;
     }
     jpeg.splice(at..at, segments.iter().copied());
-    crate::atomic::land(stage(path, |out| {
+    crate::atomic::land(crate::atomic::stage(path, |out| {
         std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
     })?)
 }
