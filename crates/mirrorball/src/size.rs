@@ -55,6 +55,16 @@ pub fn parse(s: &str) -> Result<i64, crate::Error> {
         .map_err(|_| crate::Error::request(format!("'{s}' is not a whole number of texels")))
 }
 
+/// `--size`'s text, `W` or `WxH` (also `W×H`), as numbers (each checked against the
+/// container's bound in the plan that takes it).
+pub fn parse_extent(s: &str) -> Result<(i64, Option<i64>), crate::Error> {
+    let s = s.trim();
+    match s.split_once(['x', 'X', '×']) {
+        Some((w, h)) => Ok((parse(w)?, Some(parse(h)?))),
+        None => Ok((parse(s)?, None)),
+    }
+}
+
 /// The largest `s` in `1..=hi` for which `fits(s)` holds, `fits` holding up to some size
 /// and not beyond it; 0 when it holds for none.
 pub fn largest(hi: u32, fits: impl Fn(u32) -> bool) -> u32 {

@@ -392,6 +392,33 @@ impl ProjectionSpec {
         })
     }
 
+    /// This spec with the output `w`×`h` texels (`--size WxH`, as `v360`'s `w` and `h`): a
+    /// perspective view's vertical field of view set so that its height at width `w` is
+    /// `h` with square pixels; any other projection kept, as long as `w` gives it `h`.
+    /// Refused (a request fault) where a view's `vfov` is given too, or another
+    /// projection's height at width `w` is not `h`.
+    pub fn with_height(&self, w: u32, h: u32) -> Result<ProjectionSpec, Error> {
+        let mut spec = self.clone();
+        if self.kind == ProjectionKind::Perspective {
+            if self.vfov.is_some() {
+                return Err(Error::request(format!(
+                    "--size {w}x{h}: the view's height follows its vfov; give a height or vfov, not both"
+                )));
+            }
+            let hfov = self.hfov.unwrap_or(90.0).to_radians();
+            let vfov = 2.0 * ((hfov / 2.0).tan() * h as f64 / w as f64).atan();
+            spec.vfov = Some(vfov.to_degrees());
+        }
+        let (ew, eh) = super::WorldProjection::layer_extent(&spec.build(None)?, w);
+        if (ew, eh) != (w, h) {
+            return Err(Error::request(format!(
+                "--size {w}x{h}: a {} of width {w} is {ew}x{eh} (a height is taken by flat views, which set their vfov from it; give --size {w} for others)",
+                self.kind
+            )));
+        }
+        Ok(spec)
+    }
+
     /// The projection. For Mercator without `max-lat`, `extent` (an input picture's size)
     /// fixes the limit from the aspect ratio. Each number given is checked against its
     /// interval first ([`ProjectionSpec::ranges`]); a value outside is the request's fault.

@@ -91,11 +91,7 @@ impl ViewsRequest {
 /// `--size`'s text, `W` or `WxH`, as numbers (checked against the container's bound in the
 /// plan).
 pub fn parse_size(s: &str) -> Result<(i64, Option<i64>), crate::Error> {
-    let s = s.trim();
-    match s.split_once(['x', 'X', '×']) {
-        Some((w, h)) => Ok((crate::size::parse(w)?, Some(crate::size::parse(h)?))),
-        None => Ok((crate::size::parse(s)?, None)),
-    }
+    crate::size::parse_extent(s)
 }
 
 /// A view, checked: its aim and fields, its size where known before the panorama is read.
