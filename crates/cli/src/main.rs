@@ -131,10 +131,12 @@ pub struct ConvertArgs {
     )]
     to: String,
     /// Face edge (cubes), width (lat-long, Mercator, cylinders, Hammer, sinusoidal, views) or
-    /// diameter (disk maps), in texels; one eye's, for a stereo pair (--stereo).
+    /// diameter (disk maps), in texels; one eye's, for a stereo pair (--stereo). WxH (as
+    /// v360's w and h) for a flat view sets its vfov from the height (square pixels); for
+    /// other projections the height must be the one the width gives.
     /// Default: about the source's resolution (its one eye's).
-    #[arg(long, value_parser = size::parse, allow_hyphen_values = true)]
-    size: Option<i64>,
+    #[arg(long, value_name = "W[xH]", value_parser = size::parse_extent, allow_hyphen_values = true)]
+    size: Option<(i64, Option<i64>)>,
     /// Layout of the output's layers: hcross, vcross, hstrip, vstrip, separate, or v360's
     /// c3x2, c6x1, c1x6 (with `:forder=rludfb:frot=000000`) and eac (EAC's default).
     #[arg(long, value_name = "LAYOUT")]

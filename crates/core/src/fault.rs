@@ -57,3 +57,40 @@ pub fn input_file_problem(meta: &std::io::Result<std::fs::Metadata>) -> Option<(
         Ok(_) => None,
     }
 }
+
+/// The core's error: a message for people, naming the setting or value and the problem,
+/// and whose fault it is. A projection's or layout's text that cannot be read, a value
+/// out of its range, a picture a layout cannot unpack: the request's (the caller named
+/// them); front ends keep the fault as they pass the message on.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Error {
+    /// The message.
+    pub message: String,
+    /// Whose fault.
+    pub fault: Fault,
+}
+
+impl Error {
+    /// The request's fault.
+    pub fn request(message: impl Into<String>) -> Error {
+        Error {
+            message: message.into(),
+            fault: Fault::Request,
+        }
+    }
+    /// The input's fault.
+    pub fn input(message: impl Into<String>) -> Error {
+        Error {
+            message: message.into(),
+            fault: Fault::Input,
+        }
+    }
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Error {}

@@ -564,15 +564,26 @@ impl Layout {
     /// [`Layout::unpack`], taking the picture: a one-layer map (or a separate layout) keeps
     /// its texels where they are instead of copying them (100 MB for a 4096×2048 float
     /// lat-long).
-    pub fn unpack_owned(self, image: Image, projection: Projection) -> Result<EnvMap, String> {
+    pub fn unpack_owned(
+        self,
+        image: Image,
+        projection: Projection,
+    ) -> Result<EnvMap, crate::Error> {
         if self == Layout::Separate {
-            return EnvMap::new(projection, vec![image]).map_err(|e| e.to_string());
+            return EnvMap::new(projection, vec![image])
+                .map_err(|e| crate::Error::request(e.to_string()));
         }
         self.unpack(&image, projection)
     }
 
-    /// Cuts a picture laid out this way into the layers of `projection`.
-    pub fn unpack(self, image: &Image, projection: Projection) -> Result<EnvMap, String> {
+    /// Cuts a picture laid out this way into the layers of `projection`; a picture it
+    /// does not fit is the request's fault (the caller named the layout and projection).
+    pub fn unpack(self, image: &Image, projection: Projection) -> Result<EnvMap, crate::Error> {
+        self.unpack_text(image, projection)
+            .map_err(crate::Error::request)
+    }
+
+    fn unpack_text(self, image: &Image, projection: Projection) -> Result<EnvMap, String> {
         let n = projection.layer_count();
         if self == Layout::Separate {
             return EnvMap::new(projection, vec![image.clone()]).map_err(|e| e.to_string());
@@ -802,17 +813,17 @@ impl Stereo {
     }
 
     /// The size of each eye of a `w`×`h` picture; an error when the width (`sbs`) or the
-    /// height (`tb`) does not halve evenly.
-    pub fn eye_extent(self, w: u32, h: u32) -> Result<(u32, u32), String> {
+    /// height (`tb`) does not halve evenly (the request's fault).
+    pub fn eye_extent(self, w: u32, h: u32) -> Result<(u32, u32), crate::Error> {
         let (n, what) = match self {
             Stereo::Mono => return Ok((w, h)),
             Stereo::SideBySide => (w, "width"),
             Stereo::TopBottom => (h, "height"),
         };
         if n % 2 != 0 || n == 0 {
-            return Err(format!(
+            return Err(crate::Error::request(format!(
                 "a {self} stereo pair needs an even {what}, one half per eye; {w}x{h} has {what} {n}"
-            ));
+            )));
         }
         Ok(match self {
             Stereo::SideBySide => (w / 2, h),
@@ -831,7 +842,7 @@ impl Stereo {
 
     /// The first `eyes` eyes of `picture` (left first), at most [`Stereo::eyes`]: a `2d`
     /// picture is its one eye, kept as it is.
-    pub fn split(self, picture: Image, eyes: usize) -> Result<Vec<Image>, String> {
+    pub fn split(self, picture: Image, eyes: usize) -> Result<Vec<Image>, crate::Error> {
         if self == Stereo::Mono {
             return Ok(vec![picture]);
         }
@@ -1074,7 +1085,10 @@ mod tests {
         );
         assert!(Stereo::SideBySide.join(vec![pic.clone()]).is_none());
         // Odd halves are refused by name.
-        let e = Stereo::TopBottom.split(Image::new(4, 5, 3), 2).unwrap_err();
+        let e = Stereo::TopBottom
+            .split(Image::new(4, 5, 3), 2)
+            .unwrap_err()
+            .message;
         assert!(e.contains("even height") && e.contains("4x5"), "{e}");
         assert!(Stereo::SideBySide.eye_extent(7, 4).is_err());
         // v360's eye rule.

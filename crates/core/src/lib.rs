@@ -39,7 +39,7 @@ pub use envmap::{
     bilinear_taps, count_invalid, sample_texels, sanitize_layer, CornerLanes, EnvMap, EnvMapError,
     Stats,
 };
-pub use fault::{input_file_problem, Fault};
+pub use fault::{input_file_problem, Error, Fault};
 pub use image::Image;
 pub use layout::{guess, CellGrid, CubeCells, Guess, Layout, Stereo};
 pub use projection::{

@@ -164,7 +164,7 @@ impl Staged {
         let tmp = self.tmp.take().expect("a staged file is committed once");
         let done = std::fs::rename(&tmp, &self.target).map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
-            Error::io(&self.path, e)
+            Error::io_write(&self.path, e)
         });
         forget_pending(&tmp);
         done
@@ -245,7 +245,7 @@ where
         if INTERRUPTED.load(Ordering::SeqCst) {
             return Err(Error::request(path, "interrupted".into()));
         }
-        let file = File::create(&tmp).map_err(|e| Error::io(path, e))?;
+        let file = File::create(&tmp).map_err(|e| Error::io_write(path, e))?;
         pending.push(tmp.clone());
         file
     };
@@ -257,12 +257,84 @@ where
     };
     let mut w = BufWriter::with_capacity(1 << 20, file);
     write(&mut w)?;
-    w.flush().map_err(|e| Error::io(path, e))?;
+    w.flush().map_err(|e| Error::io_write(path, e))?;
     let file = w
         .into_inner()
-        .map_err(|e| Error::io(path, e.into_error()))?;
+        .map_err(|e| Error::io_write(path, e.into_error()))?;
     drop(file);
     Ok(staged)
+}
+
+/// What a writer writes into: a buffered temporary file, or memory. Every writer
+/// here encodes into one, so a format has one encoder for files and bytes.
+pub(crate) trait Sink: Write + std::io::Seek + Send {}
+impl<T: Write + std::io::Seek + Send> Sink for T {}
+
+/// Where a writer's bytes go: a file, staged beside it ([`stage`]), or memory. The path
+/// is the one errors name (for memory, the name the bytes are given).
+#[derive(Clone, Copy)]
+pub(crate) enum Dest<'a> {
+    /// A temporary file beside this path, renamed into place when committed.
+    File(&'a Path),
+    /// A buffer in memory, called this in messages.
+    Memory(&'a Path),
+}
+
+/// What a writer made of a [`Dest`].
+#[must_use = "a staged file is removed unless committed"]
+pub(crate) enum Written {
+    /// A file staged beside its destination.
+    Staged(Staged),
+    /// The bytes of the file.
+    Bytes(Vec<u8>),
+}
+
+impl Written {
+    /// The staged file of a [`Dest::File`].
+    pub(crate) fn staged(self) -> Staged {
+        match self {
+            Written::Staged(s) => s,
+            Written::Bytes(_) => unreachable!("written to a file"),
+        }
+    }
+    /// The bytes of a [`Dest::Memory`].
+    pub(crate) fn bytes(self) -> Vec<u8> {
+        match self {
+            Written::Bytes(b) => b,
+            Written::Staged(_) => unreachable!("written to memory"),
+        }
+    }
+    /// Lands a staged file (inside [`write_together`], with its set); bytes are kept.
+    pub(crate) fn land(self) -> Result<Option<Vec<u8>>, Error> {
+        match self {
+            Written::Staged(s) => land(s).map(|()| None),
+            Written::Bytes(b) => Ok(Some(b)),
+        }
+    }
+}
+
+impl<'a> Dest<'a> {
+    /// The path errors name.
+    pub(crate) fn path(self) -> &'a Path {
+        match self {
+            Dest::File(p) | Dest::Memory(p) => p,
+        }
+    }
+    /// Calls `write` with a sink on the destination: a staged temporary file ([`stage`]),
+    /// or a buffer whose bytes come back.
+    pub(crate) fn emit<F>(self, write: F) -> Result<Written, Error>
+    where
+        F: FnOnce(&mut dyn Sink) -> Result<(), Error>,
+    {
+        match self {
+            Dest::File(path) => stage(path, |w| write(w)).map(Written::Staged),
+            Dest::Memory(_) => {
+                let mut out = std::io::Cursor::new(Vec::new());
+                write(&mut out)?;
+                Ok(Written::Bytes(out.into_inner()))
+            }
+        }
+    }
 }
 
 /// Runs `work` with the name of a scratch file beside `path` (`.NAME.PART.PID.tmp`) for

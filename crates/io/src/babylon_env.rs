@@ -96,6 +96,11 @@ pub fn write_babylon_env(path: &Path, env: &BabylonEnv) -> Result<(), Error> {
 pub fn read_babylon_env(path: &Path) -> Result<BabylonEnv, Error> {
     Error::check_input(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    env_from_bytes(path, &bytes)
+}
+
+/// [`read_babylon_env`] of a file's `bytes`, called `path` in messages.
+fn env_from_bytes(path: &Path, bytes: &[u8]) -> Result<BabylonEnv, Error> {
     let bad = |p: String| Error::input(path, p);
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
         return Err(bad(
@@ -253,8 +258,13 @@ pub(crate) fn cube_loaded(
 }
 
 /// [`read_babylon_env`]'s level 0, for [`crate::read`].
-pub(crate) fn read(path: &Path, limits: &crate::Limits) -> Result<crate::Loaded, Error> {
-    let env = read_babylon_env(path)?;
+pub(crate) fn read(
+    input: &crate::input::Input,
+    limits: &crate::Limits,
+) -> Result<crate::Loaded, Error> {
+    let path = input.path();
+    let bytes = input.all().map_err(|e| Error::io(path, e))?;
+    let env = env_from_bytes(path, &bytes)?;
     cube_loaded(
         path,
         &env.levels,

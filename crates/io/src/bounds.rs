@@ -11,19 +11,12 @@
 //! to a plausible density instead ([`Density::Plausible`]); DWA's DCT with deflated DC
 //! values is bounded by checking each block's counters (`exr_io`).
 
+use crate::input::Input;
 use crate::Error;
-use std::path::Path;
 
 /// Texels any file may declare whatever its length: tiny files of a constant colour are
 /// fine up to this (16 MiB as `f32` RGBA).
 pub(crate) const FLOOR_TEXELS: u64 = 1 << 20;
-
-/// The file's length in bytes.
-fn file_len(path: &Path) -> Result<u64, Error> {
-    std::fs::metadata(path)
-        .map(|m| m.len())
-        .map_err(|e| Error::io(path, e))
-}
 
 /// How a format's texels-a-byte bound is known.
 #[derive(Clone, Copy)]
@@ -38,13 +31,13 @@ pub(crate) enum Density {
 /// Refuses a `width × height` image declared by a `format` file of more texels than its
 /// length allows at `density` texels a byte (and more than [`FLOOR_TEXELS`]).
 pub(crate) fn check_texels_fit(
-    path: &Path,
+    input: &Input,
     width: u64,
     height: u64,
     density: Density,
     format: &str,
 ) -> Result<(), Error> {
-    let len = file_len(path)?;
+    let len = input.len();
     let per_byte = match density {
         Density::Most(n) | Density::Plausible(n) => n,
     };
@@ -65,23 +58,23 @@ pub(crate) fn check_texels_fit(
              or hostile"
         ),
     };
-    Err(Error::input(path, problem))
+    Err(Error::input(input.path(), problem))
 }
 
 /// Refuses an image whose raw samples (`raw_bytes`, as the file's header declares them)
 /// are more than `ratio` times the file's length (and more than [`FLOOR_TEXELS`] × 16
 /// bytes): for a compression that expands a byte into at most `ratio`.
 pub(crate) fn check_raw_bytes_fit(
-    path: &Path,
+    input: &Input,
     raw_bytes: u64,
     ratio: u64,
     what: &str,
 ) -> Result<(), Error> {
-    let len = file_len(path)?;
+    let len = input.len();
     let most = len.saturating_mul(ratio).max(FLOOR_TEXELS * 16);
     if raw_bytes > most {
         return Err(Error::input(
-            path,
+            input.path(),
             format!(
                 "declares {raw_bytes} bytes of samples, but {what} expands a file of {len} \
                  bytes to at most {most}: the file is corrupt or truncated"
@@ -94,11 +87,11 @@ pub(crate) fn check_raw_bytes_fit(
 /// Refuses a Radiance file declaring more scan lines than it has room for: every scan
 /// line takes at least 4 bytes (a flat or old-style run-length line starts with a whole
 /// RGBE texel; a new-style one with its 4-byte marker).
-pub(crate) fn check_lines_fit(path: &Path, height: u64) -> Result<(), Error> {
-    let len = file_len(path)?;
+pub(crate) fn check_lines_fit(input: &Input, height: u64) -> Result<(), Error> {
+    let len = input.len();
     if height > len / 4 {
         return Err(Error::input(
-            path,
+            input.path(),
             format!(
                 "declares {height} scan lines, but a file of {len} bytes holds at most {} (each \
                  takes at least 4 bytes): the file is corrupt or truncated",

@@ -22,19 +22,20 @@
 //! 2D textures. It parses the headers with `ddsfile`, checks the declared size against the
 //! [`Limits`] and the file length, and only then reads the texels it needs.
 
+use crate::atomic::{Dest, Written};
+use crate::input::{Input, Reader};
 use crate::ktx2_io::{
     check_encodable, check_limits, max_levels, mip_phrase, validate_cube, written_format,
     TexelFormat,
 };
-use crate::{atomic_write, CubeWrite, Error, Format, Limits, Loaded, WriteOptions};
+use crate::{CubeWrite, Error, Format, Limits, Loaded, WriteOptions};
 use ddsfile::{
     AlphaMode, Caps2, D3D10ResourceDimension, DxgiFormat, FourCC, Header, Header10, MiscFlag,
     PixelFormat, PixelFormatFlags,
 };
 use mirrorball_core::{Image, ProjectionKind};
 use mirrorball_encode::Encoding;
-use std::fs::File;
-use std::io::{BufReader, Read, Write};
+use std::io::Read;
 use std::path::Path;
 
 /// `"DDS "`, the magic number at the start of every DDS file.
@@ -53,10 +54,10 @@ fn dds_error(path: &Path, e: ddsfile::Error) -> Error {
 
 /// Writes a cube map with its mip chain as DDS with a DX10 header, RGBA16F or RGBA32F as
 /// `opts` asks; see [`write_dds`].
-pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<(), Error> {
-    let encoding = written_format(path, opts, "DDS")?;
-    write_dds(
-        path,
+pub fn write(dest: Dest, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<Written, Error> {
+    let encoding = written_format(dest.path(), opts, "DDS")?;
+    encode(
+        dest,
         levels,
         &CubeWrite {
             encoding,
@@ -71,6 +72,12 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
 /// mirrorball's `t = 0` row. DDS has no supercompression and no place for RGBD's or RGBM's
 /// record, so those are refused.
 pub fn write_dds(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result<(), Error> {
+    encode(Dest::File(path), levels, how)?.land().map(|_| ())
+}
+
+/// [`write_dds`] into `dest`.
+fn encode(dest: Dest, levels: &[Vec<Image>], how: &CubeWrite) -> Result<Written, Error> {
+    let path = dest.path();
     let encoding = how.encoding;
     let dxgi = match encoding {
         Encoding::Rgba16F => DxgiFormat::R16G16B16A16_Float,
@@ -122,10 +129,10 @@ pub fn write_dds(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result<
         AlphaMode::Unknown,
     );
 
-    atomic_write(path, |w| {
+    dest.emit(|mut w| {
         w.write_all(MAGIC).map_err(|e| Error::io(path, e))?;
-        header.write(w).map_err(|e| dds_error(path, e))?;
-        header10.write(w).map_err(|e| dds_error(path, e))?;
+        header.write(&mut w).map_err(|e| dds_error(path, e))?;
+        header10.write(&mut w).map_err(|e| dds_error(path, e))?;
         let mut buf = Vec::new();
         for face in 0..6 {
             for level in levels {
@@ -139,12 +146,12 @@ pub fn write_dds(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result<
 
 /// Reads level 0 of a DDS cube map (the six faces, declared cube) or 2D texture (one flat
 /// image). See the module documentation for the formats.
-pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+pub fn read(input: &Input, limits: &Limits) -> Result<Loaded, Error> {
+    let path = input.path();
     let io = |e| Error::io(path, e);
     let invalid = |problem: String| Error::input(path, problem);
-    let file = File::open(path).map_err(io)?;
-    let file_len = file.metadata().map_err(io)?.len();
-    let mut r = BufReader::new(file);
+    let file_len = input.len();
+    let mut r = input.reader().map_err(io)?;
 
     let mut magic = [0u8; 4];
     r.read_exact(&mut magic).map_err(io)?;
@@ -296,7 +303,7 @@ fn check_dds_shape(
 /// all) to the next.
 fn read_faces(
     path: &Path,
-    r: &mut BufReader<File>,
+    r: &mut Reader,
     format: TexelFormat,
     (width, height): (u32, u32),
     faces: u64,

@@ -60,6 +60,22 @@ impl Error {
             source: Some(e),
         }
     }
+    /// The system's fault, from an I/O error writing `path`: a folder that is not there,
+    /// cannot be written or is full is the system's whatever the error's kind (a missing
+    /// *input* is the input's: [`Error::io`]). The kind is kept ([`Error::io_kind`]).
+    pub fn io_write(path: &Path, e: std::io::Error) -> Error {
+        let problem = match e.kind() {
+            std::io::ErrorKind::NotFound => "cannot write: no such folder".to_string(),
+            std::io::ErrorKind::PermissionDenied => "cannot write: permission denied".into(),
+            _ => format!("cannot write: {e}"),
+        };
+        Error {
+            path: path.to_path_buf(),
+            fault: Fault::System,
+            problem,
+            source: Some(e),
+        }
+    }
     /// Refuses `path` as an input before any reader opens it: missing, a directory, or
     /// empty, each said so ([`mirrorball_core::input_file_problem`]).
     pub fn check_input(path: &Path) -> Result<(), Error> {
@@ -80,6 +96,10 @@ impl Error {
     /// The file concerned.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+    /// The kind of the I/O error behind it, if one is (a full disk: `StorageFull`).
+    pub fn io_kind(&self) -> Option<std::io::ErrorKind> {
+        self.source.as_ref().map(std::io::Error::kind)
     }
     /// What went wrong, without the file name.
     pub fn problem(&self) -> &str {

@@ -9,10 +9,10 @@
 //! crate decodes, so that neither a huge declared size nor an undecodable file (HTJ2K) gets
 //! as far as allocating texels.
 
-use crate::ldr_io::{check_limits, check_writable_size, guard_decoder, open_input};
-use crate::{
-    atomic::stage, Error, ExrCompression, Format, Limits, Loaded, Precision, Staged, WriteOptions,
-};
+use crate::atomic::{Dest, Sink, Written};
+use crate::input::{Input, Reader};
+use crate::ldr_io::{check_limits, check_writable_size, guard_decoder};
+use crate::{Error, ExrCompression, Format, Limits, Loaded, Precision, WriteOptions};
 use exr::meta::attribute::{AttributeValue, EnvironmentMap, Text};
 use exr::meta::header::Header;
 use exr::prelude::{
@@ -22,8 +22,6 @@ use exr::prelude::{
 use mirrorball_core::simd::F32x4;
 use mirrorball_core::{Image, ProjectionKind};
 use mirrorball_encode::{Range, Storage};
-use std::fs::File;
-use std::io::BufReader;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -39,25 +37,25 @@ const HALF: Range = Storage::Texels(mirrorball_encode::Encoding::Rgba16F).range(
 /// cube), and the `mirrorball:projection` and `mirrorball:layout` string attributes
 /// [`Loaded::recorded`]. Files using a compression the `exr` crate cannot decode (HTJ2K) are refused
 /// before any texel is decoded, with a message that says how to re-save them.
-pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
-    let file = open_input(path)?;
-    guard_decoder(path, "OpenEXR", || read_file(path, file, limits))
+pub fn read(input: &Input, limits: &Limits) -> Result<Loaded, Error> {
+    guard_decoder(input.path(), "OpenEXR", || read_input(input, limits))
 }
 
-fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> {
+fn read_input(input: &Input, limits: &Limits) -> Result<Loaded, Error> {
+    let path = input.path();
     // Headers only: nothing sized by the file is allocated yet. `Counted` remembers where
     // they end, which is where the offset table starts.
     let header_end = Arc::new(AtomicU64::new(0));
     let chunks = exr::block::read(
         Counted {
-            inner: BufReader::new(&file),
+            inner: input.reader().map_err(|e| Error::io(path, e))?,
             taken: header_end.clone(),
         },
         false,
     )
     .map_err(|e| read_error(path, e))?;
     let headers = chunks.headers();
-    check_headers(path, headers, limits)?;
+    check_headers(input, headers, limits)?;
 
     let layer_count = headers.len();
 
@@ -66,7 +64,7 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
     let index = headers.iter().position(is_rgb_layer).unwrap_or(0);
     if let Some(layout) = block_layout(&headers[index]) {
         let header = headers[index].clone();
-        return read_laid_out(path, &file, chunks, &header_end, index, header, &layout);
+        return read_laid_out(input, chunks, &header_end, index, header, &layout);
     }
     read_generic(path, chunks, layer_count)
 }
@@ -74,7 +72,8 @@ fn read_file(path: &Path, file: File, limits: &Limits) -> Result<Loaded, Error> 
 /// Checks the headers before any texel is read: there is an RGB layer; every RGB layer is
 /// within the `limits` and fits the file; the first one's compression is one the crate
 /// decodes; and DWAA/DWAB blocks, if any layer has them, are safe to decode.
-fn check_headers(path: &Path, headers: &[Header], limits: &Limits) -> Result<(), Error> {
+fn check_headers(input: &Input, headers: &[Header], limits: &Limits) -> Result<(), Error> {
+    let path = input.path();
     let Some(header) = headers.iter().find(|h| is_rgb_layer(h)) else {
         return Err(Error::input(path, no_rgb_layer_problem(headers)));
     };
@@ -87,7 +86,7 @@ fn check_headers(path: &Path, headers: &[Header], limits: &Limits) -> Result<(),
             h.layer_size.height() as u64,
             limits,
         )?;
-        check_fits_file(path, h)?;
+        check_fits_file(input, h)?;
     }
     if let Some(problem) = undecodable_compression(header.compression) {
         return Err(Error::input(path, problem));
@@ -96,7 +95,7 @@ fn check_headers(path: &Path, headers: &[Header], limits: &Limits) -> Result<(),
         .iter()
         .any(|h| matches!(h.compression, Compression::DWAA(_) | Compression::DWAB(_)))
     {
-        check_dwa_blocks(path)?;
+        check_dwa_blocks(input)?;
     }
     Ok(())
 }
@@ -105,21 +104,21 @@ fn check_headers(path: &Path, headers: &[Header], limits: &Limits) -> Result<(),
 /// decompressed blocks: a lone single-part ZIP scan-line layer through [`read_zip_file`]
 /// (which also counts the invalid samples), anything else through [`read_blocks`].
 fn read_laid_out(
-    path: &Path,
-    file: &File,
-    chunks: exr::block::reader::Reader<Counted<BufReader<&File>>>,
+    input: &Input,
+    chunks: exr::block::reader::Reader<Counted<Reader<'_>>>,
     header_end: &AtomicU64,
     index: usize,
     header: Header,
     layout: &[(usize, SampleType)],
 ) -> Result<Loaded, Error> {
+    let path = input.path();
     let layer_count = chunks.headers().len();
     // A multi-part file (even one of a single part) puts a part number before each
     // block: that the crate's reader handles.
     let single_part = !chunks.meta_data().requirements.has_multiple_layers;
     let (image, invalid) = if single_part && layer_count == 1 && is_zip_scanlines(&header) {
         drop(chunks);
-        read_zip_file(file, header_end.load(Ordering::Relaxed), &header, layout)
+        read_zip_file(input, header_end.load(Ordering::Relaxed), &header, layout)
             .map(|(image, invalid)| (image, Some(invalid)))
     } else {
         read_blocks(chunks, index, &header, layout).map(|image| (image, None))
@@ -157,7 +156,7 @@ fn read_laid_out(
 /// number of layers in the file.
 fn read_generic(
     path: &Path,
-    chunks: exr::block::reader::Reader<Counted<BufReader<&File>>>,
+    chunks: exr::block::reader::Reader<Counted<Reader<'_>>>,
     layer_count: usize,
 ) -> Result<Loaded, Error> {
     // On this thread: the crate's parallel decoding runs blocks on a pool of its own, where
@@ -293,17 +292,18 @@ fn image_other(opts: &WriteOptions) -> std::collections::HashMap<Text, Attribute
 /// Writes `image` as a single-part scan-line OpenEXR file: half texels unless
 /// `opts.precision` asks for float, compressed with `opts.exr_compression`, RGB or RGBA by
 /// the image's channel count. Blocks are compressed on all cores, into a temporary file
-/// that the returned [`Staged`] renames into place. `buffers` are kept between
+/// that the returned [`Written`] renames into place, or to memory (`dest`). `buffers` are kept between
 /// files.
 ///
 /// Half output writes finite values beyond ±65504 (the largest half) as it instead of
 /// overflowing to infinity ([`Range::fit`]; NaN and infinities are kept).
 pub fn write(
-    path: &Path,
+    dest: Dest,
     image: &Image,
     opts: &WriteOptions,
     buffers: &mut WriteBuffers,
-) -> Result<Staged, Error> {
+) -> Result<Written, Error> {
+    let path = dest.path();
     let sample_type = match opts.precision {
         None | Some(Precision::Half) => SampleType::F16,
         Some(Precision::Float) => SampleType::F32,
@@ -355,7 +355,7 @@ pub fn write(
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
         let mut exr_image = exr::image::Image::from_layer(layer);
         exr_image.attributes.other = image_other(opts);
-        stage(path, |out| {
+        dest.emit(|out| {
             write_layer(out, exr_image.write(), image, buffers).map_err(|e| write_error(path, e))
         })
     } else {
@@ -369,7 +369,7 @@ pub fn write(
         let layer = exr::image::Layer::new(size, layer_attributes(opts), encoding, texels);
         let mut exr_image = exr::image::Image::from_layer(layer);
         exr_image.attributes.other = image_other(opts);
-        stage(path, |out| {
+        dest.emit(|out| {
             write_layer(out, exr_image.write(), image, buffers).map_err(|e| write_error(path, e))
         })
     }
@@ -405,7 +405,7 @@ pub(crate) fn write_buffer_bytes(w: u32, h: u32, c: usize, opts: &WriteOptions) 
 /// from `image` (half samples clamped as `fit` in [`write`] does); the `exr` crate writes
 /// the header and offset table, and blocks of other compressions.
 fn write_layer<'i, L, F>(
-    out: &mut std::io::BufWriter<File>,
+    out: &mut dyn Sink,
     writer: exr::image::write::WriteImageWithOptions<'i, L, F>,
     image: &Image,
     buffers: &mut WriteBuffers,
@@ -484,7 +484,7 @@ where
 /// memory traffic for a 6×1024² float cube.)
 /// The bytes are exactly those the `exr` crate writes (a test compares them).
 fn write_uncompressed(
-    out: &mut std::io::BufWriter<File>,
+    out: &mut dyn Sink,
     headers: &[Header],
     image: &Image,
     layout: &[(usize, SampleType)],
@@ -492,7 +492,6 @@ fn write_uncompressed(
 ) -> exr::error::UnitResult {
     use exr::meta::{magic_number, MetaData};
     use rayon::prelude::*;
-    use std::io::Write;
     let header = &headers[0];
     let (w, h, c) = (
         image.width() as usize,
@@ -854,7 +853,7 @@ impl<R: std::io::Seek> std::io::Seek for Counted<R> {
 /// must sit at its place in the layer exactly once; blocks past the end of the file, or
 /// larger than their lines, are errors, never a panic or an allocation.
 fn read_zip_file(
-    file: &File,
+    input: &Input,
     table_at: u64,
     header: &Header,
     layout: &[(usize, SampleType)],
@@ -869,7 +868,7 @@ fn read_zip_file(
         static SCRATCH: RefCell<Scratch> =
             const { RefCell::new((Vec::new(), Vec::new(), Vec::new())) };
     }
-    let file_len = file.metadata()?.len();
+    let file_len = input.len();
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
     let n = layout.len();
     let lines = header.compression.scan_lines_per_block();
@@ -879,7 +878,7 @@ fn read_zip_file(
     // The offset table: one u64 a block (the count follows from the header's size, which
     // the caller has checked against the limits).
     let count = h.div_ceil(lines);
-    let table = read_offset_table(file, table_at, count, file_len)?;
+    let table = read_offset_table(input, table_at, count, file_len)?;
     // Zeroed texels in huge pages where the system has them (see `Image::new`): a 4096×2048
     // float source would otherwise take ~25,000 page faults as the blocks land.
     let mut image = Image::new(w as u32, h as u32, n);
@@ -892,14 +891,14 @@ fn read_zip_file(
     table
         .par_chunks_exact(8)
         .try_for_each(|entry| -> Result<(), exr::error::Error> {
-            let (at, y, size) = read_block_head(file, entry, file_len)?;
+            let (at, y, size) = read_block_head(input, entry, file_len)?;
             let out = claim_block_rows(&rows, y, top, lines)?;
             let bh = out.len() / (w * n);
             let expected = bh * line_bytes;
             let size = checked_block_size(size, expected, y, at, file_len)?;
             SCRATCH.with_borrow_mut(|(block, inflated, raw)| {
                 block.resize(size, 0);
-                read_at(file, block, at + 8)?;
+                input.read_at(block, at + 8)?;
                 let lines = crate::exr_zip::THREAD_ZIP
                     .with_borrow_mut(|zip| crate::exr_zip::inflate(block, expected, inflated, zip))
                     .map_err(|e| exr::error::Error::Invalid(e.into()))?;
@@ -931,7 +930,7 @@ fn truncated_zip_file() -> exr::error::Error {
 /// Reads the offset table of a [`read_zip_file`] layer: `count` little-endian u64s at
 /// byte `table_at`, which must lie inside the file's `file_len` bytes.
 fn read_offset_table(
-    file: &File,
+    input: &Input,
     table_at: u64,
     count: usize,
     file_len: u64,
@@ -944,14 +943,14 @@ fn read_offset_table(
         return Err(truncated_zip_file());
     }
     let mut table = vec![0u8; count * 8];
-    read_at(file, &mut table, table_at)?;
+    input.read_at(&mut table, table_at)?;
     Ok(table)
 }
 
 /// Reads the 8 bytes at the offset an offset table `entry` gives: the block's first line
 /// (y) and its compressed size. Returns the offset, y and the size as declared.
 fn read_block_head(
-    file: &File,
+    input: &Input,
     entry: &[u8],
     file_len: u64,
 ) -> Result<(u64, i64, i32), exr::error::Error> {
@@ -960,7 +959,7 @@ fn read_block_head(
     if at.checked_add(8).is_none_or(|end| end > file_len) {
         return Err(truncated_zip_file());
     }
-    read_at(file, &mut head, at)?;
+    input.read_at(&mut head, at)?;
     let y = i32::from_le_bytes(head[..4].try_into().expect("4 bytes")) as i64;
     let size = i32::from_le_bytes(head[4..].try_into().expect("4 bytes"));
     Ok((at, y, size))
@@ -1164,25 +1163,6 @@ fn scatter_split_f32(
     invalid
 }
 
-/// Fills `buf` from byte `at` of `file`, without moving (or needing) a shared cursor, so
-/// that several threads can read one file at once.
-#[cfg(unix)]
-fn read_at(file: &File, buf: &mut [u8], at: u64) -> std::io::Result<()> {
-    std::os::unix::fs::FileExt::read_exact_at(file, buf, at)
-}
-
-#[cfg(windows)]
-fn read_at(file: &File, mut buf: &mut [u8], mut at: u64) -> std::io::Result<()> {
-    use std::os::windows::fs::FileExt;
-    while !buf.is_empty() {
-        match file.seek_read(buf, at)? {
-            0 => return Err(std::io::ErrorKind::UnexpectedEof.into()),
-            n => (buf, at) = (&mut buf[n..], at + n as u64),
-        }
-    }
-    Ok(())
-}
-
 /// Stores one decoded texel (the crate has already converted a whole line of samples).
 #[inline]
 fn set_texel(texels: &mut Texels, p: Vec2<usize>, (r, g, b, a): (f32, f32, f32, f32)) {
@@ -1301,7 +1281,7 @@ fn sample_type_names(types: &[SampleType]) -> String {
 /// (a flat 4×4 block of halves in 3 bytes). DWAA/DWAB have no useful bound (a constant
 /// image's DC values deflate 1032:1 and stand for 64 samples each); their blocks are checked
 /// one by one instead ([`check_dwa_blocks`]).
-fn check_fits_file(path: &Path, header: &Header) -> Result<(), Error> {
+fn check_fits_file(input: &Input, header: &Header) -> Result<(), Error> {
     let ratio = match header.compression {
         Compression::Uncompressed => 1,
         Compression::RLE => 64,
@@ -1311,7 +1291,7 @@ fn check_fits_file(path: &Path, header: &Header) -> Result<(), Error> {
     };
     let raw = header.total_pixel_bytes() as u64;
     let what = format!("{} compression", compression_name(header.compression));
-    crate::bounds::check_raw_bytes_fit(path, raw, ratio, &what)
+    crate::bounds::check_raw_bytes_fit(input, raw, ratio, &what)
 }
 
 /// Checks the counters at the start of every DWAA/DWAB block against what the block's
@@ -1322,10 +1302,11 @@ fn check_fits_file(path: &Path, header: &Header) -> Result<(), Error> {
 /// bounded by the largest block the header allows), found through the offset tables as
 /// the decoder finds them, so the bytes checked are the bytes decoded; a DWA file is
 /// therefore read twice. Blocks of other compressions are skipped.
-fn check_dwa_blocks(path: &Path) -> Result<(), Error> {
-    // A handle of its own: the caller's is part way through the file.
-    let file = open_input(path)?;
-    let reader = exr::block::read(BufReader::new(file), false).map_err(|e| read_error(path, e))?;
+fn check_dwa_blocks(input: &Input) -> Result<(), Error> {
+    let path = input.path();
+    // A reader of its own: the caller's is part way through the file.
+    let reader = input.reader().map_err(|e| Error::io(path, e))?;
+    let reader = exr::block::read(reader, false).map_err(|e| read_error(path, e))?;
     let headers: Vec<Header> = reader.headers().to_vec();
     let chunks = reader
         .filter_chunks(false, |_, _, _| true)

@@ -1,15 +1,15 @@
 //! Radiance RGBE (`.hdr`): read with the `image` crate's decoder, written here with the
 //! standard new-style run-length encoding.
 
-use crate::ldr_io::{check_limits, check_writable_size, decode_error, guard_decoder, open_input};
-use crate::{atomic::stage, Error, Format, Limits, Loaded, Staged, WriteOptions};
+use crate::input::Input;
+use crate::ldr_io::{check_limits, check_writable_size, decode_error, guard_decoder};
+use crate::{atomic::Dest, atomic::Written, Error, Format, Limits, Loaded, WriteOptions};
 use image::codecs::hdr::HdrDecoder;
 use image::{DynamicImage, ImageDecoder};
 use mirrorball_core::Image;
 use mirrorball_encode::{Range, Storage};
 use rayon::prelude::*;
-use std::io::{BufRead, BufReader, Write};
-use std::path::Path;
+use std::io::BufRead;
 
 /// Rows encoded per parallel work item.
 const ROWS_PER_BAND: usize = 16;
@@ -28,10 +28,12 @@ const PEEK: usize = 1 << 16;
 /// Accepts the `#?RADIANCE` and `#?RGBE` signatures and the standard `-Y H +X W`
 /// orientation; the declared size is checked against `limits` before decoding. Header lines
 /// `mirrorball:projection=…` and `mirrorball:layout=…` become [`Loaded::recorded`].
-pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
-    let file = open_input(path)?;
+pub fn read(input: &Input, limits: &Limits) -> Result<Loaded, Error> {
+    let path = input.path();
     guard_decoder(path, "Radiance HDR", || {
-        let mut reader = BufReader::with_capacity(PEEK, file);
+        let mut reader = input
+            .reader_with_capacity(PEEK)
+            .map_err(|e| Error::io(path, e))?;
         let head = reader.fill_buf().map_err(|e| Error::io(path, e))?;
         if !head.starts_with(b"#?") {
             return Err(Error::input(
@@ -41,7 +43,7 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
         }
         // A file shorter than the peek holds its whole header: check it ends properly, so a
         // cut-off header is reported as such rather than as a strange attribute.
-        if head.len() < PEEK && !header_is_complete(head) {
+        if (head.len() as u64) == input.len() && !header_is_complete(head) {
             return Err(Error::input(
                 path,
                 "file is truncated (the header ends before the image size line)".into(),
@@ -52,12 +54,12 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             HdrDecoder::new_nonstrict(reader).map_err(|e| decode_error(path, "Radiance HDR", e))?;
         let (width, height) = decoder.dimensions();
         check_limits(path, width as u64, height as u64, limits)?;
-        crate::bounds::check_lines_fit(path, height as u64)?;
+        crate::bounds::check_lines_fit(input, height as u64)?;
         // A new-style run-length line costs at least 2 bytes a channel per 127 texels (16
         // texels a byte); old-style runs can chain repeat counts further, and files that
         // use them are rare: 64 texels a byte (and any file up to the floor) covers them.
         crate::bounds::check_texels_fit(
-            path,
+            input,
             width as u64,
             height as u64,
             crate::bounds::Density::Most(64),
@@ -104,10 +106,11 @@ pub fn rgbe_work(texels: u64) -> u64 {
 /// Writes `image` as Radiance RGBE (alpha is dropped), run-length encoded for widths from
 /// 8 to 32767 and flat otherwise, rows encoded on all cores. Negative and NaN values are
 /// written as 0, values beyond the RGBE range as its largest value. Written to a temporary
-/// file that the returned [`Staged`] renames into place. The map's projection and layout
+/// file that the returned [`Written`] renames into place, or to memory (`dest`). The map's projection and layout
 /// ([`WriteOptions::declared`]) go into the header as `mirrorball:projection=…` and
 /// `mirrorball:layout=…` lines (Radiance headers hold `NAME=value` lines).
-pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, Error> {
+pub fn write(dest: Dest, image: &Image, opts: &WriteOptions) -> Result<Written, Error> {
+    let path = dest.path();
     check_writable_size(path, image)?;
     let (w, h) = (image.width() as usize, image.height() as usize);
     let c = image.channels();
@@ -136,7 +139,7 @@ pub fn write(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, 
             out
         })
         .collect();
-    stage(path, |out| {
+    dest.emit(|out| {
         out.write_all(header.as_bytes())
             .map_err(|e| Error::io(path, e))?;
         for band in &bands {

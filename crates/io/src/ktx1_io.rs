@@ -145,8 +145,9 @@ fn encoding_of(gl_type: u32, internal: u32) -> Option<Encoding> {
 /// `Ktx1Reader` reads it (B10G11R11, RGBA16F or RGBA32F, six faces, little-endian): the six
 /// faces, declared a cube; every declared size checked against the file's length and
 /// `limits` before anything is allocated.
-pub fn read(path: &Path, limits: &crate::Limits) -> Result<crate::Loaded, Error> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+pub fn read(input: &crate::input::Input, limits: &crate::Limits) -> Result<crate::Loaded, Error> {
+    let path = input.path();
+    let bytes = input.all().map_err(|e| Error::io(path, e))?;
     let bad = |p: String| Error::input(path, p);
     const HEAD: usize = 12 + 13 * 4;
     if bytes.len() < HEAD || bytes[..12] != IDENTIFIER {

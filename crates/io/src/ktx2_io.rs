@@ -18,12 +18,13 @@
 //! This module also holds what the KTX2 and DDS code share: cube validation, texel formats
 //! and size checks.
 
-use crate::{atomic_write, Error, Format, Limits, Loaded, MapInfo, Precision, WriteOptions};
+use crate::atomic::{Dest, Written};
+use crate::input::{Input, Reader};
+use crate::{Error, Format, Limits, Loaded, MapInfo, Precision, WriteOptions};
 use half::f16;
 use mirrorball_core::{Choice, Image, ProjectionKind};
 use mirrorball_encode::{Effort, Encoding};
 use rayon::prelude::*;
-use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::Path;
 
@@ -277,14 +278,14 @@ fn gcd(a: usize, b: usize) -> usize {
 
 /// Writes a cube map with its mip chain as KTX 2.0, RGBA16F or RGBA32F as `opts` asks.
 /// See the module documentation.
-pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<(), Error> {
-    let encoding = written_format(path, opts, "KTX2")?;
+pub fn write(dest: Dest, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<Written, Error> {
+    let encoding = written_format(dest.path(), opts, "KTX2")?;
     let how = CubeWrite {
         encoding,
         declared: opts.declared,
         ..CubeWrite::default()
     };
-    write_ktx2(path, levels, &how)
+    encode(dest, levels, &how)
 }
 
 /// Writes a cube map with its mip chain as KTX 2.0 in `how.encoding`, Zstandard-compressed
@@ -314,6 +315,12 @@ pub fn write(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<
 /// assert!(loaded.description.contains("BC6H"));
 /// ```
 pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result<(), Error> {
+    encode(Dest::File(path), levels, how)?.land().map(|_| ())
+}
+
+/// [`write_ktx2`] into `dest`.
+fn encode(dest: Dest, levels: &[Vec<Image>], how: &CubeWrite) -> Result<Written, Error> {
+    let path = dest.path();
     let encoding = how.encoding;
     let size = validate_cube(path, levels)?;
     if let Some(level) = how.zstd {
@@ -347,9 +354,7 @@ pub fn write_ktx2(path: &Path, levels: &[Vec<Image>], how: &CubeWrite) -> Result
     let head = ktx2_head(encoding, size, supercompressed, &index, &dfd, &kvd);
     debug_assert_eq!(head.len() as u64, data_start);
 
-    atomic_write(path, |w| {
-        write_level_data(path, w, levels, how, &head, &index, &compressed)
-    })
+    dest.emit(|w| write_level_data(path, w, levels, how, &head, &index, &compressed))
 }
 
 /// The key/value data [`write_ktx2`] writes: `KTXorientation` = `rd`, `KTXwriter`, the
@@ -499,7 +504,7 @@ fn ktx2_head(
 /// faces encoded one at a time.
 fn write_level_data(
     path: &Path,
-    w: &mut impl Write,
+    w: &mut (impl Write + ?Sized),
     levels: &[Vec<Image>],
     how: &CubeWrite,
     head: &[u8],
@@ -676,11 +681,12 @@ fn read_u64(bytes: &[u8], at: usize) -> u64 {
 /// Reads level 0 of a KTX2 cube map (faceCount 6: the six faces, declared cube) or 2D
 /// texture (faceCount 1: one flat image, turned to top-row-first by its `KTXorientation`).
 /// Uncompressed RGBA16F, RGBA32F, RGB16F, RGB32F, B10G11R11 and E5B9G9R9 float data.
-pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
+pub fn read(input: &Input, limits: &Limits) -> Result<Loaded, Error> {
+    let path = input.path();
     let io = |e| Error::io(path, e);
     let invalid = |problem: String| Error::input(path, problem);
-    let mut file = File::open(path).map_err(io)?;
-    let file_len = file.metadata().map_err(io)?.len();
+    let mut file = input.reader().map_err(io)?;
+    let file_len = input.len();
 
     let mut head = [0u8; HEADER_LEN];
     file.read_exact(&mut head).map_err(io)?;
@@ -923,7 +929,7 @@ fn check_sections(
 fn read_checked_prefix(
     path: &Path,
     header: &ktx2::Header,
-    mut file: File,
+    mut file: Reader,
     end: u64,
 ) -> Result<Vec<u8>, Error> {
     let io = |e| Error::io(path, e);

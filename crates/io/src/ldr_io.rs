@@ -5,15 +5,16 @@
 //! against [`Limits`], the guard that turns a decoder panic into an error, and the mapping
 //! of `image` crate errors.
 
-use crate::{atomic::stage, Error, Format, Limits, Loaded, Precision, Staged, WriteOptions};
+use crate::atomic::{Dest, Written};
+use crate::input::Input;
+use crate::{Error, Format, Limits, Loaded, Precision, WriteOptions};
 use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::{DynamicImage, ExtendedColorType, ImageDecoder, ImageEncoder, ImageError, ImageFormat};
 use mirrorball_core::color::{linear_to_srgb, srgb_to_linear};
 use mirrorball_core::Image;
 use rayon::prelude::*;
-use std::fs::File;
-use std::io::{BufRead, BufReader, Cursor, Read, Seek};
+use std::io::{BufRead, Cursor, Seek};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -30,7 +31,8 @@ const CHUNK_TEXELS: usize = 1 << 14;
 /// The declared size is checked against `limits` from the header, before any texel is
 /// decoded. A PNG's `mirrorball:projection` and `mirrorball:layout` text chunks, or the
 /// same `key=value` lines in a JPEG comment segment, become [`Loaded::recorded`].
-pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Error> {
+pub fn read(input: &Input, format: Format, limits: &Limits) -> Result<Loaded, Error> {
+    let path = input.path();
     let (image_format, name) = match format {
         Format::Png => (ImageFormat::Png, "PNG"),
         Format::Jpeg => (ImageFormat::Jpeg, "JPEG"),
@@ -42,33 +44,23 @@ pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Erro
             ))
         }
     };
-    let file = open_input(path)?;
+    let io = |e| Error::io(path, e);
     guard_decoder(path, name, || {
         if format == Format::Png {
-            let mut reader = BufReader::new(file);
-            let texts =
-                crate::meta_text::read_texts(&mut reader).map_err(|e| Error::io(path, e))?;
-            let mut loaded = decode(path, reader, image_format, format, name, limits)?;
+            let mut reader = input.reader().map_err(io)?;
+            let texts = crate::meta_text::read_texts(&mut reader).map_err(io)?;
+            let mut loaded = decode(input, reader, image_format, format, name, limits)?;
             let get = |key: &str| texts.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
             let image = &loaded.layers[0];
             loaded.recorded = crate::recorded(get, image.width(), image.height());
             return Ok(loaded);
         }
         if format != Format::Jpeg {
-            return decode(
-                path,
-                BufReader::new(file),
-                image_format,
-                format,
-                name,
-                limits,
-            );
+            let reader = input.reader().map_err(io)?;
+            return decode(input, reader, image_format, format, name, limits);
         }
         // JPEG decoders fill in whatever a truncated file lacks: check for the end marker.
-        let mut bytes = Vec::new();
-        BufReader::new(file)
-            .read_to_end(&mut bytes)
-            .map_err(|e| Error::io(path, e))?;
+        let bytes = input.all().map_err(io)?;
         if !bytes.starts_with(&[0xff, 0xd8]) {
             return Err(Error::input(
                 path,
@@ -82,7 +74,14 @@ pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Erro
             ));
         }
         let comments = crate::meta_text::jpeg_comments(&bytes);
-        let mut loaded = decode(path, Cursor::new(bytes), image_format, format, name, limits)?;
+        let mut loaded = decode(
+            input,
+            Cursor::new(&bytes[..]),
+            image_format,
+            format,
+            name,
+            limits,
+        )?;
         let get = |key: &str| {
             comments
                 .iter()
@@ -97,13 +96,14 @@ pub fn read(path: &Path, format: Format, limits: &Limits) -> Result<Loaded, Erro
 
 /// Decodes with the `image` crate after checking the declared size.
 fn decode<R: BufRead + Seek>(
-    path: &Path,
+    input: &Input,
     reader: R,
     image_format: ImageFormat,
     format: Format,
     name: &str,
     limits: &Limits,
 ) -> Result<Loaded, Error> {
+    let path = input.path();
     let mut reader = image::ImageReader::with_format(reader, image_format);
     reader.limits(image_limits(limits));
     let decoder = reader.into_decoder().map_err(|e| match e {
@@ -118,7 +118,7 @@ fn decode<R: BufRead + Seek>(
     })?;
     let (width, height) = decoder.dimensions();
     check_limits(path, width as u64, height as u64, limits)?;
-    check_fits_file(path, format, name, width, height)?;
+    check_fits_file(input, format, name, width, height)?;
     let decoded = DynamicImage::from_decoder(decoder).map_err(|e| decode_error(path, name, e))?;
     let (image, depth, layout) = to_linear(path, decoded)?;
     let description = format!("{name}, {depth} sRGB, {layout}");
@@ -145,7 +145,7 @@ fn decode<R: BufRead + Seek>(
 /// *plausible* density instead: 4096 texels a byte (real pictures, lossy or lossless, come
 /// to well under 100), and every file may still declare [`crate::bounds::FLOOR_TEXELS`].
 fn check_fits_file(
-    path: &Path,
+    input: &Input,
     format: Format,
     name: &str,
     width: u32,
@@ -154,9 +154,9 @@ fn check_fits_file(
     use crate::bounds::{check_texels_fit, Density};
     let (w, h) = (width as u64, height as u64);
     match format {
-        Format::Png => check_texels_fit(path, w, h, Density::Most(8 * 1040), name),
-        Format::Jpeg => check_texels_fit(path, w, h, Density::Most(1024), name),
-        Format::Webp => check_texels_fit(path, w, h, Density::Plausible(4096), name),
+        Format::Png => check_texels_fit(input, w, h, Density::Most(8 * 1040), name),
+        Format::Jpeg => check_texels_fit(input, w, h, Density::Most(1024), name),
+        Format::Webp => check_texels_fit(input, w, h, Density::Plausible(4096), name),
         _ => Ok(()),
     }
 }
@@ -177,13 +177,15 @@ fn jpeg_is_complete(bytes: &[u8]) -> bool {
 /// to sRGB with clamping to [0, 1] and rounding to nearest. Alpha is stored linearly. A PNG
 /// records [`WriteOptions::declared`] in `tEXt` chunks, a JPEG in a comment segment; a
 /// lat-long or VR180 picture also gets GPano XMP (PNG `iTXt`, JPEG `APP1`).
-/// Written to a temporary file that the returned [`Staged`] renames into place.
+/// Written to a temporary file that the returned [`Written`] renames into place, or to
+/// memory (`dest`).
 pub fn write(
-    path: &Path,
+    dest: Dest,
     format: Format,
     image: &Image,
     opts: &WriteOptions,
-) -> Result<Staged, Error> {
+) -> Result<Written, Error> {
+    let path = dest.path();
     let sixteen = sixteen_bit(path, format, opts)?;
     check_writable_size(path, image)?;
     let (w, h) = (image.width(), image.height());
@@ -195,9 +197,9 @@ pub fn write(
     }
 
     if format == Format::Jpeg {
-        return write_jpeg(path, image, opts);
+        return write_jpeg(dest, image, opts);
     }
-    write_png(path, image, opts, sixteen)
+    write_png(dest, image, opts, sixteen)
 }
 
 /// Whether [`write`] stores 16-bit samples (PNG with [`Precision::U16`]) rather than 8-bit
@@ -231,7 +233,8 @@ fn sixteen_bit(path: &Path, format: Format, opts: &WriteOptions) -> Result<bool,
 /// Stages `image` as an 8-bit RGB JPEG at [`WriteOptions::jpeg_quality`] (92 when 0, at
 /// most 100), with [`WriteOptions::declared`] in a comment segment and GPano XMP in `APP1`
 /// when it is given.
-fn write_jpeg(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged, Error> {
+fn write_jpeg(dest: Dest, image: &Image, opts: &WriteOptions) -> Result<Written, Error> {
+    let path = dest.path();
     let (w, h) = (image.width(), image.height());
     let quality = match opts.jpeg_quality {
         0 => DEFAULT_JPEG_QUALITY,
@@ -239,7 +242,7 @@ fn write_jpeg(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged,
     };
     let bytes = encode_u8(image, 3);
     let Some(info) = &opts.declared else {
-        return stage(path, |out| {
+        return dest.emit(|out| {
             JpegEncoder::new_with_quality(out, quality)
                 .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
                 .map_err(|e| encode_error(path, "JPEG", e))
@@ -257,20 +260,19 @@ fn write_jpeg(path: &Path, image: &Image, opts: &WriteOptions) -> Result<Staged,
     if let Some(xmp) = panorama_xmp(info, w, h) {
         jpeg = crate::meta_text::with_jpeg_xmp(jpeg, &xmp);
     }
-    stage(path, |out| {
-        std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
-    })
+    dest.emit(|out| std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e)))
 }
 
 /// Stages `image` as an RGB or RGBA PNG of 8-bit or (`sixteen`) 16-bit samples, with
 /// [`WriteOptions::declared`] in `tEXt` chunks and GPano XMP in an `iTXt` chunk when it is
 /// given.
 fn write_png(
-    path: &Path,
+    dest: Dest,
     image: &Image,
     opts: &WriteOptions,
     sixteen: bool,
-) -> Result<Staged, Error> {
+) -> Result<Written, Error> {
+    let path = dest.path();
     let (w, h) = (image.width(), image.height());
     let c = image.channels();
     let (bytes, color) = if sixteen {
@@ -315,7 +317,7 @@ fn write_png(
             note.text(),
         ));
     }
-    stage(path, |out| {
+    dest.emit(|out| {
         PngEncoder::new(crate::meta_text::WithText::new(out, chunks))
             .write_image(&bytes, w, h, color)
             .map_err(|e| encode_error(path, "PNG", e))
@@ -331,7 +333,7 @@ pub fn write_grey_png(path: &Path, (w, h): (u32, u32), samples: &[u8]) -> Result
             format!("{} grey samples for a {w}×{h} picture", samples.len()),
         ));
     }
-    crate::atomic::land(stage(path, |out| {
+    crate::atomic::land(crate::atomic::stage(path, |out| {
         PngEncoder::new(out)
             .write_image(samples, w, h, ExtendedColorType::L8)
             .map_err(|e| encode_error(path, "PNG", e))
@@ -369,7 +371,7 @@ pub fn write_jpeg_with_segments(
         at = 4 + u16::from_be_bytes([jpeg[4], jpeg[5]]) as usize;
     }
     jpeg.splice(at..at, segments.iter().copied());
-    crate::atomic::land(stage(path, |out| {
+    crate::atomic::land(crate::atomic::stage(path, |out| {
         std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
     })?)
 }
@@ -631,20 +633,6 @@ pub(crate) fn check_limits(
         ));
     }
     Ok(())
-}
-
-/// Opens a file to read, refusing directories (which open fine on Unix but fail to read
-/// with an unhelpful system error).
-pub(crate) fn open_input(path: &Path) -> Result<File, Error> {
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let meta = file.metadata().map_err(|e| Error::io(path, e))?;
-    if meta.is_dir() {
-        return Err(Error::input(
-            path,
-            "is a directory, not an image file".into(),
-        ));
-    }
-    Ok(file)
 }
 
 /// Refuses to write an empty image.

@@ -32,6 +32,7 @@ mod exr_io;
 mod exr_zip;
 mod gltf_ibl;
 mod hdr_io;
+mod input;
 mod ktx1_io;
 mod ktx2_io;
 mod ldr_io;
@@ -127,7 +128,7 @@ impl MapInfo {
         w: u32,
         h: u32,
     ) -> Result<MapInfo, String> {
-        let unreadable = |key: &str, text: &str, e: String| {
+        let unreadable = |key: &str, text: &str, e: &dyn std::fmt::Display| {
             format!("records {key} = '{text}', which cannot be read ({e})")
         };
         let text = layout.unwrap_or_default();
@@ -136,22 +137,22 @@ impl MapInfo {
                 let stereo = s
                     .trim()
                     .parse::<Stereo>()
-                    .map_err(|e| unreadable(LAYOUT_KEY, text, e.to_string()))?;
+                    .map_err(|e| unreadable(LAYOUT_KEY, text, &e))?;
                 (stereo, Some(l))
             }
             None => (Stereo::Mono, layout),
         };
         let (w, h) = stereo
             .eye_extent(w, h)
-            .map_err(|e| unreadable(LAYOUT_KEY, text, e))?;
+            .map_err(|e| unreadable(LAYOUT_KEY, text, &e))?;
         let projection = ProjectionSpec::parse(projection)
             .and_then(|s| s.build(Some((w, h))))
-            .map_err(|e| unreadable(PROJECTION_KEY, projection, e))?;
+            .map_err(|e| unreadable(PROJECTION_KEY, projection, &e))?;
         let layout = layout
             .map(|l| {
                 l.trim()
                     .parse::<Layout>()
-                    .map_err(|e| unreadable(LAYOUT_KEY, l, e))
+                    .map_err(|e| unreadable(LAYOUT_KEY, l, &e))
             })
             .transpose()?;
         Ok(MapInfo {
@@ -549,6 +550,12 @@ impl Loaded {
 /// ```
 pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     let mut loaded = read_format(path, limits)?;
+    count_invalid(&mut loaded);
+    Ok(loaded)
+}
+
+/// Counts [`Loaded::invalid`] where the reader did not.
+fn count_invalid(loaded: &mut Loaded) {
     if loaded.invalid.is_none() {
         use rayon::prelude::*;
         let count = loaded
@@ -564,24 +571,182 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
             .sum();
         loaded.invalid = Some(count);
     }
-    Ok(loaded)
 }
 
 /// [`read`]'s reader for `path`'s format, once `path` is a file with bytes in it.
 fn read_format(path: &Path, limits: &Limits) -> Result<Loaded, Error> {
     Error::check_input(path)?;
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
+    if format == Format::GltfIbl {
+        // A glTF light names its images, other files beside it.
+        return gltf_ibl::read(path, limits);
+    }
+    decode(&input::Input::open(path)?, format, limits)
+}
+
+/// The one decoder of `format`, reading a file or bytes.
+fn decode(input: &input::Input, format: Format, limits: &Limits) -> Result<Loaded, Error> {
+    let path = input.path();
     match format {
-        Format::Exr => exr_io::read(path, limits),
-        Format::Hdr => hdr_io::read(path, limits),
-        Format::Png | Format::Jpeg | Format::Webp => ldr_io::read(path, format, limits),
+        Format::Exr => exr_io::read(input, limits),
+        Format::Hdr => hdr_io::read(input, limits),
+        Format::Png | Format::Jpeg | Format::Webp => ldr_io::read(input, format, limits),
         // The header parsers are other crates' (`ktx2` 0.5 panics on a DFD block dimension
         // of 255): a panic becomes an error.
-        Format::Ktx2 => ldr_io::guard_decoder(path, "KTX2", || ktx2_io::read(path, limits)),
-        Format::Dds => ldr_io::guard_decoder(path, "DDS", || dds_io::read(path, limits)),
-        Format::Ktx1 => ktx1_io::read(path, limits),
-        Format::BabylonEnv => babylon_env::read(path, limits),
-        Format::GltfIbl => gltf_ibl::read(path, limits),
+        Format::Ktx2 => ldr_io::guard_decoder(path, "KTX2", || ktx2_io::read(input, limits)),
+        Format::Dds => ldr_io::guard_decoder(path, "DDS", || dds_io::read(input, limits)),
+        Format::Ktx1 => ktx1_io::read(input, limits),
+        Format::BabylonEnv => babylon_env::read(input, limits),
+        Format::GltfIbl => Err(Error::request(
+            path,
+            "a glTF light names its images in files beside it: read it from a path".into(),
+        )),
+    }
+}
+
+/// How [`read_bytes`] and [`write_bytes`] know the container: named outright, by a file
+/// name's extension, or (reading) by the content's first bytes ([`Format::from_magic`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Hint<'a> {
+    /// This container.
+    Format(Format),
+    /// The container of this file name's extension (`upload.exr`); messages name it.
+    Name(&'a str),
+    /// Whatever the bytes' signature says (reading only).
+    Content,
+}
+
+impl Hint<'_> {
+    /// The format and the name messages give the bytes: the file name, or the container's
+    /// name and "data" (`OpenEXR data`).
+    fn resolve(self, bytes: Option<&[u8]>) -> Result<(Format, std::path::PathBuf), Error> {
+        let named = |f: Format| std::path::PathBuf::from(format!("{} data", f.name()));
+        match self {
+            Hint::Format(f) => Ok((f, named(f))),
+            Hint::Name(name) => {
+                let path = Path::new(name);
+                match Format::from_path(path).or_else(|| bytes.and_then(Format::from_magic)) {
+                    Some(f) => Ok((f, path.to_path_buf())),
+                    None => Err(Error::request(path, unknown_ext())),
+                }
+            }
+            Hint::Content => match bytes.and_then(Format::from_magic) {
+                Some(f) => Ok((f, named(f))),
+                None => Err(Error::input(
+                    Path::new("data"),
+                    "not a file format mirrorball reads (its first bytes are no known \
+                     signature: OpenEXR, Radiance HDR, PNG, JPEG, WebP, KTX2, DDS, KTX1, \
+                     Babylon.js .env)"
+                        .into(),
+                )),
+            },
+        }
+    }
+}
+
+/// Reads a file's contents held in memory, as [`read`] reads the file: the same decoder,
+/// the same checks of declared sizes against `limits` and against the bytes' length before
+/// anything is allocated, the same messages (naming the file name of `hint`, else the
+/// container: `PNG data: ...`). A glTF light (it names other files) is read only from a path.
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_io::{read_bytes, write_bytes, Fault, Format, Hint, Limits, WriteOptions};
+/// let mut img = Image::new(8, 4, 3);
+/// img.set(1, 2, &[0.25, 0.5, 4.0]);
+/// let bytes = write_bytes(&[vec![img]], Hint::Format(Format::Exr), &WriteOptions::default()).unwrap();
+/// let loaded = read_bytes(&bytes, Hint::Content, &Limits::default()).unwrap();
+/// assert_eq!(loaded.layers[0].get(1, 2), &[0.25, 0.5, 4.0]);
+/// let e = read_bytes(&bytes[..100], Hint::Name("map.exr"), &Limits::default()).unwrap_err();
+/// assert_eq!(e.fault(), Fault::Input);
+/// ```
+pub fn read_bytes(bytes: &[u8], hint: Hint<'_>, limits: &Limits) -> Result<Loaded, Error> {
+    let (format, name) = hint.resolve(Some(bytes))?;
+    if bytes.is_empty() {
+        return Err(Error::input(
+            &name,
+            format!("the {} data is empty (0 bytes)", format.name()),
+        ));
+    }
+    let mut loaded = decode(&input::Input::bytes(&name, bytes), format, limits)?;
+    count_invalid(&mut loaded);
+    Ok(loaded)
+}
+
+/// Writes a file's contents to memory, as [`write_image`] (one level of one layer) or
+/// [`write_cube`] (KTX2 and DDS: `levels` as it takes them) write the file: the same
+/// encoder, the same bytes. The container is `hint`'s ([`Hint::Content`] is refused).
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_io::{write_bytes, write_image, Format, Hint, WriteOptions};
+/// let dir = tempfile::tempdir().unwrap();
+/// let img = Image::new(4, 2, 3);
+/// let path = dir.path().join("a.png");
+/// write_image(&path, &img, &WriteOptions::default()).unwrap();
+/// let bytes = write_bytes(&[vec![img]], Hint::Name("a.png"), &WriteOptions::default()).unwrap();
+/// assert_eq!(std::fs::read(&path).unwrap(), bytes);
+/// ```
+pub fn write_bytes(
+    levels: &[Vec<Image>],
+    hint: Hint<'_>,
+    opts: &WriteOptions,
+) -> Result<Vec<u8>, Error> {
+    let (format, name) = match hint {
+        Hint::Content => {
+            return Err(Error::request(
+                Path::new("data"),
+                "writing needs a format or a file name, not the content's".into(),
+            ))
+        }
+        hint => hint.resolve(None)?,
+    };
+    let dest = atomic::Dest::Memory(&name);
+    if format.is_cube_container() {
+        return write_cube_to(dest, format, levels, opts).map(atomic::Written::bytes);
+    }
+    match levels {
+        [level] if level.len() == 1 => {
+            write_image_to(dest, format, &level[0], opts, &mut WriteBuffers::default())
+                .map(atomic::Written::bytes)
+        }
+        _ => Err(Error::request(
+            &name,
+            format!(
+                "a {} file holds one picture: pack the layers (a layout) first",
+                format.name()
+            ),
+        )),
+    }
+}
+
+impl Format {
+    /// The format whose signature `bytes` start with: OpenEXR's magic number, `#?` (Radiance),
+    /// PNG's, JPEG's start of image, RIFF…WEBP, KTX 2.0's and KTX 1.1's identifiers, `DDS `,
+    /// Babylon's `.env` magic. `None` for anything else (glTF is JSON: name it).
+    pub fn from_magic(bytes: &[u8]) -> Option<Format> {
+        let starts = |m: &[u8]| bytes.starts_with(m);
+        Some(if starts(&[0x76, 0x2f, 0x31, 0x01]) {
+            Format::Exr
+        } else if starts(b"#?") {
+            Format::Hdr
+        } else if starts(b"\x89PNG\r\n\x1a\n") {
+            Format::Png
+        } else if starts(&[0xff, 0xd8]) {
+            Format::Jpeg
+        } else if starts(b"RIFF") && bytes.get(8..12) == Some(b"WEBP") {
+            Format::Webp
+        } else if starts(b"\xabKTX 20\xbb") {
+            Format::Ktx2
+        } else if starts(b"\xabKTX 11\xbb") {
+            Format::Ktx1
+        } else if starts(b"DDS ") {
+            Format::Dds
+        } else if starts(&babylon_env::MAGIC) {
+            Format::BabylonEnv
+        } else {
+            return None;
+        })
     }
 }
 
@@ -638,10 +803,23 @@ pub(crate) fn stage_image(
     buffers: &mut WriteBuffers,
 ) -> Result<Staged, Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
+    write_image_to(atomic::Dest::File(path), format, image, opts, buffers)
+        .map(atomic::Written::staged)
+}
+
+/// The one encoder of each flat-image `format`, into a file or memory.
+fn write_image_to(
+    dest: atomic::Dest,
+    format: Format,
+    image: &Image,
+    opts: &WriteOptions,
+    buffers: &mut WriteBuffers,
+) -> Result<atomic::Written, Error> {
+    let path = dest.path();
     match format {
-        Format::Exr => exr_io::write(path, image, opts, buffers),
-        Format::Hdr => hdr_io::write(path, image, opts),
-        Format::Png | Format::Jpeg => ldr_io::write(path, format, image, opts),
+        Format::Exr => exr_io::write(dest, image, opts, buffers),
+        Format::Hdr => hdr_io::write(dest, image, opts),
+        Format::Png | Format::Jpeg => ldr_io::write(dest, format, image, opts),
         Format::Webp => Err(Error::request(
             path,
             "writing WebP is not supported; use .png".into(),
@@ -675,11 +853,23 @@ pub(crate) fn stage_image(
 /// ```
 pub fn write_cube(path: &Path, levels: &[Vec<Image>], opts: &WriteOptions) -> Result<(), Error> {
     let format = Format::from_path(path).ok_or_else(|| Error::request(path, unknown_ext()))?;
+    write_cube_to(atomic::Dest::File(path), format, levels, opts)?
+        .land()
+        .map(|_| ())
+}
+
+/// The one encoder of each cube container, into a file or memory.
+fn write_cube_to(
+    dest: atomic::Dest,
+    format: Format,
+    levels: &[Vec<Image>],
+    opts: &WriteOptions,
+) -> Result<atomic::Written, Error> {
     match format {
-        Format::Ktx2 => ktx2_io::write(path, levels, opts),
-        Format::Dds => dds_io::write(path, levels, opts),
+        Format::Ktx2 => ktx2_io::write(dest, levels, opts),
+        Format::Dds => dds_io::write(dest, levels, opts),
         _ => Err(Error::request(
-            path,
+            dest.path(),
             "only .ktx2 and .dds hold a whole cube map".into(),
         )),
     }

@@ -120,15 +120,16 @@ pub fn latlong_to_mirrorball(image: &Image) -> Image {
 }
 
 /// An OpenEXR cube map (`envmap = cube`: a vertical strip of six faces of edge
-/// `s = min(w, h/6)`) as OpenGL's six faces of edge `s`, in OpenGL's order. An error when
-/// the picture is too short to hold six faces.
-pub fn cube_to_faces(image: &Image) -> Result<Vec<Image>, String> {
+/// `s = min(w, h/6)`) as OpenGL's six faces of edge `s`, in OpenGL's order. The picture
+/// of the file `path` (which messages name) too short to hold six faces is the input's
+/// fault.
+pub fn cube_to_faces(image: &Image, path: &std::path::Path) -> Result<Vec<Image>, crate::Error> {
     let (w, h, c) = (image.width(), image.height(), image.channels());
     let s = w.min(h / 6);
     if s == 0 {
-        return Err(format!(
+        return Err(crate::Error::input(path, format!(
             "is tagged as an OpenEXR cube map (envmap = cube), but a {w}x{h} picture cannot hold its six faces stacked vertically (N by 6N)"
-        ));
+        )));
     }
     Ok((0..6)
         .into_par_iter()

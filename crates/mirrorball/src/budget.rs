@@ -86,8 +86,12 @@ pub fn human(bytes: u64) -> String {
 }
 
 /// Parses a `--max-memory` value: bytes, or a number with K, M, G or T (powers of 1024;
-/// an optional `B` or `iB` after it).
-pub fn parse_bytes(s: &str) -> Result<u64, String> {
+/// an optional `B` or `iB` after it). Text that is none is the request's fault.
+pub fn parse_bytes(s: &str) -> Result<u64, crate::Error> {
+    bytes_text(s).map_err(crate::Error::request)
+}
+
+fn bytes_text(s: &str) -> Result<u64, String> {
     let t = s.trim();
     let lower = t.to_ascii_lowercase();
     let digits = lower.trim_end_matches(['b', 'i']);
@@ -141,12 +145,13 @@ mod tests {
 
     #[test]
     fn sizes_parse() {
-        assert_eq!(parse_bytes("8G"), Ok(8 << 30));
-        assert_eq!(parse_bytes("512MiB"), Ok(512 << 20));
-        assert_eq!(parse_bytes("1.5k"), Ok(1536));
-        assert_eq!(parse_bytes("1000"), Ok(1000));
+        assert_eq!(parse_bytes("8G").unwrap(), 8 << 30);
+        assert_eq!(parse_bytes("512MiB").unwrap(), 512 << 20);
+        assert_eq!(parse_bytes("1.5k").unwrap(), 1536);
+        assert_eq!(parse_bytes("1000").unwrap(), 1000);
         for bad in ["", "G", "-1G", "nan", "x", "1e30T"] {
-            assert!(parse_bytes(bad).is_err(), "{bad}");
+            let e = parse_bytes(bad).unwrap_err();
+            assert_eq!(e.fault, mirrorball_core::Fault::Request, "{bad}");
         }
     }
 }

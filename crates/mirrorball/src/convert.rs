@@ -33,6 +33,9 @@ pub struct ConvertRequest {
     pub to: Option<ProjSpec>,
     /// The output's size (a cube's face edge, a lat-long's height…); `None`: from the input.
     pub size: Option<i64>,
+    /// The output's height, with `size` its width (`--size WxH`): a perspective view's vfov
+    /// follows from it; other projections must have that height at that width.
+    pub height: Option<i64>,
     /// The layout of the output's layers in its picture.
     pub layout: Option<Layout>,
     /// How the input picture holds its eyes (`None`: as the file records, else one eye).
@@ -71,6 +74,7 @@ impl Default for ConvertRequest {
             input_plan: InputPlan::default(),
             to: None,
             size: None,
+            height: None,
             layout: None,
             in_stereo: None,
             stereo: None,
@@ -146,12 +150,21 @@ impl ConvertPlan {
     /// container its frames are packed as), so no folder of it is checked.
     pub fn unwritten(r: &ConvertRequest) -> Result<ConvertPlan, Error> {
         let input = r.input_plan.clone();
-        let Some(to) = r.to.clone() else {
+        let Some(mut to) = r.to.clone() else {
             return Err(Error::request(
                 "--to: a sequence, a pipe or a manifest's job needs the output's projection \
                  (only a conversion of one file keeps its input's)",
             ));
         };
+        if let (Some(w), Some(h)) = (r.size, r.height) {
+            let dim = |v: i64| u32::try_from(v).ok().filter(|&v| v > 0);
+            let (Some(w), Some(h)) = (dim(w), dim(h)) else {
+                return Err(Error::request(format!(
+                    "--size {w}x{h}: give a positive width and height"
+                )));
+            };
+            to = to.with_height(w, h)?;
+        }
         let format = save::check_container(&r.output)?;
         save::check_flags(&r.output, format, &r.container_flags(), r.precision)?;
         save::check(&r.output, to.kind, r.layout)?;
@@ -226,6 +239,11 @@ impl ConvertPlan {
     /// (and its size, unless `size`), so the input is read first; what the output's
     /// container alone decides is checked before that. The output's folder must exist.
     pub fn new_and_read(r: &ConvertRequest) -> Result<(ConvertPlan, Source), Error> {
+        if r.to.is_none() && r.height.is_some() {
+            return Err(Error::request(
+                "--size WxH: give --to too (a height is the output projection's)",
+            ));
+        }
         if r.to.is_some() {
             let plan = ConvertPlan::new(r, Folders::Exist)?;
             // The room on disk now when the size gives the output's (four channels at

@@ -12,6 +12,8 @@ pub struct Error {
     pub message: String,
     /// Whose fault.
     pub fault: Fault,
+    /// The kind of the I/O error behind it, if one is ([`Error::io_kind`]).
+    io_kind: Option<std::io::ErrorKind>,
 }
 
 impl Error {
@@ -32,20 +34,35 @@ impl Error {
         Error {
             message: message.into(),
             fault,
+            io_kind: None,
         }
+    }
+    /// The kind of the I/O error behind it, if one is: a front end tells a full disk
+    /// (`StorageFull`) from the system's other failures by it.
+    pub fn io_kind(&self) -> Option<std::io::ErrorKind> {
+        self.io_kind
     }
     /// The same fault, with `context` before the message.
     pub fn context(self, context: impl fmt::Display) -> Error {
         Error {
             message: format!("{context}: {}", self.message),
-            fault: self.fault,
+            ..self
         }
+    }
+}
+
+impl From<mirrorball_core::Error> for Error {
+    fn from(e: mirrorball_core::Error) -> Error {
+        Error::new(e.fault, e.message)
     }
 }
 
 impl From<mirrorball_io::Error> for Error {
     fn from(e: mirrorball_io::Error) -> Error {
-        Error::new(e.fault(), e.to_string())
+        Error {
+            io_kind: e.io_kind(),
+            ..Error::new(e.fault(), e.to_string())
+        }
     }
 }
 

@@ -12,10 +12,12 @@
 //! - [`load`]: a file (or one file per layer, `{face}` in the name) into an [`EnvMap`] with
 //!   its projection and layout, from what the file records or guessed from its shape
 //!   ([`InputPlan`] says what the caller knows); [`load::read_prepared`] also zeroes
-//!   invalid values and returns the lines saying what was decided.
+//!   invalid values and returns the lines saying what was decided; [`load::from_bytes`]
+//!   reads a file's contents held in memory the same way.
 //! - [`save`]: a map into any writable container; the extension picks it
 //!   ([`save::check`] refuses a container or layout that cannot hold the projection before
-//!   any work), [`save::SaveOptions`] the precision, layout and compression.
+//!   any work), [`save::SaveOptions`] the precision, layout and compression;
+//!   [`save::to_bytes`] makes the same file in memory.
 //! - [`fit`]: what an output cannot hold, measured before it is written.
 //!
 //! ## Limits, checked before any work

@@ -156,8 +156,48 @@ pub fn load_eyes(
         }
         return load_layers(input, from, limits);
     }
-    let path = Path::new(input);
-    let loaded = mirrorball_io::read(path, limits)?;
+    let loaded = mirrorball_io::read(Path::new(input), limits)?;
+    interpret_loaded(input, loaded, from, layout, (asked, output))
+}
+
+/// Reads a file's contents held in memory as [`load`] reads the file (the same reader, the
+/// same projection and layout decisions): `name` is the file's name, whose extension says
+/// the container (else the bytes' signature does) and which messages name.
+///
+/// ```
+/// use mirrorball::core::{EnvMap, Image, LatLong, Projection};
+/// use mirrorball::{load, save, SaveOptions};
+/// let env = EnvMap::new(Projection::LatLong(LatLong), vec![Image::new(16, 8, 3)]).unwrap();
+/// let opts = SaveOptions { layout: None, write: Default::default(), mips: false, keep_invalid: false };
+/// let (bytes, _) = save::to_bytes(&env, "sky.exr", &opts).unwrap();
+/// let back = load::from_bytes("upload.exr", &bytes, None, None, &Default::default()).unwrap();
+/// assert_eq!(back.env.projection().name(), "latlong");
+/// ```
+pub fn from_bytes(
+    name: &str,
+    bytes: &[u8],
+    from: Option<&ProjSpec>,
+    layout: Option<Layout>,
+    limits: &Limits,
+) -> Result<Source, Error> {
+    let loaded = mirrorball_io::read_bytes(bytes, mirrorball_io::Hint::Name(name), limits)?;
+    interpret_loaded(name, loaded, from, layout, (None, Stereo::Mono))
+}
+
+/// The map in what the reader gave for `input` (a file, or bytes so named): [`load_eyes`]
+/// once the container is read.
+fn interpret_loaded(
+    input: &str,
+    loaded: Loaded,
+    from: Option<&ProjSpec>,
+    layout: Option<Layout>,
+    (asked, output): (Option<Stereo>, Stereo),
+) -> Result<Source, Error> {
+    let one_picture = |stereo: Stereo, what: &str| {
+        Error::request(format!(
+            "{input}: --in-stereo {stereo} splits one picture into eyes, but {what}"
+        ))
+    };
     let invalid = loaded.invalid();
     let Loaded {
         layers,
@@ -478,7 +518,7 @@ fn openexr_tagged(
         ProjectionKind::Cube => Some((
             EnvMap::new(
                 CubeMap.into(),
-                openexr::cube_to_faces(image).map_err(|e| bad(&e))?,
+                openexr::cube_to_faces(image, Path::new(input))?,
             )
             .map_err(|e| bad(&e))?,
             "the file is tagged envmap=cube: OpenEXR's vertical strip of faces, read into OpenGL's faces (--from cube --layout vstrip reads the picture as mirrorball's strip)",

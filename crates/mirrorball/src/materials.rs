@@ -63,8 +63,13 @@ fn spec_number(k: &str, v: &str) -> Result<f32, String> {
 }
 
 /// Parses a `--material` spec, `NAME[:key=value…]` (see [`material_of`] for the keys), with
-/// `--tint` and `--f0` as the defaults of `tint` and `f0`.
-pub fn parse_material(spec: &str, tint: [f32; 3], f0: f32) -> Result<Material, String> {
+/// `--tint` and `--f0` as the defaults of `tint` and `f0`. A spec it cannot take is the
+/// request's fault.
+pub fn parse_material(spec: &str, tint: [f32; 3], f0: f32) -> Result<Material, crate::Error> {
+    material_text(spec, tint, f0).map_err(crate::Error::request)
+}
+
+fn material_text(spec: &str, tint: [f32; 3], f0: f32) -> Result<Material, String> {
     let mut parts = spec.split(':');
     let mut e = MaterialEntry {
         kind: parts.next().unwrap_or_default().trim().to_string(),
@@ -107,7 +112,7 @@ pub fn parse_material(spec: &str, tint: [f32; 3], f0: f32) -> Result<Material, S
             }
         }
     }
-    material_of(&e)
+    entry_text(&e)
 }
 
 /// `c` of key `k`, if every channel is finite and non-negative.
@@ -120,8 +125,13 @@ fn colour(k: &str, c: [f32; 3]) -> Result<[f32; 3], String> {
 }
 
 /// The material a scene file's (or a `--material` spec's) entry describes, every value
-/// checked.
-pub fn material_of(e: &MaterialEntry) -> Result<Material, String> {
+/// checked. An entry it cannot take is the request's fault (a scene file's reader makes it
+/// the file's).
+pub fn material_of(e: &MaterialEntry) -> Result<Material, crate::Error> {
+    entry_text(e).map_err(crate::Error::request)
+}
+
+fn entry_text(e: &MaterialEntry) -> Result<Material, String> {
     let tint = colour("tint", e.tint.unwrap_or([1.0; 3]))?;
     let f0 = e.f0.unwrap_or(0.04);
     if !(0.0..=1.0).contains(&f0) {

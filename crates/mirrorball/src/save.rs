@@ -7,7 +7,7 @@ use crate::load::{layer_names, FACE};
 use mirrorball_core::Choice;
 use mirrorball_core::{EnvMap, Image, Layout, Projection, ProjectionKind, Stereo, WorldProjection};
 use mirrorball_filter::MipChain;
-use mirrorball_io::{Format, MapInfo, OutputSet, Precision, WriteOptions};
+use mirrorball_io::{Format, Hint, MapInfo, OutputSet, Precision, WriteOptions};
 use std::path::{Path, PathBuf};
 
 /// What to write.
@@ -370,6 +370,33 @@ pub fn save_eyes(
     out: &str,
     opts: &SaveOptions,
 ) -> Result<Saved, Error> {
+    save_to(eyes, stereo, out, opts, None)
+}
+
+/// The bytes of the file [`save`] writes to `out` (a file name: its extension picks the
+/// container, and messages name it), made by the same encoder, and what their storage
+/// could not hold. One file a layer (`{face}`, `--layout separate`) is several files: refused.
+pub fn to_bytes(env: &EnvMap, out: &str, opts: &SaveOptions) -> Result<(Vec<u8>, Report), Error> {
+    let mut bytes = Vec::new();
+    let saved = save_to(
+        std::slice::from_ref(env),
+        Stereo::Mono,
+        out,
+        opts,
+        Some(&mut bytes),
+    )?;
+    Ok((bytes, saved.report))
+}
+
+/// [`save_eyes`] to the file `out`, or into `memory` (no file is written; [`Saved::files`]
+/// is empty).
+fn save_to(
+    eyes: &[EnvMap],
+    stereo: Stereo,
+    out: &str,
+    opts: &SaveOptions,
+    memory: Option<&mut Vec<u8>>,
+) -> Result<Saved, Error> {
     let env = &eyes[0];
     let path = Path::new(out);
     let format = check(out, env.projection().kind(), opts.layout)?;
@@ -391,11 +418,17 @@ pub fn save_eyes(
             layout: None,
             stereo: Default::default(),
         });
-        mirrorball_io::write_cube(path, &levels, &write)?;
-        return Ok(Saved {
-            files: vec![path.to_path_buf()],
-            report,
-        });
+        let files = match memory {
+            Some(bytes) => {
+                *bytes = mirrorball_io::write_bytes(&levels, Hint::Name(out), &write)?;
+                vec![]
+            }
+            None => {
+                mirrorball_io::write_cube(path, &levels, &write)?;
+                vec![path.to_path_buf()]
+            }
+        };
+        return Ok(Saved { files, report });
     }
     let (eyes, mut report) = fit::measure_maps(eyes, storage, opts.keep_invalid);
     report.part = "eye";
@@ -407,6 +440,11 @@ pub fn save_eyes(
         _ => output_layout(out, n, opts),
     };
     if let Some(paths) = layer_files(out, n, opts) {
+        if memory.is_some() {
+            return Err(Error::request(format!(
+                "{out}: one file a layer is several files; give one picture's layout (hcross, c3x2, …) and no {FACE}"
+            )));
+        }
         // Renamed into place together: a failed or interrupted run leaves the set as it was.
         let mut set = OutputSet::new(&per_layer_write(&opts.write, *env.projection()));
         set.push_all(&paths, env.layers())?;
@@ -421,11 +459,17 @@ pub fn save_eyes(
         stereo,
     });
     let img = pack_eyes(&eyes, stereo, layout).map_err(|e| e.context(out))?;
-    mirrorball_io::write_image(path, &img, &write)?;
-    Ok(Saved {
-        files: vec![path.to_path_buf()],
-        report,
-    })
+    let files = match memory {
+        Some(bytes) => {
+            *bytes = mirrorball_io::write_bytes(&[vec![img]], Hint::Name(out), &write)?;
+            vec![]
+        }
+        None => {
+            mirrorball_io::write_image(path, &img, &write)?;
+            vec![path.to_path_buf()]
+        }
+    };
+    Ok(Saved { files, report })
 }
 
 /// Bytes [`save_eyes`] makes besides the maps it writes (`eyes` maps, each of `layers`

@@ -47,11 +47,22 @@ impl Bound {
 }
 
 /// A size flag's value for clap: any whole number, so that zero and negative sizes reach
-/// the rule and its message (which knows the largest size).
-pub fn parse(s: &str) -> Result<i64, String> {
+/// the rule and its message (which knows the largest size). Text that is no number is the
+/// request's fault.
+pub fn parse(s: &str) -> Result<i64, crate::Error> {
     s.trim()
         .parse::<i64>()
-        .map_err(|_| format!("'{s}' is not a whole number of texels"))
+        .map_err(|_| crate::Error::request(format!("'{s}' is not a whole number of texels")))
+}
+
+/// `--size`'s text, `W` or `WxH` (also `W×H`), as numbers (each checked against the
+/// container's bound in the plan that takes it).
+pub fn parse_extent(s: &str) -> Result<(i64, Option<i64>), crate::Error> {
+    let s = s.trim();
+    match s.split_once(['x', 'X', '×']) {
+        Some((w, h)) => Ok((parse(w)?, Some(parse(h)?))),
+        None => Ok((parse(s)?, None)),
+    }
 }
 
 /// The largest `s` in `1..=hi` for which `fits(s)` holds, `fits` holding up to some size
@@ -149,7 +160,9 @@ mod tests {
             );
         }
         assert_eq!(j.check("--size", 32767).unwrap(), 32767);
-        assert!(parse("12x").unwrap_err().contains("whole number"));
-        assert_eq!(parse("-5"), Ok(-5));
+        let e = parse("12x").unwrap_err();
+        assert!(e.message.contains("whole number"), "{e}");
+        assert_eq!(e.fault, mirrorball_core::Fault::Request);
+        assert_eq!(parse("-5").unwrap(), -5);
     }
 }

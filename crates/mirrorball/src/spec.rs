@@ -7,8 +7,8 @@ pub use mirrorball_core::projection::{parse_dir, ProjectionSpec as ProjSpec};
 use mirrorball_core::{Choice, Layout};
 use mirrorball_io::Precision;
 
-/// Turns a CLI string error into a request error naming the option.
-pub fn bad(option: &str, e: String) -> Error {
+/// Turns an error of a setting into a request error naming the option.
+pub fn bad(option: &str, e: impl std::fmt::Display) -> Error {
     Error::request(format!("{option}: {e}"))
 }
 

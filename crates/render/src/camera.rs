@@ -102,8 +102,12 @@ impl Camera {
         }
     }
 
-    /// Checks that the camera can form an image.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks that the camera can form an image; one that cannot is the request's fault.
+    pub fn validate(&self) -> Result<(), crate::RenderError> {
+        self.problem().map_err(crate::RenderError::request)
+    }
+
+    fn problem(&self) -> Result<(), String> {
         if self.width == 0 || self.height == 0 {
             return Err("the image must be at least 1x1".into());
         }

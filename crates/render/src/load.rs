@@ -115,7 +115,8 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
     if mesh.triangles.is_empty() {
         return Err(MeshError::input(path, "no triangles"));
     }
-    mesh.validate().map_err(|e| MeshError::input(path, e))?;
+    mesh.validate()
+        .map_err(|e| MeshError::input(path, e.to_string()))?;
     check_extent(&mesh).map_err(|e| MeshError::input(path, e))?;
     Ok(mesh)
 }
@@ -220,7 +221,8 @@ fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
                 if let Some(tc) = reader.read_tex_coords(0) {
                     part.uvs = tc.into_f32().map(Vec2::from_array).collect();
                 }
-                part.validate().map_err(|e| MeshError::input(path, e))?;
+                part.validate()
+                    .map_err(|e| MeshError::input(path, e.to_string()))?;
                 out.append(&part.transformed(m));
             }
         }
@@ -277,7 +279,8 @@ fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
                 .map(|p| Vec2::new(p[0], 1.0 - p[1]))
                 .collect();
         }
-        part.validate().map_err(|e| MeshError::input(path, e))?;
+        part.validate()
+            .map_err(|e| MeshError::input(path, e.to_string()))?;
         out.append(&part);
     }
     Ok(out)

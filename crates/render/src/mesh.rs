@@ -218,8 +218,13 @@ impl Mesh {
         self.positions.len()
     }
 
-    /// Checks that every index is in range and every array has one entry per vertex.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks that every index is in range and every array has one entry per vertex; a
+    /// mesh that fails is the input's fault (its data).
+    pub fn validate(&self) -> Result<(), crate::RenderError> {
+        self.problem().map_err(crate::RenderError::input)
+    }
+
+    fn problem(&self) -> Result<(), String> {
         let n = self.positions.len();
         if self.normals.len() != n {
             return Err(format!("{} normals for {n} vertices", self.normals.len()));

@@ -34,7 +34,12 @@ pub struct Camera {
 impl Camera {
     /// From `fov` (vertical, degrees; 45), `aspect` (width / height; 4/3), `forward`
     /// (0,0,-1) and `up` (0,1,0) of the query.
-    pub fn from_query(q: &HashMap<String, String>) -> Result<Camera, String> {
+    /// A value the query cannot give is the request's fault.
+    pub fn from_query(q: &HashMap<String, String>) -> Result<Camera, crate::Error> {
+        Camera::from_query_text(q).map_err(crate::Error::request)
+    }
+
+    fn from_query_text(q: &HashMap<String, String>) -> Result<Camera, String> {
         let num = |k: &str, default: f64| -> Result<f64, String> {
             match q.get(k) {
                 None => Ok(default),
@@ -95,8 +100,12 @@ impl Camera {
 }
 
 /// The edge to measure `p` at: `size` when given (its texels at most [`MAX_TEXELS`]), else
-/// the edge of [`DEFAULT_BUDGET`] texels.
-pub fn size_of(p: &Projection, size: Option<&str>) -> Result<u32, String> {
+/// the edge of [`DEFAULT_BUDGET`] texels. A size it cannot take is the request's fault.
+pub fn size_of(p: &Projection, size: Option<&str>) -> Result<u32, crate::Error> {
+    size_text(p, size).map_err(crate::Error::request)
+}
+
+fn size_text(p: &Projection, size: Option<&str>) -> Result<u32, String> {
     let Some(s) = size else {
         return Ok(size_for_budget(p, DEFAULT_BUDGET));
     };
@@ -200,10 +209,16 @@ mod tests {
             ("up", "0,0,-2", "parallel"),
         ] {
             let e = Camera::from_query(&query(&[(k, v)])).unwrap_err();
-            assert!(e.contains(why), "{k}={v}: {e}");
+            assert!(
+                e.message.contains(why) && e.fault == mirrorball_core::Fault::Request,
+                "{k}={v}: {e}"
+            );
         }
         assert_eq!(size_of(&cube, None).unwrap(), 512);
-        assert!(size_of(&cube, Some("2048")).unwrap_err().contains("over"));
+        assert!(size_of(&cube, Some("2048"))
+            .unwrap_err()
+            .message
+            .contains("over"));
         assert!(size_of(&cube, Some("0")).is_err());
     }
 }

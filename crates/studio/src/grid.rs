@@ -92,12 +92,12 @@ pub const MAX_LOOKUPS: usize = 2 * 4096 * 2160;
 /// `f32` triples; NaN where there is none (a negative or non-finite layer or coordinate,
 /// a layer the map does not have, a point off a disk). The simulator's heat map measures
 /// its angles between these, so that the page holds no inverse of any projection.
-pub fn directions(p: &Projection, body: &[u8]) -> Result<Vec<u8>, String> {
+pub fn directions(p: &Projection, body: &[u8]) -> Result<Vec<u8>, crate::Error> {
     if !body.len().is_multiple_of(12) || body.len() / 12 > MAX_LOOKUPS {
-        return Err(format!(
+        return Err(crate::Error::request(format!(
             "the body must be (u, v, layer) f32 triples, at most {MAX_LOOKUPS}: {} bytes",
             body.len()
-        ));
+        )));
     }
     let mut out = Vec::with_capacity(body.len());
     for t in body.chunks_exact(12) {
@@ -177,6 +177,6 @@ mod tests {
         assert!(got.iter().all(|x| x.is_nan()), "{got:?}");
         // A body that is not whole triples.
         let e = directions(&cube, &[0u8; 13]).unwrap_err();
-        assert!(e.contains("13 bytes"), "{e}");
+        assert!(e.message.contains("13 bytes") && e.status() == 400, "{e}");
     }
 }

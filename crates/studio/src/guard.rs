@@ -14,9 +14,10 @@ use axum::http::{HeaderMap, StatusCode};
 pub const TOKEN_HEADER: &str = "x-mirrorball-token";
 
 /// A fresh token: 128 random bits as 32 hexadecimal digits.
-pub fn new_token() -> Result<String, String> {
+pub fn new_token() -> Result<String, crate::Error> {
     let mut b = [0u8; 16];
-    getrandom::fill(&mut b).map_err(|e| format!("no random numbers for the token: {e}"))?;
+    getrandom::fill(&mut b)
+        .map_err(|e| crate::Error::system(format!("no random numbers for the token: {e}")))?;
     Ok(b.iter().map(|x| format!("{x:02x}")).collect())
 }
 

@@ -20,6 +20,7 @@
 //! messages, and this crate never opens a file by itself.
 
 pub mod analysis;
+pub mod error;
 pub mod geometry;
 pub mod grid;
 pub mod guard;
@@ -29,6 +30,7 @@ pub mod state;
 pub mod texture;
 mod web;
 
+pub use error::Error;
 pub use server::{open_browser, Running, Studio};
 pub use state::{Opened, SceneView};
 
@@ -48,10 +50,11 @@ pub enum Export<'a> {
 pub const EXPORT_FORMATS: [&str; 6] = ["exr", "hdr", "png", "jpg", "ktx2", "dds"];
 
 /// Reads what the studio shows: the files named on the command line and the uploads. Its
-/// errors are the messages a person reads (on the command line, or on the page).
+/// errors are the messages a person reads (on the command line, or on the page), each
+/// with whose fault it is, which the server answers by ([`Error::status`]).
 pub trait Host: Send + Sync + 'static {
     /// Reads the file `path` named on the command line: a scene file or an environment.
-    fn open(&self, path: &Path) -> Result<Opened, String>;
+    fn open(&self, path: &Path) -> Result<Opened, Error>;
     /// Reads an uploaded file called `name` whose contents are `bytes`; `alongside`, the
     /// files uploaded with it (name and contents), are the only files an uploaded scene may
     /// name besides what the host bundles.
@@ -60,19 +63,19 @@ pub trait Host: Send + Sync + 'static {
         name: &str,
         bytes: &[u8],
         alongside: &[(String, Vec<u8>)],
-    ) -> Result<Opened, String>;
+    ) -> Result<Opened, Error>;
     /// The scene shown before any scene is opened (an environment alone is shown on it).
     fn default_scene(&self) -> SceneView;
     /// `what` written as a file of container `format` (one of [`EXPORT_FORMATS`]), as the
     /// embedding program writes its own outputs: the file's bytes, or why it cannot be.
-    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String>;
+    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, Error>;
     /// The meshes the embedding program bundles, which the page offers beside the
     /// built-ins (none unless it says).
     fn bundled_meshes(&self) -> &'static [&'static str] {
         &[]
     }
     /// The bundled mesh `name` (one of [`Host::bundled_meshes`]).
-    fn bundled_mesh(&self, name: &str) -> Result<mirrorball_render::Mesh, String> {
-        Err(format!("no bundled mesh {name}"))
+    fn bundled_mesh(&self, name: &str) -> Result<mirrorball_render::Mesh, Error> {
+        Err(Error::request(format!("no bundled mesh {name}")))
     }
 }

@@ -19,7 +19,7 @@
 
 use crate::guard::Guard;
 use crate::state::{gpu_kind, ObjectChoice, State};
-use crate::{geometry, grid, lighting, texture, web, Export, Host, EXPORT_FORMATS};
+use crate::{geometry, grid, lighting, texture, web, Error, Export, Host, EXPORT_FORMATS};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State as Shared};
@@ -65,15 +65,15 @@ pub struct Running {
     pub port: u16,
     pub token: String,
     stop: Option<tokio::sync::oneshot::Sender<()>>,
-    thread: Option<std::thread::JoinHandle<Result<(), String>>>,
+    thread: Option<std::thread::JoinHandle<Result<(), Error>>>,
 }
 
 impl Running {
     /// Serves until the process ends (or the server fails).
-    pub fn wait(mut self) -> Result<(), String> {
+    pub fn wait(mut self) -> Result<(), Error> {
         match self.thread.take().map(|t| t.join()) {
             Some(Ok(r)) => r,
-            Some(Err(_)) => Err("the server thread panicked".into()),
+            Some(Err(_)) => Err(Error::system("the server thread panicked")),
             None => Ok(()),
         }
     }
@@ -122,16 +122,22 @@ impl Studio {
     /// Reads `files` (a scene and/or an environment, in order) through `host`, binds the
     /// port and serves in a thread of its own. A file that cannot be read, or a port that
     /// cannot be bound, is an error before anything is served.
-    pub fn start(&self, host: Arc<dyn Host>, files: &[PathBuf]) -> Result<Running, String> {
+    pub fn start(&self, host: Arc<dyn Host>, files: &[PathBuf]) -> Result<Running, Error> {
         let mut state = State::new(host.default_scene());
         state.bundled = host.bundled_meshes();
         for f in files {
             state.apply(host.open(f)?);
         }
+        let listen = format!("cannot listen on 127.0.0.1:{}", self.port);
         let listener = std::net::TcpListener::bind(("127.0.0.1", self.port))
-            .map_err(|e| format!("cannot listen on 127.0.0.1:{}: {e}", self.port))?;
-        let port = listener.local_addr().map_err(|e| e.to_string())?.port();
-        listener.set_nonblocking(true).map_err(|e| e.to_string())?;
+            .map_err(|e| Error::io(&listen, &e))?;
+        let port = listener
+            .local_addr()
+            .map_err(|e| Error::io(&listen, &e))?
+            .port();
+        listener
+            .set_nonblocking(true)
+            .map_err(|e| Error::io(&listen, &e))?;
         let token = crate::guard::new_token()?;
         let url = format!("http://127.0.0.1:{port}/?token={token}");
         let app = Arc::new(App {
@@ -151,7 +157,7 @@ impl Studio {
         let thread = std::thread::Builder::new()
             .name("studio".into())
             .spawn(move || serve(app, listener, stopped))
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| Error::io("cannot start the server thread", &e))?;
         Ok(Running {
             url,
             port,
@@ -167,14 +173,16 @@ fn serve(
     app: AppState,
     listener: std::net::TcpListener,
     stopped: tokio::sync::oneshot::Receiver<()>,
-) -> Result<(), String> {
+) -> Result<(), Error> {
+    let serving = "cannot serve";
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_io()
         .build()
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| Error::io(serving, &e))?;
     rt.block_on(async move {
-        let listener = tokio::net::TcpListener::from_std(listener).map_err(|e| e.to_string())?;
+        let listener =
+            tokio::net::TcpListener::from_std(listener).map_err(|e| Error::io(serving, &e))?;
         let limit = app.options.upload_limit;
         let router = Router::new()
             .route("/", get(index))
@@ -203,7 +211,7 @@ fn serve(
                 let _ = stopped.await;
             })
             .await
-            .map_err(|e| e.to_string())
+            .map_err(|e| Error::io(serving, &e))
     })
 }
 
@@ -493,7 +501,7 @@ async fn export(Shared(app): Shared<AppState>, Query(q): Query<ExportQuery>) -> 
                     convert(&app, &map, &projection, q.size)?
                 };
                 host.export(Export::Map(&map), &format)
-                    .map_err(|e| (StatusCode::UNPROCESSABLE_ENTITY, e))
+                    .map_err(|e| (e.status(), e.message))
             });
             (name, work)
         }
@@ -517,7 +525,7 @@ async fn export(Shared(app): Shared<AppState>, Query(q): Query<ExportQuery>) -> 
             let host = app.host.clone();
             let work = tokio::task::spawn_blocking(move || {
                 host.export(Export::Chain(&l.chain), &format)
-                    .map_err(|e| (StatusCode::UNPROCESSABLE_ENTITY, e))
+                    .map_err(|e| (e.status(), e.message))
             });
             (name, work)
         }
@@ -649,11 +657,11 @@ async fn analysis_of(
     };
     let camera = match crate::analysis::Camera::from_query(&q) {
         Ok(c) => c,
-        Err(e) => return bad(StatusCode::BAD_REQUEST, e),
+        Err(e) => return bad(e.status(), e.message),
     };
     let size = match crate::analysis::size_of(&p, q.get("size").map(String::as_str)) {
         Ok(n) => n,
-        Err(e) => return bad(StatusCode::BAD_REQUEST, e),
+        Err(e) => return bad(e.status(), e.message),
     };
     match tokio::task::spawn_blocking(move || crate::analysis::encode(&p, size, &camera)).await {
         Ok(j) => Json(j).into_response(),
@@ -680,7 +688,7 @@ async fn directions_of(
     };
     match tokio::task::spawn_blocking(move || grid::directions(&p, &body)).await {
         Ok(Ok(b)) => binary(b),
-        Ok(Err(m)) => bad(StatusCode::BAD_REQUEST, m),
+        Ok(Err(e)) => bad(e.status(), e.message),
         Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
     }
 }
@@ -738,9 +746,9 @@ async fn upload(
             s.apply(opened);
             Json(s.describe()).into_response()
         }
-        Ok((_, Err(message))) => {
-            s.error(message.clone());
-            bad(StatusCode::UNPROCESSABLE_ENTITY, message)
+        Ok((_, Err(e))) => {
+            s.error(e.message.clone());
+            bad(e.status(), e.message)
         }
         Err(e) => bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
     }
@@ -786,7 +794,7 @@ async fn object(Shared(app): Shared<AppState>, Query(q): Query<ObjectQuery>) -> 
                 name,
                 mesh: std::sync::Arc::new(mesh),
             },
-            Ok((_, Err(m))) => return bad(StatusCode::INTERNAL_SERVER_ERROR, m),
+            Ok((_, Err(e))) => return bad(e.status(), e.message),
             Err(e) => return bad(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()),
         }
     } else {

@@ -44,7 +44,8 @@ pub(crate) fn request(a: &ConvertArgs) -> Result<ConvertRequest, CliError> {
         to: (!a.to.is_empty())
             .then(|| ProjSpec::parse(&a.to).map_err(|e| bad("--to", e)))
             .transpose()?,
-        size: a.size,
+        size: a.size.map(|s| s.0),
+        height: a.size.and_then(|s| s.1),
         layout: crate::commands::parse_layout("--layout", a.layout.as_deref())?,
         in_stereo: parse("--in-stereo", &a.in_stereo)?,
         stereo: parse("--stereo", &a.stereo)?,

@@ -10,7 +10,7 @@ use clap::Args;
 use mirrorball::prefilter::outputs;
 use mirrorball::render::RenderRequest;
 use mirrorball_io::WriteOptions;
-use mirrorball_studio::{Export, Host, Opened, SceneView, Studio};
+use mirrorball_studio::{Error as StudioError, Export, Host, Opened, SceneView, Studio};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -47,7 +47,7 @@ pub fn run(a: StudioArgs) -> Result<(), CliError> {
     };
     let running = studio
         .start(Arc::new(CliHost), &ordered)
-        .map_err(CliError::input)?;
+        .map_err(|e| CliError::new(e.fault, e.message))?;
     let mut out = std::io::stdout();
     let _ = writeln!(out, "{}", running.url);
     let _ = out.flush();
@@ -58,7 +58,25 @@ pub fn run(a: StudioArgs) -> Result<(), CliError> {
     if !a.no_open {
         mirrorball_studio::open_browser(&running.url);
     }
-    running.wait().map_err(CliError::system)
+    running
+        .wait()
+        .map_err(|e| CliError::new(e.fault, e.message))
+}
+
+/// The library's error as the studio's: whose fault it is and the I/O error's kind kept,
+/// so the page is answered by cause.
+fn as_studio(e: CliError) -> StudioError {
+    let kind = e.io_kind();
+    StudioError::new(e.fault, e.message).with_io_kind(kind)
+}
+
+/// [`as_studio`], `shown` (a path of this process's own) called `name` in the message.
+fn studio_error(e: CliError, shown: &str, name: &str) -> StudioError {
+    let message = e.message.replace(shown, name);
+    StudioError {
+        message,
+        ..as_studio(e)
+    }
 }
 
 fn is_scene(p: &Path) -> bool {
@@ -109,13 +127,13 @@ fn scene_view(scene: Option<&Path>) -> Result<SceneView, CliError> {
 /// A new folder of this process's own under the system's temporary folder, named for
 /// `purpose` and a fresh token (so that no other process can have made it): the caller
 /// removes it.
-fn private_dir(purpose: &str) -> Result<PathBuf, String> {
+fn private_dir(purpose: &str) -> Result<PathBuf, StudioError> {
     let dir = std::env::temp_dir().join(format!(
         "mirrorball-studio-{purpose}-{}-{}",
         std::process::id(),
         mirrorball_studio::guard::new_token()?
     ));
-    std::fs::create_dir(&dir).map_err(|e| e.to_string())?;
+    std::fs::create_dir(&dir).map_err(|e| StudioError::io("cannot make a private folder", &e))?;
     Ok(dir)
 }
 
@@ -124,22 +142,34 @@ struct CliHost;
 
 impl CliHost {
     /// The environment map at `path`, called `name` in messages.
-    fn environment(path: &Path, name: &str) -> Result<Opened, String> {
+    fn environment(path: &Path, name: &str) -> Result<Opened, StudioError> {
         let shown = path.display().to_string();
         let src = load::load(&shown, None, None, &mirrorball_io::Limits::default())
-            .map_err(|e| e.to_string().replace(&shown, name))?;
+            .map_err(|e| studio_error(e, &shown, name))?;
+        Ok(CliHost::shown_environment(src, name))
+    }
+
+    /// The environment map uploaded as `name`, read from its bytes as `load` reads a file.
+    fn uploaded_environment(name: &str, bytes: &[u8]) -> Result<Opened, StudioError> {
+        let src = load::from_bytes(name, bytes, None, None, &mirrorball_io::Limits::default())
+            .map_err(|e| studio_error(e, name, name))?;
+        Ok(CliHost::shown_environment(src, name))
+    }
+
+    fn shown_environment(src: load::Source, name: &str) -> Opened {
         let mut map = src.env;
         map.sanitize();
-        Ok(Opened::Environment {
+        Opened::Environment {
             name: name.to_string(),
             map: Box::new(map),
-        })
+        }
     }
 
     /// The mesh file at `path`, called `name` in messages (as `render` reads mesh files).
-    fn mesh(path: &Path, name: &str) -> Result<mirrorball_render::Mesh, String> {
+    fn mesh(path: &Path, name: &str) -> Result<mirrorball_render::Mesh, StudioError> {
         let shown = path.display().to_string();
-        mirrorball_render::load_mesh(path).map_err(|e| e.to_string().replace(&shown, name))
+        mirrorball_render::load_mesh(path)
+            .map_err(|e| studio_error(CliError::from(e), &shown, name))
     }
 
     /// `read` of `bytes` stored as a file with extension `ext` in a folder of its own,
@@ -148,17 +178,21 @@ impl CliHost {
         name: &str,
         ext: &str,
         bytes: &[u8],
-        read: impl FnOnce(&Path) -> Result<T, String>,
-    ) -> Result<T, String> {
-        let dir =
-            private_dir("upload").map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
+        read: impl FnOnce(&Path) -> Result<T, StudioError>,
+    ) -> Result<T, StudioError> {
+        let dir = private_dir("upload").map_err(|e| cannot_store(name, e))?;
         let path = dir.join(format!("upload.{ext}"));
         let result = std::fs::write(&path, bytes)
-            .map_err(|e| format!("{name}: cannot store the upload: {e}"))
+            .map_err(|e| StudioError::io(format!("{name}: cannot store the upload"), &e))
             .and_then(|()| read(&path));
         let _ = std::fs::remove_dir_all(&dir);
         result
     }
+}
+
+/// `e`, a failure to store `name`'s upload.
+fn cannot_store(name: &str, e: StudioError) -> StudioError {
+    e.context(format!("{name}: cannot store the upload"))
 }
 
 impl CliHost {
@@ -173,9 +207,8 @@ impl CliHost {
         ext: &str,
         bytes: &[u8],
         alongside: &[(String, Vec<u8>)],
-    ) -> Result<Opened, String> {
-        let dir =
-            private_dir("scene").map_err(|e| format!("{name}: cannot store the upload: {e}"))?;
+    ) -> Result<Opened, StudioError> {
+        let dir = private_dir("scene").map_err(|e| cannot_store(name, e))?;
         let result = CliHost::scene_in(&dir, name, ext, bytes, alongside);
         let _ = std::fs::remove_dir_all(&dir);
         result
@@ -188,33 +221,34 @@ impl CliHost {
         ext: &str,
         bytes: &[u8],
         alongside: &[(String, Vec<u8>)],
-    ) -> Result<Opened, String> {
-        let stored = |e: std::io::Error| format!("{name}: cannot store the upload: {e}");
+    ) -> Result<Opened, StudioError> {
+        let stored =
+            |e: std::io::Error| StudioError::io(format!("{name}: cannot store the upload"), &e);
         // Checked as render reads it, with its messages, in the upload's name.
         let written = dir.join(format!("scene.{ext}"));
         std::fs::write(&written, bytes).map_err(stored)?;
         let shown = written.display().to_string();
         let as_written = mirrorball::render::schema::as_written(&written)
-            .map_err(|e| e.to_string().replace(&shown, name))?;
+            .map_err(|e| studio_error(e, &shown, name))?;
         let files = dir.join("files");
         std::fs::create_dir(&files).map_err(stored)?;
         // What each file the scene names became, to name it as the scene does in messages.
         let mut renamed: Vec<(String, String)> = Vec::new();
         let mut resolved = as_written.clone();
-        mirrorball::render::schema::map_files(&mut resolved, |f| -> Result<String, String> {
+        mirrorball::render::schema::map_files(&mut resolved, |f| -> Result<String, StudioError> {
             let file_name = Path::new(f).file_name().and_then(|n| n.to_str());
             let bytes: &[u8] = match alongside.iter().find(|(n, _)| Some(n.as_str()) == file_name) {
                 Some((_, b)) => b,
                 None if f.replace('\\', "/").ends_with(BUNNY_PATH) => BUNNY,
                 None => {
-                    return Err(format!(
+                    return Err(StudioError::request(format!(
                         "{name}: names the file {f}, which the studio may not read: a scene opened on \
                          the page may name only the built-in objects ({}), the bundled {BUNNY_PATH} \
                          and files picked or dropped together with it (pick or drop {} with the scene, \
                          or open the scene from the command line: mirrorball studio SCENE)",
                         mirrorball_render::Builtin::ALL.map(|b| b.name()).join(", "),
                         file_name.unwrap_or(f),
-                    ))
+                    )))
                 }
             };
             // Each file in a folder of its own, under its own name (its extension says
@@ -228,17 +262,18 @@ impl CliHost {
             Ok(path)
         })?;
         let scene = dir.join("scene-resolved.json");
-        let text = serde_json::to_string(&resolved).map_err(|e| e.to_string())?;
+        let text = serde_json::to_string(&resolved)
+            .map_err(|e| StudioError::system(format!("{name}: {e}")))?;
         std::fs::write(&scene, text).map_err(stored)?;
         let shown_resolved = scene.display().to_string();
-        let named = |message: String| {
-            let mut m = message.replace(&shown_resolved, name);
+        let named = |e: CliError| {
+            let mut m = e.message.replace(&shown_resolved, name);
             for (path, f) in &renamed {
                 m = m.replace(path, f);
             }
-            m
+            StudioError::new(e.fault, m).with_io_kind(e.io_kind())
         };
-        let mut view = scene_view(Some(&scene)).map_err(|e| named(e.to_string()))?;
+        let mut view = scene_view(Some(&scene)).map_err(named)?;
         view.name = name.to_string();
         view.source = Some(as_written);
         Ok(Opened::Scene(Box::new(view)))
@@ -262,9 +297,9 @@ fn is_mesh(p: &Path) -> bool {
 }
 
 impl Host for CliHost {
-    fn open(&self, path: &Path) -> Result<Opened, String> {
+    fn open(&self, path: &Path) -> Result<Opened, StudioError> {
         if is_scene(path) {
-            let v = scene_view(Some(path)).map_err(|e| e.to_string())?;
+            let v = scene_view(Some(path)).map_err(as_studio)?;
             return Ok(Opened::Scene(Box::new(v)));
         }
         if is_mesh(path) {
@@ -282,8 +317,8 @@ impl Host for CliHost {
         name: &str,
         bytes: &[u8],
         alongside: &[(String, Vec<u8>)],
-    ) -> Result<Opened, String> {
-        // Only the name's extension is used: the file is written to a folder of its own.
+    ) -> Result<Opened, StudioError> {
+        // Only the name's extension is used where a file is written to a folder of its own.
         let ext = Path::new(name)
             .extension()
             .and_then(|e| e.to_str())
@@ -301,17 +336,17 @@ impl Host for CliHost {
                 })
             });
         }
-        CliHost::stored(name, ext, bytes, |path| CliHost::environment(path, name))
+        CliHost::uploaded_environment(name, bytes)
     }
 
     fn bundled_meshes(&self) -> &'static [&'static str] {
         &["bunny"]
     }
 
-    fn bundled_mesh(&self, name: &str) -> Result<mirrorball_render::Mesh, String> {
+    fn bundled_mesh(&self, name: &str) -> Result<mirrorball_render::Mesh, StudioError> {
         match name {
             "bunny" => CliHost::stored(name, "obj", BUNNY, |path| CliHost::mesh(path, name)),
-            _ => Err(format!("no bundled mesh {name}")),
+            _ => Err(StudioError::request(format!("no bundled mesh {name}"))),
         }
     }
 
@@ -319,40 +354,83 @@ impl Host for CliHost {
         scene_view(None).expect("render's defaults make a scene")
     }
 
-    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String> {
-        // Written as `convert` and `prefilter` write their outputs, into a folder of its own,
-        // then read back for the page and the folder removed.
-        let dir = private_dir("export").map_err(|e| format!("cannot write the export: {e}"))?;
-        let path = dir.join(format!("export.{format}"));
-        let shown = path.display().to_string();
-        let written = match what {
-            Export::Map(map) => save::save(
-                map,
-                &shown,
-                &SaveOptions {
+    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, StudioError> {
+        // Made in memory as `convert` and `prefilter` make their outputs.
+        let file = format!("export.{format}");
+        let (bytes, report) = match what {
+            Export::Map(map) => {
+                let opts = SaveOptions {
                     layout: None,
                     write: WriteOptions::default(),
                     mips: false,
                     keep_invalid: false,
-                },
-            )
-            .map(|saved| saved.report),
+                };
+                save::to_bytes(map, &file, &opts).map_err(as_studio)?
+            }
             Export::Chain(chain) => {
-                outputs::write_cube_chain(&path, chain, &WriteOptions::default(), false)
+                outputs::cube_chain_bytes(&file, chain, &WriteOptions::default(), false)
+                    .map_err(as_studio)?
             }
         };
         // Said on the server's terminal: the page downloads the file as it is.
-        let written = written.map(|report| {
-            if let Some(line) = report.line(&format!("export.{format}"), &[]) {
-                eprintln!("{line}");
+        if let Some(line) = report.line(&file, &[]) {
+            eprintln!("{line}");
+        }
+        Ok(bytes)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mirrorball::core::{EnvMap, Image, ProjectionKind};
+    use mirrorball_core::Fault;
+
+    fn exr() -> Vec<u8> {
+        let p = ProjectionKind::LatLong.default_projection();
+        let env = EnvMap::new(p, vec![Image::new(16, 8, 3)]).unwrap();
+        let opts = SaveOptions {
+            layout: None,
+            write: WriteOptions::default(),
+            mips: false,
+            keep_invalid: false,
+        };
+        save::to_bytes(&env, "sky.exr", &opts).unwrap().0
+    }
+
+    #[test]
+    fn uploads_are_read_from_memory_and_refused_by_cause() {
+        let bytes = exr();
+        match CliHost.upload("sky.exr", &bytes, &[]) {
+            Ok(Opened::Environment { name, map }) => {
+                assert_eq!(name, "sky.exr");
+                assert_eq!((map.width(), map.height()), (16, 8));
             }
-        });
-        let result = written
-            .map_err(|e| e.to_string().replace(&shown, &format!("export.{format}")))
-            .and_then(|()| {
-                std::fs::read(&path).map_err(|e| format!("cannot read the export back: {e}"))
-            });
-        let _ = std::fs::remove_dir_all(&dir);
-        result
+            Ok(_) => panic!("not an environment"),
+            Err(e) => panic!("{e}"),
+        }
+        let e = CliHost.upload("cut.exr", &bytes[..60], &[]).err().unwrap();
+        assert_eq!((e.fault, e.status().as_u16()), (Fault::Input, 422), "{e}");
+        assert!(e.message.starts_with("cut.exr"), "{e}");
+        let e = CliHost.upload("notes.txt", b"hello", &[]).err().unwrap();
+        assert_eq!(e.status(), 400, "{e}");
+    }
+
+    #[test]
+    fn exports_are_made_in_memory() {
+        let p = ProjectionKind::Cube.default_projection();
+        let cube = EnvMap::new(p, (0..6).map(|_| Image::new(8, 8, 3)).collect()).unwrap();
+        let bytes = CliHost.export(Export::Map(&cube), "ktx2").unwrap();
+        assert_eq!(&bytes[1..7], b"KTX 20");
+        let half = EnvMap::new(p, (0..6).map(|_| Image::new(4, 4, 3)).collect()).unwrap();
+        let bytes = CliHost
+            .export(Export::Chain(&[cube.clone(), half]), "dds")
+            .unwrap();
+        assert_eq!(&bytes[..4], b"DDS ");
+        // A lat-long is no cube: the request's fault.
+        let ll = ProjectionKind::LatLong.default_projection();
+        let flat = EnvMap::new(ll, vec![Image::new(16, 8, 3)]).unwrap();
+        let e = CliHost.export(Export::Map(&flat), "dds").unwrap_err();
+        assert_eq!(e.status(), 400, "{e}");
     }
 }

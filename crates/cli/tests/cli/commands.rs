@@ -484,3 +484,72 @@ fn outside_the_circle_is_black_or_the_rim() {
     );
     assert!(!out.exists());
 }
+
+/// `--size WxH` (v360's `w` and `h`): a flat view of exactly that size, its vfov from the
+/// height (square pixels: the corners' directions agree with the fields of view); a
+/// projection whose height the width fixes takes its own height only; the vfov and a height
+/// together, a height without --to, and a half-given size are refused before any work.
+#[test]
+fn size_takes_a_width_and_height() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = asset("venice.exr");
+    let out = dir.path().join("view.exr");
+    let convert = |to: &str, size: &str| {
+        run(&[
+            "convert",
+            src.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--to",
+            to,
+            "--size",
+            size,
+            "--quiet",
+        ])
+    };
+    for (to, size, want) in [
+        ("flat", "1280x720", (1280, 720)),
+        ("flat:hfov=100", "1280x739", (1280, 739)),
+        ("cube", "32x32", (32, 32)),
+        ("latlong", "64x32", (64, 32)),
+    ] {
+        let o = convert(to, size);
+        assert!(o.status.success(), "{to} {size}: {}", stderr(&o));
+        let map = mirrorball_io::read(&out, &Default::default()).unwrap();
+        let img = &map.layers[0];
+        let got = if to == "cube" {
+            (img.width() / 4, img.height() / 3)
+        } else {
+            (img.width(), img.height())
+        };
+        assert_eq!(got, want, "{to} {size}");
+        std::fs::remove_file(&out).unwrap();
+    }
+    // Square pixels: the view's vertical field of view is the one whose tangent is the
+    // horizontal one's scaled by the aspect.
+    let spec = mirrorball_core::projection::ProjectionSpec::parse("flat")
+        .unwrap()
+        .with_height(1280, 720)
+        .unwrap();
+    let view = spec.build(None).unwrap();
+    use mirrorball_core::WorldProjection;
+    let top = view
+        .uv_to_dir(0, mirrorball_core::glam::DVec2::new(0.5, 0.0))
+        .unwrap();
+    let right = view
+        .uv_to_dir(0, mirrorball_core::glam::DVec2::new(1.0, 0.5))
+        .unwrap();
+    let (tv, th) = (top.y / -top.z, right.x / -right.z);
+    assert!((tv / th - 720.0 / 1280.0).abs() < 1e-9, "{tv} {th}");
+    for (to, size, says) in [
+        ("flat:vfov=60", "1280x720", "not both"),
+        ("latlong", "64x40", "64x32"),
+        ("cube", "32x16", "32x32"),
+        ("flat", "1280x", "whole number"),
+        ("flat", "0x720", "positive"),
+    ] {
+        let o = convert(to, size);
+        assert!(!o.status.success(), "{to} {size}");
+        assert!(stderr(&o).contains(says), "{to} {size}: {}", stderr(&o));
+        assert!(!out.exists());
+    }
+}

@@ -351,7 +351,16 @@ impl DualFisheye {
     /// a radius that is not positive, a circle wholly outside the picture (its centre more
     /// than a radius away from it), circles that overlap in the picture, non-finite values,
     /// and polynomial coefficients that make `θ_d` stop increasing within the field of view.
-    pub fn new(rig: Frame, front: FisheyeLens, back: FisheyeLens) -> Result<DualFisheye, String> {
+    /// What it refuses is the request's fault.
+    pub fn new(
+        rig: Frame,
+        front: FisheyeLens,
+        back: FisheyeLens,
+    ) -> Result<DualFisheye, crate::Error> {
+        DualFisheye::checked(rig, front, back).map_err(crate::Error::request)
+    }
+
+    fn checked(rig: Frame, front: FisheyeLens, back: FisheyeLens) -> Result<DualFisheye, String> {
         let lenses = [front, back];
         let frames = [rig, rig.turned_around()];
         let mut optics = Vec::with_capacity(2);
@@ -379,7 +388,11 @@ impl DualFisheye {
 
     /// One lens's disk, looking along `frame` before its roll; or what is wrong with it.
     fn optic(lens: &FisheyeLens, frame: Frame) -> Result<Optic, String> {
-        let fov = lens.model.fov_range().check("fov", lens.fov_deg)?;
+        let fov = lens
+            .model
+            .fov_range()
+            .check("fov", lens.fov_deg)
+            .map_err(|e| e.message)?;
         let (c, r) = (lens.centre, lens.radius);
         if !(c.x.is_finite() && c.y.is_finite() && lens.roll_deg.is_finite()) {
             return Err(format!(
@@ -1123,8 +1136,11 @@ mod tests {
 
     #[test]
     fn bad_lenses_are_refused_with_the_reason() {
-        let try_front =
-            |l: FisheyeLens| DualFisheye::new(Frame::default(), l, FisheyeLens::BACK).unwrap_err();
+        let try_front = |l: FisheyeLens| {
+            DualFisheye::new(Frame::default(), l, FisheyeLens::BACK)
+                .unwrap_err()
+                .message
+        };
         let f = FisheyeLens::FRONT;
         let e = try_front(FisheyeLens {
             fov_deg: 400.0,

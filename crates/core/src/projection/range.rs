@@ -12,7 +12,7 @@ use std::fmt;
 /// assert!(fov.contains(360.0) && !fov.contains(0.0) && !fov.contains(f64::NAN));
 /// assert_eq!(fov.to_string(), "(0°, 360°]");
 /// assert_eq!(
-///     fov.check("fov", -90.0).unwrap_err(),
+///     fov.check("fov", -90.0).unwrap_err().message,
 ///     "fov must be in (0°, 360°]; fov=-90 was given"
 /// );
 /// ```
@@ -82,12 +82,14 @@ impl Range {
         lo && hi
     }
     /// `v` if the interval holds it, else the message: `KEY must be in (0°, 360°]; KEY=V was
-    /// given`.
-    pub fn check(&self, key: &str, v: f64) -> Result<f64, String> {
+    /// given`, the request's fault.
+    pub fn check(&self, key: &str, v: f64) -> Result<f64, crate::Error> {
         if self.contains(v) {
             Ok(v)
         } else {
-            Err(format!("{key} must be in {self}; {key}={v} was given"))
+            Err(crate::Error::request(format!(
+                "{key} must be in {self}; {key}={v} was given"
+            )))
         }
     }
 }
@@ -134,7 +136,7 @@ mod tests {
         assert_eq!(r.to_string(), "(0°, 180°)");
         assert_eq!(r.check("vfov", 45.0), Ok(45.0));
         assert_eq!(
-            r.check("vfov", 180.0).unwrap_err(),
+            r.check("vfov", 180.0).unwrap_err().message,
             "vfov must be in (0°, 180°); vfov=180 was given"
         );
     }

@@ -31,7 +31,7 @@ use super::{
     Lens, LensModel, Mercator, Projection, ProjectionKind, Range, SphereMap, UnknownProjection,
     View,
 };
-use crate::Choice;
+use crate::{Choice, Error};
 use glam::DVec3;
 use std::fmt;
 
@@ -118,8 +118,13 @@ fn parse_lens(v: &str) -> Result<Lens, String> {
     Lens::parse_name(v).map_err(|e| format!("unknown lens '{v}' (known: {})", e.list()))
 }
 
-/// Parses a direction: `+x`, `-y`, `z`, or three numbers `x,y,z`.
-pub fn parse_dir(s: &str) -> Result<DVec3, String> {
+/// Parses a direction: `+x`, `-y`, `z`, or three numbers `x,y,z`. Text that is none is
+/// the request's fault.
+pub fn parse_dir(s: &str) -> Result<DVec3, Error> {
+    dir_text(s).map_err(Error::request)
+}
+
+fn dir_text(s: &str) -> Result<DVec3, String> {
     let t = s.trim().to_ascii_lowercase();
     let axis = match t.as_str() {
         "+x" | "x" => Some(DVec3::X),
@@ -150,8 +155,12 @@ pub fn parse_dir(s: &str) -> Result<DVec3, String> {
 
 impl ProjectionSpec {
     /// Parses `NAME[:key=value…]`, checking that each key applies to the kind and that the
-    /// values make a projection.
-    pub fn parse(s: &str) -> Result<ProjectionSpec, String> {
+    /// values make a projection. Text that does not is the request's fault.
+    pub fn parse(s: &str) -> Result<ProjectionSpec, Error> {
+        ProjectionSpec::parse_text(s).map_err(Error::request)
+    }
+
+    fn parse_text(s: &str) -> Result<ProjectionSpec, String> {
         let mut parts = s.split(':');
         let name = parts.next().unwrap_or_default();
         let kind: ProjectionKind = name.parse().map_err(|e: UnknownProjection| e.to_string())?;
@@ -167,8 +176,8 @@ impl ProjectionSpec {
                     .ok_or_else(|| format!("'{v}' is not a number (in '{s}')"))
             };
             match k.trim() {
-                "look" | "dir" | "view" => spec.look = Some(parse_dir(v)?),
-                "up" => spec.up = Some(parse_dir(v)?),
+                "look" | "dir" | "view" => spec.look = Some(dir_text(v)?),
+                "up" => spec.up = Some(dir_text(v)?),
                 "fov" => spec.fov = Some(num(v)?),
                 "lens" => spec.lens = Some(parse_lens(v)?),
                 "k" => spec.k = Some(parse_k("k", v)?),
@@ -242,7 +251,7 @@ impl ProjectionSpec {
         if spec.aim.iter().any(Option::is_some) {
             applies(view, "yaw/pitch/roll")?;
         }
-        spec.build(None)?; // validate values now, before any work
+        spec.build_text(None)?; // validate values now, before any work
         Ok(spec)
     }
 
@@ -383,10 +392,41 @@ impl ProjectionSpec {
         })
     }
 
+    /// This spec with the output `w`×`h` texels (`--size WxH`, as `v360`'s `w` and `h`): a
+    /// perspective view's vertical field of view set so that its height at width `w` is
+    /// `h` with square pixels; any other projection kept, as long as `w` gives it `h`.
+    /// Refused (a request fault) where a view's `vfov` is given too, or another
+    /// projection's height at width `w` is not `h`.
+    pub fn with_height(&self, w: u32, h: u32) -> Result<ProjectionSpec, Error> {
+        let mut spec = self.clone();
+        if self.kind == ProjectionKind::Perspective {
+            if self.vfov.is_some() {
+                return Err(Error::request(format!(
+                    "--size {w}x{h}: the view's height follows its vfov; give a height or vfov, not both"
+                )));
+            }
+            let hfov = self.hfov.unwrap_or(90.0).to_radians();
+            let vfov = 2.0 * ((hfov / 2.0).tan() * h as f64 / w as f64).atan();
+            spec.vfov = Some(vfov.to_degrees());
+        }
+        let (ew, eh) = super::WorldProjection::layer_extent(&spec.build(None)?, w);
+        if (ew, eh) != (w, h) {
+            return Err(Error::request(format!(
+                "--size {w}x{h}: a {} of width {w} is {ew}x{eh} (a height is taken by flat views, which set their vfov from it; give --size {w} for others)",
+                self.kind
+            )));
+        }
+        Ok(spec)
+    }
+
     /// The projection. For Mercator without `max-lat`, `extent` (an input picture's size)
     /// fixes the limit from the aspect ratio. Each number given is checked against its
-    /// interval first ([`ProjectionSpec::ranges`]).
-    pub fn build(&self, extent: Option<(u32, u32)>) -> Result<Projection, String> {
+    /// interval first ([`ProjectionSpec::ranges`]); a value outside is the request's fault.
+    pub fn build(&self, extent: Option<(u32, u32)>) -> Result<Projection, Error> {
+        self.build_text(extent).map_err(Error::request)
+    }
+
+    fn build_text(&self, extent: Option<(u32, u32)>) -> Result<Projection, String> {
         for b in self.ranges() {
             if let Some(v) = b.given {
                 b.range
@@ -646,6 +686,7 @@ mod tests {
         assert!(ProjectionSpec::parse("fisheye:fov=400:lens=stereographic").is_err());
         assert!(ProjectionSpec::parse("cube:fov=90")
             .unwrap_err()
+            .message
             .contains("does not apply"));
         assert!(ProjectionSpec::parse("sphere:look=0,0,0").is_err());
         assert!(ProjectionSpec::parse("sphere:look=+y:up=0,2,0").is_err());
@@ -657,14 +698,20 @@ mod tests {
         assert!(ProjectionSpec::parse("cea:vfov=180").is_ok());
         assert!(ProjectionSpec::parse("hammer:hfov=90")
             .unwrap_err()
+            .message
             .contains("does not apply"));
         assert!(ProjectionSpec::parse("cylindrical:yaw=10")
             .unwrap_err()
+            .message
             .contains("does not apply"));
         assert!(ProjectionSpec::parse("perspective:d=1")
             .unwrap_err()
+            .message
             .contains("does not apply"));
-        assert!(ProjectionSpec::parse("nope").unwrap_err().contains("known"));
+        assert!(ProjectionSpec::parse("nope")
+            .unwrap_err()
+            .message
+            .contains("known"));
     }
 
     /// The largest difference in direction between two projections over a grid of texture
@@ -814,7 +861,7 @@ mod tests {
             ),
             ("fisheye:k=0.1", "does not apply"),
         ] {
-            let e = ProjectionSpec::parse(bad).unwrap_err();
+            let e = ProjectionSpec::parse(bad).unwrap_err().message;
             assert!(e.contains(says), "{bad}: {e}");
         }
     }
@@ -840,7 +887,7 @@ mod tests {
                         assert!(got.is_ok(), "{text}: {got:?}");
                         continue;
                     }
-                    let e = got.unwrap_err();
+                    let e = got.unwrap_err().message;
                     let want = format!(
                         "{}: {} must be in {}; {}={v} was given",
                         b.scope, b.key, b.range, b.key
@@ -853,15 +900,21 @@ mod tests {
         assert!(checked >= 30, "{checked} refusals checked");
         // The cases, word for word.
         assert_eq!(
-            ProjectionSpec::parse("fisheye:fov=-90").unwrap_err(),
+            ProjectionSpec::parse("fisheye:fov=-90")
+                .unwrap_err()
+                .message,
             "fisheye, equidistant lens: fov must be in (0°, 360°]; fov=-90 was given"
         );
         assert_eq!(
-            ProjectionSpec::parse("fisheye:lens=orthographic:fov=200").unwrap_err(),
+            ProjectionSpec::parse("fisheye:lens=orthographic:fov=200")
+                .unwrap_err()
+                .message,
             "fisheye, orthographic lens: fov must be in (0°, 180°]; fov=200 was given"
         );
         assert_eq!(
-            ProjectionSpec::parse("pannini:d=2:hfov=250").unwrap_err(),
+            ProjectionSpec::parse("pannini:d=2:hfov=250")
+                .unwrap_err()
+                .message,
             "pannini, d=2: hfov must be in (0°, 240°); hfov=250 was given"
         );
     }

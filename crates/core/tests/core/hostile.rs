@@ -27,11 +27,11 @@ fn check_spec(s: &str) {
             // Every parsed spec builds or says why not, for no size and a small one.
             for extent in [None, Some((64, 32))] {
                 if let Err(e) = spec.build(extent) {
-                    assert!(!e.is_empty(), "{s}");
+                    assert!(!e.message.is_empty(), "{s}");
                 }
             }
         }
-        Err(e) => assert!(!e.is_empty(), "{s:?}"),
+        Err(e) => assert!(!e.message.is_empty(), "{s:?}"),
     }
 }
 

@@ -90,7 +90,8 @@ fn unpack_refuses_pictures_that_fit_no_layout() {
     let img = Image::new(100, 60, 3);
     let cube = ProjectionKind::Cube.default_projection();
     let err = Layout::HorizontalCross.unpack(&img, cube).unwrap_err();
-    assert!(err.contains("100x60"), "{err}");
+    assert!(err.message.contains("100x60"), "{err}");
+    assert_eq!(err.fault, mirrorball_core::Fault::Request);
     assert!(Layout::from_extent(100, 60, 6).is_none());
     assert!(guess(100, 60, None).is_none());
 }

@@ -1105,6 +1105,18 @@ fn failed_writes_leave_no_file_behind() {
         let path = dir.path().join("no-such-dir").join(name);
         let e = write_err(&path, &img, &WriteOptions::default());
         assert!(e.to_string().contains(name), "{e}");
+        // A folder that is not there is the system's fault, not the request's or the
+        // input's; so is one that is a file.
+        assert_eq!(e.fault(), Fault::System, "{e}");
+        assert_eq!(e.io_kind(), Some(std::io::ErrorKind::NotFound), "{e}");
+        std::fs::write(dir.path().join("a-file"), b"x").unwrap();
+        let e = write_err(
+            &dir.path().join("a-file").join(name),
+            &img,
+            &WriteOptions::default(),
+        );
+        assert_eq!(e.fault(), Fault::System, "{e}");
+        std::fs::remove_file(dir.path().join("a-file")).unwrap();
         // An empty image is refused as a request error.
         let path = dir.path().join(name);
         let e = write_err(&path, &Image::new(0, 0, 3), &WriteOptions::default());

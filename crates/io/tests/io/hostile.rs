@@ -366,7 +366,7 @@ fn dwa_counters_beyond_the_block_are_refused_before_decoding() {
 }
 
 /// CRC-32 (ISO-HDLC), for patching PNG chunks.
-fn crc32(bytes: &[u8]) -> u32 {
+pub fn crc32(bytes: &[u8]) -> u32 {
     let mut crc = !0u32;
     for &b in bytes {
         crc ^= b as u32;

@@ -1,4 +1,5 @@
 //! The mirrorball-io integration tests: one binary, one module per concern.
+mod bytes;
 mod cube;
 mod encoded;
 mod flat;

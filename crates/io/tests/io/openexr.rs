@@ -12,6 +12,7 @@ use mirrorball_core::glam::{DVec2, DVec3};
 use mirrorball_core::{CubeMap, Image, LatLong, ProjectionKind, WorldProjection};
 use mirrorball_io::openexr::{cube_to_faces, latlong_to_mirrorball};
 use std::f64::consts::PI;
+use std::path::Path;
 
 use crate::imf_envmap::{
     imf_cube_direction, imf_cube_pixel_position, imf_latlong_direction, write_tagged,
@@ -106,7 +107,7 @@ fn an_openexr_cube_strip_reads_into_opengl_faces() {
     );
     let loaded = mirrorball_io::read(&path, &Default::default()).unwrap();
     assert_eq!(loaded.declared, Some(ProjectionKind::Cube));
-    let faces = cube_to_faces(&loaded.layers[0]).unwrap();
+    let faces = cube_to_faces(&loaded.layers[0], Path::new("tagged.exr")).unwrap();
     assert_eq!(faces.len(), 6);
     let texel = (2.0 / s as f64).atan(); // a texel at a face's centre, radians
     let mut worst = 0.0f64;
@@ -139,6 +140,12 @@ fn an_openexr_cube_strip_reads_into_opengl_faces() {
 
 #[test]
 fn a_tagged_cube_too_short_for_six_faces_is_refused() {
-    let e = cube_to_faces(&Image::new(4, 5, 3)).unwrap_err();
-    assert!(e.contains("envmap = cube") && e.contains("4x5"), "{e}");
+    let e = cube_to_faces(&Image::new(4, 5, 3), Path::new("short.exr")).unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("envmap = cube") && text.contains("4x5"),
+        "{e}"
+    );
+    assert!(text.starts_with("short.exr: "), "{e}");
+    assert_eq!(e.fault(), mirrorball_io::Fault::Input);
 }

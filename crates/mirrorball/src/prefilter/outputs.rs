@@ -118,13 +118,36 @@ pub fn write_cube_chain(
     write: &WriteOptions,
     keep_invalid: bool,
 ) -> Result<fit::Report, Error> {
-    let storage = Format::from_path(path)
-        .unwrap_or(Format::Ktx2)
-        .storage(write.precision);
-    let (chain, report) = fit::measure_maps(chain, storage, keep_invalid);
-    let faces: Vec<Vec<Image>> = chain.iter().map(|l| l.layers().to_vec()).collect();
+    let format = Format::from_path(path).unwrap_or(Format::Ktx2);
+    let (faces, report) = chain_levels(format, chain, write, keep_invalid);
     mirrorball_io::write_cube(path, &faces, write)?;
     Ok(report)
+}
+
+/// [`write_cube_chain`]'s file in memory: the bytes of a `name` file (its extension says
+/// KTX2 or DDS, and messages name it), the same encoder's.
+pub fn cube_chain_bytes(
+    name: &str,
+    chain: &[EnvMap],
+    write: &WriteOptions,
+    keep_invalid: bool,
+) -> Result<(Vec<u8>, fit::Report), Error> {
+    let format = Format::from_path(Path::new(name)).unwrap_or(Format::Ktx2);
+    let (faces, report) = chain_levels(format, chain, write, keep_invalid);
+    let bytes = mirrorball_io::write_bytes(&faces, mirrorball_io::Hint::Name(name), write)?;
+    Ok((bytes, report))
+}
+
+/// The levels' faces as a `format` file holds them, and what it could not hold.
+fn chain_levels(
+    format: Format,
+    chain: &[EnvMap],
+    write: &WriteOptions,
+    keep_invalid: bool,
+) -> (Vec<Vec<Image>>, fit::Report) {
+    let (chain, report) = fit::measure_maps(chain, format.storage(write.precision), keep_invalid);
+    let faces = chain.iter().map(|l| l.layers().to_vec()).collect();
+    (faces, report)
 }
 
 /// A level's lobe as the JSON names it.

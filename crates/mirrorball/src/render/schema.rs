@@ -199,7 +199,7 @@ impl<'a> Scene<'a> {
     }
 
     /// The input's fault, in the file's name.
-    fn error(&self, e: String) -> Error {
+    fn error(&self, e: impl std::fmt::Display) -> Error {
         Error::input(format!("{}: {e}", self.path.display()))
     }
 
@@ -349,7 +349,7 @@ impl<'a> Scene<'a> {
         }
         if let Some(i) = e.intensity {
             if !(i.is_finite() && i >= 0.0) {
-                return Err(self.error("environment.intensity must be ≥ 0".into()));
+                return Err(self.error("environment.intensity must be ≥ 0"));
             }
             plan.intensity = i;
         }

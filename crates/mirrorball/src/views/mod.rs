@@ -91,12 +91,8 @@ impl ViewsRequest {
 
 /// `--size`'s text, `W` or `WxH`, as numbers (checked against the container's bound in the
 /// plan).
-pub fn parse_size(s: &str) -> Result<(i64, Option<i64>), String> {
-    let s = s.trim();
-    match s.split_once(['x', 'X', '×']) {
-        Some((w, h)) => Ok((crate::size::parse(w)?, Some(crate::size::parse(h)?))),
-        None => Ok((crate::size::parse(s)?, None)),
-    }
+pub fn parse_size(s: &str) -> Result<(i64, Option<i64>), crate::Error> {
+    crate::size::parse_extent(s)
 }
 
 /// A view, checked: its aim and fields, its size where known before the panorama is read.
@@ -813,8 +809,8 @@ mod tests {
 
     #[test]
     fn sizes_parse() {
-        assert_eq!(parse_size("640"), Ok((640, None)));
-        assert_eq!(parse_size("640x480"), Ok((640, Some(480))));
+        assert_eq!(parse_size("640").unwrap(), (640, None));
+        assert_eq!(parse_size("640x480").unwrap(), (640, Some(480)));
         assert!(parse_size("640x").is_err());
         assert_eq!(frame_name("dir/pano{face}.exr"), "pano");
         assert_eq!(frame_name("a b.png"), "a_b");

@@ -204,7 +204,7 @@ fn render_counting(
 
 /// The request's and the scene's checks before anything is prepared.
 fn validate(scene: &Scene, cam: &Camera, settings: &Settings) -> Result<(), RenderError> {
-    cam.validate().map_err(RenderError::request)?;
+    cam.validate()?;
     if let Some(prev) = &settings.motion_from {
         prev.validate()
             .map_err(|e| RenderError::request(format!("the previous frame's camera: {e}")))?;

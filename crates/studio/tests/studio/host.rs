@@ -6,21 +6,31 @@ use mirrorball_core::glam::{Mat4, Vec3};
 use mirrorball_core::{EnvMap, Image, ProjectionKind};
 use mirrorball_render::tone::Tone;
 use mirrorball_render::{Builtin, Camera, Material, Object, Scene, Settings};
-use mirrorball_studio::{Export, Host, Opened, Running, SceneView, Studio};
+use mirrorball_studio::{Error, Export, Host, Opened, Running, SceneView, Studio};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 pub struct TestHost;
 
+/// The reader's error as the studio's, `shown` called `name`: its fault and I/O kind kept.
+fn studio_error(e: mirrorball_io::Error, shown: &str, name: &str) -> Error {
+    Error::new(e.fault(), e.to_string().replace(shown, name)).with_io_kind(e.io_kind())
+}
+
+/// The name of an upload the test host fails as a full disk would (a system fault).
+pub const FULL_DISK: &str = "full-disk.exr";
+
 impl TestHost {
-    fn read(path: &Path, name: &str) -> Result<Opened, String> {
-        let loaded = mirrorball_io::read(path, &mirrorball_io::Limits::default())
-            .map_err(|e| e.to_string().replace(&path.display().to_string(), name))?;
-        let img = loaded.layers.into_iter().next().ok_or("no picture")?;
+    fn shown(loaded: mirrorball_io::Loaded, name: &str) -> Result<Opened, Error> {
+        let img = loaded
+            .layers
+            .into_iter()
+            .next()
+            .ok_or_else(|| Error::input("no picture"))?;
         // The tests' maps are lat-long (the CLI guesses; see crates/cli/src/load.rs).
         let proj = ProjectionKind::LatLong.default_projection();
-        let map = EnvMap::new(proj, vec![img]).map_err(|e| e.to_string())?;
+        let map = EnvMap::new(proj, vec![img]).map_err(|e| Error::input(e.to_string()))?;
         Ok(Opened::Environment {
             name: name.into(),
             map: Box::new(map),
@@ -29,23 +39,26 @@ impl TestHost {
 }
 
 impl Host for TestHost {
-    fn open(&self, path: &Path) -> Result<Opened, String> {
-        TestHost::read(path, &path.display().to_string())
+    fn open(&self, path: &Path) -> Result<Opened, Error> {
+        let name = path.display().to_string();
+        let loaded = mirrorball_io::read(path, &mirrorball_io::Limits::default())
+            .map_err(|e| studio_error(e, &name, &name))?;
+        TestHost::shown(loaded, &name)
     }
     fn upload(
         &self,
         name: &str,
         bytes: &[u8],
         _alongside: &[(String, Vec<u8>)],
-    ) -> Result<Opened, String> {
-        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-        let ext = Path::new(name)
-            .extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or("bin");
-        let path = dir.path().join(format!("upload.{ext}"));
-        std::fs::write(&path, bytes).map_err(|e| e.to_string())?;
-        TestHost::read(&path, name)
+    ) -> Result<Opened, Error> {
+        if name == FULL_DISK {
+            let full = std::io::Error::from(std::io::ErrorKind::StorageFull);
+            return Err(Error::io(format!("{name}: cannot store the upload"), &full));
+        }
+        let hint = mirrorball_io::Hint::Name(name);
+        let loaded = mirrorball_io::read_bytes(bytes, hint, &mirrorball_io::Limits::default())
+            .map_err(|e| studio_error(e, name, name))?;
+        TestHost::shown(loaded, name)
     }
     fn default_scene(&self) -> SceneView {
         SceneView {
@@ -67,22 +80,15 @@ impl Host for TestHost {
             builtins: vec![Some((Builtin::Sphere, 16))],
         }
     }
-    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, String> {
-        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-        let path = dir.path().join(format!("export.{format}"));
+    fn export(&self, what: Export<'_>, format: &str) -> Result<Vec<u8>, Error> {
+        let file = format!("export.{format}");
+        let hint = mirrorball_io::Hint::Name(&file);
         let opts = mirrorball_io::WriteOptions::default();
-        match what {
-            Export::Map(map) if map.layers().len() == 1 => {
-                mirrorball_io::write_image(&path, &map.layers()[0], &opts)
-            }
-            Export::Map(map) => mirrorball_io::write_cube(&path, &[map.layers().to_vec()], &opts),
-            Export::Chain(chain) => {
-                let faces: Vec<Vec<Image>> = chain.iter().map(|l| l.layers().to_vec()).collect();
-                mirrorball_io::write_cube(&path, &faces, &opts)
-            }
-        }
-        .map_err(|e| e.to_string())?;
-        std::fs::read(&path).map_err(|e| e.to_string())
+        let levels: Vec<Vec<Image>> = match what {
+            Export::Map(map) => vec![map.layers().to_vec()],
+            Export::Chain(chain) => chain.iter().map(|l| l.layers().to_vec()).collect(),
+        };
+        mirrorball_io::write_bytes(&levels, hint, &opts).map_err(|e| studio_error(e, &file, &file))
     }
 }
 

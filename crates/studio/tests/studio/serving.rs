@@ -71,7 +71,7 @@ fn a_bad_file_on_the_command_line_is_an_error_before_serving() {
         )
         .err()
         .expect("refused");
-    assert!(e.starts_with(&cut.display().to_string()), "{e}");
+    assert!(e.message.starts_with(&cut.display().to_string()), "{e}");
 }
 
 /// `GET query` of the environment, answered 200: the payload's JSON header, its length, and
