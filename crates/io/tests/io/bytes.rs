@@ -173,17 +173,8 @@ fn bytes_written_are_the_files_written_and_read_back_the_same() {
 #[test]
 fn empty_truncated_and_garbage_buffers_are_input_faults_naming_the_format() {
     let limits = Limits::default();
-    let readable = [
-        Format::Exr,
-        Format::Hdr,
-        Format::Png,
-        Format::Jpeg,
-        Format::Webp,
-        Format::Ktx2,
-        Format::Dds,
-        Format::Ktx1,
-        Format::BabylonEnv,
-    ];
+    // Every format but glTF's, which names other files and is refused from bytes.
+    let readable = Format::ALL.into_iter().filter(|f| *f != Format::GltfIbl);
     let garbage: Vec<u8> = (0..4096u32)
         .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
         .collect();
