@@ -27,7 +27,7 @@ pub struct ViewsArgs {
     /// Each view's size, W or WxH: the width of views the rig gives none, the height of
     /// views that set neither height nor vfov (default: square pixels at about the
     /// panorama's resolution).
-    #[arg(long, value_name = "W[xH]", value_parser = views::parse_size, allow_hyphen_values = true)]
+    #[arg(long, value_name = "W[xH]", value_parser = mirrorball::size::parse_extent, allow_hyphen_values = true)]
     size: Option<(i64, Option<i64>)>,
     /// The views' container: png (8-bit), png16 (16-bit PNG), jpg or exr (half float).
     #[arg(long, default_value = "png")]

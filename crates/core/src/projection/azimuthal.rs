@@ -43,6 +43,16 @@ impl Default for Frame {
 }
 
 impl Frame {
+    /// The default frame (looking along −Z, +Y up) turned by the rotation `m`: its axes
+    /// are `m`'s images of +X, +Y and −Z.
+    pub fn turned(m: glam::DMat3) -> Frame {
+        Frame {
+            right: m * DVec3::X,
+            up: m * DVec3::Y,
+            forward: m * DVec3::NEG_Z,
+        }
+    }
+
     /// The frame looking along `forward` with up as close to +Y as possible (+Z… when
     /// `forward` is vertical: looking up (+Y) gets up = +Z, looking down gets up = −Z).
     /// Returns `None` for a zero or non-finite vector.

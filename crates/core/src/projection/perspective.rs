@@ -95,13 +95,8 @@ impl View {
         }
         let half = 0.5 * hfov.to_radians();
         let (sh, ch) = half.sin_cos();
-        let m = View::frame_of(yaw, pitch, roll);
         Some(View {
-            frame: Frame {
-                right: m * DVec3::X,
-                up: m * DVec3::Y,
-                forward: m * DVec3::NEG_Z,
-            },
+            frame: Frame::turned(View::frame_of(yaw, pitch, roll)),
             d,
             pannini,
             x_max: (d + 1.0) * sh / (d + ch),

@@ -399,16 +399,7 @@ mod tests {
     fn fisheye_rays_are_cores_equidistant_fisheye() {
         use mirrorball_core::{Fisheye, Frame, Lens};
         let m = View::frame_of(30.0, -10.0, 5.0);
-        let lens = Fisheye::new(
-            Frame {
-                right: m * DVec3::X,
-                up: m * DVec3::Y,
-                forward: m * DVec3::NEG_Z,
-            },
-            Lens::Equidistant,
-            150.0,
-        )
-        .unwrap();
+        let lens = Fisheye::new(Frame::turned(m), Lens::Equidistant, 150.0).unwrap();
         let c = Camera::fisheye("f", 64, 150.0, m);
         assert_eq!(c.params().len(), 8);
         for (x, y) in [(0, 31), (31, 31), (32, 5), (50, 40), (63, 32)] {

@@ -38,7 +38,7 @@ use crate::hooks::Hooks;
 use crate::load::{self, InputPlan};
 use crate::spec::ProjSpec;
 use cameras::{Camera, Model, Shot};
-use mirrorball_core::glam::{DVec2, DVec3};
+use mirrorball_core::glam::DVec2;
 use mirrorball_core::{
     EnvMap, Fisheye, Frame, Lens, Projection, Remap, ResampleOptions, View, WorldProjection,
 };
@@ -87,12 +87,6 @@ impl ViewsRequest {
             max_samples: ResampleOptions::default().max_samples,
         }
     }
-}
-
-/// `--size`'s text, `W` or `WxH`, as numbers (checked against the container's bound in the
-/// plan).
-pub fn parse_size(s: &str) -> Result<(i64, Option<i64>), crate::Error> {
-    crate::size::parse_extent(s)
 }
 
 /// A view, checked: its aim and fields, its size where known before the panorama is read.
@@ -273,21 +267,13 @@ impl ViewsPlan {
                 };
                 let frame = View::frame_of(s.yaw, s.pitch, s.roll);
                 if s.model == Model::Fisheye {
-                    let lens = Fisheye::new(
-                        Frame {
-                            right: frame * DVec3::X,
-                            up: frame * DVec3::Y,
-                            forward: frame * DVec3::NEG_Z,
-                        },
-                        Lens::Equidistant,
-                        s.fov,
-                    )
-                    .ok_or_else(|| {
-                        Error::request(format!(
-                            "view '{}': a fisheye of {}° cannot be drawn",
-                            s.name, s.fov
-                        ))
-                    })?;
+                    let lens = Fisheye::new(Frame::turned(frame), Lens::Equidistant, s.fov)
+                        .ok_or_else(|| {
+                            Error::request(format!(
+                                "view '{}': a fisheye of {}° cannot be drawn",
+                                s.name, s.fov
+                            ))
+                        })?;
                     let cam = Camera::fisheye(&s.name, w, s.fov, frame);
                     return Ok((Projection::Fisheye(lens), cam));
                 }
@@ -809,9 +795,10 @@ mod tests {
 
     #[test]
     fn sizes_parse() {
-        assert_eq!(parse_size("640").unwrap(), (640, None));
-        assert_eq!(parse_size("640x480").unwrap(), (640, Some(480)));
-        assert!(parse_size("640x").is_err());
+        use crate::size::parse_extent;
+        assert_eq!(parse_extent("640").unwrap(), (640, None));
+        assert_eq!(parse_extent("640x480").unwrap(), (640, Some(480)));
+        assert!(parse_extent("640x").is_err());
         assert_eq!(frame_name("dir/pano{face}.exr"), "pano");
         assert_eq!(frame_name("a b.png"), "a_b");
     }
