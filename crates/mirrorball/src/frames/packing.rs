@@ -157,6 +157,76 @@ impl Packing {
         })
     }
 
+    /// This packing at `1/2^s` of its size in both directions, for a planar YUV frame's
+    /// colour planes (4:2:0: `s = 1`) whose layers are made at their own size: colour texel
+    /// `(x, y)` shows what luma texel `(2^s·x, 2^s·y)` shows, its layer texel's position
+    /// halved `s` times, or is looked up in that texel's direction. Exact (each colour
+    /// texel's layer texel covers its own block) where every cell starts at a multiple of
+    /// `2^s` (v360's cells, EAC's border of two included, for faces of an even size);
+    /// `None` where a size or a cell does not divide, or a colour texel would show nothing
+    /// its block shows.
+    pub fn halved(&self, s: u32) -> Option<Packing> {
+        let step = 1u32 << s;
+        let (w, h) = (self.width >> s, self.height >> s);
+        if s == 0
+            || self.width % step != 0
+            || self.height % step != 0
+            || self.layer_width % step != 0
+        {
+            return None;
+        }
+        let mut runs = Vec::new();
+        let mut row_starts = Vec::with_capacity(h as usize + 1);
+        let mut shown = 0usize;
+        for y in 0..h {
+            row_starts.push(runs.len() as u32);
+            let first = runs.len();
+            let luma = self.row_starts[(y << s) as usize] as usize
+                ..self.row_starts[(y << s) as usize + 1] as usize;
+            for run in &self.runs[luma] {
+                for k in 0..run.len {
+                    let at = run.at + k;
+                    if at % step != 0 {
+                        continue;
+                    }
+                    let lx = run.x as i64 + run.dx as i64 * k as i64;
+                    let ly = run.y as i64 + run.dy as i64 * k as i64;
+                    push_texel(
+                        &mut runs,
+                        first,
+                        at >> s,
+                        run.layer,
+                        (lx >> s) as u32,
+                        (ly >> s) as u32,
+                    );
+                    shown += 1;
+                }
+            }
+        }
+        row_starts.push(runs.len() as u32);
+        let lookups: Vec<(u32, DVec3)> = self
+            .lookups
+            .iter()
+            .filter(|&&(i, _)| (i % self.width) % step == 0 && (i / self.width) % step == 0)
+            .map(|&(i, d)| (((i / self.width) >> s) * w + ((i % self.width) >> s), d))
+            .collect();
+        // Every colour texel shows something where every luma texel did.
+        if !self.gaps && shown + lookups.len() != w as usize * h as usize {
+            return None;
+        }
+        let along_rows = lookups.is_empty() && runs.iter().all(Run::along_row);
+        Some(Packing {
+            width: w,
+            height: h,
+            layer_width: self.layer_width >> s,
+            row_starts,
+            runs,
+            gaps: self.gaps,
+            along_rows,
+            lookups,
+        })
+    }
+
     /// The packing of a layout that puts each of `n` layers whole in a cell of its grid
     /// (`Layout::grid_cell`: crosses and strips), from the cells alone: a turned cell's
     /// rows are its layer's, last first, read backwards. The same runs as
