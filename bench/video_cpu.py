@@ -84,8 +84,9 @@ OUT = os.path.join(tmp, "out.mkv")
 
 def best(cmd):
     t = min(cpu(cmd) for _ in range(a.rounds))
-    if os.path.exists(OUT):
-        os.remove(OUT)
+    for f in (OUT, os.path.join(tmp, "out.nut")):
+        if os.path.exists(f):
+            os.remove(f)
     return t
 
 
@@ -96,15 +97,14 @@ def size_of(path):
     return tuple(int(x) for x in probe.stdout.strip().split(","))
 
 
-def out_size(src, flags):
-    subprocess.run([a.mirrorball, "convert", src, OUT, *flags, "--codec", "rawvideo", "-q"],
+def out_size(src, flags, codec="rawvideo"):
+    subprocess.run([a.mirrorball, "convert", src, OUT, *flags, "--codec", codec, "-q"],
                    check=True)
     s = size_of(OUT)
     os.remove(OUT)
     return s
 
 
-raw = ["-c:v", "rawvideo", OUT]
 print(f"{a.frames} frames; CPU seconds (user + system, all processes), best of {a.rounds}")
 srcs = {"yuv420p": make("in8.mp4", "yuv420p"), "yuv420p10le": make("in10.mp4", "yuv420p10le")}
 cube = ["--to", "cube", "--size", "1024"]
@@ -130,15 +130,22 @@ def wanted(name):
 
 for fmt, src in srcs.items():
     target = 2 / 3 if fmt == "yuv420p" else 0.5
+    # Matroska takes raw 8-bit YUV only: 10-bit frames are written lossless by FFV1 on
+    # every side alike (the baseline pays the same encoder).
+    codec = ["-c:v", "rawvideo"] if fmt == "yuv420p" else ["-c:v", "ffv1"]
+    raw = [*codec, OUT]
     for label, v360, flags in [("cube 6x1024^2 (c3x2)", "e:c3x2", cube), ("EAC 6x1024^2", "e:eac", eac)]:
         name = f"{label} {fmt}"
         if not wanted(name):
             continue
-        w, h = out_size(src, flags)
+        w, h = out_size(src, flags, codec[1])
         t_base = best(ff + ["-i", src, "-vf", f"crop=min({w}\\,iw):min({h}\\,ih):0:0,pad={w}:{h}", *raw])
         t_v = best(ff + ["-i", src, "-vf", f"v360={v360}:w={w}:h={h}", *raw])
-        t_mb = best([a.mirrorball, "convert", src, OUT, *flags, "--codec", "rawvideo", "-q"])
+        t_mb = best([a.mirrorball, "convert", src, OUT, *flags, "--codec", codec[1], "-q"])
         report(name, (t_base, t_base), t_v, t_mb, w, h, target)
+# Raw RGB goes into NUT (Matroska refuses it); only ffmpeg writes these.
+NUT = os.path.join(tmp, "out.nut")
+raw = ["-c:v", "rawvideo", NUT]
 
 # 16-bit RGB: mirrorball through pipes (no video decoder gives rgb48le frames).
 for label, v360, flags, size in [("cube 6x1024^2 (hstrip)", "e:c6x1", cube + ["--layout", "hstrip"], (6144, 1024)),
@@ -150,7 +157,7 @@ for label, v360, flags, size in [("cube 6x1024^2 (hstrip)", "e:c6x1", cube + ["-
     w, h = size or out_size(src, flags)
     frame_in, frame_out = W * H * 6, w * h * 6
     dec = f"ffmpeg -v error -nostdin -i {src} -vf format=rgb48le -f rawvideo -"
-    enc = f"ffmpeg -y -v error -nostdin -f rawvideo -pix_fmt rgb48le -s {w}x{h} -i - -c:v rawvideo {OUT}"
+    enc = f"ffmpeg -y -v error -nostdin -f rawvideo -pix_fmt rgb48le -s {w}x{h} -i - -c:v rawvideo {NUT}"
     mb = " ".join([a.mirrorball, "convert", "-", "-", "--in-size", f"{W}x{H}", "--pix-fmt", "rgb48le", *flags, "-q"])
     t_mb = best(f"{dec} | {mb} | {enc}")
     t_mb_base = best(f"{dec} | {sys.executable} {os.path.abspath(__file__)} --cut {frame_in} {frame_out} | {enc}")
@@ -166,6 +173,7 @@ if wanted("dual fisheye"):
                    check=True)
     w, h = 3840, 1920
     flags = ["--from", "dual-fisheye:fov=190", "--to", "latlong", "--size", str(w)]
+    raw = ["-c:v", "rawvideo", OUT]
     t_base = best(ff + ["-i", df, "-vf", f"crop={w}:{h}:0:0", *raw])
     t_v = best(ff + ["-i", df, "-vf", f"v360=dfisheye:e:ih_fov=190:iv_fov=190:w={w}:h={h}", *raw])
     t_mb = best([a.mirrorball, "convert", df, OUT, *flags, "--codec", "rawvideo", "-q"])

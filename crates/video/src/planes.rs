@@ -331,6 +331,13 @@ impl Converter {
     /// Converts one frame, plane by plane.
     pub fn convert(&self, frame: &Planes) -> Result<Planes, Error> {
         let mut out = Planes::default();
+        self.convert_into(frame, &mut out)?;
+        Ok(out)
+    }
+
+    /// Converts one frame, plane by plane, into `out` (its memory reused where the planes
+    /// are made row by row).
+    pub fn convert_into(&self, frame: &Planes, out: &mut Planes) -> Result<(), Error> {
         let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
         let failed =
             |e: mirrorball_core::RemapError| Error::input(format!("{}: {e}", self.reading.input));
@@ -389,7 +396,7 @@ impl Converter {
             out.extent[k] = (picture.width(), picture.height());
             out.data[k] = self.write_plane(&picture, plan.neutral);
         }
-        Ok(out)
+        Ok(())
     }
 
     /// How plane values with `neutral` become this format's codes.
