@@ -33,6 +33,7 @@ bits, dual fisheye ≤ 1.5× the cube's.
 """
 import argparse
 import os
+import re
 import resource
 import shutil
 import subprocess
@@ -54,7 +55,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("--mirrorball", required=True)
 ap.add_argument("--frames", type=int, default=30)
 ap.add_argument("--rounds", type=int, default=3)
-ap.add_argument("--only", help="run only the cases whose name contains this")
+ap.add_argument("--only", help="run only the cases whose name matches this regular expression")
 a = ap.parse_args()
 tmp = tempfile.mkdtemp(prefix="video-cpu-")
 ff = ["ffmpeg", "-y", "-v", "error", "-nostdin"]
@@ -125,7 +126,7 @@ def report(name, t_base, t_v, t_mb, w, h, target):
 
 
 def wanted(name):
-    return a.only is None or a.only in name
+    return a.only is None or re.search(a.only, name) is not None
 
 
 for fmt, src in srcs.items():

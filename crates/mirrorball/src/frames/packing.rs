@@ -763,12 +763,15 @@ impl PlaneCodes {
     /// The code of one value (NaN: 0).
     #[inline(always)]
     pub fn code(&self, v: f32) -> u16 {
-        // Non-negative after the clamp, so adding ½ and truncating rounds half up, as
-        // `round` does for non-negative values, without a libm call.
-        ((v + self.neutral).clamp(0.0, self.max) + 0.5) as u16
+        // `max` takes the other operand of a NaN, so NaN becomes 0. Non-negative after the
+        // clamp, so adding ½ and truncating rounds half up, as `round` does for
+        // non-negative values, without a libm call.
+        let x = (v + self.neutral).max(0.0).min(self.max) + 0.5;
+        // SAFETY: `x` is finite and in [0.5, 65535.5], so it fits an i32.
+        (unsafe { x.to_int_unchecked::<i32>() }) as u16
     }
 
-    /// Values into codes.
+    /// Values into codes (eight at a time where the compiler vectorises the loop).
     pub fn encode(&self, src: &[f32], dst: &mut [u8]) {
         if self.bytes == 1 {
             for (d, &v) in dst.iter_mut().zip(src) {
@@ -813,6 +816,46 @@ mod tests {
                 img
             })
             .collect()
+    }
+
+    /// A plane's codes: the neutral value added back, rounded to nearest, clamped; NaN
+    /// and the infinities land on the range's ends, never wrap.
+    #[test]
+    fn plane_codes_round_and_clamp() {
+        let chroma = PlaneCodes {
+            bytes: 1,
+            neutral: 128.0,
+            max: 255.0,
+        };
+        let cases = [
+            (0.0, 128),
+            (-0.49, 128),
+            (0.5, 129),
+            (-128.6, 0),
+            (126.6, 255),
+            (1e30, 255),
+            (f32::INFINITY, 255),
+            (f32::NEG_INFINITY, 0),
+            (f32::NAN, 0),
+        ];
+        for (v, want) in cases {
+            assert_eq!(chroma.code(v), want, "{v}");
+        }
+        let ten = PlaneCodes {
+            bytes: 2,
+            neutral: 64.0,
+            max: 1023.0,
+        };
+        let mut out = [0u8; 6];
+        ten.encode(&[0.0, 958.6, 5000.0], &mut out);
+        assert_eq!(out, [64, 0, 0xff, 0x03, 0xff, 0x03]);
+        // Each value against `round` over a sweep (the vectorised loop and the plain one).
+        let values: Vec<f32> = (0..4000).map(|i| i as f32 * 0.0731 - 140.0).collect();
+        let mut bytes = vec![0u8; values.len()];
+        chroma.encode(&values, &mut bytes);
+        for (v, b) in values.iter().zip(&bytes) {
+            assert_eq!(*b as f32, (v + 128.0).round().clamp(0.0, 255.0), "{v}");
+        }
     }
 
     /// Two packings place every texel alike.
