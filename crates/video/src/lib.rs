@@ -415,6 +415,7 @@ fn transcode(
             .max(1.0) as i64,
         durations: std::collections::HashMap::new(),
         output: output.to_string(),
+        frame: None,
     };
     let (decoded, converted) = (Pool::default(), Pool::default());
     std::thread::scope(|s| {
@@ -588,6 +589,8 @@ struct Writer {
     /// Each frame's duration by its timestamp, given to its packet.
     durations: std::collections::HashMap<i64, i64>,
     output: String,
+    /// The last frame sent to the encoder, filled again by the next.
+    frame: Option<frame::Video>,
 }
 
 impl Writer {
@@ -604,7 +607,23 @@ impl Writer {
                     planes,
                 } => {
                     let (w, h) = planes.extent[0];
-                    let mut f = frame::Video::new(self.pix, w, h);
+                    // The last frame's buffers where the encoder holds no reference to them
+                    // (`av_frame_make_writable` copies them only where it does), so that
+                    // frames after the first touch no fresh pages.
+                    let mut f = match self.frame.take() {
+                        Some(mut f) if (f.width(), f.height()) == (w, h) => {
+                            // SAFETY: `f` is a valid frame with buffers of its own format
+                            // and size, allocated by FFmpeg (`frame::Video::new`).
+                            let made =
+                                unsafe { ffmpeg::ffi::av_frame_make_writable(f.as_mut_ptr()) };
+                            if made < 0 {
+                                frame::Video::new(self.pix, w, h)
+                            } else {
+                                f
+                            }
+                        }
+                        _ => frame::Video::new(self.pix, w, h),
+                    };
                     for k in 0..3 {
                         let (_, ph) = planes.extent[k];
                         let row = planes.data[k].len() / ph.max(1) as usize;
@@ -627,6 +646,7 @@ impl Writer {
                     self.frames += 1;
                     counter.fetch_add(1, Ordering::Relaxed);
                     done.give(planes);
+                    self.frame = Some(f);
                 }
                 Item::Copied {
                     mut packet,
