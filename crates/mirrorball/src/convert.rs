@@ -50,6 +50,9 @@ pub struct ConvertRequest {
     pub roll: f64,
     /// Mirrors applied after the rotation, in order.
     pub flip: Vec<Axis>,
+    /// A whole turn and mirrors (v360's `yaw`, `pitch`, `roll` in its `rorder` and its
+    /// flips: [`crate::v360`]), in place of `yaw`, `pitch`, `roll` and `flip`.
+    pub rotation: Option<Rotation>,
     /// An engine's axes, applied last (exactly, by moving texels, for a cube).
     pub engine: Option<Engine>,
     /// Exposure in stops.
@@ -82,6 +85,7 @@ impl Default for ConvertRequest {
             pitch: 0.0,
             roll: 0.0,
             flip: Vec::new(),
+            rotation: None,
             engine: None,
             exposure: 0.0,
             precision: None,
@@ -168,10 +172,12 @@ impl ConvertPlan {
         let format = save::check_container(&r.output)?;
         save::check_flags(&r.output, format, &r.container_flags(), r.precision)?;
         save::check(&r.output, to.kind, r.layout)?;
-        let mut rotation = Rotation::from_euler_deg(r.yaw, r.pitch, r.roll);
-        for &axis in &r.flip {
-            rotation = rotation.then(Rotation::mirror(axis));
-        }
+        let mut rotation = r.rotation.unwrap_or_else(|| {
+            r.flip.iter().fold(
+                Rotation::from_euler_deg(r.yaw, r.pitch, r.roll),
+                |rotation, &axis| rotation.then(Rotation::mirror(axis)),
+            )
+        });
         // The engine's axes come last: for a cube exactly, by moving texels; otherwise as
         // the rotation it is.
         let mut orient = AxisMap::IDENTITY;
