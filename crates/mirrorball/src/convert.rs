@@ -160,6 +160,7 @@ impl ConvertPlan {
                  (only a conversion of one file keeps its input's)",
             ));
         };
+        let (mut size, mut layout) = (r.size, r.layout);
         if let (Some(w), Some(h)) = (r.size, r.height) {
             let dim = |v: i64| u32::try_from(v).ok().filter(|&v| v > 0);
             let (Some(w), Some(h)) = (dim(w), dim(h)) else {
@@ -167,11 +168,22 @@ impl ConvertPlan {
                     "--size {w}x{h}: give a positive width and height"
                 )));
             };
-            to = to.with_height(w, h)?;
+            if to.kind == ProjectionKind::Eac && layout.is_none_or(|l| l == Layout::eac()) {
+                // The picture, as v360's w and h: v360's eac at that size.
+                let (cells, n) = mirrorball_core::CubeCells::eac_frame(w, h).ok_or_else(|| {
+                    Error::request(format!(
+                        "--size {w}x{h}: too small for an eac picture (six faces between \
+                         two-texel borders)"
+                    ))
+                })?;
+                (size, layout) = (Some(n as i64), Some(Layout::Cells(cells)));
+            } else {
+                to = to.with_height(w, h)?;
+            }
         }
         let format = save::check_container(&r.output)?;
         save::check_flags(&r.output, format, &r.container_flags(), r.precision)?;
-        save::check(&r.output, to.kind, r.layout)?;
+        save::check(&r.output, to.kind, layout)?;
         let mut rotation = r.rotation.unwrap_or_else(|| {
             r.flip.iter().fold(
                 Rotation::from_euler_deg(r.yaw, r.pitch, r.roll),
@@ -196,7 +208,7 @@ impl ConvertPlan {
             note: None,
         };
         let save = SaveOptions {
-            layout: r.layout,
+            layout,
             write,
             mips: r.mips,
             keep_invalid: input.keep_invalid,
@@ -205,8 +217,7 @@ impl ConvertPlan {
         let layers = dst.layer_count();
         let stereo = r.stereo.unwrap_or_default();
         save::check_stereo(&r.output, layers, stereo, &save)?;
-        let size = r
-            .size
+        let size = size
             .map(|s| save::size_bound(&r.output, dst, &save, stereo).check("--size", s))
             .transpose()?;
         let mut files = Files::new();

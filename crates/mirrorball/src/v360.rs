@@ -31,7 +31,7 @@
 use crate::convert::ConvertRequest;
 use crate::error::Error;
 use crate::spec::ProjSpec;
-use mirrorball_core::{Layout, ProjectionKind, Rotation, Stereo, WorldProjection};
+use mirrorball_core::{CubeCells, Layout, ProjectionKind, Rotation, Stereo, WorldProjection};
 use mirrorball_core::glam::{DMat3, DVec3};
 use std::fmt;
 
@@ -726,9 +726,12 @@ fn finish(
         })
     };
     let (from, to) = (spec("input", &from)?, spec("output", &to)?);
-    let size = match extent {
-        None => None,
-        Some((w, h)) => Some(output_size(&to, layout, w, h)? as i64),
+    let (size, layout) = match extent {
+        None => (None, layout),
+        Some((w, h)) => {
+            let (size, layout) = output_size(&to, layout, w, h)?;
+            (Some(size as i64), layout)
+        }
     };
     Ok(V360 {
         from,
@@ -743,9 +746,14 @@ fn finish(
     })
 }
 
-/// The `--size` that makes a `w`×`h` picture of `to` in `layout`; refused (naming `h`)
-/// when none does.
-fn output_size(to: &ProjSpec, layout: Option<Layout>, w: u32, h: u32) -> Result<u32, V360Error> {
+/// The `--size` that makes a `w`×`h` picture of `to` in `layout`, and the layout (v360's
+/// `eac` at any size: [`CubeCells::eac_frame`]); refused (naming `h`) when none does.
+fn output_size(
+    to: &ProjSpec,
+    layout: Option<Layout>,
+    w: u32,
+    h: u32,
+) -> Result<(u32, Option<Layout>), V360Error> {
     let refuse = |why: String| V360Error::Unsupported {
         key: "h".into(),
         value: h.to_string(),
@@ -753,15 +761,13 @@ fn output_size(to: &ProjSpec, layout: Option<Layout>, w: u32, h: u32) -> Result<
     };
     let p = to.build(None).map_err(|e| refuse(e.to_string()))?;
     match layout {
-        Some(Layout::Cells(cells)) => cells.face_size(w, h).ok_or_else(|| {
+        Some(Layout::Cells(cells)) if cells.eac_pad => CubeCells::eac_frame(w, h)
+            .map(|(cells, n)| (n, Some(Layout::Cells(cells))))
+            .ok_or_else(|| refuse(format!("w={w}:h={h}: too small for an eac picture"))),
+        Some(Layout::Cells(cells)) => cells.face_size(w, h).map(|n| (n, layout)).ok_or_else(|| {
             let (a, b) = cells.extent(1);
-            let shape = if cells.eac_pad {
-                "(3n + 4)x(2n + 8) for faces of n texels".to_string()
-            } else {
-                format!("{a}n x {b}n for faces of n texels")
-            };
             refuse(format!(
-                "w={w}:h={h}: mirrorball's {} picture is {shape}",
+                "w={w}:h={h}: mirrorball's {} picture is {a}n x {b}n for faces of n texels",
                 Layout::Cells(cells)
             ))
         }),
@@ -778,7 +784,7 @@ fn output_size(to: &ProjSpec, layout: Option<Layout>, w: u32, h: u32) -> Result<
                     p.kind()
                 )));
             }
-            Ok(w)
+            Ok((w, layout))
         }
     }
 }
@@ -856,6 +862,13 @@ mod tests {
         assert_eq!(v.size, Some(48));
         assert_eq!(v.notes.len(), 1, "{:?}", v.notes);
         assert_eq!(parse("e:e:in_stereo=sbs").unwrap().in_stereo, Stereo::SideBySide);
+        // v360's eac at any size: YouTube's 3840x2160, faces 1278⅔ by 1076 texels, made
+        // from faces of 1279.
+        let v = parse("e:eac:w=3840:h=2160").unwrap();
+        assert_eq!(v.size, Some(1279));
+        let layout = v.layout.unwrap();
+        assert_eq!(layout.to_string(), "eac");
+        assert_eq!(layout.extent(6, 1279, 1279), (3840, 2160));
         // Every name of the table reads; those refused say why, naming the key.
         for (names, p) in PROJECTIONS {
             for n in *names {

@@ -776,6 +776,10 @@ fn v360_options_land_where_v360_puts_them() {
         "e:equisolid:h_fov=180:v_fov=180:w=96:h=96",
         "e:og:h_fov=160:v_fov=160:w=96:h=96",
         "e:hequirect:yaw=-30:w=96:h=96",
+        // v360's eac at sizes of its own: YouTube's 3840x2160 scaled by a fifth (faces
+        // 254⅔ by 208 texels), and faces of whole but unequal sizes.
+        "e:eac:w=768:h=432",
+        "e:eac:yaw=100:pitch=-30:w=772:h=440",
     ] {
         compare_options(dir.path(), "latlong", e, s);
     }
@@ -816,4 +820,98 @@ fn v360_options_refused_name_the_key() {
         assert!(err.contains(named), "--v360 {options} {extra:?}: {err}");
         assert!(!out.exists(), "--v360 {options}: an output was written");
     }
+}
+
+/// An EAC frame of v360's at a size of its own (768x432: YouTube's 3840x2160 scaled by a
+/// fifth), made by ffmpeg from a direction-coded lat-long, read with `--from eac` and by
+/// v360's `eac` input alike: the same directions within one pixel. And `--to eac --size
+/// WxH` makes the frame `--v360 e:eac:w=W:h=H` makes, to the bit.
+#[test]
+fn eac_frames_of_any_size() {
+    if !have_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (_, ll) = write_input(dir.path(), "latlong", (512, 256));
+    let frame = dir.path().join("frame.png");
+    ffmpeg(&[
+        "-i",
+        ll.to_str().unwrap(),
+        "-vf",
+        "v360=e:eac:w=768:h=432:interp=line",
+        "-pix_fmt",
+        "rgb48be",
+        frame.to_str().unwrap(),
+    ]);
+    let ff = v360_raw(&frame, "v360=eac:e:w=256:h=128:yaw=20:interp=line");
+    let out = dir.path().join("read.png");
+    let o = ok(&[
+        "convert",
+        frame.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--from",
+        "eac",
+        "--to",
+        "latlong",
+        "--size",
+        "256",
+        "--yaw",
+        "20",
+        "--precision",
+        "16",
+    ]);
+    assert!(o.contains("eac"), "{o}");
+    let img = mirrorball_io::read(&out, &Default::default()).unwrap();
+    let img = &img.layers[0];
+    let dst = ProjectionSpec::parse("latlong").unwrap().build(None).unwrap();
+    let (mut compared, mut worst) = (0, 0.0f64);
+    for y in 1..127 {
+        for x in 0..256 {
+            let k = ((y * 256 + x) * 6) as usize;
+            let df = decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0));
+            let m = [0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64));
+            let (Some(df), Some(dm)) = (df, decode(m)) else {
+                panic!("texel ({x}, {y}) is black");
+            };
+            let tol = pixel_angle(&dst, x, y, 256, 128);
+            let e = df.angle_between(dm);
+            worst = worst.max(e / tol);
+            compared += 1;
+            assert!(
+                e <= tol,
+                "eac 768x432 read: texel ({x}, {y}) differs by {:.3}° (a pixel is {:.3}°)",
+                e.to_degrees(),
+                tol.to_degrees()
+            );
+        }
+    }
+    eprintln!("eac 768x432 read: {compared} texels, worst {worst:.3} of a pixel");
+
+    // --to eac --size WxH is --v360 e:eac:w=W:h=H.
+    let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+    let src = crate::util::asset("city.exr");
+    ok(&[
+        "convert",
+        src.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--to",
+        "eac",
+        "--size",
+        "768x432",
+        "-q",
+    ]);
+    ok(&[
+        "convert",
+        src.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--v360",
+        "e:eac:w=768:h=432",
+        "-q",
+    ]);
+    let (a, b) = (
+        mirrorball_io::read(&a, &Default::default()).unwrap(),
+        mirrorball_io::read(&b, &Default::default()).unwrap(),
+    );
+    assert_eq!((a.layers[0].width(), a.layers[0].height()), (768, 432));
+    assert_eq!(a.layers[0], b.layers[0]);
 }
