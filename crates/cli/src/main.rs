@@ -132,8 +132,9 @@ pub struct ConvertArgs {
     to: String,
     /// Face edge (cubes), width (lat-long, Mercator, cylinders, Hammer, sinusoidal, views) or
     /// diameter (disk maps), in texels; one eye's, for a stereo pair (--stereo). WxH (as
-    /// v360's w and h) for a flat view sets its vfov from the height (square pixels); for
-    /// other projections the height must be the one the width gives.
+    /// v360's w and h) for a flat view sets its vfov from the height (square pixels); for eac
+    /// it is the picture's size (v360's eac at any size: 3840x2160); for other projections
+    /// the height must be the one the width gives.
     /// Default: about the source's resolution (its one eye's).
     #[arg(long, value_name = "W[xH]", value_parser = size::parse_extent, allow_hyphen_values = true)]
     size: Option<(i64, Option<i64>)>,
