@@ -299,20 +299,26 @@ impl CubeCells {
     /// cell `i` (faces of `n` texels): the picture position of its centre, in texels from the
     /// picture's top-left corner (`xyz_to_eac`).
     fn frame_position(&self, (w, h): (u32, u32), i: usize, n: u32, x: u32, y: u32) -> (f64, f64) {
-        let (cols, rows) = self.grid.dims();
-        let (fw, row_h) = ((w as f64 - 4.0) / cols as f64, h as f64 / rows as f64);
-        let fh = row_h - 4.0;
         let (s, t) = (
             2.0 * (x as f64 + 0.5) / n as f64 - 1.0,
             2.0 * (y as f64 + 0.5) / n as f64 - 1.0,
         );
         // face_coords is a signed permutation: its inverse is its transpose.
         let (a, b) = (self.face_coords(i, 1.0, 0.0), self.face_coords(i, 0.0, 1.0));
-        let (c, d) = (a.0 * s + a.1 * t, b.0 * s + b.1 * t);
+        self.eac_point((w, h), i, a.0 * s + a.1 * t, b.0 * s + b.1 * t)
+    }
+
+    /// Where v360's `eac` picture of `w`×`h` texels shows cell coordinates `(c, d)` ∈
+    /// `[−1, 1]²` (right, down) of cell `i`, in texels from the picture's top-left corner:
+    /// the cell's face `(w − 4)/3` wide and `h/2 − 4` high inside its two-texel borders
+    /// (`xyz_to_eac`; with square faces of `n`, [`CubeCells::origin`] plus `(c + 1)/2·n`).
+    pub fn eac_point(&self, (w, h): (u32, u32), i: usize, c: f64, d: f64) -> (f64, f64) {
+        let (cols, rows) = self.grid.dims();
+        let (fw, row_h) = ((w as f64 - 4.0) / cols as f64, h as f64 / rows as f64);
         let (col, row) = (i as u32 % cols, i as u32 / cols);
         (
             2.0 + (col as f64 + 0.5 * (c + 1.0)) * fw,
-            2.0 + row as f64 * row_h + 0.5 * (d + 1.0) * fh,
+            2.0 + row as f64 * row_h + 0.5 * (d + 1.0) * (row_h - 4.0),
         )
     }
 

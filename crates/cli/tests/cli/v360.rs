@@ -777,7 +777,7 @@ fn v360_options_land_where_v360_puts_them() {
         "e:og:h_fov=160:v_fov=160:w=96:h=96",
         "e:hequirect:yaw=-30:w=96:h=96",
         // v360's eac at sizes of its own: YouTube's 3840x2160 scaled by a fifth (faces
-        // 254⅔ by 208 texels), and faces of whole but unequal sizes.
+        // 254⅔ by 212 texels), and faces of whole but unequal sizes.
         "e:eac:w=768:h=432",
         "e:eac:yaw=100:pitch=-30:w=772:h=440",
     ] {
