@@ -163,8 +163,9 @@ impl CubeCells {
 
     /// v360's `eac` as a `w`×`h` picture, and the edge of the square faces a map is made
     /// at to fill it (the finer of the faces' two spacings, `(w − 4)/3` and `h/2 − 4`,
-    /// rounded up); the plain [`CubeCells::EAC`] where square faces give that size. `None`
-    /// for a picture too small to hold a texel of each face.
+    /// rounded up to an even edge, which video's half-size colour planes halve); the plain
+    /// [`CubeCells::EAC`] where square faces give that size. `None` for a picture too small
+    /// to hold a texel of each face.
     pub fn eac_frame(w: u32, h: u32) -> Option<(CubeCells, u32)> {
         if let Some(n) = CubeCells::EAC.face_size(w, h) {
             return Some((CubeCells::EAC, n));
@@ -177,7 +178,8 @@ impl CubeCells {
             frame: Some((w, h)),
             ..CubeCells::EAC
         };
-        Some((cells, fw.max(fh).ceil() as u32))
+        let n = fw.max(fh).ceil() as u32;
+        Some((cells, n + n % 2))
     }
 
     /// Whether the picture is v360's `eac` at a size of its own ([`CubeCells::eac_frame`]),

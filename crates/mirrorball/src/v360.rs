@@ -863,12 +863,12 @@ mod tests {
         assert_eq!(v.notes.len(), 1, "{:?}", v.notes);
         assert_eq!(parse("e:e:in_stereo=sbs").unwrap().in_stereo, Stereo::SideBySide);
         // v360's eac at any size: YouTube's 3840x2160, faces 1278⅔ by 1076 texels, made
-        // from faces of 1279.
+        // from faces of 1280 (the finer spacing, rounded up to even).
         let v = parse("e:eac:w=3840:h=2160").unwrap();
-        assert_eq!(v.size, Some(1279));
+        assert_eq!(v.size, Some(1280));
         let layout = v.layout.unwrap();
         assert_eq!(layout.to_string(), "eac");
-        assert_eq!(layout.extent(6, 1279, 1279), (3840, 2160));
+        assert_eq!(layout.extent(6, 1280, 1280), (3840, 2160));
         // Every name of the table reads; those refused say why, naming the key.
         for (names, p) in PROJECTIONS {
             for n in *names {
