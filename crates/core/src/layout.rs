@@ -857,7 +857,11 @@ fn unpack_cells(
 
 /// [`Layout::unpack`] for v360's `eac` at a size of its own ([`CubeCells::eac_frame`]):
 /// square faces of the finer spacing, each texel read bilinearly where v360 puts its centre.
-fn unpack_frame(cells: &CubeCells, image: &Image, projection: Projection) -> Result<EnvMap, String> {
+fn unpack_frame(
+    cells: &CubeCells,
+    image: &Image,
+    projection: Projection,
+) -> Result<EnvMap, String> {
     let (w, h) = (image.width(), image.height());
     let (_, n) = CubeCells::eac_frame(w, h).ok_or_else(|| {
         format!("an eac picture of {w}x{h} is too small to hold its six faces and their borders")
@@ -892,7 +896,8 @@ fn bilinear(image: &Image, x: f64, y: f64) -> [f32; 4] {
     let mut out = [0.0f32; 4];
     let (a, b, c, d) = (at(0, 0), at(1, 0), at(0, 1), at(1, 1));
     for k in 0..image.channels().min(4) {
-        out[k] = (a[k] * (1.0 - fx) + b[k] * fx) * (1.0 - fy) + (c[k] * (1.0 - fx) + d[k] * fx) * fy;
+        out[k] =
+            (a[k] * (1.0 - fx) + b[k] * fx) * (1.0 - fy) + (c[k] * (1.0 - fx) + d[k] * fx) * fy;
     }
     out
 }

@@ -31,8 +31,8 @@
 use crate::convert::ConvertRequest;
 use crate::error::Error;
 use crate::spec::ProjSpec;
-use mirrorball_core::{CubeCells, Layout, ProjectionKind, Rotation, Stereo, WorldProjection};
 use mirrorball_core::glam::{DMat3, DVec3};
+use mirrorball_core::{CubeCells, Layout, ProjectionKind, Rotation, Stereo, WorldProjection};
 use std::fmt;
 
 /// Why a v360 option string cannot be taken: each names the key (or the projection) at
@@ -379,10 +379,9 @@ impl Proj {
                 ))
             }
             Proj::DualFisheye => Ok((format!("dfisheye:fov={}", num(circle()?)), None)),
-            Proj::Fisheye(lens) => Ok((
-                format!("fisheye:fov={}:lens={lens}", num(circle()?)),
-                None,
-            )),
+            Proj::Fisheye(lens) => {
+                Ok((format!("fisheye:fov={}:lens={lens}", num(circle()?)), None))
+            }
             Proj::Pannini => {
                 // v360 takes d from h_fov and draws X, Y ∈ [−1, 1]: X = 1 where
                 // (d + 1) sin λ = d + cos λ, i.e. λ = asin(d/R) + atan2(1, d + 1) with
@@ -490,7 +489,12 @@ pub fn parse(text: &str) -> Result<V360, V360Error> {
     }
     let get = |k: &str| given.iter().find(|(g, _)| *g == k).map(|(_, v)| v.as_str());
     let num_of = |k: &str, lo, hi| get(k).map(|v| number(k, v, lo, hi)).transpose();
-    let flag = |k: &str| get(k).map(|v| boolean(k, v)).transpose().map(|b| b == Some(true));
+    let flag = |k: &str| {
+        get(k)
+            .map(|v| boolean(k, v))
+            .transpose()
+            .map(|b| b == Some(true))
+    };
     let unsupported = |k: &str, why: &str| V360Error::Unsupported {
         key: k.into(),
         value: get(k).unwrap_or_default().into(),
@@ -540,10 +544,18 @@ pub fn parse(text: &str) -> Result<V360, V360Error> {
     }
     for k in ["h_offset", "v_offset"] {
         if num_of(k, -1.0, 1.0)?.is_some_and(|v| v != 0.0) {
-            return Err(unsupported(k, "mirrorball's views are not shifted off their axis"));
+            return Err(unsupported(
+                k,
+                "mirrorball's views are not shifted off their axis",
+            ));
         }
     }
-    for (k, hi) in [("in_pad", 0.1), ("out_pad", 0.1), ("fin_pad", 100.0), ("fout_pad", 100.0)] {
+    for (k, hi) in [
+        ("in_pad", 0.1),
+        ("out_pad", 0.1),
+        ("fin_pad", 100.0),
+        ("fout_pad", 100.0),
+    ] {
         if num_of(k, 0.0, hi)?.is_some_and(|v| v != 0.0) {
             return Err(unsupported(
                 k,
@@ -552,19 +564,23 @@ pub fn parse(text: &str) -> Result<V360, V360Error> {
         }
     }
 
-    // Projections and their fields of view.
+    // Projections and their fields of view (0, v360's default, is none given).
     let fov = |keys: &FovKeys| -> Result<Fov, V360Error> {
+        let given = |k| Ok::<_, V360Error>(num_of(k, 0.0, 360.0)?.filter(|&v| v > 0.0));
         Ok(Fov {
-            h: num_of(keys.h, 0.0, 360.0)?,
-            v: num_of(keys.v, 0.0, 360.0)?,
-            d: num_of(keys.d, 0.0, 360.0)?,
+            h: given(keys.h)?,
+            v: given(keys.v)?,
+            d: given(keys.d)?,
         })
     };
     let (in_name, out_name) = (
         get("input").unwrap_or("e").trim(),
         get("output").unwrap_or("c3x2").trim(),
     );
-    let (pin, pout) = (projection("input", in_name)?, projection("output", out_name)?);
+    let (pin, pout) = (
+        projection("input", in_name)?,
+        projection("output", out_name)?,
+    );
     let (w, h) = (num_of("w", 0.0, 32767.0)?, num_of("h", 0.0, 32767.0)?);
     for (k, v) in [("w", w), ("h", h)] {
         if v.is_some_and(|v| v.fract() != 0.0) {
@@ -605,7 +621,12 @@ pub fn parse(text: &str) -> Result<V360, V360Error> {
 
     let in_layout = cell_order(&get, "in", pin).map(|l| l.or(in_layout))?;
     let layout = cell_order(&get, "out", pout).map(|l| l.or(layout))?;
-    finish(given_rest(&get, notes)?, (from, in_layout), (to, layout), extent)
+    finish(
+        given_rest(&get, notes)?,
+        (from, in_layout),
+        (to, layout),
+        extent,
+    )
 }
 
 /// The cells' layout `{side}_forder` and `{side}_frot` give for `proj` (`None` when neither
@@ -669,7 +690,10 @@ fn given_rest<'a>(
         }
     };
     let angle = |k: &str| -> Result<f64, V360Error> {
-        Ok(get(k).map(|v| number(k, v, -180.0, 180.0)).transpose()?.unwrap_or(0.0))
+        Ok(get(k)
+            .map(|v| number(k, v, -180.0, 180.0))
+            .transpose()?
+            .unwrap_or(0.0))
     };
     let (yaw, pitch, roll) = (angle("yaw")?, angle("pitch")?, angle("roll")?);
     let order = get("rorder").unwrap_or("ypr");
@@ -835,7 +859,6 @@ impl ConvertRequest {
 mod tests {
     use super::*;
 
-
     fn err(s: &str) -> V360Error {
         parse(s).expect_err(s)
     }
@@ -861,7 +884,10 @@ mod tests {
         let v = parse("e:eac:near:148:104").unwrap();
         assert_eq!(v.size, Some(48));
         assert_eq!(v.notes.len(), 1, "{:?}", v.notes);
-        assert_eq!(parse("e:e:in_stereo=sbs").unwrap().in_stereo, Stereo::SideBySide);
+        assert_eq!(
+            parse("e:e:in_stereo=sbs").unwrap().in_stereo,
+            Stereo::SideBySide
+        );
         // v360's eac at any size: YouTube's 3840x2160, faces 1278⅔ by 1076 texels, made
         // from faces of 1280 (the finer spacing, rounded up to even).
         let v = parse("e:eac:w=3840:h=2160").unwrap();
@@ -904,7 +930,10 @@ mod tests {
         // mirrorball's --yaw 30 --pitch 20 is v360's yaw=30:pitch=-20:rorder=pyr.
         let v = parse("e:e:yaw=30:pitch=-20:rorder=pyr").unwrap();
         let ours = Rotation::from_euler_deg(30.0, 20.0, 0.0);
-        assert!(v.rotation.source_of(d).abs_diff_eq(ours.source_of(d), 1e-12));
+        assert!(v
+            .rotation
+            .source_of(d)
+            .abs_diff_eq(ours.source_of(d), 1e-12));
         // Mirrors after the turn: h_flip negates x of the source direction.
         let v = parse("e:e:yaw=90:h_flip=1").unwrap();
         let turned = parse("e:e:yaw=90").unwrap().rotation.source_of(d);

@@ -73,7 +73,7 @@ pub(crate) fn request(a: &ConvertArgs) -> Result<ConvertRequest, CliError> {
     if !a.quiet {
         v360.notes.iter().for_each(|n| eprintln!("{n}"));
     }
-    Ok(r.with_v360(&v360)?)
+    r.with_v360(&v360)
 }
 
 /// The value of `T` that `given` (the text of `flag`) names, if given.

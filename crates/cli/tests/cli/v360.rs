@@ -76,6 +76,17 @@ fn decode(c: [f64; 3]) -> Option<DVec3> {
     DVec3::from_array(c.map(|v| (v - 0.5) / 0.49)).try_normalize()
 }
 
+/// The direction coded at `(x, y)` of ffmpeg's raw `rgb48le` picture `ff`, `w` wide.
+fn ffmpeg_dir(ff: &[u8], w: u32, x: u32, y: u32) -> Option<DVec3> {
+    let k = ((y * w + x) * 6) as usize;
+    decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
+}
+
+/// The direction coded at `(x, y)` of mirrorball's 16-bit PNG, as read (linear values).
+fn mirrorball_dir(img: &mirrorball_core::Image, x: u32, y: u32) -> Option<DVec3> {
+    decode([0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64)))
+}
+
 /// A `w`×`h` 16-bit PNG of projection `p`, each pixel the code of its direction: at the
 /// texel centre, or (`align`) where FFmpeg 5.1 reads it.
 fn write_coded(path: &Path, p: &Projection, w: u32, h: u32, align: bool) {
@@ -209,12 +220,7 @@ fn compare(dir: &Path, case: &Case) {
                 continue;
             }
             inside += 1;
-            let k = ((y * w + x) * 6) as usize;
-            let f =
-                [0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0);
-            let px = img.get(x, y);
-            let m = [0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(px[c] as f64));
-            let (Some(df), Some(dm)) = (decode(f), decode(m)) else {
+            let (Some(df), Some(dm)) = (ffmpeg_dir(&ff, w, x, y), mirrorball_dir(img, x, y)) else {
                 continue; // outside a view: black in both (checked below)
             };
             compared += 1;
@@ -377,20 +383,11 @@ fn compare_packed(dir: &Path, case: &Packed) {
     let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
     let img = &mb.layers[0];
     assert_eq!((img.width(), img.height()), (w, h), "{}", case.layout);
-    let ffd = |x: u32, y: u32| {
-        let k = ((y * w + x) * 6) as usize;
-        decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
-    };
+    let ffd = |x: u32, y: u32| ffmpeg_dir(&ff, w, x, y);
     let (mut compared, mut worst) = (0, 0.0f64);
     for y in 1..h - 1 {
         for x in 1..w - 1 {
-            let (Some(df), Some(dm)) = (
-                ffd(x, y),
-                decode(
-                    [0, 1, 2]
-                        .map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64)),
-                ),
-            ) else {
+            let (Some(df), Some(dm)) = (ffd(x, y), mirrorball_dir(img, x, y)) else {
                 panic!("{}: texel ({x}, {y}) is black", case.layout);
             };
             let tol = ffmpeg_pixel(&ffd, x, y, df);
@@ -544,10 +541,7 @@ fn compare_pair(dir: &Path, case: &Pair) {
     let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
     let img = &mb.layers[0];
     assert_eq!((img.width(), img.height()), (fw, fh), "{filter}");
-    let ffd = |x: u32, y: u32| {
-        let k = ((y * fw + x) * 6) as usize;
-        decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
-    };
+    let ffd = |x: u32, y: u32| ffmpeg_dir(&ff, fw, x, y);
     let (mut compared, mut worst) = (0, 0.0f64);
     for e in 0..sout.eyes() {
         let (ox, oy) = match sout {
@@ -559,9 +553,7 @@ fn compare_pair(dir: &Path, case: &Pair) {
         let sign = if sin.source_eye(e) == 0 { 1.0 } else { -1.0 };
         for y in oy + 1..oy + h - 1 {
             for x in ox + 1..ox + w - 1 {
-                let m = [0, 1, 2]
-                    .map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64));
-                let (Some(df), Some(dm)) = (ffd(x, y), decode(m)) else {
+                let (Some(df), Some(dm)) = (ffd(x, y), mirrorball_dir(img, x, y)) else {
                     panic!("{filter}: texel ({x}, {y}) is black");
                 };
                 let tol = ffmpeg_pixel(&ffd, x, y, df);
@@ -638,9 +630,16 @@ fn stereo_pairs_land_where_v360_puts_them() {
 /// of `w`) coded with its directions, for ffmpeg and for mirrorball: a single-layer map as
 /// [`write_coded`] codes it, a map with layers (EAC) packed by its layout from faces coded at
 /// their texel centres (v360 reads EAC at pixel centres, so both get the same picture).
-fn write_input(dir: &Path, from: &str, (w, h): (u32, u32)) -> (std::path::PathBuf, std::path::PathBuf) {
+fn write_input(
+    dir: &Path,
+    from: &str,
+    (w, h): (u32, u32),
+) -> (std::path::PathBuf, std::path::PathBuf) {
     let (for_mb, for_ff) = (dir.join("opt_mb.png"), dir.join("opt_ff.png"));
-    let src = ProjectionSpec::parse(from).unwrap().build(Some((w, h))).unwrap();
+    let src = ProjectionSpec::parse(from)
+        .unwrap()
+        .build(Some((w, h)))
+        .unwrap();
     if src.layer_count() == 1 {
         write_coded(&for_mb, &src, w, h, false);
         write_coded(&for_ff, &src, w, h, true);
@@ -699,14 +698,17 @@ fn compare_options(dir: &Path, from: &str, in_size: (u32, u32), options: &str) {
     let img = mirrorball_io::read(&out, &Default::default()).unwrap();
     let img = &img.layers[0];
     let (w, h) = (img.width(), img.height());
-    assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: ffmpeg's size is not {w}x{h}");
-    let ffd = |x: u32, y: u32| {
-        (x < w && y < h).then(|| {
-            let k = ((y * w + x) * 6) as usize;
-            decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
-        })?
-    };
-    let to = mirrorball::v360::parse(options).unwrap().to.build(None).unwrap();
+    assert_eq!(
+        ff.len(),
+        (w * h * 6) as usize,
+        "{filter}: ffmpeg's size is not {w}x{h}"
+    );
+    let ffd = |x: u32, y: u32| (x < w && y < h).then(|| ffmpeg_dir(&ff, w, x, y))?;
+    let to = mirrorball::v360::parse(options)
+        .unwrap()
+        .to
+        .build(None)
+        .unwrap();
     let single = (to.layer_count() == 1).then_some(to);
     let uv = |x: u32, y: u32| DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
     let (mut compared, mut seen, mut worst) = (0, 0, 0.0f64);
@@ -716,12 +718,14 @@ fn compare_options(dir: &Path, from: &str, in_size: (u32, u32), options: &str) {
                 continue;
             };
             // v360 draws past a fisheye's circle; mirrorball leaves it black.
-            if single.as_ref().is_some_and(|p| p.density(0, uv(x, y)) <= 0.0) {
+            if single
+                .as_ref()
+                .is_some_and(|p| p.density(0, uv(x, y)) <= 0.0)
+            {
                 continue;
             }
             seen += 1;
-            let m = [0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64));
-            let Some(dm) = decode(m) else {
+            let Some(dm) = mirrorball_dir(img, x, y) else {
                 continue; // a rim texel mirrorball leaves black (counted below)
             };
             // One pixel: a single-layer output's own (its farthest neighbour's angle,
@@ -783,7 +787,12 @@ fn v360_options_land_where_v360_puts_them() {
     ] {
         compare_options(dir.path(), "latlong", e, s);
     }
-    compare_options(dir.path(), "dfisheye:fov=190", e, "dfisheye:e:ih_fov=190:iv_fov=190:w=128:h=64");
+    compare_options(
+        dir.path(),
+        "dfisheye:fov=190",
+        e,
+        "dfisheye:e:ih_fov=190:iv_fov=190:w=128:h=64",
+    );
     compare_options(dir.path(), "eac", (40, 40), "eac:e:yaw=15:w=128:h=64");
 }
 
@@ -816,7 +825,11 @@ fn v360_options_refused_name_the_key() {
         args.extend(extra);
         let o = crate::util::run(&args);
         let err = crate::util::stderr(&o);
-        assert_eq!(o.status.code(), Some(2), "--v360 {options} {extra:?}: {err}");
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "--v360 {options} {extra:?}: {err}"
+        );
         assert!(err.contains(named), "--v360 {options} {extra:?}: {err}");
         assert!(!out.exists(), "--v360 {options}: an output was written");
     }
@@ -863,14 +876,15 @@ fn eac_frames_of_any_size() {
     assert!(o.contains("eac"), "{o}");
     let img = mirrorball_io::read(&out, &Default::default()).unwrap();
     let img = &img.layers[0];
-    let dst = ProjectionSpec::parse("latlong").unwrap().build(None).unwrap();
+    let dst = ProjectionSpec::parse("latlong")
+        .unwrap()
+        .build(None)
+        .unwrap();
     let (mut compared, mut worst) = (0, 0.0f64);
     for y in 1..127 {
         for x in 0..256 {
-            let k = ((y * 256 + x) * 6) as usize;
-            let df = decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0));
-            let m = [0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64));
-            let (Some(df), Some(dm)) = (df, decode(m)) else {
+            let (Some(df), Some(dm)) = (ffmpeg_dir(&ff, 256, x, y), mirrorball_dir(img, x, y))
+            else {
                 panic!("texel ({x}, {y}) is black");
             };
             let tol = pixel_angle(&dst, x, y, 256, 128);

@@ -409,7 +409,10 @@ fn v360_options_give_v360s_pixels_in_yuv420p_and_yuv420p10le() {
                 psnr_words(&ours, &theirs, max)
             };
             eprintln!("{pix_fmt}: --v360 {options}: {db:.1} dB against v360");
-            assert!(db > 38.0, "{pix_fmt}: --v360 {options}: {db:.1} dB against v360");
+            assert!(
+                db > 38.0,
+                "{pix_fmt}: --v360 {options}: {db:.1} dB against v360"
+            );
         }
     }
 }
