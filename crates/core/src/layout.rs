@@ -841,12 +841,7 @@ fn unpack_cells(
     }
     let n = cells.face_size(w, h).ok_or_else(|| {
         let (a, b) = cells.extent(1);
-        let shape = if cells.eac_pad {
-            "(3n + 4)x(2n + 8) for faces of n texels".to_string()
-        } else {
-            format!("{}n x {}n", a, b)
-        };
-        format!("a {cells} layout needs a picture of {shape}; {w}x{h} is not")
+        format!("a {cells} layout needs a picture of {a}n x {b}n; {w}x{h} is not")
     })?;
     let mut faces = vec![Image::new(n, n, image.channels()); 6];
     cells.each_texel(n, |i, px, py, fx, fy| {
@@ -868,38 +863,18 @@ fn unpack_frame(
     })?;
     let ch = image.channels();
     let mut faces = vec![Image::new(n, n, ch); 6];
+    let mut texel = [0.0f32; 4];
     for (i, face) in cells.faces.iter().enumerate() {
         let layer = &mut faces[*face as usize];
         for y in 0..n {
             for x in 0..n {
                 let (px, py) = cells.frame_position((w, h), i, n, x, y);
-                layer.set(x, y, &bilinear(image, px - 0.5, py - 0.5)[..ch]);
+                image.bilinear_clamped((px - 0.5, py - 0.5), (0, h), &mut texel[..ch]);
+                layer.set(x, y, &texel[..ch]);
             }
         }
     }
     EnvMap::new(projection, faces).map_err(|e| e.to_string())
-}
-
-/// `image` read bilinearly at `(x, y)` in texel-centre coordinates (texel `(0, 0)`'s centre
-/// at `(0, 0)`), clamped at the edges.
-fn bilinear(image: &Image, x: f64, y: f64) -> [f32; 4] {
-    let (w, h) = (image.width() as i64, image.height() as i64);
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let at = |dx: i64, dy: i64| {
-        let (xi, yi) = (
-            (x0 as i64 + dx).clamp(0, w - 1) as u32,
-            (y0 as i64 + dy).clamp(0, h - 1) as u32,
-        );
-        image.get(xi, yi)
-    };
-    let mut out = [0.0f32; 4];
-    let (a, b, c, d) = (at(0, 0), at(1, 0), at(0, 1), at(1, 1));
-    for k in 0..image.channels().min(4) {
-        out[k] =
-            (a[k] * (1.0 - fx) + b[k] * fx) * (1.0 - fy) + (c[k] * (1.0 - fx) + d[k] * fx) * fy;
-    }
-    out
 }
 
 /// How one picture holds a stereo pair: FFmpeg `v360`'s `in_stereo`/`out_stereo`
