@@ -82,6 +82,17 @@ fn ffmpeg_dir(ff: &[u8], w: u32, x: u32, y: u32) -> Option<DVec3> {
     decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
 }
 
+/// `mirrorball convert INPUT OUT ARGS --precision 16 -q` (a 16-bit PNG), read back: its
+/// one picture.
+fn convert_16(input: &Path, out: &Path, args: &[&str]) -> mirrorball_core::Image {
+    let mut all = vec!["convert", input.to_str().unwrap(), out.to_str().unwrap()];
+    all.extend(args);
+    all.extend(["--precision", "16", "-q"]);
+    ok(&all);
+    let mut read = mirrorball_io::read(out, &Default::default()).unwrap();
+    read.layers.swap_remove(0)
+}
+
 /// The direction coded at `(x, y)` of mirrorball's 16-bit PNG, as read (linear values).
 fn mirrorball_dir(img: &mirrorball_core::Image, x: u32, y: u32) -> Option<DVec3> {
     decode([0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64)))
@@ -187,22 +198,8 @@ fn compare(dir: &Path, case: &Case) {
     assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
     let out = dir.join("out_mb.png");
     let size = case.size.to_string();
-    ok(&[
-        "convert",
-        for_mb.to_str().unwrap(),
-        out.to_str().unwrap(),
-        "--from",
-        case.from,
-        "--to",
-        case.to,
-        "--size",
-        &size,
-        "--precision",
-        "16",
-        "-q",
-    ]);
-    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
-    let img = &mb.layers[0];
+    let args = ["--from", case.from, "--to", case.to, "--size", &size];
+    let img = &convert_16(&for_mb, &out, &args);
     assert_eq!((img.width(), img.height()), (w, h), "{}", case.to);
 
     let (mut compared, mut inside, mut worst) = (0, 0, 0.0f64);
@@ -364,10 +361,7 @@ fn compare_packed(dir: &Path, case: &Packed) {
     assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
     let out = dir.join("out_mb.png");
     let size = case.size.to_string();
-    ok(&[
-        "convert",
-        for_mb.to_str().unwrap(),
-        out.to_str().unwrap(),
+    let args = [
         "--from",
         "latlong",
         "--to",
@@ -376,12 +370,8 @@ fn compare_packed(dir: &Path, case: &Packed) {
         case.layout,
         "--size",
         &size,
-        "--precision",
-        "16",
-        "-q",
-    ]);
-    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
-    let img = &mb.layers[0];
+    ];
+    let img = &convert_16(&for_mb, &out, &args);
     assert_eq!((img.width(), img.height()), (w, h), "{}", case.layout);
     let ffd = |x: u32, y: u32| ffmpeg_dir(&ff, w, x, y);
     let (mut compared, mut worst) = (0, 0.0f64);
@@ -517,9 +507,6 @@ fn compare_pair(dir: &Path, case: &Pair) {
     let out = dir.join("pair_out.png");
     let size = case.size.to_string();
     let mut args = vec![
-        "convert",
-        for_mb.to_str().unwrap(),
-        out.to_str().unwrap(),
         "--from",
         "latlong",
         "--in-stereo",
@@ -530,16 +517,11 @@ fn compare_pair(dir: &Path, case: &Pair) {
         case.out_stereo,
         "--size",
         &size,
-        "--precision",
-        "16",
-        "-q",
     ];
     if let Some(l) = case.layout {
         args.extend(["--layout", l]);
     }
-    ok(&args);
-    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
-    let img = &mb.layers[0];
+    let img = &convert_16(&for_mb, &out, &args);
     assert_eq!((img.width(), img.height()), (fw, fh), "{filter}");
     let ffd = |x: u32, y: u32| ffmpeg_dir(&ff, fw, x, y);
     let (mut compared, mut worst) = (0, 0.0f64);
@@ -685,18 +667,7 @@ fn compare_options(dir: &Path, from: &str, in_size: (u32, u32), options: &str) {
     let ff = v360_raw(&for_ff, &filter);
     let out = dir.join("opt_out.png");
     // The input's projection is the options' own: no --from.
-    ok(&[
-        "convert",
-        for_mb.to_str().unwrap(),
-        out.to_str().unwrap(),
-        "--v360",
-        options,
-        "--precision",
-        "16",
-        "-q",
-    ]);
-    let img = mirrorball_io::read(&out, &Default::default()).unwrap();
-    let img = &img.layers[0];
+    let img = &convert_16(&for_mb, &out, &["--v360", options]);
     let (w, h) = (img.width(), img.height());
     assert_eq!(
         ff.len(),
@@ -873,7 +844,7 @@ fn eac_frames_of_any_size() {
         "--precision",
         "16",
     ]);
-    assert!(o.contains("eac"), "{o}");
+    assert!(o.contains("fits eac"), "{o}");
     let img = mirrorball_io::read(&out, &Default::default()).unwrap();
     let img = &img.layers[0];
     let dst = ProjectionSpec::parse("latlong")
