@@ -104,7 +104,13 @@ impl Mapping {
             Projection::Cube(_) if layout == Some(Layout::Cells(Mapping::CUBE_CELLS)) => {
                 Some(Mapping::Cube)
             }
-            Projection::Eac(_) if matches!(layout, None | Some(Layout::Cells(CubeCells::EAC))) => {
+            // v360's eac at any size (`CubeCells::eac_frame`).
+            Projection::Eac(_)
+                if matches!(
+                    layout,
+                    None | Some(Layout::Cells(CubeCells { eac_pad: true, .. }))
+                ) =>
+            {
                 Some(Mapping::Eac)
             }
             _ => None,
