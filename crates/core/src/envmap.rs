@@ -481,6 +481,23 @@ pub(crate) fn bilinear(
     }
 }
 
+/// The four texels and weights of [`bilinear`]'s lookup at `(layer, uv)` in a map of `proj`
+/// whose layers are `w`×`h`: inside the layer the 2×2 block and its bilinear weights, at an
+/// edge the [`seam_taps`] (the weights in both cases `(1−fx)(1−fy), fx(1−fy), (1−fx)fy,
+/// fx·fy`).
+pub(crate) fn lookup_taps(
+    proj: &Projection,
+    layer: usize,
+    (w, h): (u32, u32),
+    uv: DVec2,
+) -> [(usize, u32, u32, f32); 4] {
+    let x = uv.x * w as f64 - 0.5;
+    let y = uv.y * h as f64 - 0.5;
+    let (x0, y0) = (floor_i(x), floor_i(y));
+    let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
+    seam_taps(proj, layer, (w, h), (x0, y0), (fx, fy))
+}
+
 /// [`bilinear`] at `f32` coordinates for `C`-channel images, for the conversion's batch path.
 #[inline(always)]
 pub(crate) fn bilinear32<const C: usize>(

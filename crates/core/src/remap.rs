@@ -20,7 +20,7 @@
 use crate::codes::{CodeKind, CodeWidth, Float, Narrow, Wide};
 use crate::envmap::{bilinear_blend, bilinear_mix, lerp4, seam_taps};
 use crate::projection::{Projection, WorldProjection};
-use crate::resample::{Job, PointScratch, Pyramid, PyramidPlan, RowScratch};
+use crate::resample::{Job, PointScratch, Pyramid, PyramidPlan, PyramidSpare, RowScratch};
 use crate::{Codes, EnvMap, Image, ResampleOptions};
 use mirrorball_simd::{prefetch, F32x4};
 use rayon::prelude::*;
@@ -157,8 +157,9 @@ pub struct Remap {
     /// `Some((width, height))` where the output is one picture laid out from another
     /// plan's layers ([`Remap::laid_out`]), not the projection's layers.
     picture: Option<(u32, u32)>,
-    /// The last applied source's mip levels, kept to be filled again by the next.
-    spare: Mutex<Vec<Vec<Image>>>,
+    /// The last applied source's mip levels (and blended base), kept to be filled again by
+    /// the next.
+    spare: Mutex<PyramidSpare>,
 }
 
 impl fmt::Debug for Remap {
@@ -237,7 +238,7 @@ impl Remap {
             row_starts,
             pyramid,
             picture: None,
-            spare: Mutex::new(Vec::new()),
+            spare: Mutex::new(PyramidSpare::default()),
         }
     }
 
@@ -345,7 +346,7 @@ impl Remap {
             row_starts: vec![starts],
             pyramid: self.pyramid.clone(),
             picture: Some((pw as u32, ph as u32)),
-            spare: Mutex::new(Vec::new()),
+            spare: Mutex::new(PyramidSpare::default()),
         }
     }
 
@@ -644,8 +645,8 @@ impl<'a> RemapRows<'a> {
 impl Drop for RemapRows<'_> {
     /// Gives the mip levels back to the plan, for the next source to fill.
     fn drop(&mut self) {
-        let levels = self.pyr.take_levels();
-        *self.remap.spare.lock().unwrap_or_else(|e| e.into_inner()) = levels;
+        let spare = self.pyr.take_spare();
+        *self.remap.spare.lock().unwrap_or_else(|e| e.into_inner()) = spare;
     }
 }
 

@@ -17,7 +17,7 @@
 
 use crate::codes::{CodeKind, CodeWidth, Narrow, Wide};
 use crate::envmap::{bilinear32, bilinear32_quad, bilinear_corner, bilinear_corner4, lerp_quad};
-use crate::projection::{DirRun, Lookup, Projection, WorldProjection};
+use crate::projection::{DirRun, Lookup, OverlapBlend, Projection, WorldProjection};
 use crate::{Codes, EnvMap, Image};
 use glam::{DMat3, DVec3};
 use mirrorball_simd::{prefetch as prefetch_line, F32x4, M32x4};
@@ -193,11 +193,19 @@ const BILINEAR_MAX_RATIO: f64 = 4.0;
 /// (cheap, and exact enough for a bilinear read). `mirrorball-filter`'s `MipChain` is the
 /// public, energy-exact pyramid (exact texel solid angles, odd sizes split fractionally).
 ///
-/// Its base is the source's layers, or what [`WorldProjection::blend_overlap`] makes of them
-/// (a dual fisheye's overlap blended): every lookup of the resampler and of `Remap` reads
-/// here, so the blend reaches them all and no other projection's reads change.
+/// Its base is the source's layers, or what the plan's [`OverlapBlend`] makes of them (a
+/// dual fisheye's overlap blended): every lookup of the resampler and of `Remap` reads here,
+/// so the blend reaches them all and no other projection's reads change.
 pub(crate) struct Pyramid<'a> {
     base: std::borrow::Cow<'a, [Image]>,
+    levels: Vec<Vec<Image>>,
+}
+
+/// A pyramid's memory, given back by [`Pyramid::take_spare`] for the next source of the
+/// same shape to fill: the blended base (where the projection blends) and the levels.
+#[derive(Default)]
+pub(crate) struct PyramidSpare {
+    base: Vec<Image>,
     levels: Vec<Vec<Image>>,
 }
 
@@ -209,23 +217,27 @@ impl<'a> Pyramid<'a> {
             src.layers().len(),
             depth,
         );
-        Pyramid::planned(src, &plan, Vec::new())
+        Pyramid::planned(src, &plan, PyramidSpare::default())
     }
 
-    /// The pyramid of `src` with `plan`'s block weights (made for `src`'s projection and
-    /// size), filling the images of `spare` (an earlier pyramid's levels, from
-    /// [`Pyramid::take_levels`]) where their shapes fit, so that a frame loop allocates
+    /// The pyramid of `src` with `plan`'s blend and block weights (made for `src`'s
+    /// projection and size), filling the images of `spare` (an earlier pyramid's, from
+    /// [`Pyramid::take_spare`]) where their shapes fit, so that a frame loop allocates
     /// nothing.
-    pub(crate) fn planned(
-        src: &'a EnvMap,
-        plan: &PyramidPlan,
-        spare: Vec<Vec<Image>>,
-    ) -> Pyramid<'a> {
-        let base = match src.projection().blend_overlap(src.layers()) {
-            Some(blended) => std::borrow::Cow::Owned(blended),
+    pub(crate) fn planned(src: &'a EnvMap, plan: &PyramidPlan, spare: PyramidSpare) -> Pyramid<'a> {
+        let base = match &plan.blend {
+            Some(blend) => {
+                let mut base = spare.base;
+                base.truncate(1);
+                if base.is_empty() {
+                    base.push(Image::new(0, 0, src.channels()));
+                }
+                blend.apply_into(&src.layers()[0], &mut base[0]);
+                std::borrow::Cow::Owned(base)
+            }
             None => std::borrow::Cow::Borrowed(src.layers()),
         };
-        Pyramid::build(base, None, plan, spare)
+        Pyramid::build(base, None, plan, spare.levels)
     }
 
     /// [`Pyramid::planned`] of a one-layer source held as codes: the levels below the base
@@ -235,9 +247,14 @@ impl<'a> Pyramid<'a> {
     pub(crate) fn planned_codes(
         src: Codes<'_>,
         plan: &PyramidPlan,
-        spare: Vec<Vec<Image>>,
+        spare: PyramidSpare,
     ) -> Pyramid<'a> {
-        Pyramid::build(std::borrow::Cow::Owned(Vec::new()), Some(src), plan, spare)
+        Pyramid::build(
+            std::borrow::Cow::Owned(Vec::new()),
+            Some(src),
+            plan,
+            spare.levels,
+        )
     }
 
     fn build(
@@ -305,9 +322,17 @@ impl<'a> Pyramid<'a> {
         Pyramid { base, levels }
     }
 
-    /// The levels below the base, taken out for [`Pyramid::planned`] to fill again.
-    pub(crate) fn take_levels(&mut self) -> Vec<Vec<Image>> {
-        std::mem::take(&mut self.levels)
+    /// The pyramid's memory (its levels, and its base where it made one), taken out for
+    /// [`Pyramid::planned`] to fill again.
+    pub(crate) fn take_spare(&mut self) -> PyramidSpare {
+        let base = match std::mem::take(&mut self.base) {
+            std::borrow::Cow::Owned(b) => b,
+            std::borrow::Cow::Borrowed(_) => Vec::new(),
+        };
+        PyramidSpare {
+            base,
+            levels: std::mem::take(&mut self.levels),
+        }
     }
 
     #[inline]
@@ -332,6 +357,8 @@ fn half_extent(w: u32, h: u32) -> (u32, u32) {
 /// ([`crate::Remap`]) keeps one, so that no frame works out a direction.
 #[derive(Clone)]
 pub(crate) struct PyramidPlan {
+    /// The projection's overlap blend at the base's size, where it has one.
+    blend: Option<OverlapBlend>,
     /// Per level (the first is half the base), per layer, one entry per texel of that level.
     levels: Vec<Vec<Vec<[f32; 4]>>>,
 }
@@ -341,6 +368,7 @@ impl PyramidPlan {
     /// `(w, h)` texels in `proj`.
     pub(crate) fn new(proj: &Projection, (w, h): (u32, u32), layers: usize, depth: usize) -> Self {
         let mut levels = Vec::new();
+        let (w0, h0) = (w, h);
         let (mut w, mut h) = (w.max(1), h.max(1));
         for _ in 0..depth {
             if w == 1 && h == 1 {
@@ -353,12 +381,20 @@ impl PyramidPlan {
             );
             (w, h) = half_extent(w, h);
         }
-        PyramidPlan { levels }
+        let blend = proj.overlap_blend((w0, h0), layers);
+        PyramidPlan { blend, levels }
     }
 
     /// Bytes the plan occupies.
     pub(crate) fn memory_bytes(&self) -> usize {
-        self.levels.iter().flatten().map(|l| l.len() * 16).sum()
+        let blend = self.blend.as_ref().map_or(0, OverlapBlend::memory_bytes);
+        blend
+            + self
+                .levels
+                .iter()
+                .flatten()
+                .map(|l| l.len() * 16)
+                .sum::<usize>()
     }
 }
 

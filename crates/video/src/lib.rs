@@ -61,6 +61,27 @@ pub struct VideoRequest {
 /// Frames in flight between two threads.
 const IN_FLIGHT: usize = 2;
 
+/// Frames' planes handed back by the stage that used them to the stage that fills them,
+/// so that a long video allocates (and the kernel zeroes) no fresh pages a frame.
+#[derive(Clone, Default)]
+struct Pool(Arc<std::sync::Mutex<Vec<Box<Planes>>>>);
+
+impl Pool {
+    /// Planes to fill: one handed back, else new.
+    fn take(&self) -> Box<Planes> {
+        let mut held = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        held.pop().unwrap_or_default()
+    }
+
+    /// Planes done with, kept for the next frame (as many as can be in flight).
+    fn give(&self, planes: Box<Planes>) {
+        let mut held = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if held.len() <= 2 * IN_FLIGHT + 2 {
+            held.push(planes);
+        }
+    }
+}
+
 /// What the reader hands on: a decoded frame, or a packet of a stream copied as it is.
 enum Item {
     Frame {
@@ -395,10 +416,20 @@ fn transcode(
         durations: std::collections::HashMap::new(),
         output: output.to_string(),
     };
+    let (decoded, converted) = (Pool::default(), Pool::default());
     std::thread::scope(|s| {
-        let converting = s.spawn(move || convert_stage(conv, rx1, tx2));
-        let writing = s.spawn(move || writer.run(rx2, &counter));
-        let read = read_stage(&mut ictx, decoder, (input, vindex, fmt), &map, tx1);
+        let pools = (decoded.clone(), converted.clone());
+        let converting = s.spawn(move || convert_stage(conv, rx1, tx2, pools));
+        let done = converted.clone();
+        let writing = s.spawn(move || writer.run(rx2, &counter, &done));
+        let read = read_stage(
+            &mut ictx,
+            decoder,
+            (input, vindex, fmt),
+            &map,
+            tx1,
+            &decoded,
+        );
         let panicked = |_| Error::system("a video thread stopped unexpectedly");
         let converted = converting.join().map_err(panicked)?;
         let written = writing.join().map_err(panicked)?;
@@ -416,6 +447,7 @@ fn read_stage(
     (input, vindex, fmt): (&str, usize, PlaneFormat),
     map: &[Option<usize>],
     tx: SyncSender<Item>,
+    pool: &Pool,
 ) -> Result<(), Error> {
     let mut frame = frame::Video::empty();
     let mut n = 0u64;
@@ -444,7 +476,8 @@ fn read_stage(
                     now.0, now.1, now.2, first.0, first.1, first.2
                 )));
             }
-            let planes = copy_planes(&frame, fmt);
+            let mut planes = pool.take();
+            copy_planes(&frame, fmt, &mut planes);
             // SAFETY: the frame is valid; `pkt_duration` is a plain field of FFmpeg 5's
             // AVFrame (the decoder's duration of the frame, in the stream's time base).
             #[allow(deprecated)]
@@ -452,7 +485,7 @@ fn read_stage(
             let item = Item::Frame {
                 pts: frame.timestamp(),
                 duration,
-                planes: Box::new(planes),
+                planes,
             };
             if tx.send(item).is_err() {
                 return Ok(false);
@@ -491,38 +524,46 @@ fn read_stage(
     Ok(())
 }
 
-/// The frame's three planes, rows packed.
-fn copy_planes(frame: &frame::Video, fmt: PlaneFormat) -> Planes {
-    let mut planes = Planes::default();
+/// The frame's three planes, rows packed, into `planes` (its memory reused).
+fn copy_planes(frame: &frame::Video, fmt: PlaneFormat, planes: &mut Planes) {
     let extent = (frame.width(), frame.height());
     for k in 0..3 {
         let (pw, ph) = fmt.plane_extent(k, extent).unwrap_or(extent);
         let row = pw as usize * fmt.bytes();
         let stride = frame.stride(k);
         let data = frame.data(k);
-        let mut out = Vec::with_capacity(row * ph as usize);
+        let out = &mut planes.data[k];
+        out.clear();
         for y in 0..ph as usize {
             out.extend_from_slice(&data[y * stride..y * stride + row]);
         }
-        planes.data[k] = out;
         planes.extent[k] = (pw, ph);
     }
-    planes
 }
 
 /// Converts each frame; passes copied packets on.
-fn convert_stage(conv: &Converter, rx: Receiver<Item>, tx: SyncSender<Item>) -> Result<(), Error> {
+fn convert_stage(
+    conv: &Converter,
+    rx: Receiver<Item>,
+    tx: SyncSender<Item>,
+    (decoded, converted): (Pool, Pool),
+) -> Result<(), Error> {
     for item in rx {
         let item = match item {
             Item::Frame {
                 pts,
                 duration,
                 planes,
-            } => Item::Frame {
-                pts,
-                duration,
-                planes: Box::new(conv.convert(&planes)?),
-            },
+            } => {
+                let mut out = converted.take();
+                conv.convert_into(&planes, &mut out)?;
+                decoded.give(planes);
+                Item::Frame {
+                    pts,
+                    duration,
+                    planes: out,
+                }
+            }
             copied => copied,
         };
         if tx.send(item).is_err() {
@@ -554,7 +595,7 @@ impl Writer {
         Error::system(format!("{}: {what}: {e}", self.output))
     }
 
-    fn run(mut self, rx: Receiver<Item>, counter: &AtomicU64) -> Result<u64, Error> {
+    fn run(mut self, rx: Receiver<Item>, counter: &AtomicU64, done: &Pool) -> Result<u64, Error> {
         for item in rx {
             match item {
                 Item::Frame {
@@ -585,6 +626,7 @@ impl Writer {
                     self.packets()?;
                     self.frames += 1;
                     counter.fetch_add(1, Ordering::Relaxed);
+                    done.give(planes);
                 }
                 Item::Copied {
                     mut packet,

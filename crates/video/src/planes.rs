@@ -8,12 +8,14 @@
 //! comes out black and grey instead of green; the plan's weights sum to one, so the
 //! neutral value added back leaves every covered texel as the codes' own weighted mean.
 
+use mirrorball::frames::packing::{Packing, Picture, PlaneCodes};
 use mirrorball::load;
 use mirrorball::{Error, ProjSpec};
 use mirrorball_core::{
     EnvMap, Image, Layout, Projection, Remap, ResampleOptions, Stereo, WorldProjection,
 };
 use rayon::prelude::*;
+use std::sync::Mutex;
 
 /// How a planar YUV pixel format holds a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -129,10 +131,21 @@ impl Reading {
     }
 }
 
-/// One plane's plan: the conversion of each eye's layers.
+/// One plane's plan: the conversion of each eye's layers, and where one eye becomes one
+/// picture, how its rows are encoded as they are made.
 struct PlanePlan {
     remap: Remap,
     neutral: f32,
+    packed: Option<Packed>,
+}
+
+/// A plane made and encoded row by row, with no map of the layers and no packed float
+/// picture: the packing's rows from the plan's rows (strips, crosses, one layer), or turned
+/// cells (EAC, v360's cells) from the plan laid out as the picture
+/// ([`Packing::lay_out`]).
+struct Packed {
+    packing: Packing,
+    laid: Option<(Remap, Picture)>,
 }
 
 /// The conversion of every frame: a plan for Y and one for U and V (their extent), the
@@ -150,6 +163,8 @@ pub struct Converter {
     chroma_shift: (u32, u32),
     /// What was decided about the input (its projection, layout and eyes), for people.
     pub said: String,
+    /// Each plane's floats of the last frame, filled again by the next.
+    scratch: Mutex<[Option<Image>; 3]>,
 }
 
 /// What the output is: its projection, size (`None`: the input's natural size, made even),
@@ -182,6 +197,18 @@ impl Converter {
         extent: (u32, u32),
         reading: Reading,
         target: &Target,
+    ) -> Result<Converter, Error> {
+        Converter::planned(format, extent, reading, target, true)
+    }
+
+    /// [`Converter::new`]; `by_rows`: planes of one eye made and encoded row by row
+    /// ([`Packed`]) where the layout allows, else always as maps, packed and written.
+    fn planned(
+        format: PlaneFormat,
+        extent: (u32, u32),
+        reading: Reading,
+        target: &Target,
+        by_rows: bool,
     ) -> Result<Converter, Error> {
         let input = &reading.input;
         let chroma = format.plane_extent(1, extent).ok_or_else(|| {
@@ -227,30 +254,54 @@ impl Converter {
                 picture.0, picture.1, format.name
             )));
         }
+        // One eye in and out: each plane's rows encoded as they are made ([`Packed`]).
+        let mono = by_rows && target.stereo.eyes() == 1 && luma.len() == 1;
+        let packing = |l: (u32, u32)| mono.then(|| Packing::new(target.layout, dst, l)).flatten();
+        let luma_packing = packing(layer);
         // The colour planes' layers at their own size where the layout halves with them;
-        // else (EAC's fixed border) made at the picture's size and halved.
+        // where it does not (EAC's fixed border), at their own size still where the
+        // packing halves (4:2:0 of v360's cells: each colour texel shows its block's
+        // first face texel, halved); else made at the picture's size and halved.
         let mut clayer = (layer.0 >> sx, layer.1 >> sy);
         let cpacked = packed_extent(target.layout, layers, clayer);
         let halves =
             target.stereo.extent(cpacked.0, cpacked.1) == (picture.0 >> sx, picture.1 >> sy);
-        let chroma_shift = if halves {
+        let chroma_packing = if halves {
+            packing(clayer)
+        } else if sx == sy {
+            luma_packing.as_ref().and_then(|p| p.halved(sx))
+        } else {
+            None
+        };
+        let chroma_shift = if halves || chroma_packing.is_some() {
             (0, 0)
         } else {
             clayer = layer;
             (sx, sy)
         };
-        let plan = |src: &EnvMap, out: (u32, u32), k: usize| PlanePlan {
-            remap: Remap::with_extent(
+        let plan = |src: &EnvMap, out: (u32, u32), k: usize, packing: Option<Packing>| {
+            let remap = Remap::with_extent(
                 *src.projection(),
                 (src.width(), src.height()),
                 src.layers().len(),
                 dst,
                 out,
                 &target.resample,
-            ),
-            neutral: format.neutral(k),
+            );
+            let packed = packing.map(|packing| Packed {
+                laid: (!packing.along_rows()).then(|| packing.lay_out(&remap, &dst)),
+                packing,
+            });
+            PlanePlan {
+                remap,
+                neutral: format.neutral(k),
+                packed,
+            }
         };
-        let plans = [plan(src, layer, 0), plan(csrc, clayer, 1)];
+        let plans = [
+            plan(src, layer, 0, luma_packing),
+            plan(csrc, clayer, 1, chroma_packing),
+        ];
         // From here every frame is read as the first was: the projection decided.
         let reading = Reading {
             from: Some(
@@ -268,6 +319,7 @@ impl Converter {
             out_extent: picture,
             chroma_shift,
             said,
+            scratch: Mutex::new(Default::default()),
         })
     }
 
@@ -279,17 +331,45 @@ impl Converter {
     /// Converts one frame, plane by plane.
     pub fn convert(&self, frame: &Planes) -> Result<Planes, Error> {
         let mut out = Planes::default();
+        self.convert_into(frame, &mut out)?;
+        Ok(out)
+    }
+
+    /// Converts one frame, plane by plane, into `out` (its memory reused where the planes
+    /// are made row by row).
+    pub fn convert_into(&self, frame: &Planes, out: &mut Planes) -> Result<(), Error> {
+        let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        let failed =
+            |e: mirrorball_core::RemapError| Error::input(format!("{}: {e}", self.reading.input));
         for k in 0..3 {
             let plan = &self.plans[k.min(1)];
             let (w, h) = frame.extent[k];
-            let img = self.read_plane(&frame.data[k], (w, h), plan.neutral);
-            let (eyes, _) = self.reading.eyes(img)?;
+            let img = scratch[k].take();
+            let img = self.read_plane(&frame.data[k], (w, h), plan.neutral, img);
+            let (mut eyes, _) = self.reading.eyes(img)?;
+            if let (Some(packed), 1) = (&plan.packed, eyes.len()) {
+                let codes = self.plane_codes(plan.neutral);
+                let eye = &eyes[0];
+                match &packed.laid {
+                    Some((laid, picture)) => {
+                        let rows = laid.rows(eye).map_err(failed)?;
+                        picture.encode_rows(codes, &rows, &mut out.data[k]);
+                    }
+                    None => {
+                        let rows = plan.remap.rows(eye).map_err(failed)?;
+                        packed.packing.encode_rows(codes, &rows, &mut out.data[k]);
+                    }
+                }
+                out.extent[k] = packed.packing.extent();
+                let mut layers = eyes.swap_remove(0).into_layers();
+                if layers.len() == 1 {
+                    scratch[k] = Some(layers.swap_remove(0));
+                }
+                continue;
+            }
             let mut pictures = Vec::with_capacity(eyes.len());
             for eye in &eyes {
-                let made = plan
-                    .remap
-                    .apply(eye)
-                    .map_err(|e| Error::input(format!("{}: {e}", self.reading.input)))?;
+                let made = plan.remap.apply(eye).map_err(failed)?;
                 pictures.push(if made.layers().len() == 1 {
                     made.layers()[0].clone()
                 } else {
@@ -316,40 +396,58 @@ impl Converter {
             out.extent[k] = (picture.width(), picture.height());
             out.data[k] = self.write_plane(&picture, plan.neutral);
         }
-        Ok(out)
+        Ok(())
     }
 
-    /// A plane's codes as floats less `neutral`.
-    fn read_plane(&self, bytes: &[u8], (w, h): (u32, u32), neutral: f32) -> Image {
-        let mut img = Image::new(w, h, 1);
+    /// How plane values with `neutral` become this format's codes.
+    fn plane_codes(&self, neutral: f32) -> PlaneCodes {
+        PlaneCodes {
+            bytes: self.format.bytes(),
+            neutral,
+            max: self.format.max_code(),
+        }
+    }
+
+    /// A plane's codes as floats less `neutral`, into `img`'s memory where it fits.
+    fn read_plane(
+        &self,
+        bytes: &[u8],
+        (w, h): (u32, u32),
+        neutral: f32,
+        img: Option<Image>,
+    ) -> Image {
+        let mut img = img
+            .filter(|i| (i.width(), i.height(), i.channels()) == (w, h, 1))
+            .unwrap_or_else(|| Image::new(w, h, 1));
         let data = img.data_mut();
         if self.format.bytes() == 1 {
-            data.par_iter_mut()
-                .zip(bytes.par_iter())
-                .for_each(|(v, &b)| *v = b as f32 - neutral);
+            data.par_chunks_mut(1 << 16)
+                .zip(bytes.par_chunks(1 << 16))
+                .for_each(|(v, b)| {
+                    for (v, &b) in v.iter_mut().zip(b) {
+                        *v = b as f32 - neutral;
+                    }
+                });
         } else {
-            data.par_iter_mut()
-                .zip(bytes.par_chunks_exact(2))
-                .for_each(|(v, b)| *v = u16::from_le_bytes([b[0], b[1]]) as f32 - neutral);
+            data.par_chunks_mut(1 << 16)
+                .zip(bytes.par_chunks(2 << 16))
+                .for_each(|(v, b)| {
+                    for (v, b) in v.iter_mut().zip(b.chunks_exact(2)) {
+                        *v = u16::from_le_bytes([b[0], b[1]]) as f32 - neutral;
+                    }
+                });
         }
         img
     }
 
     /// A converted plane as codes: the neutral value added back, rounded, clamped.
     fn write_plane(&self, img: &Image, neutral: f32) -> Vec<u8> {
-        let max = self.format.max_code();
-        let code = |v: f32| (v + neutral).round().clamp(0.0, max);
+        let codes = self.plane_codes(neutral);
         let data = img.data();
-        let mut out = vec![0u8; data.len() * self.format.bytes()];
-        if self.format.bytes() == 1 {
-            out.par_iter_mut()
-                .zip(data.par_iter())
-                .for_each(|(o, &v)| *o = code(v) as u8);
-        } else {
-            out.par_chunks_exact_mut(2)
-                .zip(data.par_iter())
-                .for_each(|(o, &v)| o.copy_from_slice(&(code(v) as u16).to_le_bytes()));
-        }
+        let mut out = vec![0u8; data.len() * codes.bytes];
+        out.par_chunks_mut(codes.bytes << 16)
+            .zip(data.par_chunks(1 << 16))
+            .for_each(|(o, v)| codes.encode(v, o));
         out
     }
 }
@@ -393,5 +491,122 @@ mod tests {
             PlaneFormat::named("yuv420p10le").unwrap().max_code(),
             1023.0
         );
+    }
+
+    /// A frame of codes, each plane its own smooth pattern over the whole range.
+    fn frame(fmt: PlaneFormat, (w, h): (u32, u32)) -> Planes {
+        let mut f = Planes::default();
+        for k in 0..3 {
+            let (pw, ph) = fmt.plane_extent(k, (w, h)).unwrap();
+            let max = fmt.max_code();
+            let codes = (0..pw * ph).map(|i| {
+                let (x, y) = ((i % pw) as f32 / pw as f32, (i / pw) as f32 / ph as f32);
+                let t = (6.0 * x + k as f32).sin() * (5.0 * y).cos();
+                ((0.5 + 0.45 * t) * max).round() as u32
+            });
+            f.data[k] = if fmt.bytes() == 1 {
+                codes.map(|c| c as u8).collect()
+            } else {
+                codes.flat_map(|c| (c as u16).to_le_bytes()).collect()
+            };
+            f.extent[k] = (pw, ph);
+        }
+        f
+    }
+
+    /// Planes made and encoded row by row (one eye) are the bytes the general path makes:
+    /// each plane's layers made as a map, packed by `Layout::pack`, written as codes. EAC's
+    /// 4:2:0 colour planes, made at their own size through the halved packing, are within
+    /// a code or two of the general path's (the picture's made at full size, then each
+    /// 2×2 block averaged).
+    #[test]
+    fn planes_encoded_as_rows_are_made_are_the_packed_maps_codes() {
+        let ll = ProjSpec::parse("latlong").unwrap();
+        for fmt in ["yuv420p", "yuv444p", "yuv420p10le"] {
+            let fmt = PlaneFormat::named(fmt).unwrap();
+            for (to, layout) in [
+                ("cube", "c3x2"),
+                ("cube", "hstrip"),
+                ("eac", "eac"),
+                ("latlong", "c3x2"),
+            ] {
+                let target = Target {
+                    dst: ProjSpec::parse(to).unwrap().build(None).unwrap(),
+                    size: Some(if to == "latlong" { 64 } else { 24 }),
+                    layout: layout.parse().unwrap(),
+                    stereo: Stereo::Mono,
+                    resample: ResampleOptions::default(),
+                };
+                let reading = || Reading {
+                    input: "test".into(),
+                    from: Some(ll.clone()),
+                    layout: None,
+                    stereo: (Stereo::Mono, 1),
+                };
+                let extent = (96, 48);
+                let fast = Converter::new(fmt, extent, reading(), &target).unwrap();
+                let general = Converter::planned(fmt, extent, reading(), &target, false).unwrap();
+                let what = format!("{} {to} {layout}", fmt.name);
+                assert!(fast.plans[0].packed.is_some(), "{what}");
+                let f = frame(fmt, extent);
+                // Twice: the second frame reads into the first one's memory.
+                for _ in 0..2 {
+                    let (a, b) = (fast.convert(&f).unwrap(), general.convert(&f).unwrap());
+                    assert_eq!(a.extent, b.extent, "{what}");
+                    for k in 0..3 {
+                        let (a, b) = (&a.data[k], &b.data[k]);
+                        assert_eq!(a.len(), b.len(), "{what}");
+                        let halved = k > 0 && to == "eac" && fmt.shift == (1, 1);
+                        if !halved {
+                            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+                            assert_eq!(differ, 0, "{what}: plane {k}, {differ} bytes differ");
+                            continue;
+                        }
+                        let codes = |v: &[u8]| -> Vec<f64> {
+                            match fmt.bytes() {
+                                1 => v.iter().map(|&c| c as f64).collect(),
+                                _ => v
+                                    .chunks_exact(2)
+                                    .map(|c| u16::from_le_bytes([c[0], c[1]]) as f64)
+                                    .collect(),
+                            }
+                        };
+                        let (a, b) = (codes(a), codes(b));
+                        let scale = fmt.max_code() as f64 / 255.0;
+                        let diff: Vec<f64> = a
+                            .iter()
+                            .zip(&b)
+                            .map(|(x, y)| (x - y).abs() / scale)
+                            .collect();
+                        let mean = diff.iter().sum::<f64>() / diff.len() as f64;
+                        // The border (one colour texel: a block of v360's two) is looked up in
+                        // its first luma texel's direction, not averaged over four.
+                        let (cw, ch) = (
+                            fast.out_extent.0 as usize / 2,
+                            fast.out_extent.1 as usize / 2,
+                        );
+                        let border = |i: usize| {
+                            let (x, y) = (i % cw, i / cw);
+                            x == 0 || x == cw - 1 || [0, ch / 2 - 1, ch / 2, ch - 1].contains(&y)
+                        };
+                        let worst = |edge: bool| {
+                            let mut w = 0.0f64;
+                            for (i, d) in diff.iter().enumerate() {
+                                if border(i) == edge {
+                                    w = w.max(*d);
+                                }
+                            }
+                            w
+                        };
+                        let (inner, edge) = (worst(false), worst(true));
+                        assert!(
+                            mean < 0.75 && inner <= 4.0 && edge <= 8.0,
+                            "{what}: plane {k}, mean {mean}, worst {inner} inside, {edge} on \
+                             the border (8-bit codes)"
+                        );
+                    }
+                }
+            }
+        }
     }
 }

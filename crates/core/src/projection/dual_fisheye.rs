@@ -47,17 +47,19 @@
 //! mix of both lenses' pictures: with `m_i = fov_i/2 − θ_i` the angle inside lens `i`'s rim
 //! and `t = m_i/(m_i + m_j)`, lens `i` weighs `t²(3 − 2t)` (smoothstep: 1 where the other
 //! lens's rim is, 0 at its own, a continuous slope between; the weights add up to 1). It is
-//! applied to the source's texels before any lookup ([`WorldProjection::blend_overlap`]):
+//! applied to the source's texels before any lookup ([`WorldProjection::overlap_blend`]):
 //! each texel in the band becomes the mix of itself and the other lens's bilinear lookup at
 //! its direction, so every lookup and integration point of the resampler and of `Remap`
-//! reads the mix without a change to their loops.
+//! reads the mix without a change to their loops. The band's weights and lookups are worked
+//! out once for a picture size ([`OverlapBlend`]), so a frame pays one weighted sum per band
+//! texel.
 
 use super::azimuthal::{ab_to_dir_of, dir_to_ab_of, edge_integral_of};
 use super::quadrature::gauss_legendre;
-use super::{texel_range, Frame, Lens, Projection, RadialMap, Range, WorldProjection};
-use crate::Image;
+use super::{
+    texel_range, Frame, Lens, OverlapBlend, Projection, RadialMap, Range, WorldProjection,
+};
 use glam::{DVec2, DVec3};
-use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// How a lens of a [`DualFisheye`] maps the angle from its axis to the radius on its image.
@@ -687,58 +689,37 @@ impl WorldProjection for DualFisheye {
         best.1
     }
 
-    /// The texels in the band both lenses see, each mixed with the other lens's bilinear
-    /// lookup at its direction by [`DualFisheye::blend_weights`]; `None` when the lenses
-    /// do not overlap.
     fn blends_overlap(&self) -> bool {
         self.overlaps()
     }
 
-    fn blend_overlap(&self, layers: &[Image]) -> Option<Vec<Image>> {
-        if !self.overlaps() || layers.len() != 1 {
+    /// The texels in the band both lenses see, each mixed with the other lens's bilinear
+    /// lookup at its direction by [`DualFisheye::blend_weights`]; `None` when the lenses
+    /// do not overlap.
+    fn overlap_blend(&self, (w, h): (u32, u32), layers: usize) -> Option<OverlapBlend> {
+        if !self.overlaps() || layers != 1 {
             return None;
         }
-        let src = &layers[0];
-        let (w, h, c) = (src.width(), src.height(), src.channels());
         let proj = Projection::DualFisheye(*self);
-        let mut out = src.clone();
-        out.data_mut()
-            .par_chunks_mut(w as usize * c)
-            .enumerate()
-            .for_each(|(y, row)| {
-                let v = (y as f64 + 0.5) / h as f64;
-                let mut other = [0.0f32; 4];
-                for (x, texel) in row.chunks_exact_mut(c).enumerate() {
-                    let uv = DVec2::new((x as f64 + 0.5) / w as f64, v);
-                    let Some(own) = self.lens_at(uv) else {
-                        continue;
-                    };
-                    let Some(d) = self.lens_uv_to_dir(own, uv) else {
-                        continue;
-                    };
-                    let Some(ouv) = self.lens_dir_to_uv(1 - own, d) else {
-                        continue;
-                    };
-                    let Some(wt) = self.blend_weights(d) else {
-                        continue;
-                    };
-                    let w_own = wt[own] as f32;
-                    if w_own >= 1.0 {
-                        continue;
-                    }
-                    crate::envmap::bilinear(&proj, layers, 0, ouv, &mut other[..c]);
-                    for (t, o) in texel.iter_mut().zip(&other) {
-                        *t = w_own * *t + (1.0 - w_own) * o;
-                    }
-                }
-            });
-        Some(vec![out])
+        Some(OverlapBlend::from_fn((w, h), |x, y| {
+            let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+            let own = self.lens_at(uv)?;
+            let d = self.lens_uv_to_dir(own, uv)?;
+            let ouv = self.lens_dir_to_uv(1 - own, d)?;
+            let w_own = self.blend_weights(d)?[own] as f32;
+            if w_own >= 1.0 {
+                return None;
+            }
+            let taps = crate::envmap::lookup_taps(&proj, 0, (w, h), ouv);
+            Some((w_own, taps.map(|(_, tx, ty, wt)| (ty * w + tx, wt))))
+        }))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Image;
 
     /// SplitMix64 in [0, 1).
     fn rng(mut s: u64) -> impl FnMut() -> f64 {
@@ -1072,18 +1053,58 @@ mod tests {
         for v in img.data_mut().chunks_exact_mut(4) {
             v.copy_from_slice(&[0.25, 0.5, 2.0, 1.0]);
         }
-        let out = p
-            .blend_overlap(std::slice::from_ref(&img))
-            .expect("overlap");
-        for v in out[0].data().chunks_exact(4) {
+        let blend = p.overlap_blend((64, 32), 1).expect("overlap");
+        assert!(!blend.is_empty());
+        let out = blend.apply(&img);
+        for v in out.data().chunks_exact(4) {
             for (a, b) in v.iter().zip([0.25, 0.5, 2.0, 1.0]) {
                 assert!((a - b).abs() < 1e-6, "{v:?}");
             }
         }
         // No overlap, no blend.
-        assert!(DualFisheye::default()
-            .blend_overlap(std::slice::from_ref(&img))
-            .is_none());
+        assert!(DualFisheye::default().overlap_blend((64, 32), 1).is_none());
+    }
+
+    /// The planned blend is each texel's mix worked out directly: its lens, its direction,
+    /// the other lens's bilinear lookup there (`envmap::bilinear`, the resampler's own) and
+    /// the two lenses' weights, for a map of random texels, at one, three and four channels.
+    #[test]
+    fn the_planned_blend_is_the_blend_worked_out_texel_by_texel() {
+        let mut r = rng(7);
+        for p in cases().into_iter().filter(|p| p.overlaps()) {
+            let proj = Projection::DualFisheye(p);
+            for (w, h, c) in [(96u32, 48u32, 3usize), (61, 40, 1), (64, 32, 4)] {
+                let mut img = Image::new(w, h, c);
+                img.data_mut().iter_mut().for_each(|v| *v = r() as f32);
+                let got = p.overlap_blend((w, h), 1).unwrap().apply(&img);
+                let layers = std::slice::from_ref(&img);
+                let mut mixed = 0;
+                let mut other = [0.0f32; 4];
+                for y in 0..h {
+                    for x in 0..w {
+                        let uv =
+                            DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                        let mut want = img.get(x, y).to_vec();
+                        let own = p.lens_at(uv);
+                        let d = own.and_then(|i| p.lens_uv_to_dir(i, uv));
+                        if let (Some(i), Some(d)) = (own, d) {
+                            let wt = p.blend_weights(d).unwrap()[i] as f32;
+                            if let Some(ouv) = p.lens_dir_to_uv(1 - i, d).filter(|_| wt < 1.0) {
+                                crate::envmap::bilinear(&proj, layers, 0, ouv, &mut other[..c]);
+                                for (t, o) in want.iter_mut().zip(&other) {
+                                    *t = wt * *t + (1.0 - wt) * o;
+                                }
+                                mixed += 1;
+                            }
+                        }
+                        for (a, b) in got.get(x, y).iter().zip(&want) {
+                            assert!((a - b).abs() < 1e-5, "({x}, {y}): {a} vs {b}");
+                        }
+                    }
+                }
+                assert!(mixed > 0);
+            }
+        }
     }
 
     /// The resampler's hook reads every other projection's layers as they are (the same
@@ -1095,7 +1116,12 @@ mod tests {
             let m = EnvMap::from_fn(k.default_projection(), 8, 3, |d| {
                 [d.x as f32, d.y as f32, d.z as f32, 1.0]
             });
-            assert!(m.projection().blend_overlap(m.layers()).is_none(), "{k}");
+            assert!(
+                m.projection()
+                    .overlap_blend((m.width(), m.height()), m.layers().len())
+                    .is_none(),
+                "{k}"
+            );
         }
         // And where it blends, the resampler reads the blend: a dual fisheye whose lenses
         // disagree (front 1, back 0) converted to a lat-long shows the mix in the band.

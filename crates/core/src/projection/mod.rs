@@ -21,6 +21,7 @@ mod eac;
 pub(crate) mod fastmath;
 mod latlong;
 mod octahedral;
+mod overlap;
 mod perspective;
 mod pseudo;
 pub mod quadrature;
@@ -35,12 +36,13 @@ pub use dual_fisheye::{DualFisheye, FisheyeLens, LensModel};
 pub use eac::Eac;
 pub use latlong::{LatLong, Mercator};
 pub use octahedral::{EqualAreaOctahedral, Octahedral};
+pub use overlap::OverlapBlend;
 pub use perspective::View;
 pub use pseudo::{Hammer, Sinusoidal};
 pub use range::Range;
 pub use spec::{parse_dir, Bounded, ProjectionSpec};
 
-use crate::{Choice, Image, UnknownName};
+use crate::{Choice, UnknownName};
 use glam::{DVec2, DVec3};
 use std::fmt;
 use std::str::FromStr;
@@ -243,15 +245,16 @@ pub trait WorldProjection {
         )
     }
 
-    /// For reading `layers` (this projection's) as the source of a conversion: where two
-    /// parts of the map see the same directions (a dual fisheye's overlap), the layers with
-    /// those parts blended, which every lookup then reads; `None` (the default: nothing seen
-    /// twice) reads them as they are. Called once per source map, before its lookups.
-    fn blend_overlap(&self, _layers: &[Image]) -> Option<Vec<Image>> {
+    /// For reading maps of this projection with `layers` layers of `extent` texels as the
+    /// source of a conversion: where two parts of the map see the same directions (a dual
+    /// fisheye's overlap), the blend of those parts, planned once for that size and applied
+    /// to each source map before its lookups, which then read the blend; `None` (the
+    /// default: nothing seen twice) reads the maps as they are.
+    fn overlap_blend(&self, _extent: (u32, u32), _layers: usize) -> Option<OverlapBlend> {
         None
     }
 
-    /// Whether [`WorldProjection::blend_overlap`] changes maps of this projection (some
+    /// Whether [`WorldProjection::overlap_blend`] changes maps of this projection (some
     /// direction is seen twice), so that its lookups cannot read a map as it is.
     fn blends_overlap(&self) -> bool {
         false
@@ -625,8 +628,8 @@ impl WorldProjection for Projection {
     fn wrap_texel(&self, layer: usize, x: i64, y: i64, w: u32, h: u32) -> (usize, u32, u32) {
         delegate!(self, p => p.wrap_texel(layer, x, y, w, h))
     }
-    fn blend_overlap(&self, layers: &[Image]) -> Option<Vec<Image>> {
-        delegate!(self, p => p.blend_overlap(layers))
+    fn overlap_blend(&self, extent: (u32, u32), layers: usize) -> Option<OverlapBlend> {
+        delegate!(self, p => p.overlap_blend(extent, layers))
     }
     fn blends_overlap(&self) -> bool {
         delegate!(self, p => p.blends_overlap())

@@ -157,6 +157,76 @@ impl Packing {
         })
     }
 
+    /// This packing at `1/2^s` of its size in both directions, for a planar YUV frame's
+    /// colour planes (4:2:0: `s = 1`) whose layers are made at their own size: colour texel
+    /// `(x, y)` shows what luma texel `(2^s·x, 2^s·y)` shows, its layer texel's position
+    /// halved `s` times, or is looked up in that texel's direction. Exact (each colour
+    /// texel's layer texel covers its own block) where every cell starts at a multiple of
+    /// `2^s` (v360's cells, EAC's border of two included, for faces of an even size);
+    /// `None` where a size or a cell does not divide, or a colour texel would show nothing
+    /// its block shows.
+    pub fn halved(&self, s: u32) -> Option<Packing> {
+        let step = 1u32 << s;
+        let (w, h) = (self.width >> s, self.height >> s);
+        if s == 0
+            || self.width % step != 0
+            || self.height % step != 0
+            || self.layer_width % step != 0
+        {
+            return None;
+        }
+        let mut runs = Vec::new();
+        let mut row_starts = Vec::with_capacity(h as usize + 1);
+        let mut shown = 0usize;
+        for y in 0..h {
+            row_starts.push(runs.len() as u32);
+            let first = runs.len();
+            let luma = self.row_starts[(y << s) as usize] as usize
+                ..self.row_starts[(y << s) as usize + 1] as usize;
+            for run in &self.runs[luma] {
+                for k in 0..run.len {
+                    let at = run.at + k;
+                    if at % step != 0 {
+                        continue;
+                    }
+                    let lx = run.x as i64 + run.dx as i64 * k as i64;
+                    let ly = run.y as i64 + run.dy as i64 * k as i64;
+                    push_texel(
+                        &mut runs,
+                        first,
+                        at >> s,
+                        run.layer,
+                        (lx >> s) as u32,
+                        (ly >> s) as u32,
+                    );
+                    shown += 1;
+                }
+            }
+        }
+        row_starts.push(runs.len() as u32);
+        let lookups: Vec<(u32, DVec3)> = self
+            .lookups
+            .iter()
+            .filter(|&&(i, _)| (i % self.width) % step == 0 && (i / self.width) % step == 0)
+            .map(|&(i, d)| (((i / self.width) >> s) * w + ((i % self.width) >> s), d))
+            .collect();
+        // Every colour texel shows something where every luma texel did.
+        if !self.gaps && shown + lookups.len() != w as usize * h as usize {
+            return None;
+        }
+        let along_rows = lookups.is_empty() && runs.iter().all(Run::along_row);
+        Some(Packing {
+            width: w,
+            height: h,
+            layer_width: self.layer_width >> s,
+            row_starts,
+            runs,
+            gaps: self.gaps,
+            along_rows,
+            lookups,
+        })
+    }
+
     /// The packing of a layout that puts each of `n` layers whole in a cell of its grid
     /// (`Layout::grid_cell`: crosses and strips), from the cells alone: a turned cell's
     /// rows are its layer's, last first, read backwards. The same runs as
@@ -317,7 +387,6 @@ impl Packing {
     }
 
     /// The packed frame's width and height.
-    #[cfg(test)]
     pub fn extent(&self) -> (u32, u32) {
         (self.width, self.height)
     }
@@ -330,10 +399,10 @@ impl Packing {
 
     /// Encodes `layers` (the packing's, RGB or RGBA: alpha is dropped) as one `fmt` frame
     /// into `out`, texel for texel as `fmt` would encode `Layout::pack`'s picture.
-    pub fn encode_layers(&self, fmt: PixFmt, layers: &[Image], out: &mut Vec<u8>) {
+    pub fn encode_layers(&self, fmt: impl Into<FrameCodes>, layers: &[Image], out: &mut Vec<u8>) {
         let c = layers[0].channels();
         let w = self.layer_width as usize;
-        self.encode_with(fmt, c, out, |run, _row, gathered, put| {
+        self.encode_with(fmt.into(), c, out, |run, _row, gathered, put| {
             let data = layers[run.layer as usize].data();
             if run.dx == 1 && run.dy == 0 {
                 let i = (run.y as usize * w + run.x as usize) * c;
@@ -350,7 +419,8 @@ impl Packing {
     /// looked-up ones (EAC's border) read from it in their directions. The reference
     /// [`Picture::encode_rows`] is held to.
     #[cfg(test)]
-    pub fn encode_map(&self, fmt: PixFmt, env: &EnvMap, out: &mut Vec<u8>) {
+    pub fn encode_map(&self, fmt: impl Into<FrameCodes>, env: &EnvMap, out: &mut Vec<u8>) {
+        let fmt = fmt.into();
         self.encode_layers(fmt, env.layers(), out);
         if self.lookups.is_empty() {
             return;
@@ -427,13 +497,13 @@ impl Packing {
     /// Encodes the frame whose rows `rows` makes (a `Remap` of the packing's layers) into
     /// `out`, each row made and encoded by one thread while it is in its cache. Only for a
     /// packing [`along_rows`](Packing::along_rows).
-    pub fn encode_rows(&self, fmt: PixFmt, rows: &RemapRows, out: &mut Vec<u8>) {
+    pub fn encode_rows(&self, fmt: impl Into<FrameCodes>, rows: &RemapRows, out: &mut Vec<u8>) {
         assert!(
             self.along_rows,
             "a packing with turned cells is encoded from layers"
         );
         let c = rows.row_len() / self.layer_width as usize;
-        self.encode_with(fmt, c, out, |run, row, gathered, put| {
+        self.encode_with(fmt.into(), c, out, |run, row, gathered, put| {
             row.resize(rows.row_len(), 0.0);
             rows.row_into(run.layer as usize, run.y as usize, row);
             if run.dx == 1 {
@@ -447,19 +517,18 @@ impl Packing {
 
     /// Encodes every packed row in parallel, the texels of each run (in the run's order,
     /// `c` channels each) handed to `put` by `texels(run, scratch row, scratch run, put)`.
-    fn encode_with<F>(&self, fmt: PixFmt, c: usize, out: &mut Vec<u8>, texels: F)
+    fn encode_with<F>(&self, fmt: FrameCodes, c: usize, out: &mut Vec<u8>, texels: F)
     where
         F: Fn(&Run, &mut Vec<f32>, &mut Vec<f32>, &mut dyn FnMut(&[f32])) + Sync,
     {
         let (w, h) = (self.width as usize, self.height as usize);
         let px = fmt.pixel_bytes();
         out.resize(w * h * px, 0);
-        let table = fmt.table();
         let runs_of =
             |r: usize| &self.runs[self.row_starts[r] as usize..self.row_starts[r + 1] as usize];
         let init = || (Vec::new(), Vec::new());
         match fmt {
-            PixFmt::Gbrpf32le => {
+            FrameCodes::Pix(PixFmt::Gbrpf32le) => {
                 let (g, rest) = out.split_at_mut(w * h * 4);
                 let (b, r) = rest.split_at_mut(w * h * 4);
                 g.par_chunks_mut(w * 4)
@@ -497,9 +566,7 @@ impl Packing {
                     }
                     for run in runs_of(y) {
                         let d = &mut bytes[run.at as usize * px..(run.at + run.len) as usize * px];
-                        texels(run, row, gathered, &mut |s| {
-                            fmt.encode_texels(table, s, c, d)
-                        });
+                        texels(run, row, gathered, &mut |s| fmt.encode(s, c, d));
                     }
                 },
             ),
@@ -535,8 +602,9 @@ pub struct Picture {
 impl Picture {
     /// Encodes the frame whose rows `rows` (of the laid-out plan) makes into `out`: the
     /// picture's rows as they are made, then the looked-up texels from the ring's.
-    pub fn encode_rows(&self, fmt: PixFmt, rows: &RemapRows, out: &mut Vec<u8>) {
-        self.rows.encode_rows(fmt, rows, out);
+    pub fn encode_rows(&self, fmt: impl Into<FrameCodes>, rows: &RemapRows, out: &mut Vec<u8>) {
+        let codes = fmt.into();
+        self.rows.encode_rows(codes, rows, out);
         if self.lookups.is_empty() {
             return;
         }
@@ -547,12 +615,13 @@ impl Picture {
             .enumerate()
             .for_each(|(r, row)| rows.row_into(0, ph + r, row));
         let values: Vec<f32> = match c {
+            1 => self.looked_up::<1>(&ring),
             3 => self.looked_up::<3>(&ring),
             _ => self.looked_up::<4>(&ring),
         };
         let at = self.lookups.iter().map(|l| l.at);
         encode_at(
-            fmt,
+            codes,
             (self.rows.width, self.rows.height),
             at,
             &values,
@@ -582,25 +651,24 @@ impl Picture {
 
 /// Writes `values` (`c` channels each) into the texels `at` of a `w`×`h` `fmt` frame.
 fn encode_at(
-    fmt: PixFmt,
+    fmt: FrameCodes,
     (w, h): (u32, u32),
     at: impl Iterator<Item = u32>,
     values: &[f32],
     c: usize,
     out: &mut [u8],
 ) {
-    let table = fmt.table();
     let (n, px) = (w as usize * h as usize, fmt.pixel_bytes());
     for (i, v) in at.zip(values.chunks_exact(c)) {
         let i = i as usize;
         match fmt {
-            PixFmt::Gbrpf32le => {
+            FrameCodes::Pix(PixFmt::Gbrpf32le) => {
                 for (plane, k) in PixFmt::PLANES.into_iter().enumerate() {
                     let at = (plane * n + i) * 4;
                     out[at..at + 4].copy_from_slice(&v[k].to_le_bytes());
                 }
             }
-            _ => fmt.encode_texels(table, v, c, &mut out[i * px..(i + 1) * px]),
+            _ => fmt.encode(v, c, &mut out[i * px..(i + 1) * px]),
         }
     }
 }
@@ -613,6 +681,7 @@ fn gather<'s, 'r>(
     row: impl Fn(usize) -> &'r [f32],
 ) -> &'s [f32] {
     match c {
+        1 => gather_c::<1, _>(run, into, row),
         3 => gather_c::<3, _>(run, into, row),
         _ => gather_c::<4, _>(run, into, row),
     }
@@ -634,6 +703,83 @@ fn gather_c<'s, 'r, const C: usize, R: Fn(usize) -> &'r [f32]>(
         *dst = *src;
     }
     into
+}
+
+/// What a packed frame's texels are written as: a pipe's pixel format, or one plane of a
+/// planar YUV frame ([`PlaneCodes`]).
+#[derive(Clone, Copy, Debug)]
+pub enum FrameCodes {
+    /// RGB texels in a pipe's pixel format.
+    Pix(PixFmt),
+    /// One channel: a plane's codes.
+    Plane(PlaneCodes),
+}
+
+impl From<PixFmt> for FrameCodes {
+    fn from(f: PixFmt) -> FrameCodes {
+        FrameCodes::Pix(f)
+    }
+}
+
+impl From<PlaneCodes> for FrameCodes {
+    fn from(p: PlaneCodes) -> FrameCodes {
+        FrameCodes::Plane(p)
+    }
+}
+
+impl FrameCodes {
+    fn pixel_bytes(self) -> usize {
+        match self {
+            FrameCodes::Pix(f) => f.pixel_bytes(),
+            FrameCodes::Plane(p) => p.bytes,
+        }
+    }
+
+    /// Texels of `c` channels (one for a plane) into their bytes.
+    #[inline]
+    fn encode(self, src: &[f32], c: usize, dst: &mut [u8]) {
+        match self {
+            FrameCodes::Pix(f) => f.encode_texels(f.table(), src, c, dst),
+            FrameCodes::Plane(p) => p.encode(src, dst),
+        }
+    }
+}
+
+/// One plane of a planar YUV frame as codes: each value is the code less the plane's
+/// `neutral` (so that a texel nothing is read into, zero, is black luma or grey chroma);
+/// written back as `value + neutral` rounded to the nearest code, clamped to `[0, max]`, in
+/// one byte or two (little-endian).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaneCodes {
+    /// Bytes a code: 1 or 2.
+    pub bytes: usize,
+    /// The code of zero: 0 for luma, the middle code for chroma.
+    pub neutral: f32,
+    /// The largest code (255, 1023, 4095, 65535).
+    pub max: f32,
+}
+
+impl PlaneCodes {
+    /// The code of one value (NaN: 0).
+    #[inline(always)]
+    pub fn code(&self, v: f32) -> u16 {
+        // Non-negative after the clamp, so adding ½ and truncating rounds half up, as
+        // `round` does for non-negative values, without a libm call.
+        ((v + self.neutral).clamp(0.0, self.max) + 0.5) as u16
+    }
+
+    /// Values into codes.
+    pub fn encode(&self, src: &[f32], dst: &mut [u8]) {
+        if self.bytes == 1 {
+            for (d, &v) in dst.iter_mut().zip(src) {
+                *d = self.code(v) as u8;
+            }
+        } else {
+            for (d, &v) in dst.chunks_exact_mut(2).zip(src) {
+                d.copy_from_slice(&self.code(v).to_le_bytes());
+            }
+        }
+    }
 }
 
 impl PixFmt {

@@ -331,8 +331,9 @@ fn the_pixels_are_v360s_in_yuv420p() {
         );
         // EAC's two-texel border does not halve: v360 gives each half-size colour plane a
         // two-texel border of its own, so its 4:2:0 colour planes are not its 4:4:4 ones
-        // halved (35 and 27 dB between them, its own luma identical); mirrorball's are
-        // (the picture's made and halved), so EAC is held to v360's 4:4:4 picture.
+        // halved (35 and 27 dB between them, its own luma identical); mirrorball's follow
+        // the 4:4:4 picture's geometry halved (each colour texel where its 2×2 block is,
+        // made at its own size), so EAC is held to v360's 4:4:4 picture.
         let v360 = match to {
             "eac" => format!("format=yuv444p,v360={v360}:w={w}:h={h},format=yuv420p"),
             _ => format!("v360={v360}:w={w}:h={h}"),
