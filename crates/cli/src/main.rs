@@ -132,8 +132,9 @@ pub struct ConvertArgs {
     to: String,
     /// Face edge (cubes), width (lat-long, Mercator, cylinders, Hammer, sinusoidal, views) or
     /// diameter (disk maps), in texels; one eye's, for a stereo pair (--stereo). WxH (as
-    /// v360's w and h) for a flat view sets its vfov from the height (square pixels); for
-    /// other projections the height must be the one the width gives.
+    /// v360's w and h) for a flat view sets its vfov from the height (square pixels); for eac
+    /// it is the picture's size (v360's eac at any size: 3840x2160); for other projections
+    /// the height must be the one the width gives.
     /// Default: about the source's resolution (its one eye's).
     #[arg(long, value_name = "W[xH]", value_parser = size::parse_extent, allow_hyphen_values = true)]
     size: Option<(i64, Option<i64>)>,
@@ -154,6 +155,17 @@ pub struct ConvertArgs {
     stereo: Option<String>,
     #[command(flatten)]
     input_args: InputArgs,
+    /// FFmpeg v360's options, as its filter takes them: IN:OUT[:key=value…], e.g.
+    /// 'e:eac:yaw=30:pitch=20:rorder=ypr', 'e:c3x2:out_forder=fbudlr:w=1536:h=1024',
+    /// 'e:flat:h_fov=90:v_fov=58.7:w=1280:h=720', 'dfisheye:e:ih_fov=190:iv_fov=190'. Means
+    /// what v360 means (rotations, their order and flips, face orders and turns, fields of
+    /// view, w and h, stereo modes); in place of --from, --in-layout, --to, --layout,
+    /// --in-stereo, --stereo, --yaw, --pitch, --roll and --flip (refused beside it), and of
+    /// --size when it has w and h. Without w and h the size is mirrorball's (--size). What
+    /// mirrorball cannot make exactly (barrel, tetrahedron, tsp, input flips, pads, …) is
+    /// refused, naming the key; interp is accepted (every output texel is antialiased).
+    #[arg(long, value_name = "OPTIONS")]
+    v360: Option<String>,
     /// Turn the environment about +Y (degrees; positive turns it to the left).
     #[arg(long, value_parser = finite_f64, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw: f64,

@@ -153,6 +153,27 @@ impl Image {
         out
     }
 
+    /// The texel at picture position `(x, y)` (texel centres at integers), bilinearly
+    /// between the four texels around it, the position clamped to the columns `0..width`
+    /// and the rows `rows.0..rows.1`: `channels()` values written to `out`.
+    pub fn bilinear_clamped(&self, (x, y): (f64, f64), rows: (u32, u32), out: &mut [f32]) {
+        let split = |v: f64, lo: u32, hi: u32| {
+            let f = v.clamp(lo as f64, (hi - 1) as f64);
+            let i = (f.floor() as u32).min(hi.saturating_sub(2).max(lo));
+            let t = (f - i as f64) as f32;
+            (i, (i + 1).min(hi - 1), t)
+        };
+        let (xa, xb, tx) = split(x, 0, self.width);
+        let (ya, yb, ty) = split(y, rows.0, rows.1);
+        let (a, b) = (self.get(xa, ya), self.get(xb, ya));
+        let (c, d) = (self.get(xa, yb), self.get(xb, yb));
+        for k in 0..self.channels {
+            let top = a[k] + (b[k] - a[k]) * tx;
+            let bottom = c[k] + (d[k] - c[k]) * tx;
+            out[k] = top + (bottom - top) * ty;
+        }
+    }
+
     /// The same picture mirrored left to right (`horizontal`) or top to bottom.
     pub fn flipped(&self, horizontal: bool) -> Image {
         let mut out = self.clone();

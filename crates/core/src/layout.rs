@@ -91,6 +91,15 @@ impl CellGrid {
 /// linearly past the edge (`uf = 2·uf` where `|uf| > ½`: face coordinate `±(1 + δ)` at
 /// distance `δ` past the edge in the face's `[−1, 1]`, not the tangent); [`Layout::pack`]
 /// looks the map up in that texel's direction, bilinearly. Reading ignores the border.
+///
+/// v360 draws `eac` at any picture size `W`×`H` (its default from a lat-long is
+/// `W`×`9H/8`, YouTube's 3840×2160): the faces lie between two texels of border at the left
+/// and right and two above and below each row, `(W − 4)/3` texels wide and `H/2 − 4` high,
+/// not square and not whole in general (`eac_to_xyz`, `xyz_to_eac`: each face's texels span
+/// its angles in x and y apart). Such a picture is [`CubeCells::eac_frame`]: packed by
+/// looking every texel up in the direction v360 gives its centre, and read by sampling it
+/// bilinearly where v360 puts each face texel's centre (square faces of the finer of the two
+/// spacings).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CubeCells {
     /// The grid.
@@ -101,6 +110,9 @@ pub struct CubeCells {
     pub turns: [u8; 6],
     /// v360's `eac` padding: two texels of border (see above).
     pub eac_pad: bool,
+    /// v360's `eac` picture at a size its square faces do not give (see above): its
+    /// `(width, height)`.
+    pub frame: Option<(u32, u32)>,
 }
 
 /// v360's face letters and the OpenGL face of each.
@@ -129,6 +141,7 @@ impl CubeCells {
             faces: RLUDFB,
             turns: [0; 6],
             eac_pad: false,
+            frame: None,
         }
     }
 
@@ -145,16 +158,50 @@ impl CubeCells {
         ],
         turns: [0, 0, 0, 3, 1, 3],
         eac_pad: true,
+        frame: None,
     };
 
-    /// The picture size for faces of `n` texels.
-    pub fn extent(&self, n: u32) -> (u32, u32) {
+    /// v360's `eac` as a `w`×`h` picture, and the edge of the square faces a map is made
+    /// at to fill it (the finer of the faces' two spacings, `(w − 4)/3` and `h/2 − 4`,
+    /// rounded up to an even edge, which video's half-size colour planes halve); the plain
+    /// [`CubeCells::EAC`] where square faces give that size. `None` for a picture too small
+    /// to hold a texel of each face.
+    pub fn eac_frame(w: u32, h: u32) -> Option<(CubeCells, u32)> {
+        if let Some(n) = CubeCells::EAC.face_size(w, h) {
+            return Some((CubeCells::EAC, n));
+        }
+        let (fw, fh) = ((w as f64 - 4.0) / 3.0, h as f64 / 2.0 - 4.0);
+        if fw < 1.0 || fh < 1.0 {
+            return None;
+        }
+        let cells = CubeCells {
+            frame: Some((w, h)),
+            ..CubeCells::EAC
+        };
+        let n = fw.max(fh).ceil() as u32;
+        Some((cells, n + n % 2))
+    }
+
+    /// Whether the picture is v360's `eac` at a size of its own ([`CubeCells::eac_frame`]),
+    /// not the one faces of `n` texels give.
+    fn continuous(&self, n: u32) -> bool {
+        self.frame.is_some_and(|f| f != self.with_faces(n))
+    }
+
+    /// The picture size that faces of `n` texels give.
+    fn with_faces(&self, n: u32) -> (u32, u32) {
         let (c, r) = self.grid.dims();
         if self.eac_pad {
             (c * n + 4, r * (n + 4))
         } else {
             (c * n, r * n)
         }
+    }
+
+    /// The picture size for faces of `n` texels: the frame's own, for v360's `eac` at a
+    /// size of its own.
+    pub fn extent(&self, n: u32) -> (u32, u32) {
+        self.frame.unwrap_or_else(|| self.with_faces(n))
     }
 
     /// The face size of a `w`×`h` picture in this layout, if it is one.
@@ -165,7 +212,7 @@ impl CubeCells {
         } else {
             w / c
         };
-        (n > 0 && self.extent(n) == (w, h)).then_some(n)
+        (n > 0 && self.with_faces(n) == (w, h)).then_some(n)
     }
 
     /// The top-left texel of cell `i`'s face, for faces of `n` texels.
@@ -197,8 +244,12 @@ impl CubeCells {
 
     /// For each texel `(x, y)` of each cell's face (faces of `n` texels), the face texel it
     /// shows: `f(cell, picture x, picture y, face texel x, face texel y)`, the face being
-    /// `faces[cell]`; cell by cell, each cell's rows top first, each row left to right.
+    /// `faces[cell]`; cell by cell, each cell's rows top first, each row left to right. None
+    /// for v360's `eac` at a size of its own, whose texels are all looked up.
     pub fn each_texel(&self, n: u32, mut f: impl FnMut(usize, u32, u32, u32, u32)) {
+        if self.continuous(n) {
+            return;
+        }
         let n2 = n as i64;
         for i in 0..6 {
             let (ox, oy) = self.origin(i, n);
@@ -218,17 +269,19 @@ impl CubeCells {
         }
     }
 
-    /// The direction v360 gives border texel `(px, py)` of a padded `eac` picture of faces
-    /// of `n` texels, for a map of projection `p` (EAC's faces are equi-angular inside the
-    /// edge; past it both EAC and the cube continue the gnomonic coordinate linearly).
-    fn border_dir(&self, p: &Projection, n: u32, px: u32, py: u32) -> DVec3 {
-        let (cols, _) = self.grid.dims();
-        let nf = n as f64;
+    /// The direction v360 gives texel `(px, py)` of its `eac` picture of `w`×`h` texels, for
+    /// a map of projection `p` (`eac_to_xyz`: faces `(w − 4)/3` wide and `h/2 − 4` high
+    /// between two-texel borders; EAC's faces are equi-angular inside the edge; past it both
+    /// EAC and the cube continue the gnomonic coordinate linearly).
+    fn frame_dir(&self, p: &Projection, (w, h): (u32, u32), px: u32, py: u32) -> DVec3 {
+        let (cols, rows) = self.grid.dims();
+        let (fw, row_h) = ((w as f64 - 4.0) / cols as f64, h as f64 / rows as f64);
+        let fh = row_h - 4.0;
         // Position in face widths from the left edge of the faces, and the cell.
-        let fx = (px as f64 + 0.5 - 2.0) / nf;
+        let fx = (px as f64 + 0.5 - 2.0) / fw;
         let col = (fx.floor().max(0.0) as u32).min(cols - 1);
-        let row = py / (n + 4);
-        let fy = (py as f64 + 0.5 - 2.0 - (row * (n + 4)) as f64) / nf;
+        let row = (((py as f64 + 0.5) / row_h).floor() as u32).min(rows - 1);
+        let fy = (py as f64 + 0.5 - 2.0 - row as f64 * row_h) / fh;
         let (c, d) = (2.0 * (fx - col as f64) - 1.0, 2.0 * fy - 1.0);
         let i = (row * cols + col) as usize;
         let (s, t) = self.face_coords(i, c, d);
@@ -242,6 +295,33 @@ impl CubeCells {
             }
         };
         self.faces[i].point(warp(s), warp(t)).normalize()
+    }
+
+    /// Where v360's `eac` picture of `w`×`h` texels shows face texel `(x, y)` of the face in
+    /// cell `i` (faces of `n` texels): the picture position of its centre, in texels from the
+    /// picture's top-left corner (`xyz_to_eac`).
+    fn frame_position(&self, (w, h): (u32, u32), i: usize, n: u32, x: u32, y: u32) -> (f64, f64) {
+        let (s, t) = (
+            2.0 * (x as f64 + 0.5) / n as f64 - 1.0,
+            2.0 * (y as f64 + 0.5) / n as f64 - 1.0,
+        );
+        // face_coords is a signed permutation: its inverse is its transpose.
+        let (a, b) = (self.face_coords(i, 1.0, 0.0), self.face_coords(i, 0.0, 1.0));
+        self.eac_point((w, h), i, a.0 * s + a.1 * t, b.0 * s + b.1 * t)
+    }
+
+    /// Where v360's `eac` picture of `w`×`h` texels shows cell coordinates `(c, d)` ∈
+    /// `[−1, 1]²` (right, down) of cell `i`, in texels from the picture's top-left corner:
+    /// the cell's face `(w − 4)/3` wide and `h/2 − 4` high inside its two-texel borders
+    /// (`xyz_to_eac`; with square faces of `n`, [`CubeCells::origin`] plus `(c + 1)/2·n`).
+    pub fn eac_point(&self, (w, h): (u32, u32), i: usize, c: f64, d: f64) -> (f64, f64) {
+        let (cols, rows) = self.grid.dims();
+        let (fw, row_h) = ((w as f64 - 4.0) / cols as f64, h as f64 / rows as f64);
+        let (col, row) = (i as u32 % cols, i as u32 / cols);
+        (
+            2.0 + (col as f64 + 0.5 * (c + 1.0)) * fw,
+            2.0 + row as f64 * row_h + 0.5 * (d + 1.0) * (row_h - 4.0),
+        )
     }
 
     fn parse(grid: CellGrid, opts: &str) -> Result<CubeCells, String> {
@@ -309,7 +389,7 @@ impl CubeCells {
 
 impl fmt::Display for CubeCells {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if *self == CubeCells::EAC {
+        if self.eac_pad {
             return f.write_str("eac");
         }
         f.write_str(self.grid.name())?;
@@ -479,10 +559,14 @@ impl Layout {
     }
 
     /// [`Layout::from_extent`] among the layouts that hold a map of `kind`
-    /// ([`Layout::holds`]): a cube is never read from v360's padded `eac`.
+    /// ([`Layout::holds`]): a cube is never read from v360's padded `eac`. An EAC picture of any other size is v360's `eac` at that size
+    /// ([`CubeCells::eac_frame`]).
     pub fn from_extent_of(w: u32, h: u32, kind: ProjectionKind) -> Option<(Layout, u32, u32)> {
         let layers = kind.default_projection().layer_count();
-        Layout::from_extent_where(w, h, layers, |l| l.holds(kind))
+        Layout::from_extent_where(w, h, layers, |l| l.holds(kind)).or_else(|| {
+            let (cells, n) = CubeCells::eac_frame(w, h).filter(|_| kind == ProjectionKind::Eac)?;
+            Some((Layout::Cells(cells), n, n))
+        })
     }
 
     fn from_extent_where(
@@ -665,7 +749,7 @@ impl Layout {
     /// For [`Layout::Cells`], the grid's name (`Display` adds v360's strings).
     pub fn name(self) -> &'static str {
         match self {
-            Layout::Cells(c) if c == CubeCells::EAC => "eac",
+            Layout::Cells(c) if c.eac_pad => "eac",
             Layout::Cells(c) => c.grid.name(),
             _ => Choice::name(self),
         }
@@ -722,18 +806,25 @@ fn pack_cells(cells: &CubeCells, env: &EnvMap) -> Image {
 impl CubeCells {
     /// The texels of the picture (faces of `n` texels, a map of projection `p`) that show
     /// no face texel but are looked up in a direction: EAC's two-texel border, each in
-    /// [`CubeCells::border_dir`]'s direction; none without the padding. Row by row.
+    /// [`CubeCells::frame_dir`]'s direction (every texel of v360's `eac` at a size of its own);
+    /// none without the padding. Row by row.
     fn looked_up(&self, p: &Projection, n: u32) -> Vec<(u32, u32, DVec3)> {
         if !self.eac_pad {
             return Vec::new();
         }
         let (w, h) = self.extent(n);
+        if self.continuous(n) {
+            return (0..h)
+                .flat_map(|py| (0..w).map(move |px| (px, py)))
+                .map(|(px, py)| (px, py, self.frame_dir(p, (w, h), px, py)))
+                .collect();
+        }
         let mut inside = vec![false; (w * h) as usize];
         self.each_texel(n, |_, px, py, _, _| inside[(py * w + px) as usize] = true);
         (0..h)
             .flat_map(|py| (0..w).map(move |px| (px, py)))
             .filter(|&(px, py)| !inside[(py * w + px) as usize])
-            .map(|(px, py)| (px, py, self.border_dir(p, n, px, py)))
+            .map(|(px, py)| (px, py, self.frame_dir(p, (w, h), px, py)))
             .collect()
     }
 }
@@ -745,19 +836,44 @@ fn unpack_cells(
     projection: Projection,
 ) -> Result<EnvMap, String> {
     let (w, h) = (image.width(), image.height());
+    if cells.eac_pad && cells.face_size(w, h).is_none() {
+        return unpack_frame(cells, image, projection);
+    }
     let n = cells.face_size(w, h).ok_or_else(|| {
         let (a, b) = cells.extent(1);
-        let shape = if cells.eac_pad {
-            "(3n + 4)x(2n + 8) for faces of n texels".to_string()
-        } else {
-            format!("{}n x {}n", a, b)
-        };
-        format!("a {cells} layout needs a picture of {shape}; {w}x{h} is not")
+        format!("a {cells} layout needs a picture of {a}n x {b}n; {w}x{h} is not")
     })?;
     let mut faces = vec![Image::new(n, n, image.channels()); 6];
     cells.each_texel(n, |i, px, py, fx, fy| {
         faces[cells.faces[i] as usize].set(fx, fy, image.get(px, py));
     });
+    EnvMap::new(projection, faces).map_err(|e| e.to_string())
+}
+
+/// [`Layout::unpack`] for v360's `eac` at a size of its own ([`CubeCells::eac_frame`]):
+/// square faces of the finer spacing, each texel read bilinearly where v360 puts its centre.
+fn unpack_frame(
+    cells: &CubeCells,
+    image: &Image,
+    projection: Projection,
+) -> Result<EnvMap, String> {
+    let (w, h) = (image.width(), image.height());
+    let (_, n) = CubeCells::eac_frame(w, h).ok_or_else(|| {
+        format!("an eac picture of {w}x{h} is too small to hold its six faces and their borders")
+    })?;
+    let ch = image.channels();
+    let mut faces = vec![Image::new(n, n, ch); 6];
+    let mut texel = [0.0f32; 4];
+    for (i, face) in cells.faces.iter().enumerate() {
+        let layer = &mut faces[*face as usize];
+        for y in 0..n {
+            for x in 0..n {
+                let (px, py) = cells.frame_position((w, h), i, n, x, y);
+                image.bilinear_clamped((px - 0.5, py - 0.5), (0, h), &mut texel[..ch]);
+                layer.set(x, y, &texel[..ch]);
+            }
+        }
+    }
     EnvMap::new(projection, faces).map_err(|e| e.to_string())
 }
 

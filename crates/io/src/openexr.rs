@@ -76,23 +76,7 @@ fn cube_pixel(d: DVec3, s: u32) -> (usize, DVec2) {
 /// The texel of `image` at pixel position `p` (pixel centres at integers), bilinearly
 /// between the four pixels around it, within the columns `0..w` and rows `y0..y1`.
 fn bilinear(image: &Image, p: DVec2, y0: u32, y1: u32, out: &mut [f32]) {
-    let c = image.channels();
-    let w = image.width();
-    let split = |v: f64, lo: u32, hi: u32| {
-        let f = v.clamp(lo as f64, (hi - 1) as f64);
-        let i = (f.floor() as u32).min(hi.saturating_sub(2).max(lo));
-        let t = (f - i as f64) as f32;
-        (i, (i + 1).min(hi - 1), t)
-    };
-    let (xa, xb, tx) = split(p.x, 0, w);
-    let (ya, yb, ty) = split(p.y, y0, y1);
-    let (a, b) = (image.get(xa, ya), image.get(xb, ya));
-    let (cc, d) = (image.get(xa, yb), image.get(xb, yb));
-    for k in 0..c {
-        let top = a[k] + (b[k] - a[k]) * tx;
-        let bottom = cc[k] + (d[k] - cc[k]) * tx;
-        out[k] = top + (bottom - top) * ty;
-    }
+    image.bilinear_clamped((p.x, p.y), (y0, y1), out);
 }
 
 /// An OpenEXR lat-long (`envmap = latlong`) as mirrorball's lat-long of the same size: each

@@ -50,6 +50,9 @@ pub struct ConvertRequest {
     pub roll: f64,
     /// Mirrors applied after the rotation, in order.
     pub flip: Vec<Axis>,
+    /// A whole turn and mirrors (v360's `yaw`, `pitch`, `roll` in its `rorder` and its
+    /// flips: [`crate::v360`]), in place of `yaw`, `pitch`, `roll` and `flip`.
+    pub rotation: Option<Rotation>,
     /// An engine's axes, applied last (exactly, by moving texels, for a cube).
     pub engine: Option<Engine>,
     /// Exposure in stops.
@@ -82,6 +85,7 @@ impl Default for ConvertRequest {
             pitch: 0.0,
             roll: 0.0,
             flip: Vec::new(),
+            rotation: None,
             engine: None,
             exposure: 0.0,
             precision: None,
@@ -156,6 +160,7 @@ impl ConvertPlan {
                  (only a conversion of one file keeps its input's)",
             ));
         };
+        let (mut size, mut layout) = (r.size, r.layout);
         if let (Some(w), Some(h)) = (r.size, r.height) {
             let dim = |v: i64| u32::try_from(v).ok().filter(|&v| v > 0);
             let (Some(w), Some(h)) = (dim(w), dim(h)) else {
@@ -163,15 +168,28 @@ impl ConvertPlan {
                     "--size {w}x{h}: give a positive width and height"
                 )));
             };
-            to = to.with_height(w, h)?;
+            if to.kind == ProjectionKind::Eac && layout.is_none_or(|l| l == Layout::eac()) {
+                // The picture, as v360's w and h: v360's eac at that size.
+                let (cells, n) = mirrorball_core::CubeCells::eac_frame(w, h).ok_or_else(|| {
+                    Error::request(format!(
+                        "--size {w}x{h}: too small for an eac picture (six faces between \
+                         two-texel borders)"
+                    ))
+                })?;
+                (size, layout) = (Some(n as i64), Some(Layout::Cells(cells)));
+            } else {
+                to = to.with_height(w, h)?;
+            }
         }
         let format = save::check_container(&r.output)?;
         save::check_flags(&r.output, format, &r.container_flags(), r.precision)?;
-        save::check(&r.output, to.kind, r.layout)?;
-        let mut rotation = Rotation::from_euler_deg(r.yaw, r.pitch, r.roll);
-        for &axis in &r.flip {
-            rotation = rotation.then(Rotation::mirror(axis));
-        }
+        save::check(&r.output, to.kind, layout)?;
+        let mut rotation = r.rotation.unwrap_or_else(|| {
+            r.flip.iter().fold(
+                Rotation::from_euler_deg(r.yaw, r.pitch, r.roll),
+                |rotation, &axis| rotation.then(Rotation::mirror(axis)),
+            )
+        });
         // The engine's axes come last: for a cube exactly, by moving texels; otherwise as
         // the rotation it is.
         let mut orient = AxisMap::IDENTITY;
@@ -190,7 +208,7 @@ impl ConvertPlan {
             note: None,
         };
         let save = SaveOptions {
-            layout: r.layout,
+            layout,
             write,
             mips: r.mips,
             keep_invalid: input.keep_invalid,
@@ -199,8 +217,7 @@ impl ConvertPlan {
         let layers = dst.layer_count();
         let stereo = r.stereo.unwrap_or_default();
         save::check_stereo(&r.output, layers, stereo, &save)?;
-        let size = r
-            .size
+        let size = size
             .map(|s| save::size_bound(&r.output, dst, &save, stereo).check("--size", s))
             .transpose()?;
         let mut files = Files::new();

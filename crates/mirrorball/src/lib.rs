@@ -71,6 +71,7 @@ pub mod render;
 pub mod save;
 pub mod size;
 pub mod spec;
+pub mod v360;
 pub mod views;
 
 pub use error::Error;

@@ -104,7 +104,13 @@ impl Mapping {
             Projection::Cube(_) if layout == Some(Layout::Cells(Mapping::CUBE_CELLS)) => {
                 Some(Mapping::Cube)
             }
-            Projection::Eac(_) if matches!(layout, None | Some(Layout::Cells(CubeCells::EAC))) => {
+            // v360's eac at any size (`CubeCells::eac_frame`).
+            Projection::Eac(_)
+                if matches!(
+                    layout,
+                    None | Some(Layout::Cells(CubeCells { eac_pad: true, .. }))
+                ) =>
+            {
                 Some(Mapping::Eac)
             }
             _ => None,
@@ -147,7 +153,8 @@ impl Mapping {
         s
     }
 
-    /// Whether an eye of `w`×`h` pixels has this mapping's shape: the cubes' grids exactly,
+    /// Whether an eye of `w`×`h` pixels has this mapping's shape: the cube's grid exactly,
+    /// v360's EAC at any size that holds its faces,
     /// an equirectangular picture `hfov/vfov` as wide as high (within a pixel). The error is
     /// the rule broken.
     pub fn check_eye(&self, w: u32, h: u32) -> Result<(), String> {
@@ -156,7 +163,7 @@ impl Mapping {
                 (f64::from(w) - f64::from(h) * hfov / vfov).abs() <= 1.0
             }
             Mapping::Cube => Mapping::CUBE_CELLS.face_size(w, h).is_some(),
-            Mapping::Eac => CubeCells::EAC.face_size(w, h).is_some(),
+            Mapping::Eac => CubeCells::eac_frame(w, h).is_some(),
         };
         if fits {
             return Ok(());
@@ -167,7 +174,9 @@ impl Mapping {
                 hfov / vfov
             ),
             Mapping::Cube => "a cube in c3x2 is 3 faces wide and 2 high (3n×2n)".into(),
-            Mapping::Eac => "an EAC picture of faces of n pixels is (3n + 4)×(2n + 8)".into(),
+            Mapping::Eac => {
+                "an EAC picture holds six faces between two-pixel borders: at least 7×10".into()
+            }
         })
     }
 
@@ -405,7 +414,9 @@ mod tests {
         assert!(Mapping::Cube.check_eye(96, 64).is_ok());
         assert!(Mapping::Cube.check_eye(96, 60).is_err());
         assert!(Mapping::Eac.check_eye(3 * 32 + 4, 2 * 32 + 8).is_ok());
-        assert!(Mapping::Eac.check_eye(96, 64).is_err());
+        // v360's EAC at any size that holds its faces: YouTube's 3840x2160.
+        assert!(Mapping::Eac.check_eye(3840, 2160).is_ok());
+        assert!(Mapping::Eac.check_eye(6, 9).is_err());
     }
 
     #[test]

@@ -1,8 +1,9 @@
 //! The equi-angular cube as a Spherical Video V2 mesh projection (`mshp`), the way YouTube
 //! marks its EAC streams: the specification has no box for an equi-angular cube.
 //!
-//! **The mesh.** Each of the six cells of v360's `eac` picture (core's [`CubeCells::EAC`],
-//! its two-pixel borders included in the picture size) is a grid of `K`×`K` quads. A vertex
+//! **The mesh.** Each of the six cells of v360's `eac` picture of any size (core's
+//! [`CubeCells::EAC`], [`CubeCells::eac_point`]: its two-pixel borders included in the
+//! picture size, faces not square in general) is a grid of `K`×`K` quads. A vertex
 //! at cell coordinates `(c, d)` ∈ `[−1, 1]²` (right, down) shows the face coordinates
 //! [`CubeCells::face_coords`] gives; its position is the point on the unit cube
 //! `face.point(tan(π/4·s), tan(π/4·t))` in mirrorball's world axes, which are the
@@ -58,15 +59,16 @@ pub struct Mesh {
 /// The EAC mesh for one eye of `w`×`h` pixels in v360's `eac` layout.
 pub fn eac_mesh(w: u32, h: u32) -> Result<Mesh, String> {
     let cells = CubeCells::EAC;
-    let n = cells.face_size(w, h).ok_or_else(|| {
-        format!("an EAC picture of faces of n pixels is (3n + 4)×(2n + 8); this one is {w}×{h}")
-    })?;
-    let (wf, hf, nf, kf) = (f64::from(w), f64::from(h), f64::from(n), f64::from(K));
+    if CubeCells::eac_frame(w, h).is_none() {
+        return Err(format!(
+            "an EAC picture of {w}×{h} is too small to hold its six faces and their borders"
+        ));
+    }
+    let (wf, hf, kf) = (f64::from(w), f64::from(h), f64::from(K));
     let side = K + 1;
     let mut vertices = Vec::with_capacity(6 * (side * side) as usize);
     let mut strip = Vec::new();
     for cell in 0..6 {
-        let (ox, oy) = cells.origin(cell, n);
         let face = cells.faces[cell];
         let first = vertices.len() as u32;
         for gy in 0..side {
@@ -77,8 +79,7 @@ pub fn eac_mesh(w: u32, h: u32) -> Result<Mesh, String> {
                 );
                 let (s, t) = cells.face_coords(cell, c, d);
                 let p = face.point(Eac::unwarp(s), Eac::unwarp(t));
-                let x = f64::from(ox) + (c + 1.0) / 2.0 * nf;
-                let y = f64::from(oy) + (d + 1.0) / 2.0 * nf;
+                let (x, y) = cells.eac_point((w, h), cell, c, d);
                 vertices.push([
                     p.x as f32,
                     p.y as f32,
@@ -288,7 +289,22 @@ mod tests {
         let m = eac_mesh(w, h).unwrap();
         assert_eq!(decode(&eac_mshp(w, h).unwrap()), m);
         assert_eq!(m.vertices.len(), 6 * 33 * 33);
-        assert!(eac_mesh(96, 64).is_err());
+        assert!(eac_mesh(6, 9).is_err());
+        // v360's EAC at a size of its own (YouTube's 3840x2160 scaled by a fifth): the
+        // cells' corners where v360 puts them, faces 254⅔ by 212 pixels.
+        let m = eac_mesh(768, 432).unwrap();
+        let xs: Vec<f32> = m.vertices.iter().map(|v| v[3] * 768.0).collect();
+        let ys: Vec<f32> = m.vertices.iter().map(|v| (1.0 - v[4]) * 432.0).collect();
+        let lo = |v: &[f32]| v.iter().cloned().fold(f32::MAX, f32::min);
+        let hi = |v: &[f32]| v.iter().cloned().fold(f32::MIN, f32::max);
+        assert!((lo(&xs) - 2.0).abs() < 1e-3 && (hi(&xs) - 766.0).abs() < 1e-3);
+        assert!((lo(&ys) - 2.0).abs() < 1e-3 && (hi(&ys) - 430.0).abs() < 1e-3);
+        assert!(xs.iter().any(|&x| (x - (2.0 + 764.0 / 3.0)).abs() < 1e-3));
+        // The rows' faces end at 2 + 212 and start again at 216 + 2.
+        for edge in [214.0, 218.0] {
+            assert!(ys.iter().any(|&y| (y - edge).abs() < 1e-3), "{edge}");
+        }
+        assert!(!ys.iter().any(|&y| y > 214.5 && y < 217.5));
     }
 
     /// Each triangle of the strip with its winding undone (odd ones are flipped), the

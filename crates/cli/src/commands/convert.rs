@@ -37,7 +37,7 @@ pub use mirrorball::spec::parse_precision;
 
 /// `a`'s flags as the library's request.
 pub(crate) fn request(a: &ConvertArgs) -> Result<ConvertRequest, CliError> {
-    Ok(ConvertRequest {
+    let r = ConvertRequest {
         input: a.input.clone(),
         output: a.output.clone(),
         input_plan: crate::commands::input_plan(&a.input_args)?,
@@ -64,7 +64,16 @@ pub(crate) fn request(a: &ConvertArgs) -> Result<ConvertRequest, CliError> {
         mips: a.mips,
         max_samples: a.max_samples,
         outside: parse("--outside", &a.outside)?,
-    })
+        rotation: None,
+    };
+    let Some(options) = &a.v360 else {
+        return Ok(r);
+    };
+    let v360 = mirrorball::v360::parse(options).map_err(CliError::from)?;
+    if !a.quiet {
+        v360.notes.iter().for_each(|n| eprintln!("{n}"));
+    }
+    r.with_v360(&v360)
 }
 
 /// The value of `T` that `given` (the text of `flag`) names, if given.

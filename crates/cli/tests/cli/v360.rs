@@ -76,6 +76,28 @@ fn decode(c: [f64; 3]) -> Option<DVec3> {
     DVec3::from_array(c.map(|v| (v - 0.5) / 0.49)).try_normalize()
 }
 
+/// The direction coded at `(x, y)` of ffmpeg's raw `rgb48le` picture `ff`, `w` wide.
+fn ffmpeg_dir(ff: &[u8], w: u32, x: u32, y: u32) -> Option<DVec3> {
+    let k = ((y * w + x) * 6) as usize;
+    decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
+}
+
+/// `mirrorball convert INPUT OUT ARGS --precision 16 -q` (a 16-bit PNG), read back: its
+/// one picture.
+fn convert_16(input: &Path, out: &Path, args: &[&str]) -> mirrorball_core::Image {
+    let mut all = vec!["convert", input.to_str().unwrap(), out.to_str().unwrap()];
+    all.extend(args);
+    all.extend(["--precision", "16", "-q"]);
+    ok(&all);
+    let mut read = mirrorball_io::read(out, &Default::default()).unwrap();
+    read.layers.swap_remove(0)
+}
+
+/// The direction coded at `(x, y)` of mirrorball's 16-bit PNG, as read (linear values).
+fn mirrorball_dir(img: &mirrorball_core::Image, x: u32, y: u32) -> Option<DVec3> {
+    decode([0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64)))
+}
+
 /// A `w`×`h` 16-bit PNG of projection `p`, each pixel the code of its direction: at the
 /// texel centre, or (`align`) where FFmpeg 5.1 reads it.
 fn write_coded(path: &Path, p: &Projection, w: u32, h: u32, align: bool) {
@@ -176,22 +198,8 @@ fn compare(dir: &Path, case: &Case) {
     assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
     let out = dir.join("out_mb.png");
     let size = case.size.to_string();
-    ok(&[
-        "convert",
-        for_mb.to_str().unwrap(),
-        out.to_str().unwrap(),
-        "--from",
-        case.from,
-        "--to",
-        case.to,
-        "--size",
-        &size,
-        "--precision",
-        "16",
-        "-q",
-    ]);
-    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
-    let img = &mb.layers[0];
+    let args = ["--from", case.from, "--to", case.to, "--size", &size];
+    let img = &convert_16(&for_mb, &out, &args);
     assert_eq!((img.width(), img.height()), (w, h), "{}", case.to);
 
     let (mut compared, mut inside, mut worst) = (0, 0, 0.0f64);
@@ -209,12 +217,7 @@ fn compare(dir: &Path, case: &Case) {
                 continue;
             }
             inside += 1;
-            let k = ((y * w + x) * 6) as usize;
-            let f =
-                [0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0);
-            let px = img.get(x, y);
-            let m = [0, 1, 2].map(|c| mirrorball_core::color::linear_to_srgb(px[c] as f64));
-            let (Some(df), Some(dm)) = (decode(f), decode(m)) else {
+            let (Some(df), Some(dm)) = (ffmpeg_dir(&ff, w, x, y), mirrorball_dir(img, x, y)) else {
                 continue; // outside a view: black in both (checked below)
             };
             compared += 1;
@@ -358,10 +361,7 @@ fn compare_packed(dir: &Path, case: &Packed) {
     assert_eq!(ff.len(), (w * h * 6) as usize, "{filter}: output size");
     let out = dir.join("out_mb.png");
     let size = case.size.to_string();
-    ok(&[
-        "convert",
-        for_mb.to_str().unwrap(),
-        out.to_str().unwrap(),
+    let args = [
         "--from",
         "latlong",
         "--to",
@@ -370,27 +370,14 @@ fn compare_packed(dir: &Path, case: &Packed) {
         case.layout,
         "--size",
         &size,
-        "--precision",
-        "16",
-        "-q",
-    ]);
-    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
-    let img = &mb.layers[0];
+    ];
+    let img = &convert_16(&for_mb, &out, &args);
     assert_eq!((img.width(), img.height()), (w, h), "{}", case.layout);
-    let ffd = |x: u32, y: u32| {
-        let k = ((y * w + x) * 6) as usize;
-        decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
-    };
+    let ffd = |x: u32, y: u32| ffmpeg_dir(&ff, w, x, y);
     let (mut compared, mut worst) = (0, 0.0f64);
     for y in 1..h - 1 {
         for x in 1..w - 1 {
-            let (Some(df), Some(dm)) = (
-                ffd(x, y),
-                decode(
-                    [0, 1, 2]
-                        .map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64)),
-                ),
-            ) else {
+            let (Some(df), Some(dm)) = (ffd(x, y), mirrorball_dir(img, x, y)) else {
                 panic!("{}: texel ({x}, {y}) is black", case.layout);
             };
             let tol = ffmpeg_pixel(&ffd, x, y, df);
@@ -520,9 +507,6 @@ fn compare_pair(dir: &Path, case: &Pair) {
     let out = dir.join("pair_out.png");
     let size = case.size.to_string();
     let mut args = vec![
-        "convert",
-        for_mb.to_str().unwrap(),
-        out.to_str().unwrap(),
         "--from",
         "latlong",
         "--in-stereo",
@@ -533,21 +517,13 @@ fn compare_pair(dir: &Path, case: &Pair) {
         case.out_stereo,
         "--size",
         &size,
-        "--precision",
-        "16",
-        "-q",
     ];
     if let Some(l) = case.layout {
         args.extend(["--layout", l]);
     }
-    ok(&args);
-    let mb = mirrorball_io::read(&out, &Default::default()).unwrap();
-    let img = &mb.layers[0];
+    let img = &convert_16(&for_mb, &out, &args);
     assert_eq!((img.width(), img.height()), (fw, fh), "{filter}");
-    let ffd = |x: u32, y: u32| {
-        let k = ((y * fw + x) * 6) as usize;
-        decode([0, 2, 4].map(|o| u16::from_le_bytes([ff[k + o], ff[k + o + 1]]) as f64 / 65535.0))
-    };
+    let ffd = |x: u32, y: u32| ffmpeg_dir(&ff, fw, x, y);
     let (mut compared, mut worst) = (0, 0.0f64);
     for e in 0..sout.eyes() {
         let (ox, oy) = match sout {
@@ -559,9 +535,7 @@ fn compare_pair(dir: &Path, case: &Pair) {
         let sign = if sin.source_eye(e) == 0 { 1.0 } else { -1.0 };
         for y in oy + 1..oy + h - 1 {
             for x in ox + 1..ox + w - 1 {
-                let m = [0, 1, 2]
-                    .map(|c| mirrorball_core::color::linear_to_srgb(img.get(x, y)[c] as f64));
-                let (Some(df), Some(dm)) = (ffd(x, y), decode(m)) else {
+                let (Some(df), Some(dm)) = (ffd(x, y), mirrorball_dir(img, x, y)) else {
                     panic!("{filter}: texel ({x}, {y}) is black");
                 };
                 let tol = ffmpeg_pixel(&ffd, x, y, df);
@@ -632,4 +606,297 @@ fn stereo_pairs_land_where_v360_puts_them() {
     for case in &cases {
         compare_pair(dir.path(), case);
     }
+}
+
+/// The picture of a map of projection `from` (`w`×`h`, or for a cube in v360's cells a face
+/// of `w`) coded with its directions, for ffmpeg and for mirrorball: a single-layer map as
+/// [`write_coded`] codes it, a map with layers (EAC) packed by its layout from faces coded at
+/// their texel centres (v360 reads EAC at pixel centres, so both get the same picture).
+fn write_input(
+    dir: &Path,
+    from: &str,
+    (w, h): (u32, u32),
+) -> (std::path::PathBuf, std::path::PathBuf) {
+    let (for_mb, for_ff) = (dir.join("opt_mb.png"), dir.join("opt_ff.png"));
+    let src = ProjectionSpec::parse(from)
+        .unwrap()
+        .build(Some((w, h)))
+        .unwrap();
+    if src.layer_count() == 1 {
+        write_coded(&for_mb, &src, w, h, false);
+        write_coded(&for_ff, &src, w, h, true);
+        return (for_mb, for_ff);
+    }
+    let layers = (0..src.layer_count())
+        .map(|layer| {
+            let data = (0..w * w)
+                .flat_map(|i| {
+                    let uv = DVec2::new(
+                        ((i % w) as f64 + 0.5) / w as f64,
+                        ((i / w) as f64 + 0.5) / w as f64,
+                    );
+                    code(src.uv_to_dir(layer, uv).unwrap()).map(|c| c as f32)
+                })
+                .collect();
+            mirrorball_core::Image::from_vec(w, w, 3, data).unwrap()
+        })
+        .collect();
+    let env = mirrorball_core::EnvMap::new(src, layers).unwrap();
+    let picture = mirrorball_core::Layout::default_for(src.kind())
+        .pack(&env)
+        .unwrap();
+    let codes: Vec<[u16; 3]> = picture
+        .data()
+        .chunks(3)
+        .map(|c| [c[0], c[1], c[2]].map(|v| v.round() as u16))
+        .collect();
+    write_rgb48(&for_mb, picture.width(), picture.height(), &codes);
+    std::fs::copy(&for_mb, &for_ff).unwrap();
+    (for_mb, for_ff)
+}
+
+/// `mirrorball convert --v360 OPTIONS` against `ffmpeg -vf v360=OPTIONS:interp=line` on
+/// the same direction-coded input of projection `from`: the same picture size, and the
+/// direction decoded from each texel within one of ffmpeg's pixels (its farthest
+/// neighbour, seams left out) wherever ffmpeg's texel is not black and the output
+/// projection covers it (v360 draws past a fisheye's circle), at least 97% of those
+/// compared (the rest: rim texels mirrorball leaves black).
+fn compare_options(dir: &Path, from: &str, in_size: (u32, u32), options: &str) {
+    let (for_mb, for_ff) = write_input(dir, from, in_size);
+    let filter = format!("v360={options}:interp=line");
+    let ff = v360_raw(&for_ff, &filter);
+    let out = dir.join("opt_out.png");
+    // The input's projection is the options' own: no --from.
+    let img = &convert_16(&for_mb, &out, &["--v360", options]);
+    let (w, h) = (img.width(), img.height());
+    assert_eq!(
+        ff.len(),
+        (w * h * 6) as usize,
+        "{filter}: ffmpeg's size is not {w}x{h}"
+    );
+    let ffd = |x: u32, y: u32| (x < w && y < h).then(|| ffmpeg_dir(&ff, w, x, y))?;
+    let to = mirrorball::v360::parse(options)
+        .unwrap()
+        .to
+        .build(None)
+        .unwrap();
+    let single = (to.layer_count() == 1).then_some(to);
+    let uv = |x: u32, y: u32| DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+    let (mut compared, mut seen, mut worst) = (0, 0, 0.0f64);
+    for y in 0..h {
+        for x in 0..w {
+            let Some(df) = ffd(x, y) else {
+                continue;
+            };
+            // v360 draws past a fisheye's circle; mirrorball leaves it black.
+            if single
+                .as_ref()
+                .is_some_and(|p| p.density(0, uv(x, y)) <= 0.0)
+            {
+                continue;
+            }
+            seen += 1;
+            let Some(dm) = mirrorball_dir(img, x, y) else {
+                continue; // a rim texel mirrorball leaves black (counted below)
+            };
+            // One pixel: a single-layer output's own (its farthest neighbour's angle,
+            // as `compare` takes it), ffmpeg's for cells (seams left out).
+            let tol = match &single {
+                Some(p) => pixel_angle(p, x, y, w, h),
+                None => ffmpeg_pixel(&ffd, x, y, df),
+            };
+            if tol == 0.0 {
+                continue; // no neighbour decodes: a lone texel at a rim
+            }
+            let e = df.angle_between(dm);
+            worst = worst.max(e / tol);
+            compared += 1;
+            assert!(
+                e <= tol,
+                "--v360 {options}: texel ({x}, {y}) differs by {:.3}° (a pixel is {:.3}°): \
+                 ffmpeg {df}, mirrorball {dm}",
+                e.to_degrees(),
+                tol.to_degrees()
+            );
+        }
+    }
+    eprintln!("--v360 {options:<70} {compared}/{seen} texels, worst {worst:.3} of a pixel");
+    assert!(
+        compared * 100 >= seen * 97 && compared > 500,
+        "--v360 {options}: only {compared} of the {seen} texels ffmpeg shows compared"
+    );
+}
+
+#[test]
+fn v360_options_land_where_v360_puts_them() {
+    if !have_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let e = (256, 128);
+    for order in ["ypr", "yrp", "pyr", "pry", "ryp", "rpy"] {
+        let s = format!("e:eac:yaw=30:pitch=20:roll=-50:rorder={order}:w=148:h=104");
+        compare_options(dir.path(), "latlong", e, &s);
+    }
+    for s in [
+        "e:c3x2:out_forder=fbudlr:out_frot=123012:yaw=-45:pitch=10:w=120:h=80",
+        "e:c6x1:out_forder=udfblr:roll=30:w=192:h=32",
+        "e:flat:h_fov=90:v_fov=58.71551708:w=160:h=90:yaw=40:pitch=-30:roll=20",
+        "e:flat:d_fov=100:w=160:h=90:pitch=45",
+        "e:e:yaw=20:pitch=30:roll=-40:rorder=rpy:w=128:h=64",
+        "e:e:yaw=60:h_flip=1:v_flip=true:w=128:h=64",
+        "e:e:pitch=25:d_flip=1:w=128:h=64",
+        "e:fisheye:h_fov=180:v_fov=180:yaw=90:w=96:h=96",
+        "e:sg:h_fov=200:v_fov=200:w=96:h=96",
+        "e:equisolid:h_fov=180:v_fov=180:w=96:h=96",
+        "e:og:h_fov=160:v_fov=160:w=96:h=96",
+        "e:hequirect:yaw=-30:w=96:h=96",
+        // v360's eac at sizes of its own: YouTube's 3840x2160 scaled by a fifth (faces
+        // 254⅔ by 212 texels), and faces of whole but unequal sizes.
+        "e:eac:w=768:h=432",
+        "e:eac:yaw=100:pitch=-30:w=772:h=440",
+    ] {
+        compare_options(dir.path(), "latlong", e, s);
+    }
+    compare_options(
+        dir.path(),
+        "dfisheye:fov=190",
+        e,
+        "dfisheye:e:ih_fov=190:iv_fov=190:w=128:h=64",
+    );
+    compare_options(dir.path(), "eac", (40, 40), "eac:e:yaw=15:w=128:h=64");
+}
+
+/// Options mirrorball cannot make exactly, or v360 would refuse: exit 2, the key named, no
+/// output written.
+#[test]
+fn v360_options_refused_name_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = crate::util::asset("city.exr");
+    let out = dir.path().join("out.png");
+    for (options, extra, named) in [
+        ("e:eac:bogus=1", &[][..], "bogus"),
+        ("e:eac:yaw=400", &[], "yaw"),
+        ("e:tetrahedron", &[], "tetrahedron"),
+        ("e:barrel", &[], "barrel"),
+        ("e:c3x2:out_forder=rludfq", &[], "out_forder"),
+        ("e:e:ih_flip=1", &[], "ih_flip"),
+        ("e:c3x2:w=100:h=60", &[], "h=60"),
+        ("e:eac", &["--to", "cube"][..], "--to"),
+        ("e:eac", &["--pitch", "10"][..], "--pitch"),
+        ("e:eac:w=148:h=104", &["--size", "48"][..], "--size"),
+    ] {
+        let mut args = vec![
+            "convert",
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--v360",
+            options,
+        ];
+        args.extend(extra);
+        let o = crate::util::run(&args);
+        let err = crate::util::stderr(&o);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "--v360 {options} {extra:?}: {err}"
+        );
+        assert!(err.contains(named), "--v360 {options} {extra:?}: {err}");
+        assert!(!out.exists(), "--v360 {options}: an output was written");
+    }
+}
+
+/// An EAC frame of v360's at a size of its own (768x432: YouTube's 3840x2160 scaled by a
+/// fifth), made by ffmpeg from a direction-coded lat-long, read with `--from eac` and by
+/// v360's `eac` input alike: the same directions within one pixel. And `--to eac --size
+/// WxH` makes the frame `--v360 e:eac:w=W:h=H` makes, to the bit.
+#[test]
+fn eac_frames_of_any_size() {
+    if !have_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (_, ll) = write_input(dir.path(), "latlong", (512, 256));
+    let frame = dir.path().join("frame.png");
+    ffmpeg(&[
+        "-i",
+        ll.to_str().unwrap(),
+        "-vf",
+        "v360=e:eac:w=768:h=432:interp=line",
+        "-pix_fmt",
+        "rgb48be",
+        frame.to_str().unwrap(),
+    ]);
+    let ff = v360_raw(&frame, "v360=eac:e:w=256:h=128:yaw=20:interp=line");
+    let out = dir.path().join("read.png");
+    let o = ok(&[
+        "convert",
+        frame.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--from",
+        "eac",
+        "--to",
+        "latlong",
+        "--size",
+        "256",
+        "--yaw",
+        "20",
+        "--precision",
+        "16",
+    ]);
+    assert!(o.contains("fits eac"), "{o}");
+    let img = mirrorball_io::read(&out, &Default::default()).unwrap();
+    let img = &img.layers[0];
+    let dst = ProjectionSpec::parse("latlong")
+        .unwrap()
+        .build(None)
+        .unwrap();
+    let (mut compared, mut worst) = (0, 0.0f64);
+    for y in 1..127 {
+        for x in 0..256 {
+            let (Some(df), Some(dm)) = (ffmpeg_dir(&ff, 256, x, y), mirrorball_dir(img, x, y))
+            else {
+                panic!("texel ({x}, {y}) is black");
+            };
+            let tol = pixel_angle(&dst, x, y, 256, 128);
+            let e = df.angle_between(dm);
+            worst = worst.max(e / tol);
+            compared += 1;
+            assert!(
+                e <= tol,
+                "eac 768x432 read: texel ({x}, {y}) differs by {:.3}° (a pixel is {:.3}°)",
+                e.to_degrees(),
+                tol.to_degrees()
+            );
+        }
+    }
+    eprintln!("eac 768x432 read: {compared} texels, worst {worst:.3} of a pixel");
+
+    // --to eac --size WxH is --v360 e:eac:w=W:h=H.
+    let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+    let src = crate::util::asset("city.exr");
+    ok(&[
+        "convert",
+        src.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--to",
+        "eac",
+        "--size",
+        "768x432",
+        "-q",
+    ]);
+    ok(&[
+        "convert",
+        src.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--v360",
+        "e:eac:w=768:h=432",
+        "-q",
+    ]);
+    let (a, b) = (
+        mirrorball_io::read(&a, &Default::default()).unwrap(),
+        mirrorball_io::read(&b, &Default::default()).unwrap(),
+    );
+    assert_eq!((a.layers[0].width(), a.layers[0].height()), (768, 432));
+    assert_eq!(a.layers[0], b.layers[0]);
 }

@@ -133,3 +133,63 @@ fn ctrl_c_in_a_video_leaves_no_file() {
     assert_eq!(status.code(), Some(130));
     assert_eq!(files(d), ["in.mp4"]);
 }
+
+/// `--v360` on a video: v360's EAC at a size of its own (YouTube's 3840x2160 scaled by a
+/// fifth) comes out that size, marked as a 360° video (a mesh projection, as YouTube marks
+/// EAC) that is read back as EAC with no --from; a projection mirrorball cannot make exits
+/// 2 with nothing written.
+#[cfg(feature = "video")]
+#[test]
+fn a_video_takes_v360s_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let i = d.join("in.mp4");
+    make_video(&i, "512x256", 1);
+    let o = d.join("eac.mp4");
+    let out = run(&[
+        "convert",
+        i.to_str().unwrap(),
+        o.to_str().unwrap(),
+        "--v360",
+        "e:eac:yaw=30:pitch=-20:rorder=pyr:w=768:h=432",
+        "--preset",
+        "ultrafast",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let probe = std::process::Command::new("ffprobe")
+        .args(["-v", "error", "-select_streams", "v:0", "-show_entries"])
+        .args(["stream=width,height", "-of", "csv=p=0"])
+        .arg(&o)
+        .output()
+        .expect("ffprobe runs");
+    let text = String::from_utf8_lossy(&probe.stdout);
+    assert!(text.starts_with("768,432"), "{text}");
+    // Debian's ffprobe 5.1 does not read the mesh; mirrorball does, and takes the file for
+    // what it is with no --from.
+    let info = crate::util::ok(&["info", o.to_str().unwrap()]);
+    assert!(info.contains("projection:  eac"), "{info}");
+    let back = d.join("back.mp4");
+    let out = run(&[
+        "convert",
+        o.to_str().unwrap(),
+        back.to_str().unwrap(),
+        "--to",
+        "latlong",
+        "--size",
+        "128",
+        "--preset",
+        "ultrafast",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("says eac"), "{}", stderr(&out));
+    let out = run(&[
+        "convert",
+        i.to_str().unwrap(),
+        d.join("no.mp4").to_str().unwrap(),
+        "--v360",
+        "e:barrelsplit",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("barrelsplit"), "{}", stderr(&out));
+    assert_eq!(files(d), ["back.mp4", "eac.mp4", "in.mp4"]);
+}

@@ -241,6 +241,11 @@ fn the_stereo_mode_is_written_and_read_back() {
 
 /// Raw yuv420p frames of `path` decoded by ffmpeg, through `filter` if any.
 fn raw_frames(path: &Path, filter: Option<&str>) -> Vec<u8> {
+    raw_frames_as(path, filter, "yuv420p")
+}
+
+/// The frames of `path` (through `filter`, if any) as raw `pix_fmt`.
+fn raw_frames_as(path: &Path, filter: Option<&str>, pix_fmt: &str) -> Vec<u8> {
     let mut cmd = Command::new("ffmpeg");
     cmd.args(["-v", "error", "-nostdin", "-i"]).arg(path);
     if let Some(f) = filter {
@@ -253,7 +258,7 @@ fn raw_frames(path: &Path, filter: Option<&str>) -> Vec<u8> {
             "-f",
             "rawvideo",
             "-pix_fmt",
-            "yuv420p",
+            pix_fmt,
             "-",
         ])
         .output()
@@ -264,6 +269,19 @@ fn raw_frames(path: &Path, filter: Option<&str>) -> Vec<u8> {
         String::from_utf8_lossy(&out.stderr)
     );
     out.stdout
+}
+
+/// [`psnr`] of little-endian 16-bit codes (10-bit video's samples).
+fn psnr_words(a: &[u8], b: &[u8], max: f64) -> f64 {
+    let w = |f: &[u8]| -> Vec<f64> {
+        f.chunks_exact(2)
+            .map(|c| u16::from_le_bytes([c[0], c[1]]) as f64)
+            .collect()
+    };
+    let (x, y) = (w(a), w(b));
+    assert_eq!(x.len(), y.len());
+    let mse = x.iter().zip(&y).map(|(p, q)| (p - q).powi(2)).sum::<f64>() / x.len() as f64;
+    10.0 * (max * max / mse.max(1e-12)).log10()
 }
 
 fn psnr(a: &[u8], b: &[u8], max: f64) -> f64 {
@@ -347,6 +365,56 @@ fn the_pixels_are_v360s_in_yuv420p() {
             db > 38.0,
             "{to}: {db:.1} dB against {v360} (Y, U, V: {each:.1?})"
         );
+    }
+}
+
+/// `--v360 S` on a video against `ffmpeg -vf v360=S`, in yuv420p and yuv420p10le: each
+/// plane's PSNR (a wrong turn, order or face arrangement is far below it), lossless
+/// encodes on both sides. EAC is held to v360's 4:4:4 picture (see
+/// `the_pixels_are_v360s_in_yuv420p`).
+#[test]
+fn v360_options_give_v360s_pixels_in_yuv420p_and_yuv420p10le() {
+    let dir = tempfile::tempdir().unwrap();
+    for (pix_fmt, max, bytes) in [("yuv420p", 255.0, 1), ("yuv420p10le", 1023.0, 2)] {
+        let input = source_of(
+            dir.path(),
+            &format!("in-{pix_fmt}.mkv"),
+            pix_fmt,
+            "testsrc2=size=512x256:rate=30:duration=1,gblur=sigma=1.5",
+        );
+        for options in [
+            "e:c3x2:out_forder=fbudlr:out_frot=123012:yaw=-45:pitch=10:w=384:h=256",
+            "e:eac:yaw=30:pitch=20:roll=-50:rorder=rpy:w=388:h=264",
+            "e:flat:h_fov=90:v_fov=58.71551708:w=320:h=180:pitch=30:roll=15:rorder=ryp",
+            // v360's eac at a size of its own (YouTube's 3840x2160 scaled by a fifth).
+            "e:eac:yaw=-60:w=768:h=432",
+        ] {
+            let out = dir.path().join(format!("out-{pix_fmt}.mkv"));
+            let v360 = mirrorball::v360::parse(options).unwrap();
+            let mut r = request(&input, &out, "latlong");
+            r.convert.to = None;
+            r.convert = r.convert.with_v360(&v360).unwrap();
+            r.crf = Some(0);
+            convert(&r).unwrap();
+            let filter = match options.starts_with("e:eac") {
+                true => format!("format=yuv444p10le,v360={options},format={pix_fmt}"),
+                false => format!("v360={options}"),
+            };
+            let ours = raw_frames_as(&out, None, pix_fmt);
+            let theirs = raw_frames_as(&input, Some(&filter), pix_fmt);
+            assert_eq!(ours.len(), theirs.len(), "{pix_fmt} {options}");
+            // PSNR over the codes themselves: bytes, or 10-bit codes in 16-bit words.
+            let db = if bytes == 1 {
+                psnr(&ours, &theirs, max)
+            } else {
+                psnr_words(&ours, &theirs, max)
+            };
+            eprintln!("{pix_fmt}: --v360 {options}: {db:.1} dB against v360");
+            assert!(
+                db > 38.0,
+                "{pix_fmt}: --v360 {options}: {db:.1} dB against v360"
+            );
+        }
     }
 }
 
