@@ -64,6 +64,7 @@ const IN_FLIGHT: usize = 2;
 /// Frames' planes handed back by the stage that used them to the stage that fills them,
 /// so that a long video allocates (and the kernel zeroes) no fresh pages a frame.
 #[derive(Clone, Default)]
+#[allow(clippy::vec_box)] // the boxes travel through the channels as they are
 struct Pool(Arc<std::sync::Mutex<Vec<Box<Planes>>>>);
 
 impl Pool {

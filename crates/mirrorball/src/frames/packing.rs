@@ -169,9 +169,9 @@ impl Packing {
         let step = 1u32 << s;
         let (w, h) = (self.width >> s, self.height >> s);
         if s == 0
-            || self.width % step != 0
-            || self.height % step != 0
-            || self.layer_width % step != 0
+            || !self.width.is_multiple_of(step)
+            || !self.height.is_multiple_of(step)
+            || !self.layer_width.is_multiple_of(step)
         {
             return None;
         }
@@ -186,7 +186,7 @@ impl Packing {
             for run in &self.runs[luma] {
                 for k in 0..run.len {
                     let at = run.at + k;
-                    if at % step != 0 {
+                    if !at.is_multiple_of(step) {
                         continue;
                     }
                     let lx = run.x as i64 + run.dx as i64 * k as i64;
@@ -207,7 +207,9 @@ impl Packing {
         let lookups: Vec<(u32, DVec3)> = self
             .lookups
             .iter()
-            .filter(|&&(i, _)| (i % self.width) % step == 0 && (i / self.width) % step == 0)
+            .filter(|&&(i, _)| {
+                (i % self.width).is_multiple_of(step) && (i / self.width).is_multiple_of(step)
+            })
             .map(|&(i, d)| (((i / self.width) >> s) * w + ((i % self.width) >> s), d))
             .collect();
         // Every colour texel shows something where every luma texel did.
