@@ -613,8 +613,8 @@ fn views_rerun_replaces_only_what_mirrorball_wrote() {
     let rig = dir.path().join("ring.json");
     std::fs::write(
         &rig,
-        r#"{"views": [{"name": "front"}, {"name": "right", "yaw": 90},
-                       {"name": "back", "yaw": 180}, {"name": "left", "yaw": 270}]}"#,
+        r#"{"views": [{"name": "front", "fov": 90}, {"name": "right", "yaw": 90, "fov": 90},
+                       {"name": "back", "yaw": 180, "fov": 90}, {"name": "left", "yaw": 270, "fov": 90}]}"#,
     )
     .unwrap();
     let said = run(&[
