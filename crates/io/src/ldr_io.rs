@@ -86,6 +86,9 @@ pub fn read_codes(
         return Ok(None);
     }
     let path = input.path();
+    if format == Format::Jpeg {
+        return guard_decoder(path, "JPEG", || jpeg_codes(input, limits, buf));
+    }
     let (coded, recorded) = read_with(input, format, limits, |decoder, name| {
         let wide = match decoder.color_type() {
             image::ColorType::Rgb8 => false,
@@ -147,21 +150,7 @@ fn read_with<T>(
             let (t, _) = decode(input, reader, image_format, format, name, limits, finish)?;
             return Ok((t, None));
         }
-        // JPEG decoders fill in whatever a truncated file lacks: check for the end marker.
-        let bytes = input.all().map_err(io)?;
-        if !bytes.starts_with(&[0xff, 0xd8]) {
-            return Err(Error::input(
-                path,
-                "not a valid JPEG file (no start-of-image marker)".into(),
-            ));
-        }
-        if !jpeg_is_complete(&bytes) {
-            return Err(Error::input(
-                path,
-                "file is truncated (the JPEG end-of-image marker is missing)".into(),
-            ));
-        }
-        let comments = crate::meta_text::jpeg_comments(&bytes);
+        let (bytes, comments) = jpeg_file(input)?;
         let reader = Cursor::new(&bytes[..]);
         let (t, (w, h)) = decode(input, reader, image_format, format, name, limits, finish)?;
         let get = |key: &str| {
@@ -172,6 +161,80 @@ fn read_with<T>(
         };
         Ok((t, crate::recorded(get, w, h)))
     })
+}
+
+/// A JPEG file's bytes, checked for its start and end markers (decoders fill in whatever a
+/// truncated file lacks), and its comment segments' `key=value` lines.
+fn jpeg_file<'a>(
+    input: &'a Input,
+) -> Result<(std::borrow::Cow<'a, [u8]>, Vec<(String, String)>), Error> {
+    let path = input.path();
+    let bytes = input.all().map_err(|e| Error::io(path, e))?;
+    if !bytes.starts_with(&[0xff, 0xd8]) {
+        return Err(Error::input(
+            path,
+            "not a valid JPEG file (no start-of-image marker)".into(),
+        ));
+    }
+    if !jpeg_is_complete(&bytes) {
+        return Err(Error::input(
+            path,
+            "file is truncated (the JPEG end-of-image marker is missing)".into(),
+        ));
+    }
+    let comments = crate::meta_text::jpeg_comments(&bytes);
+    Ok((bytes, comments))
+}
+
+/// [`read_codes`] of a JPEG: `image`'s decoder (zune-jpeg, with the options `image` gives
+/// it) run on the file's bytes as read, straight into `buf`; three-component pictures
+/// (YCbCr or RGB) only, others `None`.
+fn jpeg_codes(
+    input: &Input,
+    limits: &Limits,
+    buf: &mut Vec<u8>,
+) -> Result<Option<CodedPicture>, Error> {
+    use zune_core::colorspace::ColorSpace;
+    let path = input.path();
+    let (bytes, comments) = jpeg_file(input)?;
+    let fail = |e: zune_jpeg::errors::DecodeErrors| {
+        Error::input(path, format!("not a valid JPEG file ({e})"))
+    };
+    let options = zune_core::options::DecoderOptions::default()
+        .set_strict_mode(false)
+        .set_max_width(usize::MAX)
+        .set_max_height(usize::MAX);
+    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(
+        zune_core::bytestream::ZCursor::new(&bytes[..]),
+        options,
+    );
+    decoder.decode_headers().map_err(fail)?;
+    let (w, h) = decoder.dimensions().expect("headers decoded");
+    let (width, height) = (w as u32, h as u32);
+    check_limits(path, width as u64, height as u64, limits)?;
+    check_fits_file(input, Format::Jpeg, "JPEG", width, height)?;
+    match decoder.input_colorspace() {
+        Some(ColorSpace::YCbCr | ColorSpace::RGB) => {}
+        _ => return Ok(None),
+    }
+    decoder.set_options(options.jpeg_set_out_colorspace(ColorSpace::RGB));
+    let len = decoder.output_buffer_size().expect("headers decoded");
+    buf.resize(len, 0);
+    decoder.decode_into(buf).map_err(fail)?;
+    let get = |key: &str| {
+        comments
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.clone())
+    };
+    Ok(Some(CodedPicture {
+        width,
+        height,
+        wide: false,
+        recorded: crate::recorded(get, width, height),
+        format: Format::Jpeg,
+        description: "JPEG, 8-bit sRGB, RGB".into(),
+    }))
 }
 
 /// Opens the `image` crate's decoder, checks the declared size, and hands the decoder to
