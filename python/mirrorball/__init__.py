@@ -1,7 +1,8 @@
 """mirrorball: environment maps and 360° panoramas for numpy.
 
 Every projection mirrorball knows, both ways, with antialiasing; OpenEXR, Radiance HDR,
-PNG, JPEG, WebP, KTX2 and DDS files; prefiltered lighting and engine bakes. The work is
+PNG, JPEG, WebP, KTX2 and DDS files; prefiltered lighting and engine bakes; rigs of
+perspective views with the camera files COLMAP and nerfstudio read (:func:`views`). The work is
 the Rust workspace's (the same code as the ``mirrorball`` command line, bit for bit): this
 package holds no conversion logic of its own.
 
@@ -33,6 +34,7 @@ from ._native import (
     read,
     set_threads,
     sh9,
+    views,
     write,
 )
 from .py360 import c2e, c2p, e2c, e2p
@@ -53,5 +55,6 @@ __all__ = [
     "read",
     "set_threads",
     "sh9",
+    "views",
     "write",
 ]

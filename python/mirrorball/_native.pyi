@@ -154,3 +154,20 @@ def bake(
     invalid: str = "raise",
 ) -> list[str]:
     """Image-based lighting baked for ``engine`` into ``out_dir``: the CLI's ``mirrorball bake``."""
+
+def views(
+    src: PathLike,
+    out_dir: PathLike,
+    *,
+    rig: str = "cube",
+    size: Union[int, tuple[int, int], None] = None,
+    format: str = "png",
+    masks: bool = False,
+    mask: Optional[PathLike] = None,
+    max_samples: Optional[int] = None,
+    overwrite: bool = False,
+    projection: Optional[str] = None,
+    layout: Optional[str] = None,
+) -> list[str]:
+    """A panorama (or a sequence's pattern) cut into a rig of views with COLMAP's and
+    nerfstudio's camera files in ``out_dir``: the CLI's ``mirrorball views``, byte for byte."""
