@@ -11,6 +11,7 @@ import mirrorball
 from conftest import direction_latlong
 
 pycolmap = pytest.importorskip("pycolmap")
+cv2 = pytest.importorskip("cv2")
 
 
 def tree(root):
@@ -52,7 +53,7 @@ def test_pycolmap_reads_the_cameras_it_wrote(tmp, pano):
         cam = rec.cameras[image.camera_id]
         assert cam.model == pycolmap.CameraModelId.PINHOLE
         # The view's codes (as the panorama's: (d + 1)/2 of their direction d).
-        picture = mirrorball.read(out / "images" / image.name, dtype=np.uint8)[0]
+        picture = cv2.imread(str(out / "images" / image.name))[..., ::-1]
         assert picture.shape[:2] == (cam.height, cam.width)
         # The view's centre pixel holds the direction its camera looks along (COLMAP's
         # world is mirrorball's (x, -y, -z)); within the panorama's and the view's texels.
