@@ -163,11 +163,12 @@ fn read_with<T>(
     })
 }
 
+/// A JPEG's comment segments' `key=value` lines.
+type Comments = Vec<(String, String)>;
+
 /// A JPEG file's bytes, checked for its start and end markers (decoders fill in whatever a
 /// truncated file lacks), and its comment segments' `key=value` lines.
-fn jpeg_file<'a>(
-    input: &'a Input,
-) -> Result<(std::borrow::Cow<'a, [u8]>, Vec<(String, String)>), Error> {
+fn jpeg_file<'a>(input: &'a Input) -> Result<(std::borrow::Cow<'a, [u8]>, Comments), Error> {
     let path = input.path();
     let bytes = input.all().map_err(|e| Error::io(path, e))?;
     if !bytes.starts_with(&[0xff, 0xd8]) {

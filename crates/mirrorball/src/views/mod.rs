@@ -643,6 +643,9 @@ fn input_error(path: &str, problem: String) -> mirrorball_io::Error {
     mirrorball_io::Error::input(Path::new(path), problem)
 }
 
+/// A view's mask as its PNG file's bytes, and whether some pixel of it is not valid.
+type MaskFile = (Vec<u8>, bool);
+
 /// Each view's plan from a panorama of shape `src` and its mask file (a PNG of the
 /// coverage, less what `user_mask` blacks out; `None` where every pixel is valid), made
 /// in parallel, each counted by `tick`.
@@ -652,7 +655,7 @@ fn plan_views(
     (src, shape): Shape,
     user_mask: Option<&EnvMap>,
     tick: &(dyn Fn() + Sync),
-) -> Result<(Vec<Remap>, Vec<(Vec<u8>, bool)>), mirrorball_io::Error> {
+) -> Result<(Vec<Remap>, Vec<MaskFile>), mirrorball_io::Error> {
     use rayon::prelude::*;
     let opts = ResampleOptions {
         max_samples: plan.max_samples,
@@ -762,7 +765,8 @@ const JPEG_QUALITY: u8 = 92;
 /// carried, for transforms.json.
 fn write_frame(
     plan: &ViewsPlan,
-    (rig, plans, codes): (&[(Projection, Camera)], &[Remap], &mut [Vec<u8>]),
+    (rig, plans): (&[(Projection, Camera)], &[Remap]),
+    codes: &mut [Vec<u8>],
     (pano, path, frame): (&Pano, &str, &str),
     made: &mut Vec<PathBuf>,
     tick: &(dyn Fn() + Sync),
@@ -881,7 +885,8 @@ pub fn run(plan: &ViewsPlan, hooks: &dyn Hooks) -> Result<Written, Error> {
                     }
                     let carried = write_frame(
                         plan,
-                        (&rig, &plans, &mut codes),
+                        (&rig, &plans),
+                        &mut codes,
                         (&pano, path, frame),
                         &mut made,
                         &tick,
