@@ -171,3 +171,18 @@ def views(
 ) -> list[str]:
     """A panorama (or a sequence's pattern) cut into a rig of views with COLMAP's and
     nerfstudio's camera files in ``out_dir``: the CLI's ``mirrorball views``, byte for byte."""
+
+def cut_views(
+    array: Array,
+    *,
+    src: str = "latlong",
+    rig: str = "cube",
+    size: Union[int, tuple[int, int], None] = None,
+    max_samples: Optional[int] = None,
+    src_layout: Optional[str] = None,
+    dtype: DTypeLike = None,
+    linear: bool = False,
+    invalid: str = "raise",
+) -> list[dict[str, Any]]:
+    """A panorama array cut into the rig's views in memory: per view "name", "image",
+    "model", "K" (3×3 intrinsics) and "R" (3×3 cam_from_world, COLMAP's world)."""

@@ -32,6 +32,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lighting::sh9, m)?)?;
     m.add_function(wrap_pyfunction!(lighting::bake, m)?)?;
     m.add_function(wrap_pyfunction!(views::views, m)?)?;
+    m.add_function(wrap_pyfunction!(views::cut_views, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -89,3 +89,74 @@ pub fn views(
         .map(|p| p.display().to_string())
         .collect())
 }
+
+/// Cuts a panorama held as an array (H×W×C, or L×H×W×C with `src_layout="separate"`; its
+/// projection `src`) into the rig's views in memory, as `views` makes the files' pictures
+/// (the same rig, sizes and antialiasing): a list, one dict a view, in the rig's order:
+/// "name", "image" (H×W×C of `dtype`, default the array's), "model" ("PINHOLE" or
+/// "OPENCV_FISHEYE", k1..k4 = 0), "K" (3×3 intrinsics, pixel centres at half-integers) and
+/// "R" (3×3 `cam_from_world` in COLMAP's world, mirrorball's (x, −y, −z); every view at
+/// the panorama's centre).
+#[pyfunction]
+#[pyo3(signature = (array, *, src="latlong", rig="cube", size=None, max_samples=None, src_layout=None, dtype=None, linear=false, invalid="raise"))]
+#[allow(clippy::too_many_arguments)]
+pub fn cut_views<'py>(
+    py: Python<'py>,
+    array: &Bound<'py, PyAny>,
+    src: &str,
+    rig: &str,
+    size: Option<&Bound<'py, PyAny>>,
+    max_samples: Option<u32>,
+    src_layout: Option<&str>,
+    dtype: Option<&Bound<'py, PyAny>>,
+    linear: bool,
+    invalid: &str,
+) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
+    use numpy::{PyArray1, PyArrayMethods};
+    let source = crate::convert::Source::new(src, src_layout)?;
+    let want = crate::arrays::dtype_arg(py, dtype)?;
+    // The array's own dtype unless `dtype` asks for another (float32 for any other).
+    let dtype = want
+        .or_else(|| {
+            let name = array
+                .getattr("dtype")
+                .and_then(|d| d.getattr("name"))
+                .ok()?;
+            crate::arrays::Dtype::of_name(&name.extract::<String>().ok()?)
+        })
+        .unwrap_or(crate::arrays::Dtype::F32);
+    let env = crate::lighting::one_map(array, &source, linear, invalid)?;
+    let mut request = ViewsRequest::new("", "");
+    request.rig = rig.to_string();
+    request.size = size_arg(size)?;
+    if let Some(n) = max_samples {
+        request.max_samples = n;
+    }
+    let views = py
+        .detach(|| run(|| mirrorball::views::cut(&env, &request)))
+        .map_err(lib_error)?;
+    let matrix = |m: [f64; 9]| -> PyResult<Bound<'py, PyAny>> {
+        Ok(PyArray1::from_vec(py, m.to_vec())
+            .reshape([3, 3])?
+            .into_any())
+    };
+    views
+        .into_iter()
+        .map(|(cam, image)| {
+            let c = image.channels();
+            let shape = [image.height() as usize, image.width() as usize, c];
+            let picture = crate::arrays::to_numpy(py, &[image.data()], &shape, c, dtype, linear)?;
+            let (fx, fy) = cam.focal;
+            let (cx, cy) = cam.centre;
+            let r = cam.colmap_cam_from_world();
+            let d = pyo3::types::PyDict::new(py);
+            d.set_item("name", &cam.name)?;
+            d.set_item("image", picture)?;
+            d.set_item("model", cam.model.name())?;
+            d.set_item("K", matrix([fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0])?)?;
+            let rows = r.transpose().to_cols_array(); // row-major
+            d.set_item("R", matrix(rows)?)?;
+            Ok(d)
+        })
+        .collect()
+}

@@ -95,3 +95,28 @@ def test_bad_arguments_are_refused(tmp, pano):
     with pytest.raises(ValueError, match="size"):
         mirrorball.views(pano, tmp / "out", size="big")
     assert not (tmp / "out").exists()
+
+
+def test_cut_views_are_the_files_pictures_with_colmap_s_cameras(tmp):
+    """The in-memory cut of a float panorama: each view the picture `views` writes (as
+    16-bit sRGB codes, the same codes), K and R what pycolmap reads from its model."""
+    floats = direction_latlong(128, 256)
+    exr = tmp / "pano.exr"
+    mirrorball.write(exr, floats)
+    out = tmp / "out"
+    mirrorball.views(exr, out, rig="ring5", size=24, format="png16")
+    cut = mirrorball.cut_views(floats, rig="ring5", size=24, dtype=np.uint16)
+    rec = pycolmap.Reconstruction(str(out / "sparse" / "0"))
+    by_name = {image.name.split("/")[0]: image for image in rec.images.values()}
+    assert [v["name"] for v in cut] == ["yaw000", "yaw072", "yaw144", "yaw216", "yaw288", "up", "down"]
+    for v in cut:
+        image = by_name[v["name"]]
+        cam = rec.cameras[image.camera_id]
+        assert v["model"] == "PINHOLE" and v["image"].dtype == np.uint16
+        assert v["image"].shape == (cam.height, cam.width, 3)
+        assert np.allclose(v["K"], cam.calibration_matrix(), rtol=0, atol=1e-9)
+        assert np.allclose(v["R"], image.cam_from_world().rotation.matrix(), atol=1e-9)
+        written = cv2.imread(str(out / "images" / image.name), cv2.IMREAD_UNCHANGED)[..., ::-1]
+        assert np.array_equal(written, v["image"]), v["name"]
+    # float32 in, float32 out, unless dtype says otherwise (every function's rule).
+    assert mirrorball.cut_views(floats, size=8)[0]["image"].dtype == np.float32

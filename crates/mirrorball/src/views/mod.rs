@@ -126,48 +126,8 @@ impl ViewsPlan {
     /// Checks `r`: the rig, each view's fields of view and size, the container, OUT-DIR and
     /// every file written.
     pub fn new(r: &ViewsRequest) -> Result<ViewsPlan, Error> {
-        let views = rig::resolve(&r.rig)?;
-        let (format, ext, precision) = match r.format.to_ascii_lowercase().as_str() {
-            "png" => (Format::Png, "png", None),
-            "png16" => (Format::Png, "png", Some(Precision::U16)),
-            "jpg" | "jpeg" => (Format::Jpeg, "jpg", None),
-            "exr" => (Format::Exr, "exr", None),
-            other => {
-                return Err(Error::request(format!(
-                    "--format: unknown '{other}' (png, png16, jpg, exr)"
-                )))
-            }
-        };
-        if !(1..=16).contains(&r.max_samples) {
-            return Err(Error::request(format!(
-                "--max-samples: {} is outside 1..=16",
-                r.max_samples
-            )));
-        }
-        let bound =
-            crate::size::pictures(format, &format!("a .{ext} view"), |s| (s as u64, s as u64));
-        let size = r
-            .size
-            .map(|(w, h)| {
-                Ok::<_, Error>((
-                    bound.check("--size", w)?,
-                    h.map(|h| bound.check("--size", h)).transpose()?,
-                ))
-            })
-            .transpose()?;
-        if let Some(v) = views.iter().find(|v| v.model != views[0].model) {
-            return Err(Error::request(format!(
-                "--rig {}: view '{}' is {} and view '{}' is not: a rig's views are all pinhole or all fisheye (nerfstudio reads one camera model a file)",
-                r.rig,
-                v.name,
-                v.model.name(),
-                views[0].name
-            )));
-        }
-        let planned = views
-            .into_iter()
-            .map(|v| plan_view(v, size, &bound))
-            .collect::<Result<Vec<_>, _>>()?;
+        let (planned, bound) = plan_rig(r)?;
+        let (format, ext, precision) = container(&r.format)?;
         let dir = PathBuf::from(&r.out_dir);
         check_dir(&dir)?;
         let frames: Vec<(String, String)> = match Pattern::parse(&r.input)? {
@@ -265,67 +225,174 @@ impl ViewsPlan {
 
     /// The rig's cameras for a panorama `env`: each view's size (from `--size`, the view,
     /// else the panorama's resolution) and fields of view.
-    fn cameras(&self, (p, (w, h, layers)): Shape) -> Result<Vec<(Projection, Camera)>, Error> {
-        let texels = w as f64 * h as f64 * layers as f64;
-        // Texels per radian: the panorama's, were they spread evenly over what it covers.
-        let per_radian = (texels / p.covered_solid_angle()).sqrt();
-        self.views
-            .iter()
-            .map(|v| {
-                let s = &v.spec;
-                let t = (0.5 * s.fov.to_radians()).tan();
-                // The picture's half-width over the focal length: the plane's, or (a
-                // fisheye's) the rim's angle.
-                let half = match s.model {
-                    Model::Pinhole => t,
-                    Model::Fisheye => 0.5 * s.fov.to_radians(),
-                };
-                let w = match v.width {
-                    Some(w) => w,
-                    None => {
-                        let w = (2.0 * half * per_radian).round().max(16.0);
-                        self.bound
-                            .check(&format!("view '{}': its width", s.name), w as i64)?
-                    }
-                };
-                let frame = View::frame_of(s.yaw, s.pitch, s.roll);
-                if s.model == Model::Fisheye {
-                    let lens = Fisheye::new(Frame::turned(frame), Lens::Equidistant, s.fov)
-                        .ok_or_else(|| {
-                            Error::request(format!(
-                                "view '{}': a fisheye of {}° cannot be drawn",
-                                s.name, s.fov
-                            ))
-                        })?;
-                    let cam = Camera::fisheye(&s.name, w, s.fov, frame);
-                    return Ok((Projection::Fisheye(lens), cam));
+    fn cameras(&self, source: Shape) -> Result<Vec<(Projection, Camera)>, Error> {
+        rig_cameras(&self.views, &self.bound, source)
+    }
+}
+
+/// The rig's cameras for a panorama of shape `source`: each view's size (from `--size`, the
+/// view, else the panorama's resolution) and fields of view.
+fn rig_cameras(
+    views: &[Planned],
+    bound: &crate::size::Bound,
+    (p, (w, h, layers)): Shape,
+) -> Result<Vec<(Projection, Camera)>, Error> {
+    let texels = w as f64 * h as f64 * layers as f64;
+    // Texels per radian: the panorama's, were they spread evenly over what it covers.
+    let per_radian = (texels / p.covered_solid_angle()).sqrt();
+    views
+        .iter()
+        .map(|v| {
+            let s = &v.spec;
+            let t = (0.5 * s.fov.to_radians()).tan();
+            // The picture's half-width over the focal length: the plane's, or (a
+            // fisheye's) the rim's angle.
+            let half = match s.model {
+                Model::Pinhole => t,
+                Model::Fisheye => 0.5 * s.fov.to_radians(),
+            };
+            let w = match v.width {
+                Some(w) => w,
+                None => {
+                    let w = (2.0 * half * per_radian).round().max(16.0);
+                    bound.check(&format!("view '{}': its width", s.name), w as i64)?
                 }
-                let (h, vfov) = match (v.height, s.vfov) {
-                    (Some(h), Some(vfov)) => (h, vfov),
-                    (Some(h), None) => (h, fov_of(t * h as f64 / w as f64)),
-                    (None, Some(vfov)) => {
-                        let tv = (0.5 * vfov.to_radians()).tan();
-                        let h = (w as f64 * tv / t).round().max(1.0) as i64;
-                        (
-                            self.bound
-                                .check(&format!("view '{}': its height", s.name), h)?,
-                            vfov,
-                        )
-                    }
-                    (None, None) => (w, s.fov),
-                };
-                let view =
-                    View::perspective(s.fov, vfov, s.yaw, s.pitch, s.roll).ok_or_else(|| {
+            };
+            let frame = View::frame_of(s.yaw, s.pitch, s.roll);
+            if s.model == Model::Fisheye {
+                let lens = Fisheye::new(Frame::turned(frame), Lens::Equidistant, s.fov)
+                    .ok_or_else(|| {
                         Error::request(format!(
-                            "view '{}': a pinhole view of {}°×{vfov}° cannot be drawn",
+                            "view '{}': a fisheye of {}° cannot be drawn",
                             s.name, s.fov
                         ))
                     })?;
-                let cam = Camera::new(&s.name, (w, h), (s.fov, vfov), frame);
-                Ok((Projection::View(view), cam))
-            })
-            .collect()
+                let cam = Camera::fisheye(&s.name, w, s.fov, frame);
+                return Ok((Projection::Fisheye(lens), cam));
+            }
+            let (h, vfov) = match (v.height, s.vfov) {
+                (Some(h), Some(vfov)) => (h, vfov),
+                (Some(h), None) => (h, fov_of(t * h as f64 / w as f64)),
+                (None, Some(vfov)) => {
+                    let tv = (0.5 * vfov.to_radians()).tan();
+                    let h = (w as f64 * tv / t).round().max(1.0) as i64;
+                    (
+                        bound.check(&format!("view '{}': its height", s.name), h)?,
+                        vfov,
+                    )
+                }
+                (None, None) => (w, s.fov),
+            };
+            let view = View::perspective(s.fov, vfov, s.yaw, s.pitch, s.roll).ok_or_else(|| {
+                Error::request(format!(
+                    "view '{}': a pinhole view of {}°×{vfov}° cannot be drawn",
+                    s.name, s.fov
+                ))
+            })?;
+            let cam = Camera::new(&s.name, (w, h), (s.fov, vfov), frame);
+            Ok((Projection::View(view), cam))
+        })
+        .collect()
+}
+
+/// `--format`'s container: the format, the views' extension and the precision.
+fn container(name: &str) -> Result<(Format, &'static str, Option<Precision>), Error> {
+    match name.to_ascii_lowercase().as_str() {
+        "png" => Ok((Format::Png, "png", None)),
+        "png16" => Ok((Format::Png, "png", Some(Precision::U16))),
+        "jpg" | "jpeg" => Ok((Format::Jpeg, "jpg", None)),
+        "exr" => Ok((Format::Exr, "exr", None)),
+        other => Err(Error::request(format!(
+            "--format: unknown '{other}' (png, png16, jpg, exr)"
+        ))),
     }
+}
+
+/// The request's rig checked ([`plan_view`] each view, one camera model, `--max-samples`),
+/// with the size bound of its container.
+fn plan_rig(r: &ViewsRequest) -> Result<(Vec<Planned>, crate::size::Bound), Error> {
+    let views = rig::resolve(&r.rig)?;
+    let (format, ext, _) = container(&r.format)?;
+    if !(1..=16).contains(&r.max_samples) {
+        return Err(Error::request(format!(
+            "--max-samples: {} is outside 1..=16",
+            r.max_samples
+        )));
+    }
+    let bound = crate::size::pictures(format, &format!("a .{ext} view"), |s| (s as u64, s as u64));
+    let size = r
+        .size
+        .map(|(w, h)| {
+            Ok::<_, Error>((
+                bound.check("--size", w)?,
+                h.map(|h| bound.check("--size", h)).transpose()?,
+            ))
+        })
+        .transpose()?;
+    if let Some(v) = views.iter().find(|v| v.model != views[0].model) {
+        return Err(Error::request(format!(
+            "--rig {}: view '{}' is {} and view '{}' is not: a rig's views are all pinhole or all fisheye (nerfstudio reads one camera model a file)",
+            r.rig,
+            v.name,
+            v.model.name(),
+            views[0].name
+        )));
+    }
+    let planned = views
+        .into_iter()
+        .map(|v| plan_view(v, size, &bound))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((planned, bound))
+}
+
+/// The request's rig cut from a panorama held in memory (`env`: a decoded array, a frame):
+/// each view's camera and its picture, the floats [`run`] encodes into its files (the same
+/// rig, sizes, plans and antialiasing). `r`'s rig, size, format (its size bound) and
+/// `max_samples` are read; its files are not.
+///
+/// ```
+/// use mirrorball::core::{EnvMap, ProjectionKind};
+/// use mirrorball::views::{cut, ViewsRequest};
+/// let env = EnvMap::from_fn(ProjectionKind::LatLong.default_projection(), 64, 3, |d| [d.x as f32, 0.5, 0.5, 1.0]);
+/// let mut r = ViewsRequest::new("", "");
+/// r.size = Some((16, None));
+/// let views = cut(&env, &r).unwrap();
+/// assert_eq!(views.len(), 6);
+/// assert_eq!((views[0].1.width(), views[0].1.height()), (16, 16));
+/// assert_eq!(views[0].0.focal, (8.0, 8.0)); // 90°: f = w/2
+/// ```
+pub fn cut(env: &EnvMap, r: &ViewsRequest) -> Result<Vec<(Camera, mirrorball_core::Image)>, Error> {
+    use rayon::prelude::*;
+    let (views, bound) = plan_rig(r)?;
+    let source = (
+        *env.projection(),
+        (env.width(), env.height(), env.layers().len()),
+    );
+    let rig = rig_cameras(&views, &bound, source)?;
+    let texels: u64 = rig
+        .iter()
+        .map(|(_, c)| c.size.0 as u64 * c.size.1 as u64)
+        .sum();
+    let c = env.channels() as u64;
+    budget::check(
+        &format!("{} views", rig.len()),
+        0,
+        texels * (17 + 4 * c),
+        "a smaller size",
+    )?;
+    let opts = ResampleOptions {
+        max_samples: r.max_samples,
+        ..Default::default()
+    };
+    rig.into_par_iter()
+        .map(|(view, cam)| {
+            let (w, h, layers) = source.1;
+            let remap = Remap::with_extent(source.0, (w, h), layers, view, cam.size, &opts);
+            let out = remap.apply(env).map_err(|e| Error::input(e.to_string()))?;
+            let picture = out.into_layers().swap_remove(0);
+            Ok((cam, picture))
+        })
+        .collect()
 }
 
 /// The writer's name in OUT-DIR's record of the files mirrorball wrote
