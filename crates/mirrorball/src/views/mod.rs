@@ -359,7 +359,7 @@ fn plan_rig(r: &ViewsRequest) -> Result<(Vec<Planned>, crate::size::Bound), Erro
 /// let views = cut(&env, &r).unwrap();
 /// assert_eq!(views.len(), 6);
 /// assert_eq!((views[0].1.width(), views[0].1.height()), (16, 16));
-/// assert_eq!(views[0].0.focal, (8.0, 8.0)); // 90°: f = w/2
+/// assert!((views[0].0.focal.0 - 8.0).abs() < 1e-9); // 90°: f = w/2
 /// ```
 pub fn cut(env: &EnvMap, r: &ViewsRequest) -> Result<Vec<(Camera, mirrorball_core::Image)>, Error> {
     use rayon::prelude::*;
