@@ -1,7 +1,8 @@
 """mirrorball: environment maps and 360° panoramas for numpy.
 
 Every projection mirrorball knows, both ways, with antialiasing; OpenEXR, Radiance HDR,
-PNG, JPEG, WebP, KTX2 and DDS files; prefiltered lighting and engine bakes. The work is
+PNG, JPEG, WebP, KTX2 and DDS files; prefiltered lighting and engine bakes; rigs of
+perspective views with the camera files COLMAP and nerfstudio read (:func:`views`). The work is
 the Rust workspace's (the same code as the ``mirrorball`` command line, bit for bit): this
 package holds no conversion logic of its own.
 
@@ -27,12 +28,14 @@ from ._native import (
     __version__,
     bake,
     convert,
+    cut_views,
     get_threads,
     prefilter,
     projections,
     read,
     set_threads,
     sh9,
+    views,
     write,
 )
 from .py360 import c2e, c2p, e2c, e2p
@@ -45,6 +48,7 @@ __all__ = [
     "c2e",
     "c2p",
     "convert",
+    "cut_views",
     "e2c",
     "e2p",
     "get_threads",
@@ -53,5 +57,6 @@ __all__ = [
     "read",
     "set_threads",
     "sh9",
+    "views",
     "write",
 ]

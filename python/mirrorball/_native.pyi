@@ -154,3 +154,35 @@ def bake(
     invalid: str = "raise",
 ) -> list[str]:
     """Image-based lighting baked for ``engine`` into ``out_dir``: the CLI's ``mirrorball bake``."""
+
+def views(
+    src: PathLike,
+    out_dir: PathLike,
+    *,
+    rig: str = "cube",
+    size: Union[int, tuple[int, int], None] = None,
+    format: str = "png",
+    masks: bool = False,
+    mask: Optional[PathLike] = None,
+    max_samples: Optional[int] = None,
+    overwrite: bool = False,
+    projection: Optional[str] = None,
+    layout: Optional[str] = None,
+) -> list[str]:
+    """A panorama (or a sequence's pattern) cut into a rig of views with COLMAP's and
+    nerfstudio's camera files in ``out_dir``: the CLI's ``mirrorball views``, byte for byte."""
+
+def cut_views(
+    array: Array,
+    *,
+    src: str = "latlong",
+    rig: str = "cube",
+    size: Union[int, tuple[int, int], None] = None,
+    max_samples: Optional[int] = None,
+    src_layout: Optional[str] = None,
+    dtype: DTypeLike = None,
+    linear: bool = False,
+    invalid: str = "raise",
+) -> list[dict[str, Any]]:
+    """A panorama array cut into the rig's views in memory: per view "name", "image",
+    "model", "K" (3×3 intrinsics) and "R" (3×3 cam_from_world, COLMAP's world)."""

@@ -34,7 +34,7 @@ impl Dtype {
         }
     }
 
-    fn of_name(name: &str) -> Option<Dtype> {
+    pub fn of_name(name: &str) -> Option<Dtype> {
         Some(match name {
             "float32" => Dtype::F32,
             "float16" => Dtype::F16,

@@ -14,7 +14,7 @@ use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
 
 /// A path argument: `str` or `os.PathLike`.
-fn path_arg(path: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+pub fn path_arg(path: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
     path.extract::<PathBuf>().map_err(|_| {
         pyo3::exceptions::PyTypeError::new_err(format!(
             "path: a str or os.PathLike is needed, not {}",
@@ -32,7 +32,7 @@ pub fn lib_error(e: mirrorball::Error) -> PyErr {
 }
 
 /// A path as the library takes it (its names are text).
-fn path_text(path: &Path) -> PyResult<String> {
+pub fn path_text(path: &Path) -> PyResult<String> {
     path.to_str()
         .map(str::to_string)
         .ok_or_else(|| request("path", format!("{}: not valid UTF-8", path.display())))

@@ -1,6 +1,6 @@
 //! mirrorball for Python: numpy arrays in and out, through the workspace's crates (core's
 //! `Resampler` and `Remap` for conversions, io for files, filter for prefiltering and SH9,
-//! bake for engines' bakes). This crate holds no conversion logic of its own: it checks
+//! bake for engines' bakes, the library's `views` for rigs of views). This crate holds no conversion logic of its own: it checks
 //! Python's arguments, moves texels between numpy and `Image`, releases the GIL while the
 //! work runs, and turns errors into Python's exceptions by whose fault they are.
 //!
@@ -13,6 +13,7 @@ mod errors;
 mod files;
 mod lighting;
 mod threads;
+mod views;
 
 use pyo3::prelude::*;
 
@@ -30,6 +31,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lighting::prefilter, m)?)?;
     m.add_function(wrap_pyfunction!(lighting::sh9, m)?)?;
     m.add_function(wrap_pyfunction!(lighting::bake, m)?)?;
+    m.add_function(wrap_pyfunction!(views::views, m)?)?;
+    m.add_function(wrap_pyfunction!(views::cut_views, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -19,7 +19,7 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 
 /// One map from an array argument (no batch).
-fn one_map(
+pub fn one_map(
     array: &Bound<'_, PyAny>,
     source: &Source,
     linear: bool,

@@ -33,6 +33,98 @@ const CHUNK_TEXELS: usize = 1 << 14;
 /// same `key=value` lines in a JPEG comment segment, become [`Loaded::recorded`].
 pub fn read(input: &Input, format: Format, limits: &Limits) -> Result<Loaded, Error> {
     let path = input.path();
+    let (mut loaded, recorded) = read_with(input, format, limits, |decoder, name| {
+        let decoded =
+            DynamicImage::from_decoder(decoder).map_err(|e| decode_error(path, name, e))?;
+        let (image, depth, layout) = to_linear(path, decoded)?;
+        Ok(Loaded {
+            layers: vec![image],
+            declared: None,
+            recorded: None,
+            format,
+            description: format!("{name}, {depth} sRGB, {layout}"),
+            // 8- and 16-bit texels decode to values in [0, 1].
+            invalid: Some(0),
+        })
+    })?;
+    loaded.recorded = recorded;
+    Ok(loaded)
+}
+
+/// A PNG or JPEG of RGB samples read as [`read_codes`] gives it: its samples are the
+/// caller's buffer, as the file holds them.
+#[derive(Debug)]
+pub struct CodedPicture {
+    /// Texels across.
+    pub width: u32,
+    /// Texels down.
+    pub height: u32,
+    /// 16-bit samples (native byte order: on little-endian machines the little-endian
+    /// codes `mirrorball_core::Codes::u16le` reads), else 8-bit.
+    pub wide: bool,
+    /// What the file records in mirrorball's own keys, as [`Loaded::recorded`].
+    pub recorded: Option<Result<crate::MapInfo, String>>,
+    /// The container.
+    pub format: Format,
+    /// A one-line description for people, as [`read`] gives it: "JPEG, 8-bit sRGB, RGB".
+    pub description: String,
+}
+
+/// Reads a PNG or JPEG of RGB samples (8- or 16-bit, no alpha) into `buf` as the file holds
+/// them: sRGB codes, R, G, B interleaved, no float copy (a planned conversion reads them as
+/// `mirrorball_core::Codes`, through [`lut8`] or [`lut16`]: the same values [`read`] gives).
+/// `buf` is resized to the picture (its memory reused when it is large enough). The same
+/// checks, messages and records as [`read`]; `Ok(None)`, with nothing decoded, for other
+/// files (grey, alpha, WebP and the float formats): [`read`] reads those.
+pub fn read_codes(
+    input: &Input,
+    format: Format,
+    limits: &Limits,
+    buf: &mut Vec<u8>,
+) -> Result<Option<CodedPicture>, Error> {
+    if !matches!(format, Format::Png | Format::Jpeg) {
+        return Ok(None);
+    }
+    let path = input.path();
+    if format == Format::Jpeg {
+        return guard_decoder(path, "JPEG", || jpeg_codes(input, limits, buf));
+    }
+    let (coded, recorded) = read_with(input, format, limits, |decoder, name| {
+        let wide = match decoder.color_type() {
+            image::ColorType::Rgb8 => false,
+            image::ColorType::Rgb16 => true,
+            _ => return Ok(None),
+        };
+        let (width, height) = decoder.dimensions();
+        let len = usize::try_from(decoder.total_bytes()).unwrap_or(usize::MAX);
+        buf.resize(len, 0);
+        decoder
+            .read_image(buf)
+            .map_err(|e| decode_error(path, name, e))?;
+        let depth = if wide { "16-bit" } else { "8-bit" };
+        Ok(Some(CodedPicture {
+            width,
+            height,
+            wide,
+            recorded: None,
+            format,
+            description: format!("{name}, {depth} sRGB, RGB"),
+        }))
+    })?;
+    Ok(coded.map(|c| CodedPicture { recorded, ..c }))
+}
+
+/// The steps [`read`] and [`read_codes`] share: the container's checks (a JPEG's markers),
+/// the declared size against `limits` and the file's length, then `finish` with the
+/// decoder (and the format's name), under the guard that turns a decoder's panic into an
+/// error; with what the file records of its projection.
+fn read_with<T>(
+    input: &Input,
+    format: Format,
+    limits: &Limits,
+    finish: impl FnOnce(Box<dyn ImageDecoder + '_>, &str) -> Result<T, Error>,
+) -> Result<(T, Option<Result<crate::MapInfo, String>>), Error> {
+    let path = input.path();
     let (image_format, name) = match format {
         Format::Png => (ImageFormat::Png, "PNG"),
         Format::Jpeg => (ImageFormat::Jpeg, "JPEG"),
@@ -49,60 +141,114 @@ pub fn read(input: &Input, format: Format, limits: &Limits) -> Result<Loaded, Er
         if format == Format::Png {
             let mut reader = input.reader().map_err(io)?;
             let texts = crate::meta_text::read_texts(&mut reader).map_err(io)?;
-            let mut loaded = decode(input, reader, image_format, format, name, limits)?;
+            let (t, (w, h)) = decode(input, reader, image_format, format, name, limits, finish)?;
             let get = |key: &str| texts.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
-            let image = &loaded.layers[0];
-            loaded.recorded = crate::recorded(get, image.width(), image.height());
-            return Ok(loaded);
+            return Ok((t, crate::recorded(get, w, h)));
         }
         if format != Format::Jpeg {
             let reader = input.reader().map_err(io)?;
-            return decode(input, reader, image_format, format, name, limits);
+            let (t, _) = decode(input, reader, image_format, format, name, limits, finish)?;
+            return Ok((t, None));
         }
-        // JPEG decoders fill in whatever a truncated file lacks: check for the end marker.
-        let bytes = input.all().map_err(io)?;
-        if !bytes.starts_with(&[0xff, 0xd8]) {
-            return Err(Error::input(
-                path,
-                "not a valid JPEG file (no start-of-image marker)".into(),
-            ));
-        }
-        if !jpeg_is_complete(&bytes) {
-            return Err(Error::input(
-                path,
-                "file is truncated (the JPEG end-of-image marker is missing)".into(),
-            ));
-        }
-        let comments = crate::meta_text::jpeg_comments(&bytes);
-        let mut loaded = decode(
-            input,
-            Cursor::new(&bytes[..]),
-            image_format,
-            format,
-            name,
-            limits,
-        )?;
+        let (bytes, comments) = jpeg_file(input)?;
+        let reader = Cursor::new(&bytes[..]);
+        let (t, (w, h)) = decode(input, reader, image_format, format, name, limits, finish)?;
         let get = |key: &str| {
             comments
                 .iter()
                 .find(|(k, _)| k == key)
                 .map(|(_, v)| v.clone())
         };
-        let image = &loaded.layers[0];
-        loaded.recorded = crate::recorded(get, image.width(), image.height());
-        Ok(loaded)
+        Ok((t, crate::recorded(get, w, h)))
     })
 }
 
-/// Decodes with the `image` crate after checking the declared size.
-fn decode<R: BufRead + Seek>(
+/// A JPEG's comment segments' `key=value` lines.
+type Comments = Vec<(String, String)>;
+
+/// A JPEG file's bytes, checked for its start and end markers (decoders fill in whatever a
+/// truncated file lacks), and its comment segments' `key=value` lines.
+fn jpeg_file<'a>(input: &'a Input) -> Result<(std::borrow::Cow<'a, [u8]>, Comments), Error> {
+    let path = input.path();
+    let bytes = input.all().map_err(|e| Error::io(path, e))?;
+    if !bytes.starts_with(&[0xff, 0xd8]) {
+        return Err(Error::input(
+            path,
+            "not a valid JPEG file (no start-of-image marker)".into(),
+        ));
+    }
+    if !jpeg_is_complete(&bytes) {
+        return Err(Error::input(
+            path,
+            "file is truncated (the JPEG end-of-image marker is missing)".into(),
+        ));
+    }
+    let comments = crate::meta_text::jpeg_comments(&bytes);
+    Ok((bytes, comments))
+}
+
+/// [`read_codes`] of a JPEG: `image`'s decoder (zune-jpeg, with the options `image` gives
+/// it) run on the file's bytes as read, straight into `buf`; three-component pictures
+/// (YCbCr or RGB) only, others `None`.
+fn jpeg_codes(
+    input: &Input,
+    limits: &Limits,
+    buf: &mut Vec<u8>,
+) -> Result<Option<CodedPicture>, Error> {
+    use zune_core::colorspace::ColorSpace;
+    let path = input.path();
+    let (bytes, comments) = jpeg_file(input)?;
+    let fail = |e: zune_jpeg::errors::DecodeErrors| {
+        Error::input(path, format!("not a valid JPEG file ({e})"))
+    };
+    let options = zune_core::options::DecoderOptions::default()
+        .set_strict_mode(false)
+        .set_max_width(usize::MAX)
+        .set_max_height(usize::MAX);
+    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(
+        zune_core::bytestream::ZCursor::new(&bytes[..]),
+        options,
+    );
+    decoder.decode_headers().map_err(fail)?;
+    let (w, h) = decoder.dimensions().expect("headers decoded");
+    let (width, height) = (w as u32, h as u32);
+    check_limits(path, width as u64, height as u64, limits)?;
+    check_fits_file(input, Format::Jpeg, "JPEG", width, height)?;
+    match decoder.input_colorspace() {
+        Some(ColorSpace::YCbCr | ColorSpace::RGB) => {}
+        _ => return Ok(None),
+    }
+    decoder.set_options(options.jpeg_set_out_colorspace(ColorSpace::RGB));
+    let len = decoder.output_buffer_size().expect("headers decoded");
+    buf.resize(len, 0);
+    decoder.decode_into(buf).map_err(fail)?;
+    let get = |key: &str| {
+        comments
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.clone())
+    };
+    Ok(Some(CodedPicture {
+        width,
+        height,
+        wide: false,
+        recorded: crate::recorded(get, width, height),
+        format: Format::Jpeg,
+        description: "JPEG, 8-bit sRGB, RGB".into(),
+    }))
+}
+
+/// Opens the `image` crate's decoder, checks the declared size, and hands the decoder to
+/// `finish`; with the picture's size.
+fn decode<R: BufRead + Seek, T>(
     input: &Input,
     reader: R,
     image_format: ImageFormat,
     format: Format,
     name: &str,
     limits: &Limits,
-) -> Result<Loaded, Error> {
+    finish: impl FnOnce(Box<dyn ImageDecoder + '_>, &str) -> Result<T, Error>,
+) -> Result<(T, (u32, u32)), Error> {
     let path = input.path();
     let mut reader = image::ImageReader::with_format(reader, image_format);
     reader.limits(image_limits(limits));
@@ -119,18 +265,7 @@ fn decode<R: BufRead + Seek>(
     let (width, height) = decoder.dimensions();
     check_limits(path, width as u64, height as u64, limits)?;
     check_fits_file(input, format, name, width, height)?;
-    let decoded = DynamicImage::from_decoder(decoder).map_err(|e| decode_error(path, name, e))?;
-    let (image, depth, layout) = to_linear(path, decoded)?;
-    let description = format!("{name}, {depth} sRGB, {layout}");
-    Ok(Loaded {
-        layers: vec![image],
-        declared: None,
-        recorded: None,
-        format,
-        description,
-        // 8- and 16-bit texels decode to values in [0, 1].
-        invalid: Some(0),
-    })
+    Ok((finish(Box::new(decoder), name)?, (width, height)))
 }
 
 /// Refuses a PNG, JPEG or WebP whose declared size its length cannot hold (see
@@ -249,10 +384,7 @@ fn write_jpeg(dest: Dest, image: &Image, opts: &WriteOptions) -> Result<Written,
         });
     };
     // The projection and layout in a comment segment, spliced into the encoded file.
-    let mut jpeg = Vec::new();
-    JpegEncoder::new_with_quality(&mut jpeg, quality)
-        .write_image(&bytes, w, h, ExtendedColorType::Rgb8)
-        .map_err(|e| encode_error(path, "JPEG", e))?;
+    let jpeg = encode_codes(path, Format::Jpeg, (w, h), (&bytes, false), quality, &[])?;
     let (projection, layout) = info.texts();
     let mut pairs = vec![(crate::PROJECTION_KEY, projection)];
     pairs.extend(layout.map(|l| (crate::LAYOUT_KEY, l)));
@@ -327,17 +459,95 @@ fn write_png(
 /// Writes `w`×`h` 8-bit grey samples (a mask: 255 where a pixel counts, 0 where not) as a
 /// one-channel PNG, stored as given (no transfer function), through the atomic writes.
 pub fn write_grey_png(path: &Path, (w, h): (u32, u32), samples: &[u8]) -> Result<(), Error> {
+    let png = grey_png(path, (w, h), samples)?;
+    crate::atomic::land(crate::atomic::stage(path, |out| {
+        std::io::Write::write_all(out, &png).map_err(|e| Error::io(path, e))
+    })?)
+}
+
+/// [`write_grey_png`]'s file in memory (`path` names it in messages).
+pub fn grey_png(path: &Path, (w, h): (u32, u32), samples: &[u8]) -> Result<Vec<u8>, Error> {
     if samples.len() != w as usize * h as usize {
         return Err(Error::request(
             path,
             format!("{} grey samples for a {w}×{h} picture", samples.len()),
         ));
     }
-    crate::atomic::land(crate::atomic::stage(path, |out| {
-        PngEncoder::new(out)
-            .write_image(samples, w, h, ExtendedColorType::L8)
-            .map_err(|e| encode_error(path, "PNG", e))
-    })?)
+    let mut png = Vec::new();
+    PngEncoder::new(&mut png)
+        .write_image(samples, w, h, ExtendedColorType::L8)
+        .map_err(|e| encode_error(path, "PNG", e))?;
+    Ok(png)
+}
+
+/// A PNG or JPEG file in memory of `w`×`h` RGB sRGB codes as they are (`samples.0`: 8-bit,
+/// or with `samples.1` 16-bit in the machine's byte order, PNG only), `path` naming it in
+/// messages: a JPEG at `quality` (92 when 0, at most 100) with `segments` (complete JPEG
+/// marker segments, such as an EXIF `APP1`) after the encoder's own header segments (SOI
+/// and JFIF's `APP0`); a PNG with no text chunks (`segments` must be empty). The same
+/// encoders [`write`] uses, fed the codes it would make of a float image.
+pub fn encode_codes(
+    path: &Path,
+    format: Format,
+    (w, h): (u32, u32),
+    (samples, wide): (&[u8], bool),
+    quality: u8,
+    segments: &[u8],
+) -> Result<Vec<u8>, Error> {
+    let expected = w as usize * h as usize * 3 * if wide { 2 } else { 1 };
+    if samples.len() != expected {
+        return Err(Error::request(
+            path,
+            format!(
+                "{} bytes of samples for a {w}×{h} RGB picture",
+                samples.len()
+            ),
+        ));
+    }
+    let mut out = Vec::new();
+    match format {
+        Format::Jpeg if !wide => {
+            if w > u16::MAX as u32 || h > u16::MAX as u32 {
+                return Err(Error::request(
+                    path,
+                    format!(
+                        "JPEG images are at most 65535 texels wide and high; this one is {w}×{h}"
+                    ),
+                ));
+            }
+            let quality = match quality {
+                0 => DEFAULT_JPEG_QUALITY,
+                q => q.min(100),
+            };
+            JpegEncoder::new_with_quality(&mut out, quality)
+                .write_image(samples, w, h, ExtendedColorType::Rgb8)
+                .map_err(|e| encode_error(path, "JPEG", e))?;
+            // After SOI, and after APP0 (JFIF) when the encoder wrote one first.
+            let mut at = 2;
+            if out.len() > 6 && out[2] == 0xFF && out[3] == 0xE0 {
+                at = 4 + u16::from_be_bytes([out[4], out[5]]) as usize;
+            }
+            out.splice(at..at, segments.iter().copied());
+        }
+        Format::Png if segments.is_empty() => {
+            let color = if wide {
+                ExtendedColorType::Rgb16
+            } else {
+                ExtendedColorType::Rgb8
+            };
+            PngEncoder::new(&mut out)
+                .write_image(samples, w, h, color)
+                .map_err(|e| encode_error(path, "PNG", e))?;
+        }
+        other => {
+            let what = if wide { "16-bit" } else { "8-bit" };
+            return Err(Error::request(
+                path,
+                format!("{other:?} is not written from {what} codes with these segments"),
+            ));
+        }
+    }
+    Ok(out)
 }
 
 /// Writes `image` as an 8-bit RGB JPEG at `quality` (92 when 0, at most 100) with
@@ -350,27 +560,9 @@ pub fn write_jpeg_with_segments(
     segments: &[u8],
 ) -> Result<(), Error> {
     check_writable_size(path, image)?;
-    let (w, h) = (image.width(), image.height());
-    if w > u16::MAX as u32 || h > u16::MAX as u32 {
-        return Err(Error::request(
-            path,
-            format!("JPEG images are at most 65535 texels wide and high; this one is {w}×{h}"),
-        ));
-    }
-    let quality = match quality {
-        0 => DEFAULT_JPEG_QUALITY,
-        q => q.min(100),
-    };
-    let mut jpeg = Vec::new();
-    JpegEncoder::new_with_quality(&mut jpeg, quality)
-        .write_image(&encode_u8(image, 3), w, h, ExtendedColorType::Rgb8)
-        .map_err(|e| encode_error(path, "JPEG", e))?;
-    // After SOI, and after APP0 (JFIF) when the encoder wrote one first.
-    let mut at = 2;
-    if jpeg.len() > 6 && jpeg[2] == 0xFF && jpeg[3] == 0xE0 {
-        at = 4 + u16::from_be_bytes([jpeg[4], jpeg[5]]) as usize;
-    }
-    jpeg.splice(at..at, segments.iter().copied());
+    let size = (image.width(), image.height());
+    let codes = encode_u8(image, 3);
+    let jpeg = encode_codes(path, Format::Jpeg, size, (&codes, false), quality, segments)?;
     crate::atomic::land(crate::atomic::stage(path, |out| {
         std::io::Write::write_all(out, &jpeg).map_err(|e| Error::io(path, e))
     })?)

@@ -61,7 +61,8 @@ pub use ktx2_io::{write_ktx2, zstd_work, CubeWrite};
 /// sRGB encoding's one home: 8-bit codes by the thresholds between codes, 16-bit codes.
 pub use ldr_io::{encode16 as srgb16_code, encode8 as srgb8_code, thresholds8 as srgb8_thresholds};
 pub use ldr_io::{
-    lut16 as srgb16_to_linear, lut8 as srgb8_to_linear, write_grey_png, write_jpeg_with_segments,
+    encode_codes, grey_png, lut16 as srgb16_to_linear, lut8 as srgb8_to_linear, write_grey_png,
+    write_jpeg_with_segments, CodedPicture,
 };
 pub use meta_text::read_xmp;
 pub use mirrorball_encode::{Clipped, Effort, Encoding, Range, Storage};
@@ -570,6 +571,40 @@ fn count_invalid(loaded: &mut Loaded) {
             })
             .sum();
         loaded.invalid = Some(count);
+    }
+}
+
+/// Reads a PNG or JPEG of RGB samples (8- or 16-bit, no alpha) into `buf` as the file holds
+/// them, sRGB codes with no float copy ([`CodedPicture`]; [`srgb8_to_linear`] and
+/// [`srgb16_to_linear`] are their linear values, the ones [`read`] gives), with [`read`]'s
+/// checks and messages; `Ok(None)` for every other file, which [`read`] reads.
+///
+/// ```
+/// use mirrorball_core::Image;
+/// use mirrorball_io::{read, read_codes, srgb8_to_linear, write_image, Limits, WriteOptions};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("a.png");
+/// let mut img = Image::new(4, 2, 3);
+/// img.set(1, 1, &[0.25, 0.5, 1.0]);
+/// write_image(&path, &img, &WriteOptions::default()).unwrap();
+/// let mut buf = Vec::new();
+/// let coded = read_codes(&path, &Limits::default(), &mut buf).unwrap().unwrap();
+/// assert_eq!((coded.width, coded.height, coded.wide), (4, 2, false));
+/// let floats = read(&path, &Limits::default()).unwrap();
+/// let decoded: Vec<f32> = buf.iter().map(|&k| srgb8_to_linear()[k as usize]).collect();
+/// assert_eq!(decoded, floats.layers[0].data());
+/// ```
+pub fn read_codes(
+    path: &Path,
+    limits: &Limits,
+    buf: &mut Vec<u8>,
+) -> Result<Option<CodedPicture>, Error> {
+    Error::check_input(path)?;
+    match Format::from_path(path) {
+        Some(format @ (Format::Png | Format::Jpeg)) => {
+            ldr_io::read_codes(&input::Input::open(path)?, format, limits, buf)
+        }
+        _ => Ok(None),
     }
 }
 

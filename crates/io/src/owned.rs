@@ -1,8 +1,8 @@
 //! Which files in a folder mirrorball wrote: a small record in the folder
 //! ([`RECORD`], one `WRITER<TAB>NAME` line a file), so that a later run replaces only
 //! files mirrorball wrote there, refuses to replace any other (unless told to), and a
-//! writer that replaces its whole set (a bake) removes the files of its earlier set that it
-//! no longer writes.
+//! writer that replaces its whole set (a bake, a views run) removes the files of its
+//! earlier set that it no longer writes.
 //!
 //! Names are relative to the folder, `/` between folders; a line naming anything outside
 //! the folder (`..`, an absolute path) is ignored, so a record cannot point a removal
@@ -18,8 +18,8 @@ pub const RECORD: &str = ".mirrorball-files";
 
 /// The record's first lines, for whoever opens it.
 const HEADER: &str = "# The files mirrorball wrote in this folder (WRITER<TAB>NAME): it replaces \
-only these, refuses any other (unless --overwrite),\n# and a bake removes the files of the \
-bake it replaces. Delete this file to make mirrorball forget them.\n";
+only these, refuses any other (unless --overwrite),\n# and a bake or a views run removes the files of the \
+run it replaces. Delete this file to make mirrorball forget them.\n";
 
 /// A folder's record of the files mirrorball wrote in it ([`RECORD`]).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

@@ -184,6 +184,101 @@ pub fn from_bytes(
     interpret_loaded(name, loaded, from, layout, (None, Stereo::Mono))
 }
 
+/// What a file records (see `mirrorball_io::MapInfo`): unreadable, it matters only when
+/// nothing else says the projection (`from`).
+fn recorded_info(
+    input: &str,
+    recorded: Option<Result<mirrorball_io::MapInfo, String>>,
+    from: Option<&ProjSpec>,
+) -> Result<Option<mirrorball_io::MapInfo>, Error> {
+    match recorded {
+        Some(Err(e)) if from.is_none() => Err(Error::input(format!(
+            "{input}: {e}; say the projection with --from"
+        ))),
+        Some(r) => Ok(r.ok()),
+        None => Ok(None),
+    }
+}
+
+/// A one-picture map whose texels are sRGB codes in the caller's buffer ([`read_coded`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CodedMap {
+    /// The projection, decided as [`load`] decides it.
+    pub projection: Projection,
+    /// Texels across and down.
+    pub extent: (u32, u32),
+    /// 16-bit codes (little-endian on the machines this runs on), else 8-bit.
+    pub wide: bool,
+}
+
+impl CodedMap {
+    /// The codes in `bytes` (what [`read_coded`] left there) as core reads them, through
+    /// io's sRGB tables: the same values [`load`] decodes.
+    pub fn codes<'a>(&self, bytes: &'a [u8]) -> Option<mirrorball_core::Codes<'a>> {
+        if self.wide && cfg!(target_endian = "little") {
+            let table = mirrorball_io::srgb16_to_linear();
+            mirrorball_core::Codes::u16le(bytes, table, self.extent).ok()
+        } else if self.wide {
+            None
+        } else {
+            let table = mirrorball_io::srgb8_to_linear();
+            mirrorball_core::Codes::u8(bytes, table, self.extent).ok()
+        }
+    }
+}
+
+/// Reads `input` as [`read_prepared`] does, but into `buf` as the file's sRGB codes with no
+/// float copy, where the file is a PNG or JPEG of RGB samples that is one layer as it is
+/// (no `{face}` files, no stereo pair, no packed layout): the map's shape and the lines
+/// saying what was read and decided (8- and 16-bit samples hold no invalid values).
+/// `Ok(None)` for any other input: [`read_prepared`] reads it.
+pub fn read_coded(
+    input: &str,
+    plan: &InputPlan,
+    buf: &mut Vec<u8>,
+) -> Result<Option<(CodedMap, Vec<String>)>, Error> {
+    if input.contains(FACE) {
+        return Ok(None);
+    }
+    let limits = Limits::default();
+    let Some(pic) = mirrorball_io::read_codes(Path::new(input), &limits, buf)? else {
+        return Ok(None);
+    };
+    let from = plan.from.as_ref();
+    let recorded = recorded_info(input, pic.recorded, from)?;
+    if recorded.as_ref().is_some_and(|r| r.stereo != Stereo::Mono) {
+        return Ok(None);
+    }
+    let records_other = |p: &Projection| match &recorded {
+        Some(info) if info.projection != *p => format!("; the file records {}", info.projection),
+        _ => String::new(),
+    };
+    let (w, h) = (pic.width, pic.height);
+    let (projection, layout, decided) = decide(
+        input,
+        (w, h),
+        from,
+        plan.layout,
+        recorded,
+        None,
+        records_other,
+    )?;
+    if layout != Layout::Separate || projection.layer_count() != 1 {
+        return Ok(None);
+    }
+    let note = format!(
+        "read {input} ({}): {} {w}x{h} — {decided}",
+        pic.description,
+        projection.name()
+    );
+    let map = CodedMap {
+        projection,
+        extent: (w, h),
+        wide: pic.wide,
+    };
+    Ok(Some((map, vec![note])))
+}
+
 /// The map in what the reader gave for `input` (a file, or bytes so named): [`load_eyes`]
 /// once the container is read.
 fn interpret_loaded(
@@ -207,17 +302,7 @@ fn interpret_loaded(
         description,
         ..
     } = loaded;
-    // What the file records (see `mirrorball_io::MapInfo`): unreadable, it matters only
-    // when nothing else says the projection.
-    let recorded = match recorded {
-        Some(Err(e)) if from.is_none() => {
-            return Err(Error::input(format!(
-                "{input}: {e}; say the projection with --from"
-            )))
-        }
-        Some(r) => r.ok(),
-        None => None,
-    };
+    let recorded = recorded_info(input, recorded, from)?;
     // Said after "as asked" when the file says something else.
     let records_other = |p: &Projection| match (&recorded, declared) {
         (Some(info), _) if info.projection != *p => {
@@ -344,6 +429,33 @@ pub fn interpret(
     records_other: impl Fn(&Projection) -> String,
 ) -> Result<(EnvMap, String), Error> {
     let (w, h) = (image.width(), image.height());
+    let (proj, layout, decided) = decide(
+        input,
+        (w, h),
+        from,
+        layout,
+        recorded,
+        declared,
+        records_other,
+    )?;
+    let env = layout
+        .unpack_owned(image, proj)
+        .map_err(|e| Error::input(format!("{input}: {e}")))?;
+    Ok((env, decided))
+}
+
+/// What [`interpret`] decides of a `w`×`h` picture before it is unpacked: its projection
+/// and layout, checked against its shape, and the decision's words (a picture held as codes
+/// is decided so with no float copy of it).
+pub fn decide(
+    input: &str,
+    (w, h): (u32, u32),
+    from: Option<&ProjSpec>,
+    layout: Option<Layout>,
+    recorded: Option<mirrorball_io::MapInfo>,
+    declared: Option<ProjectionKind>,
+    records_other: impl Fn(&Projection) -> String,
+) -> Result<(Projection, Layout, String), Error> {
     let (proj, layout, decided) = match (from, layout, recorded) {
         (Some(spec), Some(l), _) => {
             if let Some(why) = l.refusal(spec.kind, "--from") {
@@ -407,10 +519,7 @@ pub fn interpret(
         )));
     }
     check_shape(input, &proj, w, h, layout)?;
-    let env = layout
-        .unpack_owned(image, proj)
-        .map_err(|e| Error::input(format!("{input}: {e}")))?;
-    Ok((env, decided))
+    Ok((proj, layout, decided))
 }
 
 /// The projection `spec` names, for a `w`×`h` picture.

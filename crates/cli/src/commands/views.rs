@@ -47,6 +47,11 @@ pub struct ViewsArgs {
         value_parser = clap::value_parser!(u32).range(1..=16)
     )]
     max_samples: u32,
+    /// Replace files in OUT-DIR that mirrorball did not write (by default such a file is
+    /// left alone and the run refused; files an earlier run wrote are replaced, and those
+    /// it wrote that this run does not are removed).
+    #[arg(long)]
+    overwrite: bool,
     #[command(flatten)]
     input_args: InputArgs,
     /// Print nothing but errors.
@@ -65,6 +70,7 @@ pub fn run(a: ViewsArgs) -> Result<(), CliError> {
         masks: a.masks,
         mask: a.mask,
         max_samples: a.max_samples,
+        overwrite: a.overwrite,
     };
     let plan = ViewsPlan::new(&request)?;
     views::run(&plan, &Printer { quiet: a.quiet })?;

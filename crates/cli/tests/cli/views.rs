@@ -588,3 +588,150 @@ fn views_fisheye_rigs_are_opencv_fisheye_cameras() {
         stderr(&o)
     );
 }
+
+#[test]
+fn views_rerun_replaces_only_what_mirrorball_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let pano = direction_panorama(dir.path(), 64);
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    ok(&["views", &pano, o, "--size", "8", "-q"]);
+    let first = files(&out);
+    assert!(
+        first.contains(&"images/up/pano.png".to_string()),
+        "{first:?}"
+    );
+    assert!(
+        first.contains(&mirrorball_io::RECORD.to_string()),
+        "{first:?}"
+    );
+    // The user's own files, beside and among the views.
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    std::fs::write(out.join("images/up/mine.png"), "mine too").unwrap();
+    // A rig of four views: the up and down views the first run wrote are removed (and the
+    // down view's folder, left empty), the user's files stay.
+    let rig = dir.path().join("ring.json");
+    std::fs::write(
+        &rig,
+        r#"{"views": [{"name": "front", "fov": 90}, {"name": "right", "yaw": 90, "fov": 90},
+                       {"name": "back", "yaw": 180, "fov": 90}, {"name": "left", "yaw": 270, "fov": 90}]}"#,
+    )
+    .unwrap();
+    let said = run(&[
+        "views",
+        &pano,
+        o,
+        "--size",
+        "8",
+        "--rig",
+        rig.to_str().unwrap(),
+    ]);
+    assert!(said.status.success(), "{}", stderr(&said));
+    assert!(
+        stderr(&said).contains("removed 2 files an earlier run wrote"),
+        "{}",
+        stderr(&said)
+    );
+    let second = files(&out);
+    for gone in ["images/up/pano.png", "images/down/pano.png", "images/down/"] {
+        assert!(!second.contains(&gone.to_string()), "{gone}: {second:?}");
+    }
+    for kept in ["notes.txt", "images/up/mine.png", "images/left/pano.png"] {
+        assert!(second.contains(&kept.to_string()), "{kept}: {second:?}");
+    }
+    assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
+    let (cams, images) = read_model(&out.join("sparse/0"));
+    assert_eq!((cams.len(), images.len()), (4, 4));
+    // A file of the user's where a view would land: refused before any work, nothing
+    // changed; --overwrite replaces it.
+    let other = dir.path().join("other");
+    std::fs::create_dir_all(other.join("images/front")).unwrap();
+    std::fs::write(other.join("images/front/pano.png"), "the user's").unwrap();
+    let refused = run(&["views", &pano, other.to_str().unwrap(), "--size", "8"]);
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    let e = stderr(&refused);
+    assert!(
+        e.contains("images/front/pano.png") && e.contains("--overwrite"),
+        "{e}"
+    );
+    assert_eq!(
+        files(&other),
+        ["images/", "images/front/", "images/front/pano.png"]
+    );
+    ok(&[
+        "views",
+        &pano,
+        other.to_str().unwrap(),
+        "--size",
+        "8",
+        "--overwrite",
+        "-q",
+    ]);
+    assert_ne!(
+        std::fs::read(other.join("images/front/pano.png")).unwrap(),
+        b"the user's"
+    );
+}
+
+#[test]
+fn views_of_8_and_16_bit_pictures_are_the_views_of_their_floats() {
+    // An 8-bit PNG and a 16-bit PNG are read as their codes (no float copy); the same
+    // texels as a float EXR are read as floats: every view file is the same bytes.
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (96u32, 48u32);
+    let mut img = mirrorball_core::Image::new(w, h, 3);
+    for y in 0..h {
+        for x in 0..w {
+            let k = (x * 7 + y * 13) as f32;
+            img.set(x, y, &[(k * 0.37).sin().abs(), (k * 0.11).cos().abs(), 0.5]);
+        }
+    }
+    for (precision, format) in [
+        (mirrorball_io::Precision::U8, "png"),
+        (mirrorball_io::Precision::U8, "jpg"),
+        (mirrorball_io::Precision::U16, "png16"),
+    ] {
+        let png = dir.path().join(format!("pano{format}.png"));
+        let opts = mirrorball_io::WriteOptions {
+            precision: Some(precision),
+            ..Default::default()
+        };
+        mirrorball_io::write_image(&png, &img, &opts).unwrap();
+        // The PNG's texels, decoded as io reads them, in a float EXR.
+        let decoded = mirrorball_io::read(&png, &Default::default()).unwrap();
+        let exr = dir.path().join(format!("pano{format}.exr"));
+        let float = mirrorball_io::WriteOptions {
+            precision: Some(mirrorball_io::Precision::Float),
+            ..Default::default()
+        };
+        mirrorball_io::write_image(&exr, &decoded.layers[0], &float).unwrap();
+        let mut made = Vec::new();
+        for (src, name) in [(&png, "codes"), (&exr, "floats")] {
+            let out = dir.path().join(format!("{format}-{name}"));
+            ok(&[
+                "views",
+                src.to_str().unwrap(),
+                out.to_str().unwrap(),
+                "--size",
+                "20",
+                "--format",
+                format,
+            ]);
+            made.push(out);
+        }
+        let ext = if format == "jpg" { "jpg" } else { "png" };
+        for view in ["front", "right", "back", "left", "up", "down"] {
+            let [a, b] = [0, 1].map(|i| {
+                let file = made[i]
+                    .join("images")
+                    .join(view)
+                    .join(format!("pano{format}.{ext}"));
+                std::fs::read(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()))
+            });
+            assert!(
+                a == b,
+                "{format} {view}: the codes' view differs from the floats'"
+            );
+        }
+    }
+}

@@ -92,6 +92,31 @@ impl<'a> DirRun<'a> {
     }
 }
 
+/// [`WorldProjection::span_dirs_f32`]'s default: `p`'s `span_dirs`, 32 texels at a time,
+/// converted (for projections that override it for some of their cases only).
+pub(crate) fn span_dirs_f32_of<P: WorldProjection + ?Sized>(
+    p: &P,
+    layer: usize,
+    y: u32,
+    (w, h): (u32, u32),
+    x0: u32,
+    out: DirRun,
+) {
+    const CHUNK: usize = 32;
+    let mut buf = [None; CHUNK];
+    let n = out.x.len();
+    for start in (0..n).step_by(CHUNK) {
+        let m = CHUNK.min(n - start);
+        p.span_dirs(layer, y, w, h, x0 + start as u32, &mut buf[..m]);
+        for (i, t) in buf[..m].iter().enumerate() {
+            let (d, dens) = t.unwrap_or((DVec3::Z, -1.0));
+            let k = start + i;
+            (out.x[k], out.y[k], out.z[k], out.density[k]) =
+                (d.x as f32, d.y as f32, d.z as f32, dens as f32);
+        }
+    }
+}
+
 /// The behaviour every world projection shares. All math is in `f64`.
 pub trait WorldProjection {
     /// Number of layers: 6 for the cube types (OpenGL order +X −X +Y −Y +Z −Z), 2 for the
@@ -176,19 +201,7 @@ pub trait WorldProjection {
     /// [`span_dirs`](WorldProjection::span_dirs); the cube and the lat-long compute it
     /// directly.
     fn span_dirs_f32(&self, layer: usize, y: u32, w: u32, h: u32, x0: u32, out: DirRun) {
-        const CHUNK: usize = 32;
-        let mut buf = [None; CHUNK];
-        let n = out.x.len();
-        for start in (0..n).step_by(CHUNK) {
-            let m = CHUNK.min(n - start);
-            self.span_dirs(layer, y, w, h, x0 + start as u32, &mut buf[..m]);
-            for (i, t) in buf[..m].iter().enumerate() {
-                let (d, dens) = t.unwrap_or((DVec3::Z, -1.0));
-                let k = start + i;
-                (out.x[k], out.y[k], out.z[k], out.density[k]) =
-                    (d.x as f32, d.y as f32, d.z as f32, dens as f32);
-            }
-        }
+        span_dirs_f32_of(self, layer, y, (w, h), x0, out)
     }
 
     /// The solid angle the projection covers: 4π for all but those with a limit (fisheye,

@@ -24,7 +24,7 @@
 
 use super::cube::cube_area;
 use super::quadrature::gauss_legendre;
-use super::{texel_range, Frame, Range, WorldProjection};
+use super::{texel_range, DirRun, Frame, Range, WorldProjection};
 use glam::{DMat3, DVec2, DVec3};
 
 /// A rectilinear or Pannini view (see the module documentation).
@@ -170,6 +170,17 @@ impl View {
         (DVec3::new(p.x / s, p.y / s, c), s, c)
     }
 
+    /// The density (`dω/du dv`) where the picture plane's point is `l` (`local_of_plane`'s
+    /// direction over cos θ) and its `cos φ` is `c`.
+    #[inline]
+    fn density_at(&self, l: DVec3, c: f64) -> f64 {
+        // l = (sin φ, tan θ, cos φ): cos θ = 1/√(1 + tan²θ).
+        let cos_t = 1.0 / (1.0 + l.y * l.y).sqrt();
+        let d = self.d;
+        let jac = cos_t.powi(3) * (d + c).powi(3) / ((d + 1.0).powi(2) * (1.0 + d * c));
+        4.0 * self.x_max * self.y_max * jac
+    }
+
     /// View longitude φ at picture-plane abscissa `X`.
     #[inline]
     fn phi_of_x(&self, x: f64) -> f64 {
@@ -240,11 +251,72 @@ impl WorldProjection for View {
             return 0.0;
         }
         let (l, _, c) = self.local_of_plane(DVec2::new(a * self.x_max, b * self.y_max));
-        // l = (sin φ, tan θ, cos φ): cos θ = 1/√(1 + tan²θ).
-        let cos_t = 1.0 / (1.0 + l.y * l.y).sqrt();
-        let d = self.d;
-        let jac = cos_t.powi(3) * (d + c).powi(3) / ((d + 1.0).powi(2) * (1.0 + d * c));
-        4.0 * self.x_max * self.y_max * jac
+        self.density_at(l, c)
+    }
+    /// A rectilinear view's directions and densities in closed form (Pannini's through
+    /// `span_dirs`): the plane point `(X, Y, 1)` in the view's frame is the direction's
+    /// multiple, `|(X, Y, 1)|² = 1 + X² + Y²`, and the density `4·X_max·Y_max/(1 + X² +
+    /// Y²)^{3/2}`; `U·Y + F` once a row.
+    fn span_dirs_f32(&self, layer: usize, y: u32, w: u32, h: u32, x0: u32, out: DirRun) {
+        if self.d != 0.0 {
+            return super::span_dirs_f32_of(self, layer, y, (w, h), x0, out);
+        }
+        let b = 1.0 - 2.0 * ((y as f64 + 0.5) / h as f64);
+        let f = &self.frame;
+        let yy = b * self.y_max;
+        let row = f.up * yy + f.forward;
+        let scale = 4.0 * self.x_max * self.y_max;
+        for (i, (x, y, z, d)) in out.texels().enumerate() {
+            let u = ((x0 as usize + i) as f64 + 0.5) / w as f64;
+            let a = 2.0 * u - 1.0;
+            if a.abs() > 1.0 + 1e-12 || b.abs() > 1.0 + 1e-12 {
+                (*x, *y, *z, *d) = (0.0, 0.0, 1.0, -1.0);
+                continue;
+            }
+            let xx = a * self.x_max;
+            let inv = 1.0 / (1.0 + xx * xx + yy * yy).sqrt();
+            let dir = (f.right * xx + row) * inv;
+            let density = if a.abs() > 1.0 || b.abs() > 1.0 {
+                0.0
+            } else {
+                scale * inv * inv * inv
+            };
+            (*x, *y, *z, *d) = (dir.x as f32, dir.y as f32, dir.z as f32, density as f32);
+        }
+    }
+    /// `uv_to_dir` and `density` of each texel centre of the run, the same bits, with the
+    /// picture-plane point worked out once a texel (the planner's loop over a view).
+    fn span_dirs(
+        &self,
+        _layer: usize,
+        y: u32,
+        w: u32,
+        h: u32,
+        x0: u32,
+        out: &mut [Option<(DVec3, f64)>],
+    ) {
+        let b = 1.0 - 2.0 * ((y as f64 + 0.5) / h as f64);
+        if b.abs() > 1.0 + 1e-12 {
+            out.fill(None);
+            return;
+        }
+        let f = &self.frame;
+        for (i, o) in out.iter_mut().enumerate() {
+            let u = ((x0 as usize + i) as f64 + 0.5) / w as f64;
+            let a = 2.0 * u - 1.0;
+            if a.abs() > 1.0 + 1e-12 {
+                *o = None;
+                continue;
+            }
+            let (l, _, c) = self.local_of_plane(DVec2::new(a * self.x_max, b * self.y_max));
+            let dir = (f.right * l.x + f.up * l.y + f.forward * l.z).normalize();
+            let density = if a.abs() > 1.0 || b.abs() > 1.0 {
+                0.0
+            } else {
+                self.density_at(l, c)
+            };
+            *o = Some((dir, density));
+        }
     }
     fn texel_solid_angle(&self, _layer: usize, x: u32, y: u32, w: u32, h: u32) -> f64 {
         let (u0, u1) = texel_range(x, w);
@@ -265,6 +337,68 @@ impl WorldProjection for View {
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    #[test]
+    fn span_dirs_f32_are_uv_to_dir_and_density() {
+        // A rectilinear view in closed form, a Pannini one through span_dirs: within f32's
+        // rounding of the f64 methods.
+        for view in [
+            View::perspective(90.0, 90.0, 0.0, 0.0, 0.0).unwrap(),
+            View::perspective(120.0, 70.0, 10.0, -20.0, 5.0).unwrap(),
+            View::pannini(0.7, 150.0, 80.0, 30.0, 10.0, -5.0).unwrap(),
+        ] {
+            let (w, h) = (41, 29);
+            for y in 0..h {
+                let n = w as usize - 3;
+                let (mut xs, mut ys, mut zs, mut ds) =
+                    (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+                let run = DirRun {
+                    x: &mut xs,
+                    y: &mut ys,
+                    z: &mut zs,
+                    density: &mut ds,
+                };
+                view.span_dirs_f32(0, y, w, h, 3, run);
+                for i in 0..n {
+                    let x = 3 + i as u32;
+                    let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                    let want = view.uv_to_dir(0, uv).unwrap();
+                    let got = DVec3::new(xs[i] as f64, ys[i] as f64, zs[i] as f64);
+                    assert!((got - want).length() < 2e-7, "({x}, {y}): {got} vs {want}");
+                    let dens = view.density(0, uv);
+                    assert!(
+                        (ds[i] as f64 - dens).abs() < 2e-7 * dens,
+                        "({x}, {y}): {} vs {dens}",
+                        ds[i]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn span_dirs_are_uv_to_dir_and_density_bit_for_bit() {
+        let views = [
+            View::perspective(90.0, 90.0, 0.0, 0.0, 0.0).unwrap(),
+            View::perspective(100.0, 70.0, 10.0, -20.0, 5.0).unwrap(),
+            View::pannini(0.7, 150.0, 80.0, 30.0, 10.0, -5.0).unwrap(),
+        ];
+        for view in views {
+            let (w, h) = (37, 23);
+            for y in 0..h {
+                let mut run = vec![None; 40];
+                view.span_dirs(0, y, w, h, 5, &mut run);
+                for (i, got) in run.iter().enumerate() {
+                    let x = 5 + i as u32;
+                    let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                    let want = view.uv_to_dir(0, uv).map(|d| (d, view.density(0, uv)));
+                    // Past the right edge (x ≥ w) there is no direction, as uv_to_dir says.
+                    assert_eq!(*got, want, "({x}, {y})");
+                    assert_eq!(got.is_some(), x < w, "({x}, {y})");
+                }
+            }
+        }
+    }
 
     #[test]
     fn pannini_with_d_zero_is_rectilinear() {

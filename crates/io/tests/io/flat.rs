@@ -1529,3 +1529,65 @@ fn exr_zip_blocks_agree_with_the_exr_crate_both_ways() {
         }
     }
 }
+
+/// `read_codes` gives a PNG's or JPEG's samples as the file holds them: through io's sRGB
+/// tables they are `read`'s floats, bit for bit (8-bit JPEG and PNG, 16-bit PNG, with a
+/// JPEG's recorded projection); grey and alpha pictures are left to `read`.
+#[test]
+fn read_codes_are_read_s_floats() {
+    use mirrorball_io::{read, read_codes, srgb16_to_linear, srgb8_to_linear, Precision};
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (37, 19);
+    let mut img = Image::new(w, h, 3);
+    for y in 0..h {
+        for x in 0..w {
+            let k = (x * 5 + y * 11) as f32;
+            img.set(x, y, &[(k * 0.3).sin().abs(), (k * 0.07).cos().abs(), 0.25]);
+        }
+    }
+    let mut buf = vec![7u8; 3]; // reused: resized to the picture
+    for (name, precision) in [
+        ("a.png", Precision::U8),
+        ("b.png", Precision::U16),
+        ("c.jpg", Precision::U8),
+    ] {
+        let path = dir.path().join(name);
+        let opts = WriteOptions {
+            precision: Some(precision),
+            declared: Some(MapInfo {
+                projection: ProjectionKind::LatLong.default_projection(),
+                layout: None,
+                stereo: Default::default(),
+            }),
+            ..Default::default()
+        };
+        write_image(&path, &img, &opts).unwrap();
+        let floats = read(&path, &Limits::default()).unwrap();
+        let coded = read_codes(&path, &Limits::default(), &mut buf)
+            .unwrap()
+            .unwrap();
+        assert_eq!((coded.width, coded.height), (w, h), "{name}");
+        assert_eq!(coded.wide, precision == Precision::U16, "{name}");
+        assert_eq!(coded.description, floats.description, "{name}");
+        assert_eq!(
+            coded.recorded.unwrap().unwrap().projection,
+            floats.recorded.unwrap().unwrap().projection
+        );
+        let decoded: Vec<f32> = if coded.wide {
+            buf.chunks_exact(2)
+                .map(|b| srgb16_to_linear()[u16::from_le_bytes([b[0], b[1]]) as usize])
+                .collect()
+        } else {
+            buf.iter().map(|&k| srgb8_to_linear()[k as usize]).collect()
+        };
+        assert!(decoded == floats.layers[0].data(), "{name}");
+    }
+    // A grey PNG and one with alpha: not codes of RGB, left to `read`.
+    let grey = dir.path().join("grey.png");
+    mirrorball_io::write_grey_png(&grey, (4, 2), &[9; 8]).unwrap();
+    assert!(read_codes(&grey, &Limits::default(), &mut buf)
+        .unwrap()
+        .is_none());
+    let missing = read_codes(&dir.path().join("none.jpg"), &Limits::default(), &mut buf);
+    assert!(missing.is_err());
+}
