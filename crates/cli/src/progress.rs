@@ -55,8 +55,14 @@ fn run<T: Send>(
         ProgressBar::new(total)
     };
     bar.set_length(total);
+    // Frames (a sequence's, a video's) are counted one by one: their count and rate shown.
+    let template = if matches!(label, "frames" | "video") {
+        "{msg:>10} [{bar:40}] {pos}/{len} frames, {per_sec} {elapsed}/{eta}"
+    } else {
+        "{msg:>10} [{bar:40}] {percent:>3}% {elapsed}/{eta}"
+    };
     bar.set_style(
-        ProgressStyle::with_template("{msg:>10} [{bar:40}] {percent:>3}% {elapsed}/{eta}")
+        ProgressStyle::with_template(template)
             .expect("valid template")
             .progress_chars("=> "),
     );
