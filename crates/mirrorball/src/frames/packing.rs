@@ -526,6 +526,7 @@ impl Packing {
         let (w, h) = (self.width as usize, self.height as usize);
         let px = fmt.pixel_bytes();
         out.resize(w * h * px, 0);
+        let table = fmt.table();
         let runs_of =
             |r: usize| &self.runs[self.row_starts[r] as usize..self.row_starts[r + 1] as usize];
         let init = || (Vec::new(), Vec::new());
@@ -568,7 +569,7 @@ impl Packing {
                     }
                     for run in runs_of(y) {
                         let d = &mut bytes[run.at as usize * px..(run.at + run.len) as usize * px];
-                        texels(run, row, gathered, &mut |s| fmt.encode(s, c, d));
+                        texels(run, row, gathered, &mut |s| fmt.encode(table, s, c, d));
                     }
                 },
             ),
@@ -660,7 +661,7 @@ fn encode_at(
     c: usize,
     out: &mut [u8],
 ) {
-    let (n, px) = (w as usize * h as usize, fmt.pixel_bytes());
+    let (n, px, table) = (w as usize * h as usize, fmt.pixel_bytes(), fmt.table());
     for (i, v) in at.zip(values.chunks_exact(c)) {
         let i = i as usize;
         match fmt {
@@ -670,7 +671,7 @@ fn encode_at(
                     out[at..at + 4].copy_from_slice(&v[k].to_le_bytes());
                 }
             }
-            _ => fmt.encode(v, c, &mut out[i * px..(i + 1) * px]),
+            _ => fmt.encode(table, v, c, &mut out[i * px..(i + 1) * px]),
         }
     }
 }
@@ -737,11 +738,20 @@ impl FrameCodes {
         }
     }
 
-    /// Texels of `c` channels (one for a plane) into their bytes.
-    #[inline]
-    fn encode(self, src: &[f32], c: usize, dst: &mut [u8]) {
+    /// The sRGB code table of an integer pixel format, looked up once per frame.
+    fn table(self) -> Option<&'static SrgbTable> {
         match self {
-            FrameCodes::Pix(f) => f.encode_texels(f.table(), src, c, dst),
+            FrameCodes::Pix(f) => f.table(),
+            FrameCodes::Plane(_) => None,
+        }
+    }
+
+    /// Texels of `c` channels (one for a plane) into their bytes, `table` being
+    /// [`FrameCodes::table`].
+    #[inline]
+    fn encode(self, table: Option<&SrgbTable>, src: &[f32], c: usize, dst: &mut [u8]) {
+        match self {
+            FrameCodes::Pix(f) => f.encode_texels(table, src, c, dst),
             FrameCodes::Plane(p) => p.encode(src, dst),
         }
     }
