@@ -26,14 +26,11 @@ test('the viewport draws every projection the server lists and the simulator sho
   try {
     const first = await openStudio(chromium, s.url);
     const listed = await first.page.evaluate(() => window.studio.view.state.projections);
-    const kinds = await first.page.evaluate(() => window.studio.G.KINDS);
     const menu = await first.page.$$eval('#projection option', (o) => o.map((x) => x.value));
     await first.page.close();
     assert.ok(listed.length >= 19, `${listed.length} projections listed`);
     for (const p of listed) {
       assert.ok(menu.includes(p.name), `the menu lacks ${p.name}`);
-      // The shaders the page has are the ones the server says it has.
-      assert.equal(kinds.includes(p.name), p.gpu, `${p.name}: gpu ${p.gpu}`);
     }
     for (const p of listed) {
       const { page, logs } = await openStudio(chromium, `${s.url}&mode=3&projection=${p.name}&size=32`);

@@ -162,7 +162,7 @@ pub struct ConvertArgs {
     /// view, w and h, stereo modes); in place of --from, --in-layout, --to, --layout,
     /// --in-stereo, --stereo, --yaw, --pitch, --roll and --flip (refused beside it), and of
     /// --size when it has w and h. Without w and h the size is mirrorball's (--size). What
-    /// mirrorball cannot make exactly (barrel, tetrahedron, tsp, input flips, pads, …) is
+    /// mirrorball cannot make exactly (barrel, tsp, input flips, pads, …) is
     /// refused, naming the key; interp is accepted (every output texel is antialiased).
     #[arg(long, value_name = "OPTIONS")]
     v360: Option<String>,

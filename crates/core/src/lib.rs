@@ -42,13 +42,10 @@ pub use envmap::{
 pub use fault::{input_file_problem, Error, Fault};
 pub use image::Image;
 pub use layout::{guess, CellGrid, CubeCells, Guess, Layout, Stereo};
+pub use projection::types::*;
 pub use projection::{
-    AngularMap, ContinuousCube, CubeFace, CubeMap, Cylinder, CylinderRule, DirRun, DualParaboloid,
-    Eac, EqualAreaOctahedral, FaceLanes, Fisheye, Frame, Hammer, LatLong, Lens, Lookup, Mercator,
-    Octahedral, Projection, ProjectionKind, RadialMap, Sinusoidal, SphereMap, UnknownProjection,
-    View, WorldProjection,
+    DirRun, Lookup, Projection, ProjectionKind, UnknownProjection, WorldProjection,
 };
-pub use projection::{DualFisheye, FisheyeLens, LensModel};
 pub use remap::{Remap, RemapError, RemapRows};
 pub use resample::{
     resample, resample_memory, resample_to_extent, Axis, Outside, ResampleOptions, Resampler,

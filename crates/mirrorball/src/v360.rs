@@ -186,6 +186,8 @@ pub enum Proj {
     Sinusoidal,
     /// `pannini`: `pannini:d=D` where `h_fov` is D, drawn over `X, Y ∈ [−1, 1]`.
     Pannini,
+    /// `tetrahedron`.
+    Tetrahedron,
     /// A v360 projection mirrorball does not make: why.
     Refused(&'static str),
 }
@@ -214,10 +216,7 @@ pub const PROJECTIONS: &[(&[&str], Proj)] = &[
         &["barrel", "fb", "barrelsplit"],
         Proj::Refused("Facebook's barrel layouts are not among mirrorball's projections"),
     ),
-    (
-        &["tetrahedron"],
-        Proj::Refused("the tetrahedron is not among mirrorball's projections"),
-    ),
+    (&["tetrahedron"], Proj::Tetrahedron),
     (
         &["tsp"],
         Proj::Refused("the truncated square pyramid is not among mirrorball's projections"),
@@ -353,6 +352,7 @@ impl Proj {
             Proj::HalfEquirect => plain("half-equirect"),
             Proj::Hammer => plain("hammer"),
             Proj::Sinusoidal => plain("sinusoidal"),
+            Proj::Tetrahedron => plain("tetrahedron"),
             Proj::Cells(grid) => Ok(("cube".into(), Some(grid.parse().expect("a grid")))),
             Proj::Eac => Ok(("eac".into(), Some(Layout::eac()))),
             Proj::Flat => {
@@ -952,7 +952,7 @@ mod tests {
             ("e:eac:rorder=ypx", "rorder"),
             ("e:eac:rorder=yp", "rorder"),
             ("e:cube", "output"),
-            ("e:tetrahedron", "output"),
+            ("e:tsp", "output"),
             ("barrel:e", "input"),
             ("e:c3x2:out_forder=rludfx", "out_forder"),
             ("e:eac:out_forder=rludfb", "out_forder"),

@@ -405,29 +405,13 @@ pub fn layout_of(layers: usize) -> Value {
     json!({ "name": layout.name(), "grid": [c, r], "cells": cells })
 }
 
-/// The projections the viewport's shaders know, by the name the page loads their GLSL under
-/// (`gl.js` `projectionSource`: `web/glsl/`, one file per projection's direction → uv).
+/// The name the page loads projection `p`'s shader under, where the viewport has one:
+/// `web/glsl/projections/NAME.glsl`, NAME the core's name for its kind (`gl.js`
+/// `projectionSource`). A projection without one (the dual fisheye: two lenses with their own
+/// centres, rolls and distortion) is sent to the page as its lat-long conversion
+/// (server.rs `texture`).
 pub fn gpu_kind(p: &Projection) -> Option<&'static str> {
-    match p {
-        Projection::LatLong(_)
-        | Projection::Cube(_)
-        | Projection::Sphere(_)
-        | Projection::Paraboloid(_)
-        | Projection::ContinuousCube(_)
-        | Projection::Mercator(_)
-        | Projection::Angular(_)
-        | Projection::Fisheye(_)
-        | Projection::Octahedral(_)
-        | Projection::EqualAreaOctahedral(_)
-        | Projection::Cylinder(_)
-        | Projection::Hammer(_)
-        | Projection::Sinusoidal(_)
-        | Projection::View(_)
-        | Projection::Eac(_) => Some(p.name()),
-        // Two lenses with their own centres, rolls and distortion: the server sends the
-        // page a lat-long conversion of it instead (server.rs `texture`).
-        Projection::DualFisheye(_) => None,
-    }
+    crate::web::projection_shader(p.name()).map(|_| p.name())
 }
 
 /// The frame the shader measures a map's directions in, as the columns (right, up, axis):

@@ -3,70 +3,19 @@
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 
-/// `(name, content type, contents)` of files under `web/`, by their names there.
-macro_rules! files {
-    ($($name:literal: $kind:literal),* $(,)?) => {
-        &[$(($name, $kind, include_str!(concat!("../web/", $name)))),*]
-    };
-}
-
 const HTML: &str = "text/html; charset=utf-8";
 const JS: &str = "text/javascript; charset=utf-8";
 const GLSL: &str = "text/plain; charset=utf-8";
 
-/// Every file the page loads.
-const FILES: &[(&str, &str, &str)] = files![
-    "index.html": "html",
-    "studio.js": "js",
-    "gl.js": "js",
-    "sim.js": "js",
-    "analysis.js": "js",
-    "glsl/math.glsl": "glsl",
-    "panels.js": "js",
-    "glsl/latlong.glsl": "glsl",
-    "glsl/cubeface.glsl": "glsl",
-    "glsl/cube.glsl": "glsl",
-    "glsl/continuous_cube.glsl": "glsl",
-    "glsl/eac.glsl": "glsl",
-    "glsl/mercator.glsl": "glsl",
-    "glsl/radial.glsl": "glsl",
-    "glsl/lens.glsl": "glsl",
-    "glsl/sphere.glsl": "glsl",
-    "glsl/paraboloid.glsl": "glsl",
-    "glsl/fisheye.glsl": "glsl",
-    "glsl/octahedral.glsl": "glsl",
-    "glsl/equal_area_octahedral.glsl": "glsl",
-    "glsl/cylinder.glsl": "glsl",
-    "glsl/hammer.glsl": "glsl",
-    "glsl/sinusoidal.glsl": "glsl",
-    "glsl/view.glsl": "glsl",
-    "glsl/bilinear.glsl": "glsl",
-    "glsl/lighting.glsl": "glsl",
-    "glsl/display.glsl": "glsl",
-    "glsl/interpolate.glsl": "glsl",
-    "glsl/cone.glsl": "glsl",
-    "glsl/paraboloid_hw.glsl": "glsl",
-    "glsl/texgen.glsl": "glsl",
-    "glsl/viewport.vert": "glsl",
-    "glsl/viewport.frag": "glsl",
-    "glsl/sim-record.glsl": "glsl",
-    "glsl/sim-surface.frag": "glsl",
-    "glsl/sim-map.frag": "glsl",
-    "greene.js": "js",
-    "glsl/greene-background.frag": "glsl",
-    "glsl/greene-object.vert": "glsl",
-    "glsl/greene-object.frag": "glsl",
-    "glsl/greene-mirror.frag": "glsl",
-    "glsl/greene-fisheye-inverse.glsl": "glsl",
-    "glsl/greene-omnimax.frag": "glsl",
-];
+/// Every file under `web/`, `(path there, contents)` (build.rs lists the folder).
+const FILES: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/web_files.rs"));
 
 /// The embedded file `name`: its content type and contents.
 pub(crate) fn get(name: &str) -> Option<(&'static str, &'static str)> {
-    let (_, kind, contents) = FILES.iter().find(|(n, _, _)| *n == name)?;
-    let content_type = match *kind {
-        "html" => HTML,
-        "js" => JS,
+    let (_, contents) = FILES.iter().find(|(n, _)| *n == name)?;
+    let content_type = match name.rsplit('.').next() {
+        Some("html") => HTML,
+        Some("js") => JS,
         _ => GLSL,
     };
     Some((content_type, contents))
@@ -77,27 +26,44 @@ pub(crate) fn respond((content_type, contents): (&'static str, &'static str)) ->
     ([(header::CONTENT_TYPE, content_type)], contents).into_response()
 }
 
+/// The viewport's shader of projection kind `name` (the core's name), if it has one.
+pub(crate) fn projection_shader(name: &str) -> Option<&'static str> {
+    get(&format!("glsl/projections/{name}.glsl")).map(|(_, c)| c)
+}
+
 #[cfg(test)]
 mod tests {
+    use super::FILES;
+    use mirrorball_core::ProjectionKind;
+
     #[test]
-    fn every_file_under_web_is_embedded() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("web");
-        let mut on_disk = Vec::new();
-        for dir in [root.clone(), root.join("glsl")] {
-            for e in std::fs::read_dir(&dir).unwrap() {
-                let p = e.unwrap().path();
-                if p.is_file() {
-                    on_disk.push(
-                        p.strip_prefix(&root)
-                            .unwrap()
-                            .to_string_lossy()
-                            .replace('\\', "/"),
-                    );
+    fn every_projection_shader_is_a_kinds_and_every_need_is_a_file() {
+        let mut shaders = 0;
+        for (name, contents) in FILES {
+            if let Some(kind) = name
+                .strip_prefix("glsl/projections/")
+                .and_then(|n| n.strip_suffix(".glsl"))
+            {
+                shaders += 1;
+                assert!(
+                    ProjectionKind::ALL.iter().any(|k| k.name() == kind),
+                    "web/{name} names no projection of the core's table"
+                );
+            }
+            if name.ends_with(".glsl") {
+                for line in contents.lines() {
+                    let Some(needs) = line.strip_prefix("// needs:") else {
+                        continue;
+                    };
+                    for need in needs.split_whitespace() {
+                        assert!(
+                            super::get(&format!("glsl/{need}.glsl")).is_some(),
+                            "web/{name} needs {need}.glsl, which is not under web/glsl"
+                        );
+                    }
                 }
             }
         }
-        for f in on_disk {
-            assert!(super::get(&f).is_some(), "web/{f} is not embedded");
-        }
+        assert!(shaders >= 19, "{shaders} projection shaders embedded");
     }
 }

@@ -31,39 +31,33 @@ export async function glsl(name) {
 }
 
 /**
- * The GLSL files of each projection's envUv, in order, by the server's name for it
- * (state.rs `gpu_kind`): math.glsl first, then the shared machines (cube faces, the disks'
- * radius and lenses), then the projection's own file, one home per formula.
+ * The GLSL of projection `kind`'s envUv: its file `glsl/projections/KIND.glsl` (KIND the
+ * core's name; the server says `gpu: true` for exactly the kinds that have one, state.rs
+ * `gpu_kind`), after math.glsl and the shared machines it names on its `// needs:` lines
+ * (cube faces, the disks' radius and lenses, ...: files under glsl/, each with its own needs),
+ * each file once and after what it needs: one home per formula.
  */
-const SOURCES = {
-  latlong: ['latlong'],
-  cube: ['cubeface', 'cube'],
-  sphere: ['radial', 'lens', 'sphere'],
-  paraboloid: ['radial', 'lens', 'paraboloid'],
-  'continuous-cube': ['cubeface', 'continuous_cube'],
-  eac: ['cubeface', 'eac'],
-  mercator: ['mercator'],
-  angular: ['radial', 'lens', 'fisheye'],
-  fisheye: ['radial', 'lens', 'fisheye'],
-  octahedral: ['octahedral'],
-  'equal-area-octahedral': ['equal_area_octahedral'],
-  cylindrical: ['cylinder'],
-  'cylindrical-equal-area': ['cylinder'],
-  'half-equirect': ['cylinder'],
-  hammer: ['hammer'],
-  sinusoidal: ['sinusoidal'],
-  perspective: ['view'],
-  pannini: ['view'],
-};
-
-/** The projections the shaders know, by the server's name for them. */
-export const KINDS = Object.keys(SOURCES);
-
-/** The GLSL of projection `kind`'s envUv (with math.glsl and the machines it uses). */
 export async function projectionSource(kind) {
-  if (!KINDS.includes(kind)) throw new Error(`the viewport does not draw ${kind} maps`);
-  const parts = await Promise.all(['math', ...SOURCES[kind]].map((f) => glsl(`${f}.glsl`)));
-  return parts.join('\n');
+  const order = [];
+  const seen = new Set();
+  const visit = async (name, chain) => {
+    if (seen.has(name)) return;
+    if (chain.includes(name)) throw new Error(`the shaders' needs go round: ${[...chain, name].join(' -> ')}`);
+    let text;
+    try {
+      text = await glsl(`${name}.glsl`);
+    } catch (e) {
+      throw new Error(name.startsWith('projections/') ? `the viewport does not draw ${kind} maps` : `${name}.glsl: ${e.message}`);
+    }
+    for (const line of text.matchAll(/^\/\/ needs:(.*)$/gm)) {
+      for (const need of line[1].trim().split(/\s+/).filter(Boolean)) await visit(need, [...chain, name]);
+    }
+    seen.add(name);
+    order.push(text);
+  };
+  await visit('math', []);
+  await visit(`projections/${kind}`, []);
+  return order.join('\n');
 }
 
 /** An environment payload (texture.rs): its JSON header and texels. */
@@ -366,7 +360,8 @@ export async function envUvOnGpu(gl, kind, frame, params, dirs) {
 /**
  * Checks projection `spec`'s shader against the core on the server's grid of `n` cells a
  * side: each direction's (u, v, layer) must be the core's, or (on a seam, where two are
- * right) the one the direction was made from, within `tolerance` in u and v.
+ * right) the one the direction was made from, within `tolerance` in u and v, or else name
+ * the direction itself (the core's uv_to_dir of it within 2π·`tolerance` rad).
  */
 export async function checkProjection(gl, { kind, spec, n = 64, tolerance = 1e-4 }) {
   const buf = await (await api(`/api/grid?projection=${encodeURIComponent(spec)}&n=${n}`)).arrayBuffer();
@@ -379,6 +374,7 @@ export async function checkProjection(gl, { kind, spec, n = 64, tolerance = 1e-4
   let seams = 0;
   let failed = 0;
   const failures = [];
+  const apart = [];
   for (let i = 0; i < count; i++) {
     const g = got.subarray(4 * i, 4 * i + 3);
     const err = (k) => {
@@ -391,14 +387,36 @@ export async function checkProjection(gl, { kind, spec, n = 64, tolerance = 1e-4
     const e = Math.min(e0, err(6));
     if (e < e0) seams++;
     if (e > tolerance) {
-      failed++;
-      if (failures.length < 10) {
-        failures.push({ dir: Array.from(dirs.subarray(3 * i, 3 * i + 3)), got: Array.from(g), core: Array.from(values.subarray(9 * i + 3, 9 * i + 9)) });
-      }
+      apart.push(i);
     } else if (e > worst) {
       worst = e;
       worstAt = { dir: Array.from(dirs.subarray(3 * i, 3 * i + 3)), got: Array.from(g), core: Array.from(values.subarray(9 * i + 3, 9 * i + 9)) };
     }
+  }
+  // Coordinates apart from both of the core's may still name the direction: a point of an
+  // edge the picture holds twice (a tetrahedron's top edge, folded at its middle). The core
+  // turns them back into directions (`/api/directions`), which must be the one asked for
+  // within the angle `tolerance` spans across a whole map.
+  if (apart.length) {
+    const body = new Float32Array(3 * apart.length);
+    apart.forEach((i, k) => body.set(got.subarray(4 * i, 4 * i + 3), 3 * k));
+    const r = await api(`/api/directions?projection=${encodeURIComponent(spec)}`, { method: 'POST', body });
+    const back = new Float32Array(await r.arrayBuffer());
+    apart.forEach((i, k) => {
+      const d = dirs.subarray(3 * i, 3 * i + 3);
+      const b = back.subarray(3 * k, 3 * k + 3);
+      const len = Math.hypot(...d);
+      const cross = Math.hypot(d[1] * b[2] - d[2] * b[1], d[2] * b[0] - d[0] * b[2], d[0] * b[1] - d[1] * b[0]);
+      const angle = Math.atan2(cross, d[0] * b[0] + d[1] * b[1] + d[2] * b[2]);
+      if (len > 0 && angle <= 2 * Math.PI * tolerance) {
+        seams++;
+        return;
+      }
+      failed++;
+      if (failures.length < 10) {
+        failures.push({ dir: Array.from(d), got: Array.from(got.subarray(4 * i, 4 * i + 3)), core: Array.from(values.subarray(9 * i + 3, 9 * i + 9)), back: Array.from(b) });
+      }
+    });
   }
   return { count, worst, worstAt, seams, failed, failures };
 }

@@ -16,7 +16,7 @@ fn edge_for_budget(kind: ProjectionKind, budget: f64) -> u32 {
 }
 
 /// Recorded log-PSNR (dB) at 1× budget: city, venice, studio, sky.
-const RECORDED: [(ProjectionKind, [f64; 4]); 18] = [
+const RECORDED: [(ProjectionKind, [f64; 4]); 19] = [
     (ProjectionKind::Cube, [43.76, 41.30, 39.36, 43.91]),
     (ProjectionKind::Sphere, [40.88, 35.12, 38.93, 42.85]),
     (ProjectionKind::Paraboloid, [43.00, 40.31, 39.89, 43.96]),
@@ -41,12 +41,13 @@ const RECORDED: [(ProjectionKind, [f64; 4]); 18] = [
     (ProjectionKind::Pannini, [44.27, 39.20, 47.27, 43.15]),
     (ProjectionKind::Eac, [45.05, 42.89, 40.11, 43.60]),
     (ProjectionKind::DualFisheye, [43.90, 42.39, 39.30, 43.44]),
+    (ProjectionKind::Tetrahedron, [42.83, 42.08, 38.36, 42.61]),
 ];
 
 /// Recorded log-PSNR (dB) at 4× budget for the newer projections (measured by this test's
 /// own output, opt-level 2): city, venice, studio, sky.
 /// A new projection is one row here and one in [`RECORDED`].
-const RECORDED_4X: [(ProjectionKind, [f64; 4]); 9] = [
+const RECORDED_4X: [(ProjectionKind, [f64; 4]); 10] = [
     (ProjectionKind::Cylindrical, [45.71, 42.18, 38.72, 51.48]),
     (
         ProjectionKind::CylindricalEqualArea,
@@ -59,6 +60,7 @@ const RECORDED_4X: [(ProjectionKind, [f64; 4]); 9] = [
     (ProjectionKind::Pannini, [44.02, 38.83, 47.10, 42.87]),
     (ProjectionKind::Eac, [46.64, 43.77, 39.75, 43.90]),
     (ProjectionKind::DualFisheye, [47.29, 44.05, 39.79, 44.72]),
+    (ProjectionKind::Tetrahedron, [46.29, 44.02, 40.24, 43.71]),
 ];
 
 #[test]

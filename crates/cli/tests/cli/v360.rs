@@ -751,6 +751,7 @@ fn v360_options_land_where_v360_puts_them() {
         "e:equisolid:h_fov=180:v_fov=180:w=96:h=96",
         "e:og:h_fov=160:v_fov=160:w=96:h=96",
         "e:hequirect:yaw=-30:w=96:h=96",
+        "e:tetrahedron:yaw=30:pitch=-20:w=128:h=64",
         // v360's eac at sizes of its own: YouTube's 3840x2160 scaled by a fifth (faces
         // 254⅔ by 212 texels), and faces of whole but unequal sizes.
         "e:eac:w=768:h=432",
@@ -765,6 +766,7 @@ fn v360_options_land_where_v360_puts_them() {
         "dfisheye:e:ih_fov=190:iv_fov=190:w=128:h=64",
     );
     compare_options(dir.path(), "eac", (40, 40), "eac:e:yaw=15:w=128:h=64");
+    compare_options(dir.path(), "tetrahedron", e, "tetrahedron:e:w=128:h=64");
 }
 
 /// Options mirrorball cannot make exactly, or v360 would refuse: exit 2, the key named, no
@@ -777,7 +779,7 @@ fn v360_options_refused_name_the_key() {
     for (options, extra, named) in [
         ("e:eac:bogus=1", &[][..], "bogus"),
         ("e:eac:yaw=400", &[], "yaw"),
-        ("e:tetrahedron", &[], "tetrahedron"),
+        ("e:tsp", &[], "tsp"),
         ("e:barrel", &[], "barrel"),
         ("e:c3x2:out_forder=rludfq", &[], "out_forder"),
         ("e:e:ih_flip=1", &[], "ih_flip"),

@@ -27,20 +27,28 @@ mod pseudo;
 pub mod quadrature;
 mod range;
 mod spec;
+mod tetrahedron;
 
-pub use azimuthal::{AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap, SphereMap};
-pub use continuous_cube::ContinuousCube;
-pub use cube::{CubeFace, CubeMap, FaceLanes};
-pub use cylindrical::{Cylinder, CylinderRule};
-pub use dual_fisheye::{DualFisheye, FisheyeLens, LensModel};
-pub use eac::Eac;
-pub use latlong::{LatLong, Mercator};
-pub use octahedral::{EqualAreaOctahedral, Octahedral};
+/// The projection types, one `pub use` each: the crate's root re-exports all of them.
+pub mod types {
+    pub use super::azimuthal::{
+        AngularMap, DualParaboloid, Fisheye, Frame, Lens, RadialMap, SphereMap,
+    };
+    pub use super::continuous_cube::ContinuousCube;
+    pub use super::cube::{CubeFace, CubeMap, FaceLanes};
+    pub use super::cylindrical::{Cylinder, CylinderRule};
+    pub use super::dual_fisheye::{DualFisheye, FisheyeLens, LensModel};
+    pub use super::eac::Eac;
+    pub use super::latlong::{LatLong, Mercator};
+    pub use super::octahedral::{EqualAreaOctahedral, Octahedral};
+    pub use super::perspective::View;
+    pub use super::pseudo::{Hammer, Sinusoidal};
+    pub use super::tetrahedron::Tetrahedron;
+}
 pub use overlap::OverlapBlend;
-pub use perspective::View;
-pub use pseudo::{Hammer, Sinusoidal};
 pub use range::Range;
 pub use spec::{parse_dir, Bounded, ProjectionSpec};
+pub use types::*;
 
 use crate::{Choice, UnknownName};
 use glam::{DVec2, DVec3};
@@ -408,6 +416,10 @@ projections! {
     DualFisheye: ["dual-fisheye", "dfisheye", "dualfisheye", "dual_fisheye"],
         "two lenses back to back in one 2:1 picture",
         Projection::DualFisheye(DualFisheye::default());
+    /// FFmpeg v360's tetrahedron net.
+    Tetrahedron: ["tetrahedron", "tetra"],
+        "FFmpeg v360's tetrahedron unfolded, 2:1",
+        Projection::Tetrahedron(Tetrahedron);
 }
 
 impl ProjectionKind {
@@ -486,99 +498,103 @@ impl FromStr for ProjectionKind {
     }
 }
 
-/// Any world projection, with its parameters. Implements [`WorldProjection`] by delegating
-/// to the named type inside.
-// The dual fisheye (two lenses, each with its frame) is the largest variant, a few hundred
-// bytes: `Projection` stays `Copy` and is passed by reference in the loops.
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Projection {
-    /// See [`LatLong`].
-    LatLong(LatLong),
-    /// See [`CubeMap`].
-    Cube(CubeMap),
-    /// See [`SphereMap`].
-    Sphere(SphereMap),
-    /// See [`DualParaboloid`].
-    Paraboloid(DualParaboloid),
-    /// See [`ContinuousCube`].
-    ContinuousCube(ContinuousCube),
-    /// See [`Mercator`].
-    Mercator(Mercator),
-    /// See [`AngularMap`].
-    Angular(AngularMap),
-    /// See [`Fisheye`].
-    Fisheye(Fisheye),
-    /// See [`Octahedral`].
-    Octahedral(Octahedral),
-    /// See [`EqualAreaOctahedral`].
-    EqualAreaOctahedral(EqualAreaOctahedral),
-    /// See [`Cylinder`]: cylindrical, cylindrical equal-area or half equirectangular, by
-    /// its [`CylinderRule`].
-    Cylinder(Cylinder),
-    /// See [`Hammer`].
-    Hammer(Hammer),
-    /// See [`Sinusoidal`].
-    Sinusoidal(Sinusoidal),
-    /// See [`View`]: perspective or Pannini.
-    View(View),
-    /// See [`Eac`].
-    Eac(Eac),
-    /// See [`DualFisheye`].
-    DualFisheye(DualFisheye),
+/// The one list of projection types: each row is a variant of [`Projection`] and the type
+/// it holds, and the kind of a value of it where the variant is not itself a kind's name
+/// (a [`Cylinder`] is one of three kinds, a [`View`] one of two). The enum, its
+/// [`WorldProjection`] delegation, [`Projection::kind`] and the `From` conversions come
+/// from it.
+macro_rules! projection_types {
+    ($($(#[$doc:meta])* $v:ident($t:ty) $(, |$c:ident| $kind:expr)?;)+) => {
+        /// Any world projection, with its parameters. Implements [`WorldProjection`] by
+        /// delegating to the named type inside.
+        // The dual fisheye (two lenses, each with its frame) is the largest variant, a few
+        // hundred bytes: `Projection` stays `Copy` and is passed by reference in the loops.
+        #[allow(clippy::large_enum_variant)]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum Projection {
+            $($(#[$doc])* $v($t),)+
+        }
+
+        /// `$e` with `$p` bound to the projection type inside `$self`.
+        macro_rules! delegate {
+            ($self_:ident, $p_:ident => $e_:expr) => {
+                match $self_ {
+                    $(Projection::$v($p_) => $e_,)+
+                }
+            };
+        }
+
+        impl Projection {
+            /// Which kind of projection this is.
+            pub fn kind(&self) -> ProjectionKind {
+                match self {
+                    $(Projection::$v(_p) => projection_types!(@kind _p, $v $(, |$c| $kind)?),)+
+                }
+            }
+        }
+
+        $(
+            impl From<$t> for Projection {
+                fn from(p: $t) -> Projection {
+                    Projection::$v(p)
+                }
+            }
+        )+
+    };
+    (@kind $p:ident, $v:ident) => { ProjectionKind::$v };
+    (@kind $p:ident, $v:ident, |$c:ident| $kind:expr) => {{
+        let $c = $p;
+        $kind
+    }};
 }
 
-macro_rules! delegate {
-    ($self:ident, $p:ident => $e:expr) => {
-        match $self {
-            Projection::LatLong($p) => $e,
-            Projection::Cube($p) => $e,
-            Projection::Sphere($p) => $e,
-            Projection::Paraboloid($p) => $e,
-            Projection::ContinuousCube($p) => $e,
-            Projection::Mercator($p) => $e,
-            Projection::Angular($p) => $e,
-            Projection::Fisheye($p) => $e,
-            Projection::Octahedral($p) => $e,
-            Projection::EqualAreaOctahedral($p) => $e,
-            Projection::Cylinder($p) => $e,
-            Projection::Hammer($p) => $e,
-            Projection::Sinusoidal($p) => $e,
-            Projection::View($p) => $e,
-            Projection::Eac($p) => $e,
-            Projection::DualFisheye($p) => $e,
-        }
+projection_types! {
+    /// See [`LatLong`].
+    LatLong(LatLong);
+    /// See [`CubeMap`].
+    Cube(CubeMap);
+    /// See [`SphereMap`].
+    Sphere(SphereMap);
+    /// See [`DualParaboloid`].
+    Paraboloid(DualParaboloid);
+    /// See [`ContinuousCube`].
+    ContinuousCube(ContinuousCube);
+    /// See [`Mercator`].
+    Mercator(Mercator);
+    /// See [`AngularMap`].
+    Angular(AngularMap);
+    /// See [`Fisheye`].
+    Fisheye(Fisheye);
+    /// See [`Octahedral`].
+    Octahedral(Octahedral);
+    /// See [`EqualAreaOctahedral`].
+    EqualAreaOctahedral(EqualAreaOctahedral);
+    /// See [`Cylinder`]: cylindrical, cylindrical equal-area or half equirectangular, by
+    /// its [`CylinderRule`].
+    Cylinder(Cylinder), |c| match c.rule() {
+        CylinderRule::Central => ProjectionKind::Cylindrical,
+        CylinderRule::EqualArea => ProjectionKind::CylindricalEqualArea,
+        CylinderRule::Equidistant => ProjectionKind::HalfEquirect,
     };
+    /// See [`Hammer`].
+    Hammer(Hammer);
+    /// See [`Sinusoidal`].
+    Sinusoidal(Sinusoidal);
+    /// See [`View`]: perspective or Pannini.
+    View(View), |v| if v.is_pannini() {
+        ProjectionKind::Pannini
+    } else {
+        ProjectionKind::Perspective
+    };
+    /// See [`Eac`].
+    Eac(Eac);
+    /// See [`DualFisheye`].
+    DualFisheye(DualFisheye);
+    /// See [`Tetrahedron`].
+    Tetrahedron(Tetrahedron);
 }
 
 impl Projection {
-    /// Which kind of projection this is.
-    pub fn kind(&self) -> ProjectionKind {
-        match self {
-            Projection::LatLong(_) => ProjectionKind::LatLong,
-            Projection::Cube(_) => ProjectionKind::Cube,
-            Projection::Sphere(_) => ProjectionKind::Sphere,
-            Projection::Paraboloid(_) => ProjectionKind::Paraboloid,
-            Projection::ContinuousCube(_) => ProjectionKind::ContinuousCube,
-            Projection::Mercator(_) => ProjectionKind::Mercator,
-            Projection::Angular(_) => ProjectionKind::Angular,
-            Projection::Fisheye(_) => ProjectionKind::Fisheye,
-            Projection::Octahedral(_) => ProjectionKind::Octahedral,
-            Projection::EqualAreaOctahedral(_) => ProjectionKind::EqualAreaOctahedral,
-            Projection::Cylinder(c) => match c.rule() {
-                CylinderRule::Central => ProjectionKind::Cylindrical,
-                CylinderRule::EqualArea => ProjectionKind::CylindricalEqualArea,
-                CylinderRule::Equidistant => ProjectionKind::HalfEquirect,
-            },
-            Projection::Hammer(_) => ProjectionKind::Hammer,
-            Projection::Sinusoidal(_) => ProjectionKind::Sinusoidal,
-            Projection::View(v) if v.is_pannini() => ProjectionKind::Pannini,
-            Projection::View(_) => ProjectionKind::Perspective,
-            Projection::Eac(_) => ProjectionKind::Eac,
-            Projection::DualFisheye(_) => ProjectionKind::DualFisheye,
-        }
-    }
-
     /// The canonical name of this projection's kind.
     pub fn name(&self) -> &'static str {
         self.kind().name()
@@ -648,32 +664,6 @@ impl WorldProjection for Projection {
         delegate!(self, p => p.blends_overlap())
     }
 }
-
-macro_rules! impl_from {
-    ($($v:ident($t:ty)),*) => {$(
-        impl From<$t> for Projection {
-            fn from(p: $t) -> Projection { Projection::$v(p) }
-        }
-    )*};
-}
-impl_from!(
-    LatLong(LatLong),
-    Cube(CubeMap),
-    Sphere(SphereMap),
-    Paraboloid(DualParaboloid),
-    ContinuousCube(ContinuousCube),
-    Mercator(Mercator),
-    Angular(AngularMap),
-    Fisheye(Fisheye),
-    Octahedral(Octahedral),
-    EqualAreaOctahedral(EqualAreaOctahedral),
-    Cylinder(Cylinder),
-    Hammer(Hammer),
-    Sinusoidal(Sinusoidal),
-    View(View),
-    Eac(Eac),
-    DualFisheye(DualFisheye)
-);
 
 /// The `[lo, hi]` range in `uv` of texel index `i` of `n`.
 #[inline]

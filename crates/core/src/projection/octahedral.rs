@@ -7,7 +7,7 @@
 //! triangles. The square's border is mirrored about each side's midpoint, which is how
 //! texels outside it wrap.
 
-use super::quadrature::polygon_solid_angle;
+use super::quadrature::{clip, polygon_solid_angle};
 use super::{texel_range, WorldProjection};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -68,22 +68,6 @@ fn wrap_octa(x: i64, y: i64, w: u32, h: u32) -> (u32, u32) {
         }
     }
     (x.clamp(0, w - 1) as u32, y.clamp(0, h - 1) as u32)
-}
-
-/// Clips a convex polygon to the half-plane `n·p ≤ c` (Sutherland–Hodgman).
-fn clip(poly: &[DVec2], n: DVec2, c: f64) -> Vec<DVec2> {
-    let mut out = Vec::with_capacity(poly.len() + 2);
-    for i in 0..poly.len() {
-        let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
-        let (dp, dq) = (n.dot(p) - c, n.dot(q) - c);
-        if dp <= 0.0 {
-            out.push(p);
-        }
-        if (dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0) {
-            out.push(p + (q - p) * (dp / (dp - dq)));
-        }
-    }
-    out
 }
 
 /// The standard octahedral map: `(a, b) = (x, z)/(|x|+|y|+|z|)` for `y ≥ 0`, folded

@@ -1,7 +1,7 @@
 //! Exact-integration helpers shared by the projections: Gauss–Legendre quadrature and the
 //! solid angle of spherical polygons.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 /// 16-point Gauss–Legendre nodes on `[-1, 1]` (positive half; the rule is symmetric) and
 /// their weights, each the `f64` nearest the true value: the roots `xᵢ` of the Legendre
@@ -63,6 +63,22 @@ pub fn polygon_solid_angle(v: &[DVec3]) -> f64 {
         s += triangle_solid_angle(v[0], v[i], v[i + 1]);
     }
     s.abs()
+}
+
+/// Clips a convex polygon to the half-plane `n·p ≤ c` (Sutherland–Hodgman).
+pub(crate) fn clip(poly: &[DVec2], n: DVec2, c: f64) -> Vec<DVec2> {
+    let mut out = Vec::with_capacity(poly.len() + 2);
+    for i in 0..poly.len() {
+        let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (dp, dq) = (n.dot(p) - c, n.dot(q) - c);
+        if dp <= 0.0 {
+            out.push(p);
+        }
+        if (dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0) {
+            out.push(p + (q - p) * (dp / (dp - dq)));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

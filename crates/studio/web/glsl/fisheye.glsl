@@ -1,3 +1,4 @@
+// needs: radial lens
 // Fisheye and angular maps: direction -> (u, v, layer), as mirrorball-core's
 // projection/azimuthal.rs (`Fisheye`, `AngularMap`: a `RadialMap` of any lens, `dir_to_ab`):
 // rho = f(theta)/k, k = f(theta_max), theta from uFrame's third column (the map's look).

@@ -1,3 +1,4 @@
+// needs: radial
 // The four lenses of mirrorball-core's projection/azimuthal.rs (`Lens`, `RadialMap::rho_of_theta`
 // before its division by k): f(theta) for a direction at s = |l| sin(theta), z = |l| cos(theta),
 // len = |l| (radial.glsl), each written so that it stays well-conditioned where it is used.

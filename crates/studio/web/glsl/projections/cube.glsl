@@ -1,3 +1,4 @@
+// needs: cubeface
 // OpenGL cube map: direction -> (u, v, layer), as mirrorball-core's `CubeMap::uv_f32`: the
 // face of cubeface.glsl, s = sc/(2|ma|) + 1/2, t = tc/(2|ma|) + 1/2, row 0 at t = 0. Layer -1:
 // no face (a zero or non-finite direction). Comes after cubeface.glsl.

@@ -1,3 +1,4 @@
+// needs: radial lens
 // Dual paraboloid: direction -> (u, v, layer), as mirrorball-core's projection/azimuthal.rs
 // (`DualParaboloid`): layer 0 when forward.d >= 0 (uFrame's third column is forward), else
 // layer 1, whose frame is layer 0's turned half a turn about up (right -> -right, forward ->

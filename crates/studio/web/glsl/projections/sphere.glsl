@@ -1,3 +1,4 @@
+// needs: radial lens
 // OpenGL sphere map: direction -> (u, v, layer), as mirrorball-core's projection/azimuthal.rs
 // (`SphereMap`): an equal-area lens, rho = sin(theta/2) (theta_max = pi, so sin(theta_max/2)
 // = 1), theta measured from the axis pointing back at the camera that took it (uFrame's third

@@ -1,3 +1,4 @@
+// needs: cubeface
 // Grimm & Niebruegge's continuous cube (Continuous Cube Mapping, Appendix A's Cg shader),
 // corrected as mirrorball-core's projection/continuous_cube.rs corrects it (its module comment
 // derives the formulas): OpenGL's face (cubeface.glsl) and (s, t) axes, and inside the face,

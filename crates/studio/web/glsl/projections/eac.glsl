@@ -1,3 +1,4 @@
+// needs: cubeface
 // Equi-angular cube map (YouTube's EAC, v360's eac): direction -> (u, v, layer), as
 // mirrorball-core's projection/eac.rs: OpenGL's face and (s, t) axes (cubeface.glsl), and
 // inside the face the angle instead of the tangent, p = 4/pi atan(sc/|ma|), likewise q,

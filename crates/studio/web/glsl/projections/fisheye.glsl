@@ -1,0 +1,2 @@
+// needs: fisheye
+// The fisheye: fisheye.glsl's envUv (the lens and field of view in uParams).

@@ -1,0 +1,2 @@
+// needs: view
+// The Pannini view: view.glsl's envUv (its d in uParams).
