@@ -1,18 +1,17 @@
-//! `prefilter`, `sh9` and `bake`: the filter crate's `Prefilterer`, `sh::project` and
-//! `irradiance_map_sh`, and the bake crate's `Bake`, the same calls in the same order as the
-//! CLI's `prefilter` and `bake` make them.
+//! `prefilter`, `sh9` and `bake`: the library's in-memory chain (`mirrorball::prefilter`'s
+//! `shape` and `chain`, what the CLI's `prefilter` makes its files of), `sh::project`, and
+//! the bake crate's `Bake`, the same calls in the same order as the CLI's `bake` makes them.
 
 use crate::arrays::{self, Dtype};
 use crate::convert::{spec_arg, Source};
 use crate::errors::{by_fault, request};
+use crate::files::lib_error;
 use crate::threads::run;
+use mirrorball::prefilter::{chain, shape, ChainRequest};
+use mirrorball::Quiet;
 use mirrorball_bake::{Bake, BakeOptions, Engine};
-use mirrorball_core::{EnvMap, Layout, ProjectionKind, WorldProjection};
-use mirrorball_filter::mip::level_count;
-use mirrorball_filter::{
-    chain_lobes, irradiance, sh, IrradianceMethod, Lobe, LobeKind, MipChain, MipFilter,
-    PrefilterOptions, Prefilterer, RoughnessMapping, Window,
-};
+use mirrorball_core::{EnvMap, Layout, WorldProjection};
+use mirrorball_filter::{sh, IrradianceMethod, LobeKind, PrefilterOptions, RoughnessMapping};
 use mirrorball_io::{Effort, Encoding};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -112,54 +111,31 @@ pub fn prefilter<'py>(
         _ => Dtype::F32,
     });
     let size = match size {
-        Some(s) if (1..=16384).contains(&s) => s as u32,
+        Some(s) if (1..=16384).contains(&s) => Some(s as u32),
         Some(s) => return Err(request("size", format!("{s} is outside 1..=16384"))),
-        None => match kind {
-            LobeKind::Lambert => 32,
-            _ => env.natural_size(ProjectionKind::Cube).clamp(1, 512),
+        None => None,
+    };
+    let req = ChainRequest {
+        size,
+        levels,
+        mapping,
+        irradiance: method,
+        opts: PrefilterOptions {
+            samples,
+            cube_size,
+            ..Default::default()
         },
+        ..ChainRequest::new(kind, out)
     };
-    let (w0, h0) = out.layer_extent(size);
-    let full = level_count(w0, h0);
-    let levels = levels.unwrap_or(full).min(full);
-    if let RoughnessMapping::Custom(r) = &mapping {
-        if kind != LobeKind::Lambert && r.len() != levels {
-            return Err(request(
-                "mapping",
-                format!(
-                    "lists {} roughness values but the chain has {levels} levels",
-                    r.len()
-                ),
-            ));
-        }
-    }
-    let lobes = chain_lobes(kind, &mapping, levels);
-    let opts = PrefilterOptions {
-        samples,
-        cube_size,
-        ..Default::default()
-    };
-    let chain: Vec<EnvMap> =
-        py.detach(|| {
-            run(|| match kind {
-                LobeKind::Lambert => {
-                    let top =
-                        match method {
-                            IrradianceMethod::Exact => {
-                                Prefilterer::for_chain(&env, &[Lobe::Lambert], out, size, opts)
-                                    .render(&Lobe::Lambert, out, size)
-                            }
-                            IrradianceMethod::Sh => {
-                                let sh9 = sh::project(&env);
-                                irradiance::irradiance_map_sh(&sh9, Window::None, out, size)
-                            }
-                        };
-                    MipChain::build_levels(&top, MipFilter::Box, levels).into_levels()
-                }
-                _ => Prefilterer::for_chain(&env, &lobes, out, size, opts)
-                    .render_chain(&lobes, out, size),
+    let chain = py
+        .detach(|| {
+            run(|| {
+                let shape = shape(&env, &req)?;
+                chain(&env, &req, &shape, &Quiet)
             })
-        });
+        })
+        .map_err(lib_error)?
+        .levels;
     let c = env.channels();
     chain
         .iter()

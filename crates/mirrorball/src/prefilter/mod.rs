@@ -14,26 +14,96 @@ use crate::error::Error;
 use crate::hooks::Hooks;
 use crate::load::{self, InputPlan};
 use crate::save;
-use crate::spec::bad;
 use mirrorball_core::{count, EnvMap, Projection, ProjectionKind, WorldProjection};
 use mirrorball_filter::mip::level_count;
 use mirrorball_filter::sh;
+use mirrorball_filter::sh::Window;
 use mirrorball_filter::{
     chain_lobes, compress, irradiance, Compression, EnergyReport, IrradianceMethod, Lobe, LobeKind,
-    MipChain, MipFilter, Prefilterer, RoughnessMapping,
+    MipChain, MipFilter, PrefilterOptions, Prefilterer, RoughnessMapping,
 };
 use outputs::Described;
 pub use plan::Plan;
 use std::time::Instant;
 
-/// The chain's shape, known once the source is read.
-struct Chain {
-    projection: Projection,
+/// A prefiltered chain asked for in memory, apart from any file: the lobe and what each
+/// level holds. [`shape`] works out its levels from a source, [`chain`] makes it; `run`
+/// makes the command line's chain through the same two.
+#[derive(Clone, Debug)]
+pub struct ChainRequest {
+    pub lobe: LobeKind,
+    /// The chain's projection.
+    pub to: Projection,
+    /// Level 0's size (as `--size`); `None`: 32 for Lambert, else about the source's
+    /// resolution, at most 512.
+    pub size: Option<u32>,
+    /// How many levels (`None`: down to 1×1).
+    pub levels: Option<usize>,
+    /// Roughness per level (GGX, Phong without exponents).
+    pub mapping: RoughnessMapping,
+    /// Phong's exponent per level, in place of the mapping.
+    pub exponents: Option<Vec<f64>>,
+    /// Lambert's irradiance: exact or from the SH9.
+    pub irradiance: IrradianceMethod,
+    /// The SH window of Lambert's irradiance from the SH9.
+    pub window: Window,
+    /// Samples per texel and the working cube.
+    pub opts: PrefilterOptions,
+    /// Level 0's default size taken down to a power of two (a cube container's chain halves
+    /// exactly).
+    pub power_of_two: bool,
+}
+
+impl ChainRequest {
+    /// `lobe` into `to` with the command line's defaults (linear roughness, exact
+    /// irradiance, 128 samples).
+    pub fn new(lobe: LobeKind, to: Projection) -> ChainRequest {
+        ChainRequest {
+            lobe,
+            to,
+            size: None,
+            levels: None,
+            mapping: RoughnessMapping::Linear,
+            exponents: None,
+            irradiance: IrradianceMethod::Exact,
+            window: Window::None,
+            opts: PrefilterOptions::default(),
+            power_of_two: false,
+        }
+    }
+}
+
+/// A chain's shape, known once the source is read ([`shape`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Shape {
+    pub projection: Projection,
     /// Level 0's size (as `--size`: face edge, width or diameter).
-    size: u32,
+    pub size: u32,
     /// Level 0's layer extent.
-    extent: (u32, u32),
-    levels: usize,
+    pub extent: (u32, u32),
+    pub levels: usize,
+}
+
+/// A chain made by [`chain`]: its levels, each level's lobe and the source's SH9.
+pub struct Prefiltered {
+    pub levels: Vec<EnvMap>,
+    pub lobes: Vec<Lobe>,
+    pub sh9: sh::Sh9,
+}
+
+/// The chain `req` asks for of `env`, made as [`run`] makes it (checked against the memory
+/// budget first), with a progress bar through `hooks`.
+pub fn chain(
+    env: &EnvMap,
+    req: &ChainRequest,
+    shape: &Shape,
+    hooks: &dyn Hooks,
+) -> Result<Prefiltered, Error> {
+    let lobes = lobes(req, shape.levels);
+    check_memory(req, shape, env, &lobes)?;
+    let sh9 = sh::project(env);
+    let levels = prefilter(req, env, shape, &lobes, &sh9, hooks);
+    Ok(Prefiltered { levels, lobes, sh9 })
 }
 
 /// What to prefilter, as plain values: the command line's `prefilter` flags (each
@@ -100,19 +170,21 @@ impl PrefilterRequest {
 
 /// Prefilters what `a` asks for and writes its files, saying what it does through `hooks`.
 pub fn run(a: &PrefilterRequest, hooks: &dyn Hooks) -> Result<(), Error> {
-    let mut plan = Plan::new(a)?;
+    let plan = Plan::new(a)?;
     let t0 = Instant::now();
     let (env, energy) = read(&plan, hooks)?;
-    let shape = chain_shape(&plan, &env)?;
+    let req = plan.chain_request()?;
+    let shape = shape(&env, &req)?;
     if plan.size.is_none() {
         plan.check_room(shape.size)?;
     }
-    let lobes = lobes(&plan, shape.levels);
-    check_memory(&plan, &shape, &env, &lobes)?;
 
     let t1 = Instant::now();
-    let sh9 = sh::project(&env);
-    let chain = prefilter(&mut plan, &env, &shape, &lobes, &sh9, hooks);
+    let Prefiltered {
+        levels: chain,
+        lobes,
+        sh9,
+    } = self::chain(&env, &req, &shape, hooks)?;
     let t_filter = t1.elapsed();
 
     let t2 = Instant::now();
@@ -182,16 +254,17 @@ fn read(plan: &Plan, hooks: &dyn Hooks) -> Result<(EnvMap, Option<EnergyReport>)
     Ok((env, energy))
 }
 
-/// The output's projection, level 0's size (32 for Lambert; else about the source's, at
-/// most 512, a power of two in a cube container) and the number of levels; a list of values
-/// per level must say every level (padding would be a silent guess).
-fn chain_shape(plan: &Plan, env: &EnvMap) -> Result<Chain, Error> {
-    let projection: Projection = plan.to.build(None).map_err(|e| bad("--to", e))?;
-    let size = plan.size.unwrap_or_else(|| match plan.kind {
+/// The shape of the chain `req` asks for of `env`: level 0's size (32 for Lambert; else
+/// about the source's, at most 512, a power of two where `req.power_of_two`) and the number
+/// of levels; a list of values per level must say every level (padding would be a silent
+/// guess).
+pub fn shape(env: &EnvMap, req: &ChainRequest) -> Result<Shape, Error> {
+    let projection = req.to;
+    let size = req.size.unwrap_or_else(|| match req.lobe {
         LobeKind::Lambert => 32,
         _ => {
             let s = save::default_size(env, ProjectionKind::Cube).clamp(1, 512);
-            if plan.format.is_cube_container() {
+            if req.power_of_two {
                 // Largest power of two not above it.
                 1 << (31 - s.leading_zeros())
             } else {
@@ -201,10 +274,10 @@ fn chain_shape(plan: &Plan, env: &EnvMap) -> Result<Chain, Error> {
     });
     let (w0, h0) = projection.layer_extent(size);
     let full = level_count(w0, h0);
-    let levels = plan.levels.unwrap_or(full).min(full);
-    let listed = match (&plan.mapping, &plan.exponents) {
+    let levels = req.levels.unwrap_or(full).min(full);
+    let listed = match (&req.mapping, &req.exponents) {
         (_, Some(e)) => Some(("--exponents", "exponent", e.len())),
-        (RoughnessMapping::Custom(r), None) if plan.kind != LobeKind::Lambert => {
+        (RoughnessMapping::Custom(r), None) if req.lobe != LobeKind::Lambert => {
             Some(("--mapping", "roughness value", r.len()))
         }
         _ => None,
@@ -214,10 +287,10 @@ fn chain_shape(plan: &Plan, env: &EnvMap) -> Result<Chain, Error> {
             "{flag} lists {} but the chain has {} ({w0}x{h0} down to {}); give {levels}, or --levels {n}",
             count(n as u64, what),
             count(levels as u64, "level"),
-            if plan.levels.is_some() { "--levels" } else { "1x1" }
+            if req.levels.is_some() { "--levels" } else { "1x1" }
         )));
     }
-    Ok(Chain {
+    Ok(Shape {
         projection,
         size,
         extent: (w0, h0),
@@ -226,29 +299,34 @@ fn chain_shape(plan: &Plan, env: &EnvMap) -> Result<Chain, Error> {
 }
 
 /// The lobe of each level.
-fn lobes(plan: &Plan, levels: usize) -> Vec<Lobe> {
-    match (&plan.exponents, plan.kind) {
+fn lobes(req: &ChainRequest, levels: usize) -> Vec<Lobe> {
+    match (&req.exponents, req.lobe) {
         (Some(e), LobeKind::Phong) => (0..levels)
             .map(|i| Lobe::Phong {
                 exponent: *e.get(i).or(e.last()).unwrap_or(&f64::INFINITY),
             })
             .collect(),
-        _ => chain_lobes(plan.kind, &plan.mapping, levels),
+        _ => chain_lobes(req.lobe, &req.mapping, levels),
     }
 }
 
 /// The prefilterer's peak (its working cube and pyramids, as fine as the levels rendered
 /// need), the chain (the source's channels, with its mips) and the source held meanwhile.
 /// Lambert from SH makes no working cube.
-fn check_memory(plan: &Plan, shape: &Chain, env: &EnvMap, lobes: &[Lobe]) -> Result<(), Error> {
+fn check_memory(
+    req: &ChainRequest,
+    shape: &Shape,
+    env: &EnvMap,
+    lobes: &[Lobe],
+) -> Result<(), Error> {
     let (w0, h0) = shape.extent;
     let out = shape.projection;
-    let working = match (plan.kind, plan.irradiance) {
+    let working = match (req.lobe, req.irradiance) {
         (LobeKind::Lambert, IrradianceMethod::Sh) => 0,
         (LobeKind::Lambert, IrradianceMethod::Exact) => {
-            Prefilterer::memory_for_chain(env, &[Lobe::Lambert], out, shape.size, &plan.opts)
+            Prefilterer::memory_for_chain(env, &[Lobe::Lambert], out, shape.size, &req.opts)
         }
-        _ => Prefilterer::memory_for_chain(env, lobes, out, shape.size, &plan.opts),
+        _ => Prefilterer::memory_for_chain(env, lobes, out, shape.size, &req.opts),
     };
     let chain = w0 as u64 * h0 as u64 * out.layer_count() as u64;
     budget::check_prefilter(
@@ -269,9 +347,9 @@ fn check_memory(plan: &Plan, shape: &Chain, env: &EnvMap, lobes: &[Lobe]) -> Res
 /// engines read any level). The working cube is made as fine as the levels rendered need
 /// (no finer than the source), unless --cube-size says otherwise.
 fn prefilter(
-    plan: &mut Plan,
+    req: &ChainRequest,
     env: &EnvMap,
-    shape: &Chain,
+    shape: &Shape,
     lobes: &[Lobe],
     sh9: &sh::Sh9,
     hooks: &dyn Hooks,
@@ -279,18 +357,18 @@ fn prefilter(
     let (out, size, levels) = (shape.projection, shape.size, shape.levels);
     // The work the bar runs to, in the prefilterer's units (none for SH irradiance, which
     // takes no time worth a bar).
-    let work = match (plan.kind, plan.irradiance) {
+    let work = match (req.lobe, req.irradiance) {
         (LobeKind::Lambert, IrradianceMethod::Sh) => 0,
         (LobeKind::Lambert, IrradianceMethod::Exact) => {
-            mirrorball_filter::chain_work(env, &[Lobe::Lambert], out, size, &plan.opts)
+            mirrorball_filter::chain_work(env, &[Lobe::Lambert], out, size, &req.opts)
         }
-        _ => mirrorball_filter::chain_work(env, lobes, out, size, &plan.opts),
+        _ => mirrorball_filter::chain_work(env, lobes, out, size, &req.opts),
     };
     let mut chain = Vec::new();
     hooks.progress("prefilter", work, &mut |counter| {
-        plan.opts.progress = Some(counter);
-        let opts = plan.opts.clone();
-        chain = match (plan.kind, plan.irradiance) {
+        let mut opts = req.opts.clone();
+        opts.progress = Some(counter);
+        chain = match (req.lobe, req.irradiance) {
             (LobeKind::Lambert, method) => {
                 let top = match method {
                     IrradianceMethod::Exact => {
@@ -301,7 +379,7 @@ fn prefilter(
                         )
                     }
                     IrradianceMethod::Sh => {
-                        irradiance::irradiance_map_sh(sh9, plan.window, out, size)
+                        irradiance::irradiance_map_sh(sh9, req.window, out, size)
                     }
                 };
                 MipChain::build_levels(&top, MipFilter::Box, levels).into_levels()

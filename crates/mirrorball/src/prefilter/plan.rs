@@ -161,6 +161,22 @@ impl Plan {
         self.files()?.room(bytes)
     }
 
+    /// The chain this plan asks for, as [`super::chain`] takes it.
+    pub fn chain_request(&self) -> Result<super::ChainRequest, Error> {
+        Ok(super::ChainRequest {
+            lobe: self.kind,
+            to: self.to.build(None).map_err(|e| bad("--to", e))?,
+            size: self.size,
+            levels: self.levels,
+            mapping: self.mapping.clone(),
+            exponents: self.exponents.clone(),
+            irradiance: self.irradiance,
+            window: self.window,
+            opts: self.opts.clone(),
+            power_of_two: self.format.is_cube_container(),
+        })
+    }
+
     /// The side outputs that will be written: the SH JSON, the preview sheet, the BRDF
     /// table.
     pub fn side_files(&self) -> Vec<&Path> {
