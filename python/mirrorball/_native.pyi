@@ -26,8 +26,8 @@ def projections() -> list[str]:
 
 def convert(
     array: Array,
-    src: str = "latlong",
-    dst: str = "cube",
+    src: Optional[str] = None,
+    dst: Optional[str] = None,
     size: Optional[int] = None,
     layout: Optional[str] = None,
     *,
@@ -38,16 +38,20 @@ def convert(
     exposure: float = 0.0,
     max_samples: int = 8,
     outside: Optional[str] = None,
+    v360: Optional[str] = None,
     dtype: DTypeLike = None,
     linear: bool = False,
     invalid: str = "raise",
     out: Optional[Array] = None,
 ) -> Array:
-    """Converts an environment map (H×W×C or N×H×W×C) from ``src`` to ``dst``, antialiased:
-    the CLI's ``mirrorball convert``, bit for bit. ``outside``: what texels outside the
-    output's covered part hold, ``"black"`` or ``"rim"`` (the CLI's ``--outside``; default:
-    black for fisheye, dual fisheye, Hammer and sinusoidal, the rim's value for sphere,
-    angular and paraboloid maps)."""
+    """Converts an environment map (H×W×C or N×H×W×C) from ``src`` (default ``"latlong"``)
+    to ``dst`` (default ``"cube"``), antialiased: the CLI's ``mirrorball convert``, bit for
+    bit. ``outside``: what texels outside the output's covered part hold, ``"black"`` or
+    ``"rim"`` (the CLI's ``--outside``; default: black for fisheye, dual fisheye, Hammer and
+    sinusoidal, the rim's value for sphere, angular and paraboloid maps). ``v360``: FFmpeg's
+    v360 filter options (``"e:eac:yaw=30:w=3840:h=2160"``, the CLI's ``--v360``) in place of
+    ``src``, ``dst``, ``src_layout``, ``layout``, ``yaw``, ``pitch``, ``roll`` and, with
+    ``w`` and ``h``, ``size``; refused beside them."""
 
 class Remap:
     """A conversion planned once for sources of one shape, applied to many arrays."""
@@ -55,8 +59,8 @@ class Remap:
     def __init__(
         self,
         src_shape: Sequence[int],
-        src: str = "latlong",
-        dst: str = "cube",
+        src: Optional[str] = None,
+        dst: Optional[str] = None,
         size: Optional[int] = None,
         layout: Optional[str] = None,
         *,
@@ -67,6 +71,7 @@ class Remap:
         exposure: float = 0.0,
         max_samples: int = 8,
         outside: Optional[str] = None,
+        v360: Optional[str] = None,
     ) -> None: ...
     def apply(
         self,

@@ -69,6 +69,78 @@ pub fn options(
     })
 }
 
+/// What a conversion's arguments say, or what its `v360` option string says in their
+/// place: the source, the output's projection, size and layout, and the options.
+pub struct Asked {
+    pub source: Source,
+    pub dst: ProjectionSpec,
+    pub size: Option<i64>,
+    pub layout: Option<Layout>,
+    pub opts: ResampleOptions,
+}
+
+/// The conversion arguments `convert` and `Remap` share, read as [`Asked`]. `v360`: FFmpeg
+/// v360's options (`IN:OUT[:key=value…]`, the CLI's `--v360`, the library's `v360::parse`)
+/// in place of `src`, `dst`, `src_layout`, `layout`, `yaw`, `pitch`, `roll` (refused beside
+/// them) and of `size` when it has `w` and `h`.
+#[allow(clippy::too_many_arguments)]
+pub fn asked(
+    v360: Option<&str>,
+    (src, dst): (Option<&str>, Option<&str>),
+    (size, layout, src_layout): (Option<i64>, Option<&str>, Option<&str>),
+    turn: (f64, f64, f64),
+    exposure: f32,
+    max_samples: u32,
+    outside: Option<&str>,
+) -> PyResult<Asked> {
+    let mut opts = options(turn, exposure, max_samples, outside)?;
+    let Some(text) = v360 else {
+        return Ok(Asked {
+            source: Source::new(src.unwrap_or("latlong"), src_layout)?,
+            dst: spec_arg("dst", dst.unwrap_or("cube"))?,
+            size,
+            layout: layout_arg("layout", layout)?,
+            opts,
+        });
+    };
+    let v = mirrorball::v360::parse(text).map_err(|e| request("v360", e))?;
+    let given = [
+        ("src", src.is_some()),
+        ("dst", dst.is_some()),
+        ("src_layout", src_layout.is_some()),
+        ("layout", layout.is_some()),
+        ("size", size.is_some() && v.size.is_some()),
+        ("yaw", turn.0 != 0.0),
+        ("pitch", turn.1 != 0.0),
+        ("roll", turn.2 != 0.0),
+    ];
+    if let Some((arg, _)) = given.iter().find(|(_, g)| *g) {
+        return Err(request(
+            arg,
+            "v360 says it too: give it in the v360 options only (or leave v360 out)",
+        ));
+    }
+    if v.in_stereo != mirrorball_core::Stereo::Mono || v.out_stereo != mirrorball_core::Stereo::Mono
+    {
+        return Err(request(
+            "v360",
+            "in_stereo/out_stereo: stereo pictures are converted by the CLI (convert --v360); here one eye at a time",
+        ));
+    }
+    opts.rotation = v.rotation;
+    Ok(Asked {
+        source: Source {
+            arg: "v360",
+            spec: v.from,
+            layout: v.in_layout,
+        },
+        dst: v.to,
+        size: v.size.or(size),
+        layout: v.layout,
+        opts,
+    })
+}
+
 /// How a source picture is read: its projection text and layout.
 #[derive(Clone, Debug)]
 pub struct Source {
@@ -520,10 +592,12 @@ fn make_all<'py>(
 
 /// The output projection and its layers' size: `size` as the CLI's `--size` (a cube's face
 /// edge, a lat-long's width…), by default the source's resolution kept.
-fn destination(dst: &str, size: Option<i64>, src: &EnvMap) -> PyResult<(Projection, (u32, u32))> {
-    let dst = spec_arg("dst", dst)?
-        .build(None)
-        .map_err(|e| request("dst", e))?;
+fn destination(
+    dst: &ProjectionSpec,
+    size: Option<i64>,
+    src: &EnvMap,
+) -> PyResult<(Projection, (u32, u32))> {
+    let dst = dst.build(None).map_err(|e| request("dst", e))?;
     let size = match size {
         None => src.natural_size(dst.kind()),
         Some(s) if (1..=65536).contains(&s) => s as u32,
@@ -548,14 +622,17 @@ fn destination(dst: &str, size: Option<i64>, src: &EnvMap) -> PyResult<(Projecti
 /// (default: the input's). uint8/uint16 arrays are sRGB codes,
 /// as the CLI reads PNG; `linear=True` reads and writes them as linear codes. `invalid`:
 /// NaN and infinite values "raise" (default), are set to "zero" (as the CLI), or "keep".
+/// `v360`: FFmpeg's v360 filter options ("e:eac:yaw=30:w=3840:h=2160", the CLI's --v360)
+/// in place of `src`, `dst`, `src_layout`, `layout`, `yaw`, `pitch`, `roll` and, with `w`
+/// and `h`, `size`: what v360 means by them, refused beside them.
 #[pyfunction]
-#[pyo3(signature = (array, src="latlong", dst="cube", size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8, outside=None, dtype=None, linear=false, invalid="raise", out=None))]
+#[pyo3(signature = (array, src=None, dst=None, size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8, outside=None, v360=None, dtype=None, linear=false, invalid="raise", out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn convert<'py>(
     py: Python<'py>,
     array: &Bound<'py, PyAny>,
-    src: &str,
-    dst: &str,
+    src: Option<&str>,
+    dst: Option<&str>,
     size: Option<i64>,
     layout: Option<&str>,
     src_layout: Option<&str>,
@@ -565,25 +642,36 @@ pub fn convert<'py>(
     exposure: f32,
     max_samples: u32,
     outside: Option<&str>,
+    v360: Option<&str>,
     dtype: Option<&Bound<'py, PyAny>>,
     linear: bool,
     invalid: &str,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let source = Source::new(src, src_layout)?;
-    let opts = options((yaw, pitch, roll), exposure, max_samples, outside)?;
-    let layout = layout_arg("layout", layout)?;
+    let Asked {
+        source,
+        dst,
+        size,
+        layout,
+        opts,
+    } = asked(
+        v360,
+        (src, dst),
+        (size, layout, src_layout),
+        (yaw, pitch, roll),
+        exposure,
+        max_samples,
+        outside,
+    )?;
     let want = arrays::dtype_arg(py, dtype)?;
     let invalid = arrays::invalid_arg(invalid)?;
     // Checked before the array is read.
-    spec_arg("dst", dst)?
-        .build(None)
-        .map_err(|e| request("dst", e))?;
+    dst.build(None).map_err(|e| request("dst", e))?;
     let pics = arrays::pictures(array, "array", source.lead(), linear, invalid)?;
     let batched = pics.lead.len() > usize::from(source.separate_layers());
     let (dtype, c) = (want.unwrap_or(pics.dtype), pics.channels());
     let maps = source.maps("array", pics)?;
-    let (dst, extent) = destination(dst, size, &maps[0])?;
+    let (dst, extent) = destination(&dst, size, &maps[0])?;
     let place = Placement::new(dst, layout, extent, c)?;
     let make = |i: usize, f: &mut dyn FnMut(&dyn Rows) -> PyResult<()>| {
         let r = run(|| Resampler::new(&maps[i], dst, extent.0, extent.1, &opts));
@@ -633,13 +721,13 @@ pub struct Remap {
 #[pymethods]
 impl Remap {
     #[new]
-    #[pyo3(signature = (src_shape, src="latlong", dst="cube", size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8, outside=None))]
+    #[pyo3(signature = (src_shape, src=None, dst=None, size=None, layout=None, *, src_layout=None, yaw=0.0, pitch=0.0, roll=0.0, exposure=0.0, max_samples=8, outside=None, v360=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         src_shape: Vec<i64>,
-        src: &str,
-        dst: &str,
+        src: Option<&str>,
+        dst: Option<&str>,
         size: Option<i64>,
         layout: Option<&str>,
         src_layout: Option<&str>,
@@ -649,10 +737,23 @@ impl Remap {
         exposure: f32,
         max_samples: u32,
         outside: Option<&str>,
+        v360: Option<&str>,
     ) -> PyResult<Remap> {
-        let source = Source::new(src, src_layout)?;
-        let opts = options((yaw, pitch, roll), exposure, max_samples, outside)?;
-        let layout = layout_arg("layout", layout)?;
+        let Asked {
+            source,
+            dst,
+            size,
+            layout,
+            opts,
+        } = asked(
+            v360,
+            (src, dst),
+            (size, layout, src_layout),
+            (yaw, pitch, roll),
+            exposure,
+            max_samples,
+            outside,
+        )?;
         let (h, w) = match src_shape[..] {
             [h, w] | [h, w, 3] | [h, w, 4] if h > 0 && w > 0 && h <= 1 << 20 && w <= 1 << 20 => {
                 (h as u32, w as u32)
@@ -688,7 +789,7 @@ impl Remap {
         let n = proj.layer_count();
         let probe = EnvMap::new(proj, (0..n).map(|_| Image::new(lw, lh, 3)).collect())
             .map_err(|e| request("src_shape", e))?;
-        let (dst, extent) = destination(dst, size, &probe)?;
+        let (dst, extent) = destination(&dst, size, &probe)?;
         drop(probe);
         Placement::new(dst, layout, extent, 3)?;
         let plan = py.detach(|| {

@@ -4,6 +4,7 @@ prefilter and a bake."""
 import filecmp
 
 import numpy as np
+import pytest
 
 import mirrorball as mb
 
@@ -74,3 +75,43 @@ def test_bake_equals_the_cli(cli, sky_path, tmp):
     assert len(files) >= 4
     for name in names:
         assert filecmp.cmp(tmp / "a" / "out" / name, tmp / "b" / "out" / name, shallow=False), name
+
+
+def test_v360_options_equal_the_cli(cli, city_path, tmp):
+    """v360= means what the CLI's --v360 means: the same 16-bit codes for EAC at v360's own
+    size (YouTube's 16:9 frame scaled), a rotated c3x2 cube and a tetrahedron, as array and
+    plan (the CLI's pictures read as they lie, by OpenCV)."""
+    import cv2
+
+    array, _ = mb.read(city_path)
+    for i, options in enumerate([
+        "e:eac:yaw=30:pitch=-10:w=384:h=216",
+        "e:c3x2:out_forder=fbudlr:roll=20:w=192:h=128",
+        "e:tetrahedron:w=128:h=64",
+    ]):
+        out = tmp / f"cli{i}.png"
+        cli("convert", city_path, out, "--v360", options, "--precision", "16", "--quiet")
+        theirs = cv2.imread(str(out), cv2.IMREAD_UNCHANGED)[..., ::-1]
+        ours = mb.convert(array, v360=options, invalid="zero", dtype=np.uint16)
+        assert ours.shape == theirs.shape, options
+        assert np.array_equal(ours, theirs), options
+        plan = mb.Remap(array.shape, v360=options)
+        planned = plan.apply(array, invalid="zero", dtype=np.uint16).astype(np.int32)
+        assert np.abs(planned - theirs).max() <= 2, options
+
+
+def test_v360_is_refused_beside_what_it_says(city_path):
+    array, _ = mb.read(city_path)
+    for kwargs, named in [
+        (dict(dst="cube"), "dst"),
+        (dict(yaw=10), "yaw"),
+        (dict(layout="hcross"), "layout"),
+        (dict(size=64, v360="e:eac:w=384:h=216"), "size"),
+    ]:
+        kwargs.setdefault("v360", "e:eac")
+        with pytest.raises(ValueError, match=named):
+            mb.convert(array, invalid="zero", **kwargs)
+    with pytest.raises(ValueError, match="bogus"):
+        mb.convert(array, v360="e:eac:bogus=1")
+    with pytest.raises(ValueError, match="stereo"):
+        mb.convert(array, v360="e:e:in_stereo=sbs:out_stereo=sbs")
