@@ -851,6 +851,7 @@ fn write_image_to(
     buffers: &mut WriteBuffers,
 ) -> Result<atomic::Written, Error> {
     let path = dest.path();
+    check_channels(path, std::slice::from_ref(image))?;
     match format {
         Format::Exr => exr_io::write(dest, image, opts, buffers),
         Format::Hdr => hdr_io::write(dest, image, opts),
@@ -900,6 +901,9 @@ fn write_cube_to(
     levels: &[Vec<Image>],
     opts: &WriteOptions,
 ) -> Result<atomic::Written, Error> {
+    for level in levels {
+        check_channels(dest.path(), level)?;
+    }
     match format {
         Format::Ktx2 => ktx2_io::write(dest, levels, opts),
         Format::Dds => dds_io::write(dest, levels, opts),
@@ -907,6 +911,22 @@ fn write_cube_to(
             dest.path(),
             "only .ktx2 and .dds hold a whole cube map".into(),
         )),
+    }
+}
+
+/// Refuses pictures every writer cannot take: files hold RGB or RGBA (a one-channel plane,
+/// which core's images may be, is for the caller to expand or pack).
+fn check_channels(path: &Path, images: &[Image]) -> Result<(), Error> {
+    match images.iter().find(|i| !matches!(i.channels(), 3 | 4)) {
+        Some(i) => Err(Error::request(
+            path,
+            format!(
+                "a picture of {} channel{}: files are written with 3 (RGB) or 4 (RGBA)",
+                i.channels(),
+                if i.channels() == 1 { "" } else { "s" }
+            ),
+        )),
+        None => Ok(()),
     }
 }
 

@@ -240,3 +240,36 @@ fn an_absurd_declared_size_is_refused_before_allocating() {
     assert!(e.problem().contains("60000 scan lines"), "{e}");
     assert!(e.to_string().starts_with("Radiance HDR data"), "{e}");
 }
+
+/// A one-channel picture (core's images may be one plane) is
+/// refused by every writer, to a file or to bytes, flat or cube: the request's fault, the
+/// file named, nothing written, no panic.
+#[test]
+fn one_channel_pictures_are_refused_by_every_writer() {
+    let dir = tempfile::tempdir().unwrap();
+    {
+        let c = 1;
+        for name in ["a.exr", "a.hdr", "a.png", "a.jpg"] {
+            let path = dir.path().join(name);
+            let e = write_image(&path, &picture(c), &WriteOptions::default()).unwrap_err();
+            assert_eq!(e.fault(), mirrorball_core::Fault::Request, "{name}");
+            assert!(
+                e.to_string().contains(name) && e.to_string().contains("channel"),
+                "{e}"
+            );
+            assert!(!path.exists(), "{name}");
+            assert!(write_bytes(
+                &[vec![picture(c)]],
+                Hint::Name(name),
+                &WriteOptions::default()
+            )
+            .is_err());
+        }
+        for name in ["a.ktx2", "a.dds"] {
+            let faces: Vec<Image> = (0..6).map(|_| Image::new(4, 4, c)).collect();
+            let e = write_bytes(&[faces], Hint::Name(name), &WriteOptions::default()).unwrap_err();
+            assert_eq!(e.fault(), mirrorball_core::Fault::Request, "{name}");
+        }
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
