@@ -9,8 +9,8 @@
 //!   (`REFLECTIONMAP_OPPOSITEZ`, `Materials/materialHelper.functions.js:778`,
 //!   `Shaders/ShadersInclude/pbrBlockReflection.js:39`), so both see mirrorball's world
 //!   (viewer along −Z) through the lookup `(x, y, −z)`: the cube Babylon gets shows, at
-//!   `d`, what mirrorball's shows at `(d.x, d.y, −d.z)` ([`orientation`], applied by the
-//!   bake before [`write`]).
+//!   `d`, what mirrorball's shows at `(d.x, d.y, −d.z)` ([`Target::orientation`], applied by the
+//!   bake before [`Target::write`]).
 //! - **Rows.** Each PNG is uploaded with `invertY` (`_OnImageReadyAsync`,
 //!   `Misc/environmentTextureTools.pure.js:358`) and drawn into the face by a full-screen
 //!   pass whose `vUV = 0` is the face's row `t = 0`: the picture's bottom row is `t = 0`,
@@ -26,7 +26,7 @@
 //!   ([`babylon_harmonics`], [`spherical_polynomial`]); no irradiance cube.
 //! - **Texels.** RGBD (`mirrorball_encode`'s, Babylon's `toRGBD`), 8-bit PNG.
 
-use crate::{mip_levels, BakeOptions, ChainSpec, Description, Lighting};
+use crate::{mip_levels, BakeOptions, ChainSpec, Description, Lighting, Target};
 use mirrorball_core::{Axis, AxisMap, EnvMap};
 use mirrorball_filter::sh::Sh9;
 use mirrorball_io::{write_babylon_env, BabylonEnv, Encoding, Error, Rgba8Face};
@@ -43,15 +43,19 @@ const MINIMUM_VARIANCE: f64 = 0.0005;
 /// The `.env` file's name in the output folder.
 pub(crate) const FILE: &str = "environment.env";
 
-/// How Babylon looks its cubes up: at `(x, y, −z)` of mirrorball's world (the module
-/// documentation), so its cube shows at `e` what mirrorball's shows at `e` mirrored in z.
-pub(crate) fn orientation() -> AxisMap {
-    AxisMap::mirror(Axis::Z)
-}
+/// Babylon.js's rules.
+pub(crate) struct Babylon;
 
-/// What Babylon takes.
-pub(crate) fn describe() -> Description {
-    Description {
+impl Target for Babylon {
+    /// How Babylon looks its cubes up: at `(x, y, −z)` of mirrorball's world (the module
+    /// documentation), so its cube shows at `e` what mirrorball's shows at `e` mirrored in z.
+    fn orientation(&self) -> AxisMap {
+        AxisMap::mirror(Axis::Z)
+    }
+
+    /// What Babylon takes.
+    fn describe(&self) -> Description {
+        Description {
         files: "environment.env",
         containers: "Babylon .env (JSON manifest, RGBD PNG faces per level down to 1x1)",
         encodings: &[Encoding::Rgbd],
@@ -61,16 +65,53 @@ pub(crate) fn describe() -> Description {
         diffuse: "the manifest's spherical polynomial, from SH as Babylon makes it (Maths/sphericalPolynomial.pure.js:40, 375)",
         background: None,
     }
-}
+    }
 
-/// The levels Babylon takes: the whole chain down to 1×1, level `i` at the roughness the
-/// shader reads it at, no irradiance cube.
-pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
-    let size = opts.size;
-    ChainSpec {
-        levels: mip_levels(size, |i, _| level_roughness(i, size, LOD_GENERATION_SCALE)),
-        diffuse_face: None,
-        background_face: None,
+    /// The levels Babylon takes: the whole chain down to 1×1, level `i` at the roughness the
+    /// shader reads it at, no irradiance cube.
+    fn chain_spec(&self, opts: &BakeOptions) -> ChainSpec {
+        let size = opts.size;
+        ChainSpec {
+            levels: mip_levels(size, |i, _| level_roughness(i, size, LOD_GENERATION_SCALE)),
+            diffuse_face: None,
+            background_face: None,
+        }
+    }
+
+    /// [`FILE`].
+    fn file_names(&self, _opts: &BakeOptions) -> Vec<String> {
+        vec![FILE.to_string()]
+    }
+
+    /// Writes `environment.env` into `dir`, from lighting already in Babylon's axes
+    /// ([`Target::orientation`]).
+    fn write(&self, l: &Lighting, dir: &Path, _opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+        let path = dir.join(FILE);
+        let env = BabylonEnv {
+            polynomial: spherical_polynomial(&babylon_harmonics(&l.sh9)),
+            lod_generation_scale: LOD_GENERATION_SCALE,
+            levels: l.specular.iter().map(rgbd_faces).collect(),
+        };
+        write_babylon_env(&path, &env)?;
+        Ok(vec![path])
+    }
+
+    /// The note's body: how Babylon loads it.
+    fn readme(&self, opts: &BakeOptions, _spec: &ChainSpec) -> String {
+        format!(
+        "## Loading it\n\n\
+         `{FILE}`: a Babylon `.env` (RGBD PNG specular chain {size}² down to 1×1, level i \
+         GGX at α = 2^(i/0.8)/{size}, as Babylon's shader reads it; diffuse light from its \
+         spherical polynomial). Babylon's world (left-handed, or right-handed with \
+         `scene.useRightHandedSystem`) sees it the right way round: +X right, +Y up, and \
+         what mirrorball shows ahead (−Z) straight ahead of Babylon's default camera.\n\n\
+         ```js\n\
+         const env = new BABYLON.CubeTexture(\"{FILE}\", scene); // or CubeTexture.CreateFromPrefilteredData\n\
+         scene.environmentTexture = env;\n\
+         scene.createDefaultSkybox(env, true, 1000, 0); // optional background\n\
+         ```\n",
+        size = opts.size,
+    )
     }
 }
 
@@ -97,7 +138,7 @@ pub(crate) fn shader_lod(roughness: f64, width: u32, scale: f64) -> f64 {
 /// `(d.x, d.y, −d.z)`, texel for texel.
 #[cfg(test)]
 pub(crate) fn babylon_cube(cube: &EnvMap) -> EnvMap {
-    cube.transformed(&orientation()).expect("a cube")
+    cube.transformed(&Babylon.orientation()).expect("a cube")
 }
 
 /// The six PNG pictures of one level of a cube already in Babylon's directions: RGBD, each
@@ -156,37 +197,6 @@ pub(crate) fn spherical_polynomial(irradiance: &[[f64; 3]; 9]) -> [[f64; 3]; 9] 
             v / PI
         })
     })
-}
-
-/// Writes `environment.env` into `dir`, from lighting already in Babylon's axes
-/// ([`orientation`]).
-pub(crate) fn write(l: &Lighting, dir: &Path, _opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    let path = dir.join(FILE);
-    let env = BabylonEnv {
-        polynomial: spherical_polynomial(&babylon_harmonics(&l.sh9)),
-        lod_generation_scale: LOD_GENERATION_SCALE,
-        levels: l.specular.iter().map(rgbd_faces).collect(),
-    };
-    write_babylon_env(&path, &env)?;
-    Ok(vec![path])
-}
-
-/// The note's body: how Babylon loads it.
-pub(crate) fn readme(opts: &BakeOptions) -> String {
-    format!(
-        "## Loading it\n\n\
-         `{FILE}`: a Babylon `.env` (RGBD PNG specular chain {size}² down to 1×1, level i \
-         GGX at α = 2^(i/0.8)/{size}, as Babylon's shader reads it; diffuse light from its \
-         spherical polynomial). Babylon's world (left-handed, or right-handed with \
-         `scene.useRightHandedSystem`) sees it the right way round: +X right, +Y up, and \
-         what mirrorball shows ahead (−Z) straight ahead of Babylon's default camera.\n\n\
-         ```js\n\
-         const env = new BABYLON.CubeTexture(\"{FILE}\", scene); // or CubeTexture.CreateFromPrefilteredData\n\
-         scene.environmentTexture = env;\n\
-         scene.createDefaultSkybox(env, true, 1000, 0); // optional background\n\
-         ```\n",
-        size = opts.size,
-    )
 }
 
 #[cfg(test)]
@@ -257,7 +267,7 @@ mod tests {
             let r = radiance(d);
             [r[0] as f32, r[1] as f32, r[2] as f32, 1.0]
         });
-        let sh = mirrorball_filter::sh::project(&env).transformed(&orientation());
+        let sh = mirrorball_filter::sh::project(&env).transformed(&Babylon.orientation());
         let ours = spherical_polynomial(&babylon_harmonics(&sh));
         // Babylon's basis (SH3ylmBasisConstants × SH3ylmBasisTrigonometricTerms).
         let k = |a: f64| a.sqrt();
@@ -334,11 +344,11 @@ mod round_trip {
             size: 16,
             ..Default::default()
         };
-        let spec = chain_spec(&opts);
+        let spec = Babylon.chain_spec(&opts);
         let world = Lighting::from_env(&env, &spec, Default::default());
-        let lighting = world.clone().oriented(&orientation());
+        let lighting = world.clone().oriented(&Babylon.orientation());
         let dir = tempfile::tempdir().unwrap();
-        let files = write(&lighting, dir.path(), &opts).unwrap();
+        let files = Babylon.write(&lighting, dir.path(), &opts).unwrap();
         assert_eq!(files[0], dir.path().join(FILE));
         let back = read_babylon_env(&files[0]).unwrap();
         assert_eq!(back.lod_generation_scale, LOD_GENERATION_SCALE);

@@ -6,8 +6,8 @@
 //!   environment_map.wesl:92`, and `:259`, `:272` for the view's own map), and so does the
 //!   skybox (`bevy_core_pipeline/src/skybox/skybox.wesl:80`). Bevy shows world direction
 //!   `d` from its cube `B` at `(d.x, d.y, −d.z)`; for that to be the world's radiance,
-//!   `B(x, y, z) = C(x, y, −z)` with `C` mirrorball's cube: [`orientation`], applied by the
-//!   bake before [`write`].
+//!   `B(x, y, z) = C(x, y, −z)` with `C` mirrorball's cube: [`Target::orientation`], applied by the
+//!   bake before [`Target::write`].
 //! - **Roughness to mip.** `radiance_level = perceptual_roughness ×
 //!   smallest_specular_mip_level_for_view` (`environment_map.wesl:242`; `:161` with
 //!   `textureNumLevels − 1` for probes), which is `mip_level_count − 1`
@@ -43,7 +43,7 @@
 //! Zstandard supercompression (`opts.zstd`) is read by Bevy's default 3D features
 //! (`zstd_rust`).
 
-use crate::{mip_levels, BakeOptions, ChainSpec, Description, Lighting};
+use crate::{mip_levels, BakeOptions, ChainSpec, Description, Lighting, Target};
 use mirrorball_core::{Axis, AxisMap, Image};
 use mirrorball_io::{write_ktx2, CubeWrite, Encoding, Error};
 use std::path::{Path, PathBuf};
@@ -64,66 +64,69 @@ fn roughness_of_level(i: usize, n: usize) -> f64 {
     i as f64 / (n.max(2) - 1) as f64
 }
 
-/// The levels Bevy takes: the full chain of `opts.size` at [`roughness_of_level`], the
-/// 32×32 diffuse cube and the sky.
-pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
-    ChainSpec {
-        levels: mip_levels(opts.size, roughness_of_level),
-        diffuse_face: Some(DIFFUSE_FACE),
-        background_face: Some(opts.background_face()),
-    }
-}
+/// Bevy's rules.
+pub(crate) struct Bevy;
 
-/// Refuses, before any work, what Bevy cannot load: an encoding it does not sample, a face
-/// edge that is not a power of two (Bevy's filter and mip rule assume one), BC6H below 4×4.
-pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
-    let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
-    match encoding {
-        Encoding::Rgba16F
-        | Encoding::Rgb9E5
-        | Encoding::B10G11R11
-        | Encoding::Bc6hUnsigned
-        | Encoding::Bc6hSigned => {}
-        Encoding::Rgba32F => {
-            return Err(
-                "Bevy samples environment maps through a filtering sampler, and \
+impl Target for Bevy {
+    /// The levels Bevy takes: the full chain of `opts.size` at [`roughness_of_level`], the
+    /// 32×32 diffuse cube and the sky.
+    fn chain_spec(&self, opts: &BakeOptions) -> ChainSpec {
+        ChainSpec {
+            levels: mip_levels(opts.size, roughness_of_level),
+            diffuse_face: Some(DIFFUSE_FACE),
+            background_face: Some(opts.background_face()),
+        }
+    }
+
+    /// Refuses, before any work, what Bevy cannot load: an encoding it does not sample, a face
+    /// edge that is not a power of two (Bevy's filter and mip rule assume one), BC6H below 4×4.
+    fn check(&self, opts: &BakeOptions) -> Result<(), crate::Error> {
+        let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
+        match encoding {
+            Encoding::Rgba16F
+            | Encoding::Rgb9E5
+            | Encoding::B10G11R11
+            | Encoding::Bc6hUnsigned
+            | Encoding::Bc6hSigned => {}
+            Encoding::Rgba32F => {
+                return Err(crate::Error::request(
+                    "Bevy samples environment maps through a filtering sampler, and \
                         RGBA32F is not filterable in wgpu without a device feature: use \
-                        rgba16f, rgb9e5, b10g11r11 or bc6h"
-                    .into(),
-            )
+                        rgba16f, rgb9e5, b10g11r11 or bc6h",
+                ))
+            }
+            Encoding::Rgbd | Encoding::Rgbm => {
+                return Err(crate::Error::request(format!(
+                    "Bevy's shaders do not decode {}: use rgba16f, rgb9e5, b10g11r11 or bc6h",
+                    encoding.label()
+                )))
+            }
         }
-        Encoding::Rgbd | Encoding::Rgbm => {
-            return Err(format!(
-                "Bevy's shaders do not decode {}: use rgba16f, rgb9e5, b10g11r11 or bc6h",
-                encoding.label()
-            ))
+        if !opts.size.is_power_of_two() {
+            return Err(crate::Error::request(format!(
+                "Bevy's environment maps have power-of-two faces, not {}",
+                opts.size
+            )));
         }
+        let smallest = opts.size.min(opts.background_face());
+        if encoding.is_block_compressed() && smallest < 4 {
+            return Err(crate::Error::request(format!(
+                "{} needs faces of at least 4×4 (one block), not {smallest}",
+                encoding.label(),
+            )));
+        }
+        Ok(())
     }
-    if !opts.size.is_power_of_two() {
-        return Err(format!(
-            "Bevy's environment maps have power-of-two faces, not {}",
-            opts.size
-        ));
-    }
-    let smallest = opts.size.min(opts.background_face());
-    if encoding.is_block_compressed() && smallest < 4 {
-        return Err(format!(
-            "{} needs faces of at least 4×4 (one block), not {smallest}",
-            encoding.label(),
-        ));
-    }
-    Ok(())
-}
 
-/// How Bevy looks its cubes up: at `(x, y, −z)` (the module documentation), so its cube
-/// shows at `e` what mirrorball's world shows at `e` mirrored in z.
-pub(crate) fn orientation() -> AxisMap {
-    AxisMap::mirror(Axis::Z)
-}
+    /// How Bevy looks its cubes up: at `(x, y, −z)` (the module documentation), so its cube
+    /// shows at `e` what mirrorball's world shows at `e` mirrored in z.
+    fn orientation(&self) -> AxisMap {
+        AxisMap::mirror(Axis::Z)
+    }
 
-/// What Bevy takes.
-pub(crate) fn describe() -> Description {
-    Description {
+    /// What Bevy takes.
+    fn describe(&self) -> Description {
+        Description {
         files: "specular.ktx2, diffuse.ktx2 (EnvironmentMapLight), skybox.ktx2 (Skybox)",
         containers: "KTX2 cubes with mips",
         encodings: &[
@@ -139,89 +142,90 @@ pub(crate) fn describe() -> Description {
         diffuse: "diffuse.ktx2: E/pi, 32x32, one level (environment_map.wesl:380-383)",
         background: Some("skybox.ktx2, the source as a cube, one level, mirrored in z (Skybox, skybox.wesl:80)"),
     }
-}
+    }
 
-/// The files written, for the checks before any work.
-pub(crate) fn file_names() -> Vec<String> {
-    vec![
-        SPECULAR_FILE.into(),
-        DIFFUSE_FILE.into(),
-        SKYBOX_FILE.into(),
-    ]
-}
+    /// The files written, for the checks before any work.
+    fn file_names(&self, _opts: &BakeOptions) -> Vec<String> {
+        vec![
+            SPECULAR_FILE.into(),
+            DIFFUSE_FILE.into(),
+            SKYBOX_FILE.into(),
+        ]
+    }
 
-/// Writes Bevy's files into `dir`: [`SPECULAR_FILE`], [`DIFFUSE_FILE`] and [`SKYBOX_FILE`],
-/// from lighting already in Bevy's axes ([`orientation`]).
-pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    check(opts).map_err(|e| Error::request(dir, e))?;
-    let n = l.specular.len();
-    for (i, &r) in l.roughness.iter().enumerate() {
-        let want = roughness_of_level(i, n);
-        if (r - want).abs() > 1e-9 {
+    /// Writes Bevy's files into `dir`: [`SPECULAR_FILE`], [`DIFFUSE_FILE`] and [`SKYBOX_FILE`],
+    /// from lighting already in Bevy's axes ([`Target::orientation`]).
+    fn write(&self, l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+        self.check(opts)
+            .map_err(|e| Error::request(dir, e.message))?;
+        let n = l.specular.len();
+        for (i, &r) in l.roughness.iter().enumerate() {
+            let want = roughness_of_level(i, n);
+            if (r - want).abs() > 1e-9 {
+                return Err(Error::request(
+                    dir,
+                    format!(
+                        "specular level {i} of {n} was prefiltered at roughness {r}, but Bevy \
+                     reads it as {want}: make the lighting from Engine::Bevy.chain_spec"
+                    ),
+                ));
+            }
+        }
+        let (Some(diffuse), Some(sky)) = (&l.diffuse, &l.background) else {
             return Err(Error::request(
                 dir,
-                format!(
-                    "specular level {i} of {n} was prefiltered at roughness {r}, but Bevy \
-                     reads it as {want}: make the lighting from Engine::Bevy.chain_spec"
-                ),
-            ));
-        }
-    }
-    let (Some(diffuse), Some(sky)) = (&l.diffuse, &l.background) else {
-        return Err(Error::request(
-            dir,
-            "Bevy needs a diffuse and a background cube; this lighting lacks one: make it \
+                "Bevy needs a diffuse and a background cube; this lighting lacks one: make it \
              from Engine::Bevy.chain_spec"
-                .into(),
-        ));
-    };
-    let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
-    let how = |content: &str| CubeWrite {
-        encoding,
-        effort: opts.effort,
-        zstd: opts.zstd,
-        declared: None,
-        metadata: vec![
-            ("mirrorball:engine".into(), "bevy".into()),
-            ("mirrorball:content".into(), content.into()),
-            ("mirrorball:source".into(), opts.source.clone()),
-        ],
-    };
-    let specular_path = dir.join(SPECULAR_FILE);
-    let levels: Vec<Vec<Image>> = l.specular.iter().map(|m| m.layers().to_vec()).collect();
-    write_ktx2(
-        &specular_path,
-        &levels,
-        &how(&format!(
-            "GGX radiance, level m of {n} at perceptual roughness m/{}, z mirrored",
-            n.max(2) - 1
-        )),
-    )?;
-    let diffuse_path = dir.join(DIFFUSE_FILE);
-    write_ktx2(
-        &diffuse_path,
-        &[diffuse.layers().to_vec()],
-        &how("Lambertian irradiance / pi, z mirrored"),
-    )?;
-    let sky_path = dir.join(SKYBOX_FILE);
-    write_ktx2(
-        &sky_path,
-        &[sky.layers().to_vec()],
-        &how("the source as a cube, z mirrored"),
-    )?;
-    Ok(vec![specular_path, diffuse_path, sky_path])
-}
+                    .into(),
+            ));
+        };
+        let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
+        let how = |content: &str| CubeWrite {
+            encoding,
+            effort: opts.effort,
+            zstd: opts.zstd,
+            declared: None,
+            metadata: vec![
+                ("mirrorball:engine".into(), "bevy".into()),
+                ("mirrorball:content".into(), content.into()),
+                ("mirrorball:source".into(), opts.source.clone()),
+            ],
+        };
+        let specular_path = dir.join(SPECULAR_FILE);
+        let levels: Vec<Vec<Image>> = l.specular.iter().map(|m| m.layers().to_vec()).collect();
+        write_ktx2(
+            &specular_path,
+            &levels,
+            &how(&format!(
+                "GGX radiance, level m of {n} at perceptual roughness m/{}, z mirrored",
+                n.max(2) - 1
+            )),
+        )?;
+        let diffuse_path = dir.join(DIFFUSE_FILE);
+        write_ktx2(
+            &diffuse_path,
+            &[diffuse.layers().to_vec()],
+            &how("Lambertian irradiance / pi, z mirrored"),
+        )?;
+        let sky_path = dir.join(SKYBOX_FILE);
+        write_ktx2(
+            &sky_path,
+            &[sky.layers().to_vec()],
+            &how("the source as a cube, z mirrored"),
+        )?;
+        Ok(vec![specular_path, diffuse_path, sky_path])
+    }
 
-/// The note's body: what the files hold and a few lines of Bevy to load them.
-pub(crate) fn readme(opts: &BakeOptions, spec: &ChainSpec) -> String {
-    let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
-    let level_count = spec.levels.len();
-    let levels = mirrorball_core::count(level_count as u64, "level");
-    let zstd = match opts.zstd {
-        Some(z) => format!(", Zstandard level {z} (Bevy's `zstd_rust` or `zstd_c` feature)"),
-        None => String::new(),
-    };
-    format!(
+    /// The note's body: what the files hold and a few lines of Bevy to load them.
+    fn readme(&self, opts: &BakeOptions, spec: &ChainSpec) -> String {
+        let encoding = opts.encoding.unwrap_or(DEFAULT_ENCODING);
+        let level_count = spec.levels.len();
+        let levels = mirrorball_core::count(level_count as u64, "level");
+        let zstd = match opts.zstd {
+            Some(z) => format!(", Zstandard level {z} (Bevy's `zstd_rust` or `zstd_c` feature)"),
+            None => String::new(),
+        };
+        format!(
         "## Loading it\n\n\
          For Bevy's `EnvironmentMapLight`, {enc}{zstd}:\n\n\
          - `{SPECULAR_FILE}`: {size}² faces, {levels} down to 1×1, level m GGX-filtered at\n  \
@@ -253,6 +257,7 @@ pub(crate) fn readme(opts: &BakeOptions, spec: &ChainSpec) -> String {
         last = level_count.max(2) - 1,
         sky = spec.background_face.unwrap_or(opts.size),
     )
+    }
 }
 
 #[cfg(test)]
@@ -266,7 +271,7 @@ mod tests {
         let cube = ProjectionKind::Cube.default_projection();
         let code = |x: f64, y: f64, z: f64| [x as f32, y as f32, z as f32, 1.0];
         let c = EnvMap::from_fn(cube, 8, 3, |d| code(d.x, d.y, d.z));
-        let b = c.transformed(&orientation()).unwrap();
+        let b = c.transformed(&Bevy.orientation()).unwrap();
         for face in CubeFace::ALL {
             for y in 0..8 {
                 for x in 0..8 {
@@ -290,7 +295,7 @@ mod tests {
 
     #[test]
     fn roughness_climbs_to_one_at_1x1() {
-        let spec = chain_spec(&BakeOptions {
+        let spec = Bevy.chain_spec(&BakeOptions {
             size: 512,
             ..Default::default()
         });
@@ -313,8 +318,8 @@ mod tests {
             encoding,
             ..Default::default()
         };
-        assert!(check(&with(256, None)).is_ok());
-        assert!(check(&with(256, Some(Encoding::Bc6hUnsigned))).is_ok());
+        assert!(Bevy.check(&with(256, None)).is_ok());
+        assert!(Bevy.check(&with(256, Some(Encoding::Bc6hUnsigned))).is_ok());
         for bad in [
             with(256, Some(Encoding::Rgba32F)),
             with(256, Some(Encoding::Rgbd)),
@@ -322,7 +327,9 @@ mod tests {
             with(96, None),
             with(2, Some(Encoding::Bc6hSigned)),
         ] {
-            let e = check(&bad).unwrap_err();
+            let e = Bevy.check(&bad).unwrap_err();
+            assert_eq!(e.fault, mirrorball_core::Fault::Request);
+            let e = e.to_string();
             assert!(e.contains("Bevy") || e.contains("4×4"), "{e}");
         }
     }

@@ -18,7 +18,7 @@
 //! Unreal: `ComputeReflectionCaptureMipFromRoughness` (ReflectionEnvironmentShared.ush):
 //! `RoughnessMapping::Ue4`.
 
-use crate::{chain_by, cube_write, faces, BakeOptions, ChainSpec, Description, Engine, Lighting};
+use crate::{chain_by, cube_write, faces, BakeOptions, ChainSpec, Description, Lighting, Target};
 use mirrorball_core::{Axis, AxisMap};
 use mirrorball_filter::RoughnessMapping;
 use mirrorball_io::{Encoding, Error};
@@ -39,21 +39,22 @@ pub(crate) fn unity_roughness(m: usize) -> f64 {
     (1.7 - (2.89 - 2.8 * t).sqrt()) / 1.4
 }
 
-/// Each engine's roughness per level.
-fn mapping(engine: Engine, levels: usize) -> RoughnessMapping {
-    match engine {
-        Engine::Unity => RoughnessMapping::Custom((0..levels).map(unity_roughness).collect()),
-        _ => RoughnessMapping::Ue4,
-    }
+/// The two engines that take DDS cubes: the same files, each in its own world and with its
+/// own roughness rule.
+pub(crate) enum Dds {
+    /// Unity.
+    Unity,
+    /// Unreal Engine.
+    Unreal,
 }
 
-/// The full chain at the engine's roughness rule, and a 32² diffuse cube.
-pub(crate) fn chain_spec(engine: Engine, opts: &BakeOptions) -> ChainSpec {
-    let n = (32 - opts.size.max(1).leading_zeros()) as usize;
-    ChainSpec {
-        levels: chain_by(opts, &mapping(engine, n)),
-        diffuse_face: Some(DIFFUSE_FACE),
-        background_face: None,
+impl Dds {
+    /// The engine's roughness per level.
+    fn mapping(&self, levels: usize) -> RoughnessMapping {
+        match self {
+            Dds::Unity => RoughnessMapping::Custom((0..levels).map(unity_roughness).collect()),
+            Dds::Unreal => RoughnessMapping::Ue4,
+        }
     }
 }
 
@@ -64,78 +65,83 @@ const ENCODINGS: &[Encoding] = &[
     Encoding::Rgba32F,
 ];
 
-pub(crate) fn describe(engine: Engine) -> Description {
-    match engine {
-        Engine::Unity => Description {
-            files: "specular.dds (GGX chain to 1x1), diffuse.dds (irradiance/pi, 32²)",
-            containers: "DDS (DX10 header)",
-            encodings: ENCODINGS,
-            zstd: false,
-            convention: "left-handed, +Y up, +Z forward: z mirrored, (x, y, -z)",
-            rule: "mip = 6 * r * (1.7 - 0.7 r) (ImageBasedLighting.hlsl \
-                   PerceptualRoughnessToMipmapLevel; levels past 6 hold r = 1)",
-            diffuse: "diffuse.dds sampled at the normal (Unity makes its own SH from a probe)",
-            background: None,
-        },
-        _ => Description {
-            files: "specular.dds (GGX chain to 1x1), diffuse.dds (irradiance/pi, 32²)",
-            containers: "DDS (DX10 header)",
-            encodings: ENCODINGS,
-            zstd: false,
-            convention: "left-handed, Z up, X forward, Y right: (y, z, -x)",
-            rule: "mip = levels - 2 + 1.2 log2(r) (ReflectionEnvironmentShared.ush \
-                   ComputeReflectionCaptureMipFromRoughness)",
-            diffuse: "diffuse.dds sampled at the normal (a Sky Light makes its own SH)",
-            background: None,
-        },
-    }
-}
-
-/// The engine's axes (see the module documentation).
-pub(crate) fn orientation(engine: Engine) -> AxisMap {
-    match engine {
-        Engine::Unity => AxisMap::mirror(Axis::Z),
-        _ => {
-            AxisMap::new([(Axis::Y, 1), (Axis::Z, 1), (Axis::X, -1)]).expect("a signed permutation")
-        }
-    }
-}
-
 /// The specular chain's file.
 const SPECULAR: &str = "specular.dds";
 /// The diffuse cube's file.
 const DIFFUSE: &str = "diffuse.dds";
 
-/// `specular.dds`, `diffuse.dds`.
-pub(crate) fn file_names() -> Vec<String> {
-    vec![SPECULAR.into(), DIFFUSE.into()]
-}
-
-pub(crate) fn write(
-    _engine: Engine,
-    l: &Lighting,
-    dir: &Path,
-    opts: &BakeOptions,
-) -> Result<Vec<PathBuf>, Error> {
-    let specular = dir.join(SPECULAR);
-    mirrorball_io::write_dds(&specular, &faces(&l.specular), &cube_write(opts, vec![]))?;
-    let mut files = vec![specular];
-    if let Some(d) = &l.diffuse {
-        let diffuse = dir.join(DIFFUSE);
-        mirrorball_io::write_dds(
-            &diffuse,
-            &faces(std::slice::from_ref(d)),
-            &cube_write(opts, vec![]),
-        )?;
-        files.push(diffuse);
+impl Target for Dds {
+    /// The full chain at the engine's roughness rule, and a 32² diffuse cube.
+    fn chain_spec(&self, opts: &BakeOptions) -> ChainSpec {
+        let n = (32 - opts.size.max(1).leading_zeros()) as usize;
+        ChainSpec {
+            levels: chain_by(opts, &self.mapping(n)),
+            diffuse_face: Some(DIFFUSE_FACE),
+            background_face: None,
+        }
     }
-    Ok(files)
-}
 
-/// The note's body: where to put the files and the lines that load them.
-pub(crate) fn readme(engine: Engine) -> String {
-    match engine {
-        Engine::Unity => format!(
+    fn describe(&self) -> Description {
+        match self {
+            Dds::Unity => Description {
+                files: "specular.dds (GGX chain to 1x1), diffuse.dds (irradiance/pi, 32²)",
+                containers: "DDS (DX10 header)",
+                encodings: ENCODINGS,
+                zstd: false,
+                convention: "left-handed, +Y up, +Z forward: z mirrored, (x, y, -z)",
+                rule: "mip = 6 * r * (1.7 - 0.7 r) (ImageBasedLighting.hlsl \
+                   PerceptualRoughnessToMipmapLevel; levels past 6 hold r = 1)",
+                diffuse: "diffuse.dds sampled at the normal (Unity makes its own SH from a probe)",
+                background: None,
+            },
+            Dds::Unreal => Description {
+                files: "specular.dds (GGX chain to 1x1), diffuse.dds (irradiance/pi, 32²)",
+                containers: "DDS (DX10 header)",
+                encodings: ENCODINGS,
+                zstd: false,
+                convention: "left-handed, Z up, X forward, Y right: (y, z, -x)",
+                rule: "mip = levels - 2 + 1.2 log2(r) (ReflectionEnvironmentShared.ush \
+                   ComputeReflectionCaptureMipFromRoughness)",
+                diffuse: "diffuse.dds sampled at the normal (a Sky Light makes its own SH)",
+                background: None,
+            },
+        }
+    }
+
+    /// The engine's axes (see the module documentation).
+    fn orientation(&self) -> AxisMap {
+        match self {
+            Dds::Unity => AxisMap::mirror(Axis::Z),
+            Dds::Unreal => AxisMap::new([(Axis::Y, 1), (Axis::Z, 1), (Axis::X, -1)])
+                .expect("a signed permutation"),
+        }
+    }
+
+    /// `specular.dds`, `diffuse.dds`.
+    fn file_names(&self, _opts: &BakeOptions) -> Vec<String> {
+        vec![SPECULAR.into(), DIFFUSE.into()]
+    }
+
+    fn write(&self, l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+        let specular = dir.join(SPECULAR);
+        mirrorball_io::write_dds(&specular, &faces(&l.specular), &cube_write(opts, vec![]))?;
+        let mut files = vec![specular];
+        if let Some(d) = &l.diffuse {
+            let diffuse = dir.join(DIFFUSE);
+            mirrorball_io::write_dds(
+                &diffuse,
+                &faces(std::slice::from_ref(d)),
+                &cube_write(opts, vec![]),
+            )?;
+            files.push(diffuse);
+        }
+        Ok(files)
+    }
+
+    /// The note's body: where to put the files and the lines that load them.
+    fn readme(&self, _opts: &BakeOptions, _spec: &ChainSpec) -> String {
+        match self {
+        Dds::Unity => format!(
             "## Loading it\n\n\
              Put `{SPECULAR}` and `{DIFFUSE}` under `Assets/Resources/` (any folder of that \
              name). In the texture importer: Texture Shape Cube, Mapping Auto, Convolution \
@@ -162,7 +168,7 @@ pub(crate) fn readme(engine: Engine) -> String {
              half3 diff = SAMPLE_TEXTURECUBE(_Diffuse, sampler_Diffuse, normalWS).rgb; // E/pi\n\
              ```\n"
         ),
-        _ => format!(
+        Dds::Unreal => format!(
             "## Loading it\n\n\
              Import `{SPECULAR}` and `{DIFFUSE}` into the Content folder (Import, or drag them \
              in): each becomes a TextureCube asset of the same name; set Compression Settings \
@@ -181,6 +187,7 @@ pub(crate) fn readme(engine: Engine) -> String {
              samples it with TextureSampleParameterCube at MipLevel = \
              ComputeReflectionCaptureMipFromRoughness(Roughness, MipCount - 1).\n"
         ),
+    }
     }
 }
 

@@ -24,7 +24,7 @@
 //!   Kᵢ times mirrorball's E/π coefficient ([`prescaled`]).
 
 use crate::{
-    chain_by, cube_write, faces, write_text, BakeOptions, ChainSpec, Description, Lighting,
+    chain_by, cube_write, faces, write_text, BakeOptions, ChainSpec, Description, Lighting, Target,
 };
 use mirrorball_core::AxisMap;
 use mirrorball_filter::sh::{self, Sh9};
@@ -39,17 +39,21 @@ const SKYBOX: &str = "skybox.ktx";
 /// The SH as text.
 const SH_TXT: &str = "sh.txt";
 
-/// The full chain at Filament's roughness rule; diffuse light is SH only; the skybox.
-pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
-    ChainSpec {
-        levels: chain_by(opts, &RoughnessMapping::Filament),
-        diffuse_face: None,
-        background_face: Some(opts.background_face()),
-    }
-}
+/// Filament's rules.
+pub(crate) struct Filament;
 
-pub(crate) fn describe() -> Description {
-    Description {
+impl Target for Filament {
+    /// The full chain at Filament's roughness rule; diffuse light is SH only; the skybox.
+    fn chain_spec(&self, opts: &BakeOptions) -> ChainSpec {
+        ChainSpec {
+            levels: chain_by(opts, &RoughnessMapping::Filament),
+            diffuse_face: None,
+            background_face: Some(opts.background_face()),
+        }
+    }
+
+    fn describe(&self) -> Description {
+        Description {
         files: "ibl.ktx (GGX chain to 1x1, SH under the key sh), skybox.ktx, sh.txt",
         containers: "KTX1 (Filament's Ktx1Reader)",
         encodings: &[Encoding::B10G11R11, Encoding::Rgba16F, Encoding::Rgba32F],
@@ -62,79 +66,48 @@ pub(crate) fn describe() -> Description {
                   computeIrradianceSH3Bands), in sh.txt and the ibl file's sh key",
         background: Some("skybox.ktx, the source as a cube, one level (Skybox::Builder)"),
     }
-}
-
-/// Filament's axes and cube lookups are mirrorball's (see the module documentation).
-pub(crate) fn orientation() -> AxisMap {
-    AxisMap::IDENTITY
-}
-
-/// The nine coefficients Filament's `IndirectLight::Builder::irradiance(3, sh)` takes: for
-/// each, the basis constant Kᵢ times the coefficient of E/π (cmgen's pre-scaled SH), so
-/// that `Σ shᵢ Pᵢ(n)` is E(n)/π.
-pub(crate) fn prescaled(sh9: &Sh9) -> [[f64; 3]; 9] {
-    let lambert = sh9.lambert();
-    let mut out = [[0.0; 3]; 9];
-    for (i, o) in out.iter_mut().enumerate() {
-        *o = lambert.coeffs[i].map(|c| c * sh::CONSTANTS[i]);
     }
-    out
-}
 
-/// `sh.txt` as cmgen writes it (`outputSh`): one line per coefficient, band l then m from
-/// −l to l, `(r, g, b); // Llm, irradiance, pre-scaled base`, fifteen decimals, each number
-/// 18 wide; Filament's samples read it back with `sscanf("(%f,%f,%f)")`.
-pub(crate) fn sh_txt(sh: &[[f64; 3]; 9]) -> String {
-    let mut out = String::new();
-    let mut i = 0;
-    for l in 0..3i32 {
-        for m in -l..=l {
-            let c = sh[i];
-            out += &format!(
-                "({:18.15}, {:18.15}, {:18.15}); // L{l}{m}, irradiance, pre-scaled base\n",
-                c[0], c[1], c[2]
-            );
-            i += 1;
-        }
+    /// Filament's axes and cube lookups are mirrorball's (see the module documentation).
+    fn orientation(&self) -> AxisMap {
+        AxisMap::IDENTITY
     }
-    out
-}
 
-/// `ibl.ktx`, `skybox.ktx`, `sh.txt`: cmgen's names without the source's in front.
-pub(crate) fn file_names() -> Vec<String> {
-    [IBL, SKYBOX, SH_TXT].map(String::from).to_vec()
-}
+    /// `ibl.ktx`, `skybox.ktx`, `sh.txt`: cmgen's names without the source's in front.
+    fn file_names(&self, _opts: &BakeOptions) -> Vec<String> {
+        [IBL, SKYBOX, SH_TXT].map(String::from).to_vec()
+    }
 
-pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    let [ibl, skybox, txt] = [IBL, SKYBOX, SH_TXT].map(|n| dir.join(n));
-    let Some(sky) = &l.background else {
-        return Err(Error::request(
-            dir,
-            "Filament's skybox is the background; this lighting has none: make it from \
+    fn write(&self, l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+        let [ibl, skybox, txt] = [IBL, SKYBOX, SH_TXT].map(|n| dir.join(n));
+        let Some(sky) = &l.background else {
+            return Err(Error::request(
+                dir,
+                "Filament's skybox is the background; this lighting has none: make it from \
              Engine::Filament.chain_spec"
-                .into(),
-        ));
-    };
-    let sh = prescaled(&l.sh9);
-    let sh32: Vec<[f32; 3]> = sh.iter().map(|c| c.map(|v| v as f32)).collect();
-    let with_sh = cube_write(
-        opts,
-        vec![("sh".into(), mirrorball_io::filament_sh_text(&sh32))],
-    );
-    mirrorball_io::write_ktx1(&ibl, &faces(&l.specular), &with_sh)?;
-    mirrorball_io::write_ktx1(
-        &skybox,
-        &faces(std::slice::from_ref(sky)),
-        &cube_write(opts, vec![]),
-    )?;
-    write_text(&txt, &sh_txt(&sh))?;
-    Ok(vec![ibl, skybox, txt])
-}
+                    .into(),
+            ));
+        };
+        let sh = prescaled(&l.sh9);
+        let sh32: Vec<[f32; 3]> = sh.iter().map(|c| c.map(|v| v as f32)).collect();
+        let with_sh = cube_write(
+            opts,
+            vec![("sh".into(), mirrorball_io::filament_sh_text(&sh32))],
+        );
+        mirrorball_io::write_ktx1(&ibl, &faces(&l.specular), &with_sh)?;
+        mirrorball_io::write_ktx1(
+            &skybox,
+            &faces(std::slice::from_ref(sky)),
+            &cube_write(opts, vec![]),
+        )?;
+        write_text(&txt, &sh_txt(&sh))?;
+        Ok(vec![ibl, skybox, txt])
+    }
 
-pub(crate) fn readme(spec: &ChainSpec) -> String {
-    let sky = spec.background_face.unwrap_or(spec.levels[0].0);
-    format!(
-        "## Loading it\n\n\
+    fn readme(&self, _opts: &BakeOptions, spec: &ChainSpec) -> String {
+        let sky = spec.background_face.unwrap_or(spec.levels[0].0);
+        format!(
+            "## Loading it\n\n\
          As the files `cmgen --deploy` writes (without the source's name in front): `{IBL}` \
          the specular cube with its mip chain (the SH under the key `sh`), `{SKYBOX}` the \
          source itself for the sky ({sky}² faces), `{SH_TXT}` the nine pre-scaled irradiance \
@@ -168,5 +141,37 @@ pub(crate) fn readme(spec: &ChainSpec) -> String {
          (cmgen mirrors only to undo its own reading of panoramas). Where cmgen puts a \
          panorama's centre at +Z, mirrorball puts it at -Z, ahead of the default camera: \
          `IndirectLight::setRotation` with a half turn about +Y matches cmgen's.\n"
-    )
+        )
+    }
+}
+
+/// The nine coefficients Filament's `IndirectLight::Builder::irradiance(3, sh)` takes: for
+/// each, the basis constant Kᵢ times the coefficient of E/π (cmgen's pre-scaled SH), so
+/// that `Σ shᵢ Pᵢ(n)` is E(n)/π.
+pub(crate) fn prescaled(sh9: &Sh9) -> [[f64; 3]; 9] {
+    let lambert = sh9.lambert();
+    let mut out = [[0.0; 3]; 9];
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = lambert.coeffs[i].map(|c| c * sh::CONSTANTS[i]);
+    }
+    out
+}
+
+/// `sh.txt` as cmgen writes it (`outputSh`): one line per coefficient, band l then m from
+/// −l to l, `(r, g, b); // Llm, irradiance, pre-scaled base`, fifteen decimals, each number
+/// 18 wide; Filament's samples read it back with `sscanf("(%f,%f,%f)")`.
+pub(crate) fn sh_txt(sh: &[[f64; 3]; 9]) -> String {
+    let mut out = String::new();
+    let mut i = 0;
+    for l in 0..3i32 {
+        for m in -l..=l {
+            let c = sh[i];
+            out += &format!(
+                "({:18.15}, {:18.15}, {:18.15}); // L{l}{m}, irradiance, pre-scaled base\n",
+                c[0], c[1], c[2]
+            );
+            i += 1;
+        }
+    }
+    out
 }

@@ -22,8 +22,9 @@
 //! light the right way round in a right-handed scene (`useRightHandedSystem`, the usual
 //! setting for glTF). The light's `rotation` is the identity and its `intensity` 1.
 
+use crate::babylon::Babylon;
 use crate::babylon::{babylon_harmonics, level_roughness, rgbd_faces};
-use crate::{BakeOptions, ChainSpec, Description, Lighting};
+use crate::{BakeOptions, ChainSpec, Description, Lighting, Target};
 use mirrorball_core::AxisMap;
 use mirrorball_io::{write_gltf_ibl, Encoding, Error, GltfIbl};
 use std::path::{Path, PathBuf};
@@ -34,27 +35,30 @@ pub(crate) const LOWEST_EDGE: u32 = 16;
 /// The glTF file's name in the output folder.
 pub(crate) const FILE: &str = "lighting.gltf";
 
-/// Refuses, before any work, what the extension cannot hold beyond [`crate::Bake::new`]'s
-/// checks: a level 0 under 2×2.
-pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
-    if opts.size < 2 {
-        return Err(
-            "EXT_lights_image_based needs level 0 at least 2×2 (its loader divides by \
-             log2 of the size)"
-                .into(),
-        );
+/// `EXT_lights_image_based`'s rules.
+pub(crate) struct Gltf;
+
+impl Target for Gltf {
+    /// Refuses, before any work, what the extension cannot hold beyond [`crate::Bake::new`]'s
+    /// checks: a level 0 under 2×2.
+    fn check(&self, opts: &BakeOptions) -> Result<(), crate::Error> {
+        if opts.size < 2 {
+            return Err(crate::Error::request(
+                "EXT_lights_image_based needs level 0 at least 2×2 (its loader divides by \
+             log2 of the size)",
+            ));
+        }
+        Ok(())
     }
-    Ok(())
-}
 
-/// The light's faces are looked up as Babylon's `.env` faces are ([`crate::babylon`]).
-pub(crate) fn orientation() -> AxisMap {
-    crate::babylon::orientation()
-}
+    /// The light's faces are looked up as Babylon's `.env` faces are ([`crate::babylon`]).
+    fn orientation(&self) -> AxisMap {
+        Babylon.orientation()
+    }
 
-/// What the extension holds.
-pub(crate) fn describe() -> Description {
-    Description {
+    /// What the extension holds.
+    fn describe(&self) -> Description {
+        Description {
         files: "lighting.gltf, lighting_specular_L_{px,nx,py,ny,pz,nz}.png per level L",
         containers: "glTF 2.0 JSON with EXT_lights_image_based, RGBD PNG faces",
         encodings: &[Encoding::Rgbd],
@@ -64,71 +68,57 @@ pub(crate) fn describe() -> Description {
         diffuse: "irradianceCoefficients: 9x3 SH of the irradiance E in Babylon's basis",
         background: None,
     }
-}
-
-/// The files written, for the checks before any work.
-pub(crate) fn file_names(opts: &BakeOptions) -> Vec<String> {
-    let levels = chain_spec(opts).levels.len();
-    let stem = FILE.trim_end_matches(".gltf");
-    std::iter::once(FILE.to_string())
-        .chain((0..levels).flat_map(|l| {
-            ["px", "nx", "py", "ny", "pz", "nz"]
-                .into_iter()
-                .map(move |f| format!("{stem}_specular_{l}_{f}.png"))
-        }))
-        .collect()
-}
-
-/// The light's name: the source's file name.
-fn light_name(opts: &BakeOptions) -> String {
-    std::path::Path::new(&opts.source)
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or("environment")
-        .to_string()
-}
-
-/// Babylon's loader's `lodGenerationScale` for `levels` levels of edge `size` down.
-pub(crate) fn lod_generation_scale(levels: usize, size: u32) -> f64 {
-    (levels as f64 - 1.0) / f64::from(size.max(2)).log2()
-}
-
-/// The levels: level 0's edge halved down to [`LOWEST_EDGE`], level `i` at the roughness
-/// Babylon's loader and shader read it at; no irradiance cube (SH only).
-pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
-    let size = opts.size.max(1);
-    let n = (size
-        .trailing_zeros()
-        .saturating_sub(LOWEST_EDGE.trailing_zeros())
-        + 1) as usize;
-    let scale = lod_generation_scale(n, size);
-    ChainSpec {
-        levels: (0..n)
-            .map(|i| ((size >> i).max(1), level_roughness(i, size, scale)))
-            .collect(),
-        diffuse_face: None,
-        background_face: None,
     }
-}
 
-/// Writes `lighting.gltf` and its images into `dir`, from lighting already in Babylon's
-/// axes ([`orientation`]).
-pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    let ibl = GltfIbl {
-        name: light_name(opts),
-        intensity: 1.0,
-        rotation: [0.0, 0.0, 0.0, 1.0],
-        irradiance_coefficients: babylon_harmonics(&l.sh9),
-        levels: l.specular.iter().map(rgbd_faces).collect(),
-    };
-    write_gltf_ibl(&dir.join(FILE), &ibl)
-}
+    /// The files written, for the checks before any work.
+    fn file_names(&self, opts: &BakeOptions) -> Vec<String> {
+        let levels = self.chain_spec(opts).levels.len();
+        let stem = FILE.trim_end_matches(".gltf");
+        std::iter::once(FILE.to_string())
+            .chain((0..levels).flat_map(|l| {
+                ["px", "nx", "py", "ny", "pz", "nz"]
+                    .into_iter()
+                    .map(move |f| format!("{stem}_specular_{l}_{f}.png"))
+            }))
+            .collect()
+    }
 
-/// The note's body: how a glTF viewer (Babylon's loader) takes it.
-pub(crate) fn readme(opts: &BakeOptions) -> String {
-    let n = chain_spec(opts).levels.len();
-    format!(
-        "## Loading it\n\n\
+    /// The levels: level 0's edge halved down to [`LOWEST_EDGE`], level `i` at the roughness
+    /// Babylon's loader and shader read it at; no irradiance cube (SH only).
+    fn chain_spec(&self, opts: &BakeOptions) -> ChainSpec {
+        let size = opts.size.max(1);
+        let n = (size
+            .trailing_zeros()
+            .saturating_sub(LOWEST_EDGE.trailing_zeros())
+            + 1) as usize;
+        let scale = lod_generation_scale(n, size);
+        ChainSpec {
+            levels: (0..n)
+                .map(|i| ((size >> i).max(1), level_roughness(i, size, scale)))
+                .collect(),
+            diffuse_face: None,
+            background_face: None,
+        }
+    }
+
+    /// Writes `lighting.gltf` and its images into `dir`, from lighting already in Babylon's
+    /// axes ([`Target::orientation`]).
+    fn write(&self, l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+        let ibl = GltfIbl {
+            name: light_name(opts),
+            intensity: 1.0,
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            irradiance_coefficients: babylon_harmonics(&l.sh9),
+            levels: l.specular.iter().map(rgbd_faces).collect(),
+        };
+        write_gltf_ibl(&dir.join(FILE), &ibl)
+    }
+
+    /// The note's body: how a glTF viewer (Babylon's loader) takes it.
+    fn readme(&self, opts: &BakeOptions, _spec: &ChainSpec) -> String {
+        let n = self.chain_spec(opts).levels.len();
+        format!(
+            "## Loading it\n\n\
          `{FILE}`: glTF 2.0 with one `EXT_lights_image_based` light, referenced by the \
          default scene: {n} specular levels of six RGBD PNG faces ({size}² down to {low}²), \
          level i GGX at α = 2^(i·log2({size})/{last})/{size} (roughness 1 at the last level, \
@@ -146,10 +136,25 @@ pub(crate) fn readme(opts: &BakeOptions) -> String {
          it makes at its default `gammaSpace` (true), though the extension says a \
          four-channel PNG is linear RGBD; the line above undoes that (the texture marks the \
          materials that use it for an update).\n",
-        size = opts.size,
-        low = opts.size >> (n - 1),
-        last = (n - 1).max(1),
-    )
+            size = opts.size,
+            low = opts.size >> (n - 1),
+            last = (n - 1).max(1),
+        )
+    }
+}
+
+/// The light's name: the source's file name.
+fn light_name(opts: &BakeOptions) -> String {
+    std::path::Path::new(&opts.source)
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("environment")
+        .to_string()
+}
+
+/// Babylon's loader's `lodGenerationScale` for `levels` levels of edge `size` down.
+pub(crate) fn lod_generation_scale(levels: usize, size: u32) -> f64 {
+    (levels as f64 - 1.0) / f64::from(size.max(2)).log2()
 }
 
 #[cfg(test)]
@@ -158,7 +163,7 @@ mod tests {
 
     #[test]
     fn the_chain_runs_from_a_mirror_to_roughness_one_at_the_lowest_level() {
-        let spec = chain_spec(&BakeOptions {
+        let spec = Gltf.chain_spec(&BakeOptions {
             size: 256,
             ..Default::default()
         });
@@ -168,7 +173,7 @@ mod tests {
         assert!((spec.levels[4].1 - (1.0f64 - 0.0005).sqrt()).abs() < 1e-12);
         assert!(spec.levels.windows(2).all(|w| w[0].1 < w[1].1));
         // A 16² bake is one mirror level, as the loader reads it (scale 0).
-        let small = chain_spec(&BakeOptions {
+        let small = Gltf.chain_spec(&BakeOptions {
             size: 16,
             ..Default::default()
         });
@@ -191,16 +196,17 @@ mod tests {
             source: "/maps/coded.exr".into(),
             ..Default::default()
         };
-        let spec = chain_spec(&opts);
-        let lighting = Lighting::from_env(&env, &spec, Default::default()).oriented(&orientation());
+        let spec = Gltf.chain_spec(&opts);
+        let lighting =
+            Lighting::from_env(&env, &spec, Default::default()).oriented(&Gltf.orientation());
         let dir = tempfile::tempdir().unwrap();
-        let files = write(&lighting, dir.path(), &opts).unwrap();
+        let files = Gltf.write(&lighting, dir.path(), &opts).unwrap();
         assert_eq!(files.len(), 2 * 6 + 1);
         let names: Vec<String> = files
             .iter()
             .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
             .collect();
-        let mut expected = file_names(&opts);
+        let mut expected = Gltf.file_names(&opts);
         expected.sort();
         let mut got = names.clone();
         got.sort();

@@ -77,52 +77,99 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
-/// An engine (or plain API) mirrorball bakes lighting for, named as `--for` takes it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Engine {
-    /// Bevy: a diffuse and a specular KTX2 cube (`EnvironmentMapLight`).
-    Bevy,
-    /// three.js.
-    Three,
-    /// Babylon.js: a `.env` file.
-    Babylon,
-    /// glTF 2.0 with `EXT_lights_image_based`.
-    Gltf,
-    /// Filament: KTX1 cubes and SH, as cmgen's `--deploy` writes them.
-    Filament,
-    /// Unity: DDS cubes.
-    Unity,
-    /// Unreal Engine: DDS cubes.
-    Unreal,
-    /// Plain OpenGL / Vulkan: KTX2 cubes in the OpenGL convention.
-    Ktx2,
+/// Declares the engines: each row a variant, its names as `--for` takes them (canonical
+/// first) and its module's [`Target`]. The one table every engine operation is dispatched
+/// through ([`Engine::target`]); [`Engine`], its `Choice` names and [`ENGINES`] come from it.
+macro_rules! engines {
+    ($($(#[$doc:meta])* $engine:ident: [$($name:literal),+ $(,)?], $target:expr;)+) => {
+        /// An engine (or plain API) mirrorball bakes lighting for, named as `--for` takes it.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Engine {
+            $($(#[$doc])* $engine,)+
+        }
+
+        impl mirrorball_core::Choice for Engine {
+            const NAMES: &'static [(Self, &'static [&'static str])] =
+                &[$((Engine::$engine, &[$($name),+]),)+];
+        }
+
+        /// Every engine, in the order `--for list` prints them.
+        pub const ENGINES: [Engine; [$(stringify!($engine)),+].len()] = [$(Engine::$engine),+];
+
+        impl Engine {
+            /// The engine's rules, as its module states them.
+            pub(crate) fn target(self) -> &'static dyn Target {
+                match self {
+                    $(Engine::$engine => &$target,)+
+                }
+            }
+        }
+    };
 }
 
-impl mirrorball_core::Choice for Engine {
-    const NAMES: &'static [(Self, &'static [&'static str])] = &[
-        (Engine::Bevy, &["bevy"]),
-        (Engine::Three, &["three", "threejs", "three.js"]),
-        (Engine::Babylon, &["babylon", "babylonjs", "babylon.js"]),
-        (Engine::Gltf, &["gltf", "ext-lights-image-based"]),
-        (Engine::Filament, &["filament", "cmgen"]),
-        (Engine::Unity, &["unity"]),
-        (Engine::Unreal, &["unreal", "ue", "ue5"]),
-        (Engine::Ktx2, &["ktx2", "opengl", "vulkan"]),
-    ];
+engines! {
+    /// Bevy: a diffuse and a specular KTX2 cube (`EnvironmentMapLight`).
+    Bevy: ["bevy"], bevy::Bevy;
+    /// three.js.
+    Three: ["three", "threejs", "three.js"], three::Three;
+    /// Babylon.js: a `.env` file.
+    Babylon: ["babylon", "babylonjs", "babylon.js"], babylon::Babylon;
+    /// glTF 2.0 with `EXT_lights_image_based`.
+    Gltf: ["gltf", "ext-lights-image-based"], gltf::Gltf;
+    /// Filament: KTX1 cubes and SH, as cmgen's `--deploy` writes them.
+    Filament: ["filament", "cmgen"], filament::Filament;
+    /// Unity: DDS cubes.
+    Unity: ["unity"], dds::Dds::Unity;
+    /// Unreal Engine: DDS cubes.
+    Unreal: ["unreal", "ue", "ue5"], dds::Dds::Unreal;
+    /// Plain OpenGL / Vulkan: KTX2 cubes in the OpenGL convention.
+    Ktx2: ["ktx2", "opengl", "vulkan"], ktx2::Ktx2;
 }
 mirrorball_core::choice_traits!(Engine);
 
-/// Every engine, in the order `--for list` prints them.
-pub const ENGINES: [Engine; 8] = [
-    Engine::Bevy,
-    Engine::Three,
-    Engine::Babylon,
-    Engine::Gltf,
-    Engine::Filament,
-    Engine::Unity,
-    Engine::Unreal,
-    Engine::Ktx2,
-];
+/// One engine's rules, each stated once, in its module (`NAME.rs`, a unit type
+/// implementing this): what its lighting is made of, what it takes, its axes, its files and
+/// how to load them. [`Engine`]'s methods call it through [`Engine::target`].
+pub(crate) trait Target: Sync {
+    /// Refuses, before any work, what this engine's own rules forbid beyond
+    /// [`Bake::new`]'s checks (which every engine shares): nothing by default.
+    fn check(&self, _opts: &BakeOptions) -> Result<(), Error> {
+        Ok(())
+    }
+
+    /// What the engine's lighting is made of, for a bake asked as `opts` says.
+    fn chain_spec(&self, opts: &BakeOptions) -> ChainSpec;
+
+    /// What the engine takes and how it reads it.
+    fn describe(&self) -> Description;
+
+    /// How a cube in mirrorball's world axes is turned for the engine
+    /// ([`Engine::orientation`]).
+    fn orientation(&self) -> AxisMap;
+
+    /// The files a bake writes into its folder, besides `README.md`
+    /// ([`Engine::file_names`]).
+    fn file_names(&self, opts: &BakeOptions) -> Vec<String>;
+
+    /// Writes the engine's files into `dir` (which exists) from lighting already in its
+    /// axes; returns the files written.
+    fn write(
+        &self,
+        l: &Lighting,
+        dir: &Path,
+        opts: &BakeOptions,
+    ) -> Result<Vec<PathBuf>, mirrorball_io::Error>;
+
+    /// How to load the files in the engine's own code: the README's body, naming only the
+    /// files [`Target::file_names`] lists, by their paths in the folder.
+    fn readme(&self, opts: &BakeOptions, spec: &ChainSpec) -> String;
+
+    /// Texels of `spec`'s cubes written as Radiance RGBE rather than in the bake's
+    /// encoding (for [`Bake::write_work`]): none by default.
+    fn rgbe_texels(&self, _spec: &ChainSpec) -> u64 {
+        0
+    }
+}
 
 /// What an engine's lighting is made of, before any of it is made: the specular levels
 /// (each a cube face edge and a GGX perceptual roughness, in the order the engine stores
@@ -330,39 +377,17 @@ impl Engine {
     /// Refuses, before any work, what this engine's own rules forbid beyond
     /// [`Bake::new`]'s checks (which every engine shares: size, encodings, Zstandard).
     pub fn check(self, opts: &BakeOptions) -> Result<(), Error> {
-        match self {
-            Engine::Bevy => bevy::check(opts),
-            Engine::Gltf => gltf::check(opts),
-            Engine::Three => three::check(opts),
-            _ => Ok(()),
-        }
-        .map_err(Error::request)
+        self.target().check(opts)
     }
 
     /// What this engine's lighting is made of, for a bake asked as `opts` says.
     pub fn chain_spec(self, opts: &BakeOptions) -> ChainSpec {
-        match self {
-            Engine::Bevy => bevy::chain_spec(opts),
-            Engine::Three => three::chain_spec(opts),
-            Engine::Babylon => babylon::chain_spec(opts),
-            Engine::Gltf => gltf::chain_spec(opts),
-            Engine::Filament => filament::chain_spec(opts),
-            Engine::Unity | Engine::Unreal => dds::chain_spec(self, opts),
-            Engine::Ktx2 => ktx2::chain_spec(opts),
-        }
+        self.target().chain_spec(opts)
     }
 
     /// What the engine takes and how it reads it.
     pub fn describe(self) -> Description {
-        match self {
-            Engine::Bevy => bevy::describe(),
-            Engine::Three => three::describe(),
-            Engine::Babylon => babylon::describe(),
-            Engine::Gltf => gltf::describe(),
-            Engine::Filament => filament::describe(),
-            Engine::Unity | Engine::Unreal => dds::describe(self),
-            Engine::Ktx2 => ktx2::describe(),
-        }
+        self.target().describe()
     }
 
     /// How a cube in mirrorball's world axes is turned for the engine: the engine, looking
@@ -370,15 +395,7 @@ impl Engine {
     /// `orientation().source_of(e)`. The one place each engine's convention is applied
     /// (`bake`, and `convert --for`).
     pub fn orientation(self) -> AxisMap {
-        match self {
-            Engine::Bevy => bevy::orientation(),
-            Engine::Three => three::orientation(),
-            Engine::Babylon => babylon::orientation(),
-            Engine::Gltf => gltf::orientation(),
-            Engine::Filament => filament::orientation(),
-            Engine::Unity | Engine::Unreal => dds::orientation(self),
-            Engine::Ktx2 => ktx2::orientation(),
-        }
+        self.target().orientation()
     }
 
     /// The files a bake writes into its folder, besides `README.md`, relative to it (`/`
@@ -386,29 +403,7 @@ impl Engine {
     /// folder is the bake's, so the names are the engine's own, never the source's (only
     /// how many there are may depend on `opts`: glTF's images per level).
     pub fn file_names(self, opts: &BakeOptions) -> Vec<String> {
-        match self {
-            Engine::Bevy => bevy::file_names(),
-            Engine::Three => three::file_names(),
-            Engine::Babylon => vec![babylon::FILE.to_string()],
-            Engine::Gltf => gltf::file_names(opts),
-            Engine::Filament => filament::file_names(),
-            Engine::Unity | Engine::Unreal => dds::file_names(),
-            Engine::Ktx2 => ktx2::file_names(),
-        }
-    }
-
-    /// How to load the files in the engine's own code: the README's body, naming only
-    /// the files [`Engine::file_names`] lists, by their paths in the folder.
-    fn readme(self, opts: &BakeOptions, spec: &ChainSpec) -> String {
-        match self {
-            Engine::Bevy => bevy::readme(opts, spec),
-            Engine::Three => three::readme(opts, spec),
-            Engine::Babylon => babylon::readme(opts),
-            Engine::Gltf => gltf::readme(opts),
-            Engine::Filament => filament::readme(spec),
-            Engine::Unity | Engine::Unreal => dds::readme(self),
-            Engine::Ktx2 => ktx2::readme(opts),
-        }
+        self.target().file_names(opts)
     }
 }
 
@@ -433,25 +428,7 @@ pub fn write(
         turned = lighting.clone().oriented(&map);
         &turned
     };
-    Ok(write_engine(engine, l, dir, opts)?)
-}
-
-/// The engine's own files, written by its module (`l` already in its axes).
-fn write_engine(
-    engine: Engine,
-    l: &Lighting,
-    dir: &Path,
-    opts: &BakeOptions,
-) -> Result<Vec<PathBuf>, mirrorball_io::Error> {
-    match engine {
-        Engine::Bevy => bevy::write(l, dir, opts),
-        Engine::Three => three::write(l, dir, opts),
-        Engine::Babylon => babylon::write(l, dir, opts),
-        Engine::Gltf => gltf::write(l, dir, opts),
-        Engine::Filament => filament::write(l, dir, opts),
-        Engine::Unity | Engine::Unreal => dds::write(engine, l, dir, opts),
-        Engine::Ktx2 => ktx2::write(l, dir, opts),
-    }
+    Ok(engine.target().write(l, dir, opts)?)
 }
 
 /// The note every bake writes beside its files.
@@ -565,12 +542,7 @@ impl Bake {
     /// encoders and container writers count there): every cube encoded in the bake's
     /// encoding, and supercompressed when asked.
     pub fn write_work(&self) -> u64 {
-        let sq = |f: u32| 6 * f as u64 * f as u64;
-        // three's background is six Radiance files; every other cube is in the encoding.
-        let rgbe = match self.engine {
-            Engine::Three => self.spec.background_face.map_or(0, sq),
-            _ => 0,
-        };
+        let rgbe = self.engine.target().rgbe_texels(&self.spec);
         let texels = self.texels() - rgbe;
         let encoding = self.encoding();
         let zstd = self.opts.zstd.map_or(0, |_| {
@@ -676,7 +648,7 @@ impl Bake {
             mirrorball_io::made_folder(dir);
         }
         let result = mirrorball_io::write_together(|| {
-            let files = write_engine(self.engine, lighting, dir, &self.opts)?;
+            let files = self.engine.target().write(lighting, dir, &self.opts)?;
             write_text(&dir.join(README), &self.readme(dir, &files))?;
             let mut names = relative(dir, &files);
             names.push(README.to_string());
@@ -731,7 +703,7 @@ impl Bake {
             convention = d.convention,
             rule = d.rule,
             diffuse = d.diffuse,
-            body = self.engine.readme(&self.opts, &self.spec),
+            body = self.engine.target().readme(&self.opts, &self.spec),
         )
     }
 }

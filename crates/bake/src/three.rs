@@ -30,12 +30,12 @@
 //! `(−x, y, z)`: `envMapRotation` and `backgroundRotation` are premultiplied by
 //! `diag(−1, 1, 1)` (`WebGLMaterials.js` 9 and 248–252, `WebGLBackground.js` 17 and
 //! 144–148), and a loaded `CompressedCubeTexture` is such a cube too. Both files are
-//! therefore written as the world mirrored in x ([`orientation`], applied by the bake
-//! before [`write`]), so that three's lookup at `(−x, y, z)` returns mirrorball's radiance
+//! therefore written as the world mirrored in x ([`Target::orientation`], applied by the bake
+//! before [`Target::write`]), so that three's lookup at `(−x, y, z)` returns mirrorball's radiance
 //! in `(x, y, z)`. Faces are uploaded unchanged,
 //! row 0 to `t = 0` (`CubeTexture` and `DataTexture` have `flipY` false).
 
-use crate::{BakeOptions, ChainSpec, Description, Lighting};
+use crate::{BakeOptions, ChainSpec, Description, Lighting, Target};
 use mirrorball_core::{Axis, AxisMap, Image};
 use mirrorball_io::{CubeWrite, Encoding, Error, WriteOptions};
 use std::path::{Path, PathBuf};
@@ -62,43 +62,47 @@ pub(crate) fn lod_to_roughness(lod: u32, max_lod: u32) -> f64 {
     }
 }
 
-/// Refuses a size that has no PMREM levels, before any work (the encodings and Zstandard
-/// three cannot load are refused by [`crate::Bake::new`], from [`describe`]).
-pub(crate) fn check(opts: &BakeOptions) -> Result<(), String> {
-    let size = opts.size;
-    if !size.is_power_of_two() || size < 2 << LOD_MIN {
-        return Err(format!(
-            "three.js needs a power-of-two size of at least {} (its PMREM's levels go down to \
+/// three.js's rules.
+pub(crate) struct Three;
+
+impl Target for Three {
+    /// Refuses a size that has no PMREM levels, before any work (the encodings and Zstandard
+    /// three cannot load are refused by [`crate::Bake::new`], from [`Target::describe`]).
+    fn check(&self, opts: &BakeOptions) -> Result<(), crate::Error> {
+        let size = opts.size;
+        if !size.is_power_of_two() || size < 2 << LOD_MIN {
+            return Err(crate::Error::request(format!(
+                "three.js needs a power-of-two size of at least {} (its PMREM's levels go down to \
              {0}×{0} faces, 2^LOD_MIN with LOD_MIN = {LOD_MIN}); {size} was asked",
-            2 << LOD_MIN
-        ));
+                2 << LOD_MIN
+            )));
+        }
+        Ok(())
     }
-    Ok(())
-}
 
-/// three's PMREM levels: faces `size >> lod` for `lod` in `0..=log2(size) − LOD_MIN`, each at
-/// [`lod_to_roughness`]; no diffuse cube (three takes diffuse light from the last level);
-/// the plain cube at the background's size.
-pub(crate) fn chain_spec(opts: &BakeOptions) -> ChainSpec {
-    let max_lod = opts.size.max(1).ilog2().saturating_sub(LOD_MIN);
-    ChainSpec {
-        levels: (0..=max_lod)
-            .map(|lod| ((opts.size >> lod).max(1), lod_to_roughness(lod, max_lod)))
-            .collect(),
-        diffuse_face: None,
-        background_face: Some(opts.background_face()),
+    /// three's PMREM levels: faces `size >> lod` for `lod` in `0..=log2(size) − LOD_MIN`, each at
+    /// [`lod_to_roughness`]; no diffuse cube (three takes diffuse light from the last level);
+    /// the plain cube at the background's size.
+    fn chain_spec(&self, opts: &BakeOptions) -> ChainSpec {
+        let max_lod = opts.size.max(1).ilog2().saturating_sub(LOD_MIN);
+        ChainSpec {
+            levels: (0..=max_lod)
+                .map(|lod| ((opts.size >> lod).max(1), lod_to_roughness(lod, max_lod)))
+                .collect(),
+            diffuse_face: None,
+            background_face: Some(opts.background_face()),
+        }
     }
-}
 
-/// How three looks its cubes up: at `(−x, y, z)` (the module documentation), so its cube
-/// shows at `e` what mirrorball's world shows at `e` mirrored in x.
-pub(crate) fn orientation() -> AxisMap {
-    AxisMap::mirror(Axis::X)
-}
+    /// How three looks its cubes up: at `(−x, y, z)` (the module documentation), so its cube
+    /// shows at `e` what mirrorball's world shows at `e` mirrored in x.
+    fn orientation(&self) -> AxisMap {
+        AxisMap::mirror(Axis::X)
+    }
 
-/// What three takes.
-pub(crate) fn describe() -> Description {
-    Description {
+    /// What three takes.
+    fn describe(&self) -> Description {
+        Description {
         files: "pmrem.dds (three's own PMREM), cube/{px,nx,py,ny,pz,nz}.hdr (the plain cube)",
         containers: "DDS (BC6H cube with mips, for DDSLoader), Radiance HDR faces (HDRCubeTextureLoader)",
         encodings: &[Encoding::Bc6hUnsigned, Encoding::Bc6hSigned],
@@ -108,65 +112,70 @@ pub(crate) fn describe() -> Description {
         diffuse: "the PMREM's last, roughness-1 level times pi (envmap_physical_pars_fragment.glsl.js 4-19)",
         background: Some("cube/ (six RGBE faces: px nx py ny pz nz), the source as a cube, mirrored in x (scene.background)"),
     }
-}
-
-/// The files written, for the checks before any work.
-pub(crate) fn file_names() -> Vec<String> {
-    std::iter::once(PMREM_FILE.to_string())
-        .chain(CUBE_FACES.iter().map(|f| format!("{CUBE_DIR}/{f}")))
-        .collect()
-}
-
-/// Writes three's files into `dir`: `pmrem.dds` and `cube/{px,nx,py,ny,pz,nz}.hdr` (the
-/// background), from lighting already in three's axes ([`orientation`]).
-pub(crate) fn write(l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
-    let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
-    let levels: Vec<Vec<Image>> = l.specular.iter().map(|m| m.layers().to_vec()).collect();
-    let pmrem = dir.join(PMREM_FILE);
-    mirrorball_io::write_dds(
-        &pmrem,
-        &levels,
-        &CubeWrite {
-            encoding,
-            effort: opts.effort,
-            ..CubeWrite::default()
-        },
-    )?;
-    let mut files = vec![pmrem];
-
-    let Some(background) = &l.background else {
-        return Err(Error::request(
-            dir,
-            "three's plain cube is the background; this lighting has none: make it from \
-             Engine::Three.chain_spec"
-                .into(),
-        ));
-    };
-    let cube = dir.join(CUBE_DIR);
-    std::fs::create_dir_all(&cube).map_err(|e| Error::io(&cube, e))?;
-    for (face, name) in background.layers().iter().zip(CUBE_FACES) {
-        let path = cube.join(name);
-        mirrorball_io::write_image(&path, face, &WriteOptions::default())?;
-        files.push(path);
     }
-    Ok(files)
-}
 
-/// The note's body: what each file is and the lines of three.js that load it.
-pub(crate) fn readme(opts: &BakeOptions, spec: &ChainSpec) -> String {
-    let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
-    let faces: Vec<String> = CUBE_FACES
-        .iter()
-        .map(|f| format!("'{CUBE_DIR}/{f}'"))
-        .collect();
-    let levels: Vec<String> = spec
-        .levels
-        .iter()
-        .enumerate()
-        .map(|(lod, (face, r))| format!("{lod}: {face}×{face} at {r:.4}"))
-        .collect();
-    format!(
-        r#"## Loading it
+    /// The files written, for the checks before any work.
+    fn file_names(&self, _opts: &BakeOptions) -> Vec<String> {
+        std::iter::once(PMREM_FILE.to_string())
+            .chain(CUBE_FACES.iter().map(|f| format!("{CUBE_DIR}/{f}")))
+            .collect()
+    }
+
+    /// Writes three's files into `dir`: `pmrem.dds` and `cube/{px,nx,py,ny,pz,nz}.hdr` (the
+    /// background), from lighting already in three's axes ([`Target::orientation`]).
+    fn write(&self, l: &Lighting, dir: &Path, opts: &BakeOptions) -> Result<Vec<PathBuf>, Error> {
+        let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
+        let levels: Vec<Vec<Image>> = l.specular.iter().map(|m| m.layers().to_vec()).collect();
+        let pmrem = dir.join(PMREM_FILE);
+        mirrorball_io::write_dds(
+            &pmrem,
+            &levels,
+            &CubeWrite {
+                encoding,
+                effort: opts.effort,
+                ..CubeWrite::default()
+            },
+        )?;
+        let mut files = vec![pmrem];
+
+        let Some(background) = &l.background else {
+            return Err(Error::request(
+                dir,
+                "three's plain cube is the background; this lighting has none: make it from \
+             Engine::Three.chain_spec"
+                    .into(),
+            ));
+        };
+        let cube = dir.join(CUBE_DIR);
+        std::fs::create_dir_all(&cube).map_err(|e| Error::io(&cube, e))?;
+        for (face, name) in background.layers().iter().zip(CUBE_FACES) {
+            let path = cube.join(name);
+            mirrorball_io::write_image(&path, face, &WriteOptions::default())?;
+            files.push(path);
+        }
+        Ok(files)
+    }
+
+    /// The background's six Radiance faces.
+    fn rgbe_texels(&self, spec: &ChainSpec) -> u64 {
+        spec.background_face.map_or(0, |f| 6 * f as u64 * f as u64)
+    }
+
+    /// The note's body: what each file is and the lines of three.js that load it.
+    fn readme(&self, opts: &BakeOptions, spec: &ChainSpec) -> String {
+        let encoding = opts.encoding.unwrap_or(Encoding::Bc6hUnsigned);
+        let faces: Vec<String> = CUBE_FACES
+            .iter()
+            .map(|f| format!("'{CUBE_DIR}/{f}'"))
+            .collect();
+        let levels: Vec<String> = spec
+            .levels
+            .iter()
+            .enumerate()
+            .map(|(lod, (face, r))| format!("{lod}: {face}×{face} at {r:.4}"))
+            .collect();
+        format!(
+            r#"## Loading it
 
 In three.js (r187):
 
@@ -204,9 +213,10 @@ scene.background = await new HDRCubeTextureLoader()
 Without BC6H support, set `scene.environment` to the plain cube: three then makes its own
 PMREM from it (`PMREMGenerator`).
 "#,
-        label = encoding.label(),
-        levels = levels.join(", "),
-        sky = spec.background_face.unwrap_or(opts.size),
-        faces = faces.join(", "),
-    )
+            label = encoding.label(),
+            levels = levels.join(", "),
+            sky = spec.background_face.unwrap_or(opts.size),
+            faces = faces.join(", "),
+        )
+    }
 }

@@ -2,16 +2,27 @@
 
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 pub use mirrorball_core::Fault;
 
 /// A file problem, naming the file.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Error {
     path: PathBuf,
     fault: Fault,
     problem: String,
-    source: Option<std::io::Error>,
+    source: Option<Arc<std::io::Error>>,
+}
+
+/// Equal when the file, the fault, the problem and the I/O error's kind are.
+impl PartialEq for Error {
+    fn eq(&self, other: &Error) -> bool {
+        self.path == other.path
+            && self.fault == other.fault
+            && self.problem == other.problem
+            && self.io_kind() == other.io_kind()
+    }
 }
 
 impl Error {
@@ -57,7 +68,7 @@ impl Error {
             path: path.to_path_buf(),
             fault,
             problem,
-            source: Some(e),
+            source: Some(Arc::new(e)),
         }
     }
     /// The system's fault, from an I/O error writing `path`: a folder that is not there,
@@ -73,7 +84,7 @@ impl Error {
             path: path.to_path_buf(),
             fault: Fault::System,
             problem,
-            source: Some(e),
+            source: Some(Arc::new(e)),
         }
     }
     /// Refuses `path` as an input before any reader opens it: missing, a directory, or
@@ -99,7 +110,7 @@ impl Error {
     }
     /// The kind of the I/O error behind it, if one is (a full disk: `StorageFull`).
     pub fn io_kind(&self) -> Option<std::io::ErrorKind> {
-        self.source.as_ref().map(std::io::Error::kind)
+        self.source.as_ref().map(|e| e.kind())
     }
     /// What went wrong, without the file name.
     pub fn problem(&self) -> &str {
@@ -115,6 +126,6 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        self.source.as_ref().map(|e| e as _)
+        self.source.as_deref().map(|e| e as _)
     }
 }

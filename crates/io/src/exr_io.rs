@@ -125,7 +125,7 @@ fn read_laid_out(
     }
     .map_err(|e| read_error(path, e))?;
     let declared = envmap_kind(header.own_attributes.environment_map);
-    let recorded = recorded_info(&header.own_attributes, image.width(), image.height());
+    let recorded = recorded_info(path, &header.own_attributes, image.width(), image.height());
     let types: Vec<SampleType> = header.channels.list.iter().map(|c| c.sample_type).collect();
     let layer_name = header
         .own_attributes
@@ -175,6 +175,7 @@ fn read_generic(
     let layer = exr_image.layer_data;
     let declared = envmap_kind(layer.attributes.environment_map);
     let recorded = recorded_info(
+        path,
         &layer.attributes,
         layer.size.width() as u32,
         layer.size.height() as u32,
@@ -224,17 +225,18 @@ fn envmap_kind(envmap: Option<EnvironmentMap>) -> Option<ProjectionKind> {
     })
 }
 
-/// [`Loaded::recorded`] from a layer's string attributes.
+/// [`Loaded::recorded`] from the string attributes of a layer of `path`.
 fn recorded_info(
+    path: &Path,
     attributes: &LayerAttributes,
     w: u32,
     h: u32,
-) -> Option<Result<crate::MapInfo, String>> {
+) -> Option<Result<crate::MapInfo, Error>> {
     let get = |key: &str| match attributes.other.get(&Text::new_or_panic(key)) {
         Some(AttributeValue::Text(t)) => Some(t.to_string()),
         _ => None,
     };
-    crate::recorded(get, w, h)
+    crate::recorded(path, get, w, h)
 }
 
 /// The string attribute `key = value` (the texts are ASCII, which OpenEXR's strings hold).

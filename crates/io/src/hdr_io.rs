@@ -67,7 +67,7 @@ pub fn read(input: &Input, limits: &Limits) -> Result<Loaded, Error> {
         )?;
         let lines = decoder.metadata().custom_attributes;
         let get = |key: &str| lines.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
-        let recorded = crate::recorded(get, width, height);
+        let recorded = crate::recorded(path, get, width, height);
         let decoded = DynamicImage::from_decoder(decoder)
             .map_err(|e| decode_error(path, "Radiance HDR", e))?;
         let data = match decoded {

@@ -240,7 +240,7 @@ pub fn read(input: &crate::input::Input, limits: &crate::Limits) -> Result<crate
     Ok(crate::Loaded {
         layers,
         declared: Some(mirrorball_core::ProjectionKind::Cube),
-        recorded: crate::recorded(get, w, w),
+        recorded: crate::recorded(path, get, w, w),
         format: crate::Format::Ktx1,
         description: format!(
             "KTX1 cube map (Filament), {}, {}{sh}",

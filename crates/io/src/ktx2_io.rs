@@ -748,7 +748,7 @@ pub fn read(input: &Input, limits: &Limits) -> Result<Loaded, Error> {
     let mut layers = decode_faces(path, format, level0, width, height, faces)?;
 
     let levels = mip_phrase(level_count);
-    let recorded = crate::recorded(get, width, height);
+    let recorded = crate::recorded(path, get, width, height);
     let (declared, description) = orient_and_describe(&reader, format, &levels, &mut layers);
     Ok(Loaded {
         layers,

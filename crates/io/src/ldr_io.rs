@@ -63,7 +63,7 @@ pub struct CodedPicture {
     /// codes `mirrorball_core::Codes::u16le` reads), else 8-bit.
     pub wide: bool,
     /// What the file records in mirrorball's own keys, as [`Loaded::recorded`].
-    pub recorded: Option<Result<crate::MapInfo, String>>,
+    pub recorded: Option<Result<crate::MapInfo, Error>>,
     /// The container.
     pub format: Format,
     /// A one-line description for people, as [`read`] gives it: "JPEG, 8-bit sRGB, RGB".
@@ -123,7 +123,7 @@ fn read_with<T>(
     format: Format,
     limits: &Limits,
     finish: impl FnOnce(Box<dyn ImageDecoder + '_>, &str) -> Result<T, Error>,
-) -> Result<(T, Option<Result<crate::MapInfo, String>>), Error> {
+) -> Result<(T, Option<Result<crate::MapInfo, Error>>), Error> {
     let path = input.path();
     let (image_format, name) = match format {
         Format::Png => (ImageFormat::Png, "PNG"),
@@ -143,7 +143,7 @@ fn read_with<T>(
             let texts = crate::meta_text::read_texts(&mut reader).map_err(io)?;
             let (t, (w, h)) = decode(input, reader, image_format, format, name, limits, finish)?;
             let get = |key: &str| texts.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
-            return Ok((t, crate::recorded(get, w, h)));
+            return Ok((t, crate::recorded(path, get, w, h)));
         }
         if format != Format::Jpeg {
             let reader = input.reader().map_err(io)?;
@@ -159,7 +159,7 @@ fn read_with<T>(
                 .find(|(k, _)| k == key)
                 .map(|(_, v)| v.clone())
         };
-        Ok((t, crate::recorded(get, w, h)))
+        Ok((t, crate::recorded(path, get, w, h)))
     })
 }
 
@@ -232,7 +232,7 @@ fn jpeg_codes(
         width,
         height,
         wide: false,
-        recorded: crate::recorded(get, width, height),
+        recorded: crate::recorded(path, get, width, height),
         format: Format::Jpeg,
         description: "JPEG, 8-bit sRGB, RGB".into(),
     }))

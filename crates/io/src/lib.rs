@@ -120,17 +120,22 @@ impl MapInfo {
         (self.projection.to_string(), layout)
     }
 
-    /// Reads the recorded texts back for a `w`×`h` picture (whose shape, an eye's for a
-    /// stereo pair, fixes a Mercator map's latitude limit when the text has none). The
-    /// error says what was recorded and why it cannot be read.
+    /// Reads the texts recorded in `path` back for a `w`×`h` picture (whose shape, an
+    /// eye's for a stereo pair, fixes a Mercator map's latitude limit when the text has
+    /// none). The error, the input's, names the file and says what was recorded and why it
+    /// cannot be read.
     pub fn from_texts(
+        path: &Path,
         projection: &str,
         layout: Option<&str>,
         w: u32,
         h: u32,
-    ) -> Result<MapInfo, String> {
+    ) -> Result<MapInfo, Error> {
         let unreadable = |key: &str, text: &str, e: &dyn std::fmt::Display| {
-            format!("records {key} = '{text}', which cannot be read ({e})")
+            Error::input(
+                path,
+                format!("records {key} = '{text}', which cannot be read ({e})"),
+            )
         };
         let text = layout.unwrap_or_default();
         let (stereo, layout) = match layout.and_then(|l| l.split_once('/')) {
@@ -510,7 +515,7 @@ pub struct Loaded {
     /// What the file records in mirrorball's own keys ([`PROJECTION_KEY`], [`LAYOUT_KEY`]):
     /// `None` when it records nothing, an error (saying what was recorded) when the record
     /// cannot be read.
-    pub recorded: Option<Result<MapInfo, String>>,
+    pub recorded: Option<Result<MapInfo, Error>>,
     /// The container.
     pub format: Format,
     /// A one-line description for people: "OpenEXR, half, ZIP compression, RGB".
@@ -963,16 +968,18 @@ fn unknown_ext() -> String {
         .to_string()
 }
 
-/// [`Loaded::recorded`] from a file's text metadata (`get` looks a key up) for a `w`×`h`
-/// picture: nothing unless the projection key is there.
+/// [`Loaded::recorded`] from the text metadata of `path` (`get` looks a key up) for a
+/// `w`×`h` picture: nothing unless the projection key is there.
 pub(crate) fn recorded(
+    path: &Path,
     get: impl Fn(&str) -> Option<String>,
     w: u32,
     h: u32,
-) -> Option<Result<MapInfo, String>> {
+) -> Option<Result<MapInfo, Error>> {
     let projection = get(PROJECTION_KEY)?;
     let layout = get(LAYOUT_KEY);
     Some(MapInfo::from_texts(
+        path,
         projection.trim(),
         layout.as_deref().map(str::trim),
         w,

@@ -86,7 +86,10 @@ impl From<mirrorball_bake::Error> for Error {
 
 impl From<mirrorball_spherical::Error> for Error {
     fn from(e: mirrorball_spherical::Error) -> Error {
-        Error::new(e.fault(), e.to_string())
+        Error {
+            io_kind: e.io_kind(),
+            ..Error::new(e.fault(), e.to_string())
+        }
     }
 }
 

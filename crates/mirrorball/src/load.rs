@@ -188,12 +188,13 @@ pub fn from_bytes(
 /// nothing else says the projection (`from`).
 fn recorded_info(
     input: &str,
-    recorded: Option<Result<mirrorball_io::MapInfo, String>>,
+    recorded: Option<Result<mirrorball_io::MapInfo, mirrorball_io::Error>>,
     from: Option<&ProjSpec>,
 ) -> Result<Option<mirrorball_io::MapInfo>, Error> {
     match recorded {
         Some(Err(e)) if from.is_none() => Err(Error::input(format!(
-            "{input}: {e}; say the projection with --from"
+            "{input}: {}; say the projection with --from",
+            e.problem()
         ))),
         Some(r) => Ok(r.ok()),
         None => Ok(None),

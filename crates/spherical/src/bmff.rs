@@ -6,6 +6,8 @@
 //! `largesize` after the type; `size` 0 means "to the end of the container" (the file, at
 //! the top level). Sizes count the header.
 
+use crate::Error;
+
 /// A box type.
 pub type FourCC = [u8; 4];
 
@@ -50,11 +52,11 @@ pub fn name(kind: &FourCC) -> String {
 /// container ends sooner), with `room` bytes left in the container from `start`. The
 /// declared size must fit the room: a box that claims more than its container holds is a
 /// truncated or corrupt file, said so here before anything is allocated for it.
-pub fn parse_header(head: &[u8], start: u64, room: u64) -> Result<Header, String> {
+pub fn parse_header(head: &[u8], start: u64, room: u64) -> Result<Header, Error> {
     if room < 8 || head.len() < 8 {
-        return Err(format!(
+        return Err(Error::malformed(format!(
             "{room} stray bytes at offset {start}, too few for a box header"
-        ));
+        )));
     }
     let size32 = u32::from_be_bytes([head[0], head[1], head[2], head[3]]);
     let kind: FourCC = [head[4], head[5], head[6], head[7]];
@@ -62,33 +64,33 @@ pub fn parse_header(head: &[u8], start: u64, room: u64) -> Result<Header, String
         0 => (8, room),
         1 => {
             if room < 16 || head.len() < 16 {
-                return Err(format!(
+                return Err(Error::malformed(format!(
                     "box {} at offset {start} declares a 64-bit size but is cut off",
                     name(&kind)
-                ));
+                )));
             }
             let large = u64::from_be_bytes(head[8..16].try_into().expect("eight bytes"));
             if large < 16 {
-                return Err(format!(
+                return Err(Error::malformed(format!(
                     "box {} at offset {start} declares a 64-bit size of {large} bytes, less than its header",
                     name(&kind)
-                ));
+                )));
             }
             (16, large)
         }
         s if s < 8 => {
-            return Err(format!(
+            return Err(Error::malformed(format!(
                 "box {} at offset {start} declares {s} bytes, less than its header",
                 name(&kind)
-            ))
+            )))
         }
         s => (8, u64::from(s)),
     };
     if size > room {
-        return Err(format!(
+        return Err(Error::malformed(format!(
             "box {} at offset {start} declares {size} bytes, but only {room} remain (the file is truncated or corrupt)",
             name(&kind)
-        ));
+        )));
     }
     Ok(Header {
         kind,
@@ -101,7 +103,7 @@ pub fn parse_header(head: &[u8], start: u64, room: u64) -> Result<Header, String
 /// The boxes laid end to end in `bytes`, whose first byte is at offset `base` (for
 /// messages). Fewer than 8 bytes left over at the end are returned as the tail (QuickTime
 /// ends some lists with a 4-byte zero terminator).
-pub fn headers_in(bytes: &[u8], base: u64) -> Result<(Vec<Header>, usize), String> {
+pub fn headers_in(bytes: &[u8], base: u64) -> Result<(Vec<Header>, usize), Error> {
     let mut out = Vec::new();
     let mut at = 0usize;
     while bytes.len() - at >= 8 {
@@ -174,7 +176,7 @@ impl Node {
 
     /// The box whose header is `h` in `bytes` (offsets as `h.start - base`): the containers
     /// on the way from `moov` to the sample descriptions opened, every other box a leaf.
-    pub fn parse(bytes: &[u8], h: &Header, base: u64) -> Result<Node, String> {
+    pub fn parse(bytes: &[u8], h: &Header, base: u64) -> Result<Node, Error> {
         let from = (h.payload_start() - base) as usize;
         let payload = &bytes[from..(h.end() - base) as usize];
         match container_head(&h.kind) {
@@ -184,13 +186,13 @@ impl Node {
     }
 
     /// A container of type `kind` from its payload: `head_len` bytes of head, then boxes.
-    pub fn open(kind: &FourCC, payload: &[u8], head_len: usize, at: u64) -> Result<Node, String> {
+    pub fn open(kind: &FourCC, payload: &[u8], head_len: usize, at: u64) -> Result<Node, Error> {
         if payload.len() < head_len {
-            return Err(format!(
+            return Err(Error::malformed(format!(
                 "box {} (payload at offset {at}) holds {} bytes, fewer than the {head_len} its fields need",
                 name(kind),
                 payload.len()
-            ));
+            )));
         }
         let (head, rest) = payload.split_at(head_len);
         let base = at + head_len as u64;
@@ -347,11 +349,15 @@ mod tests {
     #[test]
     fn sizes_that_do_not_fit_are_refused() {
         let e = parse_header(&header(2000, b"moov", None), 40, 1000).unwrap_err();
+        assert_eq!(e.fault(), mirrorball_core::Fault::Input);
+        let e = e.to_string();
         assert!(
             e.contains("'moov'") && e.contains("2000") && e.contains("1000"),
             "{e}"
         );
-        let e = parse_header(&header(1, b"mdat", Some(u64::MAX)), 0, 1 << 40).unwrap_err();
+        let e = parse_header(&header(1, b"mdat", Some(u64::MAX)), 0, 1 << 40)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("truncated"), "{e}");
         assert!(parse_header(&header(4, b"free", None), 0, 100).is_err());
         assert!(parse_header(&header(1, b"mdat", Some(8)), 0, 100).is_err());

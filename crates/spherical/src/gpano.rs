@@ -6,6 +6,7 @@
 
 use crate::mapping::{Crop, Mapping};
 use crate::xml;
+use crate::Error;
 use mirrorball_core::{Layout, Projection, Stereo};
 
 /// The PNG `iTXt` keyword that holds an XMP packet (XMP Specification Part 3, §1.1.5).
@@ -57,15 +58,15 @@ pub fn packet(crop: &Crop) -> String {
 /// What a packet's GPano properties say: `None` when it has none (no `ProjectionType`);
 /// else the crop for an equirectangular one (the picture's own size, `w`×`h`, when the crop
 /// fields are absent: a whole panorama), or why it is not one mirrorball reads.
-pub fn parse(xmp: &str, w: u32, h: u32) -> Option<Result<Crop, String>> {
+pub fn parse(xmp: &str, w: u32, h: u32) -> Option<Result<Crop, Error>> {
     if !xmp.contains(NAMESPACE) {
         return None;
     }
     let projection = xml::value(xmp, "ProjectionType")?;
     if projection != "equirectangular" {
-        return Some(Err(format!(
+        return Some(Err(Error::malformed(format!(
             "GPano:ProjectionType is '{projection}', not equirectangular"
-        )));
+        ))));
     }
     Some(Ok(Crop::parse(xmp).unwrap_or(Crop {
         full_width: w,

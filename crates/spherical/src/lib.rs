@@ -16,8 +16,11 @@
 //! [`Mapping`] (see [`mapping`]).
 //!
 //! Every declared size in a file is checked against the room its container really has
-//! before anything is allocated ([`bmff`]); errors name the file and carry core's
-//! [`mirrorball_core::Fault`].
+//! before anything is allocated ([`bmff`]). Every function that can fail returns the one
+//! [`Error`], which carries core's [`mirrorball_core::Fault`]: a box, payload or XML that
+//! breaks its format is the input's ([`Error::malformed`]), metadata a picture's size or
+//! the format cannot carry the request's ([`Error::unfit`]); the file's reader names the
+//! file ([`Error::at`]).
 #![warn(missing_docs)]
 
 pub mod bmff;

@@ -16,6 +16,7 @@
 
 use crate::v2::{Bounds, ProjectionData};
 use crate::xml;
+use crate::Error;
 use mirrorball_core::projection::{Cylinder, CylinderRule};
 use mirrorball_core::{CellGrid, Choice, CubeCells, Layout, Projection};
 
@@ -157,7 +158,7 @@ impl Mapping {
     /// v360's EAC at any size that holds its faces,
     /// an equirectangular picture `hfov/vfov` as wide as high (within a pixel). The error is
     /// the rule broken.
-    pub fn check_eye(&self, w: u32, h: u32) -> Result<(), String> {
+    pub fn check_eye(&self, w: u32, h: u32) -> Result<(), Error> {
         let fits = match self {
             Mapping::Equirect { hfov, vfov } => {
                 (f64::from(w) - f64::from(h) * hfov / vfov).abs() <= 1.0
@@ -168,7 +169,7 @@ impl Mapping {
         if fits {
             return Ok(());
         }
-        Err(match self {
+        Err(Error::unfit(match self {
             Mapping::Equirect { hfov, vfov } => format!(
                 "an equirectangular picture of {hfov}°×{vfov}° is {}:1",
                 hfov / vfov
@@ -177,7 +178,7 @@ impl Mapping {
             Mapping::Eac => {
                 "an EAC picture holds six faces between two-pixel borders: at least 7×10".into()
             }
-        })
+        }))
     }
 
     /// `equi`'s bounds for an equirectangular mapping.
@@ -212,7 +213,7 @@ impl Mapping {
     }
 
     /// The `proj` data box for a picture whose eye is `w`×`h` pixels.
-    pub fn projection_data(&self, w: u32, h: u32) -> Result<ProjectionData, String> {
+    pub fn projection_data(&self, w: u32, h: u32) -> Result<ProjectionData, Error> {
         self.check_eye(w, h)?;
         Ok(match *self {
             Mapping::Equirect { hfov, vfov } => {
@@ -228,8 +229,8 @@ impl Mapping {
 
     /// The mapping a `proj` data box states for an eye of `w`×`h` pixels, or why
     /// mirrorball cannot read it.
-    pub fn from_data(data: &ProjectionData, w: u32, h: u32) -> Result<Mapping, String> {
-        match data {
+    pub fn from_data(data: &ProjectionData, w: u32, h: u32) -> Result<Mapping, Error> {
+        let mapping = match data {
             ProjectionData::Equirect(b) => Mapping::from_bounds(b).ok_or_else(|| {
                 format!(
                     "an equirectangular picture cropped off-centre (bounds top {}, bottom {}, left {}, right {} of 2^32)",
@@ -248,7 +249,8 @@ impl Mapping {
                 "projection box {} is not one of the specification's",
                 crate::bmff::name(k)
             )),
-        }
+        };
+        mapping.map_err(Error::malformed)
     }
 }
 

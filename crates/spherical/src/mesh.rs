@@ -25,6 +25,7 @@
 //! counter-clockwise seen from outside the sphere, as the VR180 reference mesh generator
 //! (`docs/vr180.md`) makes them.
 
+use crate::Error;
 use mirrorball_core::{CubeCells, Eac};
 
 /// Quads along each face edge.
@@ -57,12 +58,12 @@ pub struct Mesh {
 }
 
 /// The EAC mesh for one eye of `w`×`h` pixels in v360's `eac` layout.
-pub fn eac_mesh(w: u32, h: u32) -> Result<Mesh, String> {
+pub fn eac_mesh(w: u32, h: u32) -> Result<Mesh, Error> {
     let cells = CubeCells::EAC;
     if CubeCells::eac_frame(w, h).is_none() {
-        return Err(format!(
+        return Err(Error::unfit(format!(
             "an EAC picture of {w}×{h} is too small to hold its six faces and their borders"
-        ));
+        )));
     }
     let (wf, hf, kf) = (f64::from(w), f64::from(h), f64::from(K));
     let side = K + 1;
@@ -191,7 +192,7 @@ pub fn mesh_box(m: &Mesh) -> Vec<u8> {
 
 /// The `mshp` payload after its version and flags (`crc`, `raw `, the mesh) for the EAC
 /// picture of one eye of `w`×`h` pixels.
-pub fn eac_mshp(w: u32, h: u32) -> Result<Vec<u8>, String> {
+pub fn eac_mshp(w: u32, h: u32) -> Result<Vec<u8>, Error> {
     let mut rest = b"raw ".to_vec();
     rest.extend_from_slice(&mesh_box(&eac_mesh(w, h)?));
     let mut out = crc32(&rest).to_be_bytes().to_vec();

@@ -47,8 +47,8 @@ impl Movie {
     pub fn open(path: &Path) -> Result<(File, Movie), Error> {
         let mut file = File::open(path).map_err(|e| Error::io(path, e))?;
         let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
-        let top = top_level(&mut file, len).map_err(|e| Error::input(path, e))?;
-        check_top(&top).map_err(|e| Error::input(path, e))?;
+        let top = top_level(&mut file, path, len)?;
+        check_top(&top).map_err(|e| e.at(path))?;
         let moov_at = *top
             .iter()
             .find(|h| &h.kind == b"moov")
@@ -74,8 +74,8 @@ impl Movie {
             },
             0,
         )
-        .map_err(|e| Error::input(path, format!("in its movie box: {e}")))?;
-        open_video_entries(&mut moov).map_err(|e| Error::input(path, e))?;
+        .map_err(|e| e.within("in its movie box").at(path))?;
+        open_video_entries(&mut moov).map_err(|e| e.at(path))?;
         if video_tracks(&moov).next().is_none() {
             return Err(Error::input(path, "has no video track"));
         }
@@ -91,8 +91,9 @@ impl Movie {
     }
 }
 
-/// The top-level boxes of a file of `len` bytes, each header checked against the length.
-fn top_level(file: &mut File, len: u64) -> Result<Vec<Header>, String> {
+/// The top-level boxes of `file` (`path`, `len` bytes), each header checked against the
+/// length.
+fn top_level(file: &mut File, path: &Path, len: u64) -> Result<Vec<Header>, Error> {
     let mut out: Vec<Header> = Vec::new();
     let mut at = 0u64;
     while at < len {
@@ -100,16 +101,16 @@ fn top_level(file: &mut File, len: u64) -> Result<Vec<Header>, String> {
         let n = (len - at).min(16) as usize;
         file.seek(SeekFrom::Start(at))
             .and_then(|_| file.read_exact(&mut head[..n]))
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| Error::io(path, e))?;
         if out.is_empty() && !looks_like_a_box(&head[..n]) {
-            return Err(not_a_movie(&head[..n]));
+            return Err(Error::input(path, not_a_movie(&head[..n])));
         }
-        let h = parse_header(&head[..n], at, len - at)?;
+        let h = parse_header(&head[..n], at, len - at).map_err(|e| e.at(path))?;
         at = h.end();
         out.push(h);
     }
     if out.is_empty() {
-        return Err("is empty, not an MP4 or MOV file".into());
+        return Err(Error::input(path, "is empty, not an MP4 or MOV file"));
     }
     Ok(out)
 }
@@ -137,22 +138,24 @@ fn not_a_movie(head: &[u8]) -> String {
 }
 
 /// One movie box, no fragments.
-fn check_top(top: &[Header]) -> Result<(), String> {
+fn check_top(top: &[Header]) -> Result<(), Error> {
     let count = |k: &FourCC| top.iter().filter(|h| &h.kind == k).count();
     match count(b"moov") {
         1 => {}
-        0 => return Err(
-            "has no movie box ('moov'): not a complete MP4 or MOV file (an unfinished recording?)"
-                .into(),
-        ),
-        n => return Err(format!("has {n} movie boxes ('moov'); a file has one")),
+        0 => return Err(Error::malformed(
+            "has no movie box ('moov'): not a complete MP4 or MOV file (an unfinished recording?)",
+        )),
+        n => {
+            return Err(Error::malformed(format!(
+                "has {n} movie boxes ('moov'); a file has one"
+            )))
+        }
     }
     if count(b"moof") > 0 {
-        return Err(
+        return Err(Error::malformed(
             "is a fragmented MP4 ('moof' boxes), which tag does not rewrite; remux it first \
-             (ffmpeg -i IN -c copy OUT.mp4)"
-                .into(),
-        );
+             (ffmpeg -i IN -c copy OUT.mp4)",
+        ));
     }
     Ok(())
 }
@@ -192,7 +195,7 @@ pub fn stsd_mut(trak: &mut Node) -> Option<&mut Node> {
 }
 
 /// Opens every video track's sample entries: 78 bytes of fields, then boxes.
-fn open_video_entries(moov: &mut Node) -> Result<(), String> {
+fn open_video_entries(moov: &mut Node) -> Result<(), Error> {
     let Some(traks) = moov.children_mut() else {
         return Ok(());
     };
@@ -205,8 +208,9 @@ fn open_video_entries(moov: &mut Node) -> Result<(), String> {
         };
         for e in entries.iter_mut() {
             if let Body::Leaf(payload) = &e.body {
-                *e = Node::open(&e.kind, payload, VISUAL_FIELDS, 0)
-                    .map_err(|err| format!("its video sample entry {}: {err}", name(&e.kind)))?;
+                *e = Node::open(&e.kind, payload, VISUAL_FIELDS, 0).map_err(|err| {
+                    err.within(format_args!("its video sample entry {}", name(&e.kind)))
+                })?;
             }
         }
     }
@@ -223,9 +227,9 @@ pub struct VideoTrack {
     /// `st3d`, if there.
     pub stereo: Option<StereoMode>,
     /// `sv3d`, if there, or why it cannot be read.
-    pub sv3d: Option<Result<Sv3d, String>>,
+    pub sv3d: Option<Result<Sv3d, Error>>,
     /// The V1 `uuid` box, if there, or why it cannot be read.
-    pub v1: Option<Result<V1, String>>,
+    pub v1: Option<Result<V1, Error>>,
 }
 
 /// How mirrorball reads a video: what the metadata says, resolved (V2 before V1).
@@ -289,15 +293,15 @@ impl VideoTrack {
     /// The mapping and stereo arrangement the metadata states, V2 first (the RFC: V2 takes
     /// priority): `Ok(None)` when the track has none, an error saying what it has when
     /// mirrorball cannot read that.
-    pub fn reading(&self) -> Result<Option<Reading>, String> {
+    pub fn reading(&self) -> Result<Option<Reading>, Error> {
         if let Some(sv3d) = &self.sv3d {
             let sv3d = sv3d
                 .as_ref()
-                .map_err(|e| format!("its 'sv3d' box is unreadable: {e}"))?;
+                .map_err(|e| e.clone().within("its 'sv3d' box is unreadable"))?;
             let mode = self.stereo.unwrap_or(StereoMode::Mono);
-            let stereo = mode
-                .stereo()
-                .ok_or_else(|| format!("its stereo mode is {}", mode.describe()))?;
+            let stereo = mode.stereo().ok_or_else(|| {
+                Error::malformed(format!("its stereo mode is {}", mode.describe()))
+            })?;
             let (w, h) = self.eye(stereo);
             let mapping = Mapping::from_data(&sv3d.data, w, h)?;
             return Ok(Some(Reading {
@@ -311,16 +315,15 @@ impl VideoTrack {
         };
         let v1 = v1
             .as_ref()
-            .map_err(|e| format!("its V1 XML is unreadable: {e}"))?;
-        let stereo = v1
-            .stereo()
-            .and_then(StereoMode::stereo)
-            .ok_or_else(|| format!("its V1 stereo mode is {:?}", v1.stereo_mode))?;
+            .map_err(|e| e.clone().within("its V1 XML is unreadable"))?;
+        let stereo = v1.stereo().and_then(StereoMode::stereo).ok_or_else(|| {
+            Error::malformed(format!("its V1 stereo mode is {:?}", v1.stereo_mode))
+        })?;
         let mapping = v1.mapping().ok_or_else(|| {
-            format!(
+            Error::malformed(format!(
                 "its V1 XML says Spherical {}, ProjectionType '{}'",
                 v1.spherical, v1.projection_type
-            )
+            ))
         })?;
         Ok(Some(Reading {
             mapping,
@@ -340,15 +343,17 @@ pub fn read(path: &Path) -> Result<Vec<VideoTrack>, Error> {
 
 /// The entries of a chunk offset or similar table: `(count, width)` from the payload of
 /// `stco` (4), `co64` (8), checked against the bytes there.
-pub fn table(kind: &FourCC, p: &[u8]) -> Result<(usize, usize), String> {
+pub fn table(kind: &FourCC, p: &[u8]) -> Result<(usize, usize), Error> {
     let width = if kind == b"co64" { 8 } else { 4 };
-    let count = be_u32(p, 4).ok_or_else(|| format!("{} is cut short", name(kind)))? as usize;
+    let count = be_u32(p, 4)
+        .ok_or_else(|| Error::malformed(format!("{} is cut short", name(kind))))?
+        as usize;
     if (p.len() - 8) / width < count {
-        return Err(format!(
+        return Err(Error::malformed(format!(
             "{} declares {count} entries but holds {} bytes",
             name(kind),
             p.len() - 8
-        ));
+        )));
     }
     Ok((count, width))
 }

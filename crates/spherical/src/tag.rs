@@ -18,7 +18,7 @@ use crate::mapping::Mapping;
 use crate::movie::{self, Movie};
 use crate::v2::{self, Pose, StereoMode, Sv3d};
 use crate::{v1, Error};
-use mirrorball_core::{Fault, Stereo};
+use mirrorball_core::Stereo;
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::Path;
@@ -70,15 +70,13 @@ pub struct Tagging {
 /// written.
 pub fn plan(path: &Path, change: &Change) -> Result<Tagging, Error> {
     let (file, movie) = Movie::open(path)?;
-    let (tagged, tracks) =
-        retag(&movie.moov, change).map_err(|(fault, e)| Error::new(path, fault, e))?;
+    let (tagged, tracks) = retag(&movie.moov, change).map_err(|e| e.at(path))?;
     let at = Span {
         start: movie.moov_at.start,
         end: movie.moov_at.end(),
         len: movie.len,
     };
-    let (moov, tables_moved, promoted, shift) =
-        relocate(&tagged, &at).map_err(|e| Error::input(path, e))?;
+    let (moov, tables_moved, promoted, shift) = relocate(&tagged, &at).map_err(|e| e.at(path))?;
     let moov = moov.to_bytes();
     let summary = Summary {
         tracks,
@@ -146,7 +144,7 @@ fn copy_range(from: &mut &File, out: &mut impl Write, at: u64, n: u64) -> std::i
 const AFTER_SPHERICAL: [&FourCC; 3] = [b"clap", b"pasp", b"btrt"];
 
 /// The movie box with `change` made to every video track; the number of tracks changed.
-fn retag(moov: &Node, change: &Change) -> Result<(Node, usize), (Fault, String)> {
+fn retag(moov: &Node, change: &Change) -> Result<(Node, usize), Error> {
     let mut moov = moov.clone();
     let mut tracks = 0;
     let traks = moov.children_mut().expect("moov is a container");
@@ -165,12 +163,11 @@ fn retag(moov: &Node, change: &Change) -> Result<(Node, usize), (Fault, String)>
 
 /// Puts `st3d` and `sv3d` in each of the track's visual sample entries (after removing old
 /// ones); returns the boxes the track itself gets (V1's `uuid`).
-fn retag_entries(trak: &mut Node, change: &Change) -> Result<Vec<Node>, (Fault, String)> {
+fn retag_entries(trak: &mut Node, change: &Change) -> Result<Vec<Node>, Error> {
     let mut extra = Vec::new();
-    let entries = movie::stsd_mut(trak).and_then(Node::children_mut).ok_or((
-        Fault::Input,
-        "a video track has no sample descriptions".to_string(),
-    ))?;
+    let entries = movie::stsd_mut(trak)
+        .and_then(Node::children_mut)
+        .ok_or_else(|| Error::malformed("a video track has no sample descriptions"))?;
     for entry in entries.iter_mut() {
         let size = movie::entry_size(entry);
         let Some(children) = entry.children_mut() else {
@@ -185,19 +182,17 @@ fn retag_entries(trak: &mut Node, change: &Change) -> Result<Vec<Node>, (Fault, 
         else {
             continue;
         };
-        let (w, h) = size.ok_or((
-            Fault::Input,
-            "a video sample entry is cut short".to_string(),
-        ))?;
+        let (w, h) = size.ok_or_else(|| Error::malformed("a video sample entry is cut short"))?;
         let (ew, eh) = stereo
             .eye_extent(w, h)
-            .map_err(|e| (Fault::Request, format!("the video is {w}×{h}: {e}")))?;
+            .map_err(|e| Error::unfit(format!("the video is {w}×{h}: {e}")))?;
+        // Every rule projection_data gives is the request's: the size cannot hold it.
         let data = mapping.projection_data(ew, eh).map_err(|rule| {
             let what = match stereo {
                 Stereo::Mono => format!("the video is {w}×{h}"),
                 s => format!("each eye of this {s} pair ({w}×{h}) is {ew}×{eh}"),
             };
-            (Fault::Request, format!("{what}, but {rule}"))
+            Error::unfit(format!("{what}, but {}", rule.problem()))
         })?;
         let at = children
             .iter()
@@ -210,8 +205,7 @@ fn retag_entries(trak: &mut Node, change: &Change) -> Result<Vec<Node>, (Fault, 
         });
         children.splice(at..at, [v2::st3d(StereoMode::of(stereo)), sv3d]);
         if v1 && extra.is_empty() {
-            let xml = v1::xml(&mapping, StereoMode::of(stereo), ew, eh)
-                .map_err(|e| (Fault::Request, e))?;
+            let xml = v1::xml(&mapping, StereoMode::of(stereo), ew, eh)?;
             extra.push(v1::node(&xml));
         }
     }
@@ -227,7 +221,7 @@ struct Span {
 
 /// `moov` (once at `at` in its file) with every offset past its end moved by the change
 /// in its size: the new box, the tables moved, those made 64-bit, and the shift.
-fn relocate(moov: &Node, at: &Span) -> Result<(Node, usize, usize, i64), String> {
+fn relocate(moov: &Node, at: &Span) -> Result<(Node, usize, usize, i64), Error> {
     let old = (at.end - at.start) as i64;
     let mut shift = moov.size() as i64 - old;
     for _ in 0..8 {
@@ -239,11 +233,13 @@ fn relocate(moov: &Node, at: &Span) -> Result<(Node, usize, usize, i64), String>
         }
         shift = now;
     }
-    Err("the chunk offsets do not settle (more than 8 rounds of 64-bit promotion)".into())
+    Err(Error::malformed(
+        "the chunk offsets do not settle (more than 8 rounds of 64-bit promotion)",
+    ))
 }
 
 /// Moves the offsets of every `stco`, `co64` and `saio` in `moov`'s tracks.
-fn shift_tables(moov: &mut Node, at: &Span, shift: i64) -> Result<(usize, usize), String> {
+fn shift_tables(moov: &mut Node, at: &Span, shift: i64) -> Result<(usize, usize), Error> {
     let (mut tables, mut promoted) = (0, 0);
     let traks = moov.children_mut().expect("moov is a container");
     for trak in traks.iter_mut().filter(|t| &t.kind == b"trak") {
@@ -271,19 +267,20 @@ fn stbl_mut(trak: &mut Node) -> Option<&mut Vec<Node>> {
 
 /// Where offset `o` goes: past the movie box it moves by `shift`; inside it, or past the
 /// end of the file, is an error.
-fn moved(o: u64, at: &Span, shift: i64) -> Result<u64, String> {
+fn moved(o: u64, at: &Span, shift: i64) -> Result<u64, Error> {
     if o >= at.len {
-        Err(format!(
+        Err(Error::malformed(format!(
             "an offset ({o}) points past the end of the file ({} bytes): the file is truncated",
             at.len
-        ))
+        )))
     } else if o >= at.end {
-        Ok(o.checked_add_signed(shift).ok_or("an offset overflows")?)
+        o.checked_add_signed(shift)
+            .ok_or_else(|| Error::malformed("an offset overflows"))
     } else if o >= at.start {
-        Err(format!(
+        Err(Error::malformed(format!(
             "an offset ({o}) points inside the movie box ({}..{}); the file is corrupt",
             at.start, at.end
-        ))
+        )))
     } else {
         Ok(o)
     }
@@ -320,7 +317,7 @@ fn shifted(
     width: usize,
     at: &Span,
     shift: i64,
-) -> Result<Option<(Vec<u64>, bool)>, String> {
+) -> Result<Option<(Vec<u64>, bool)>, Error> {
     let new = old
         .iter()
         .map(|&o| moved(o, at, shift))
@@ -333,7 +330,7 @@ fn shifted(
 }
 
 /// `stco`/`co64`: whether any offset moved, and whether it became `co64`.
-fn shift_chunk_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, bool), String> {
+fn shift_chunk_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, bool), Error> {
     let p = t.payload().expect("a leaf");
     let (count, width) = movie::table(&t.kind, p)?;
     let Some((new, wide)) = shifted(&read_offsets(p, 8, count, width), width, at, shift)? else {
@@ -349,9 +346,9 @@ fn shift_chunk_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, boo
 
 /// `saio` (ISO/IEC 14496-12 §8.7.9): version 0 offsets are 32-bit, version 1 64-bit;
 /// `flags & 1` puts an aux_info_type and its parameter before the count.
-fn shift_aux_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, bool), String> {
+fn shift_aux_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, bool), Error> {
     let p = t.payload().expect("a leaf");
-    let short = || format!("{} is cut short", name(&t.kind));
+    let short = || Error::malformed(format!("{} is cut short", name(&t.kind)));
     let (version, flags) = (
         *p.first().ok_or_else(short)?,
         be_u32(p, 0).ok_or_else(short)? & 0xFF_FFFF,
@@ -360,10 +357,10 @@ fn shift_aux_offsets(t: &mut Node, at: &Span, shift: i64) -> Result<(bool, bool)
     let count = be_u32(p, head).ok_or_else(short)? as usize;
     let width = if version == 0 { 4 } else { 8 };
     if (p.len() - head - 4) / width < count {
-        return Err(format!(
+        return Err(Error::malformed(format!(
             "'saio' declares {count} offsets but holds {} bytes",
             p.len() - head - 4
-        ));
+        )));
     }
     let old = read_offsets(p, head + 4, count, width);
     let Some((new, wide)) = shifted(&old, width, at, shift)? else {
@@ -424,9 +421,9 @@ mod tests {
         // An offset inside the old movie box is a corrupt file.
         let bad = moov_with(stco(&[150]));
         let e = relocate(&bad, &span(100, 100 + bad.size() - 8)).unwrap_err();
-        assert!(e.contains("inside"), "{e}");
+        assert!(e.to_string().contains("inside"), "{e}");
         let e = relocate(&moov, &Span { len: 4000, ..at }).unwrap_err();
-        assert!(e.contains("past the end"), "{e}");
+        assert!(e.to_string().contains("past the end"), "{e}");
     }
 
     #[test]

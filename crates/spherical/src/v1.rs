@@ -7,6 +7,7 @@ use crate::bmff::Node;
 use crate::mapping::{Crop, Mapping};
 use crate::v2::StereoMode;
 use crate::xml;
+use crate::Error;
 
 /// The `uuid` box's user type.
 pub const UUID: [u8; 16] = [
@@ -50,12 +51,11 @@ impl V1 {
 }
 
 /// The XML for `mapping` (an equirectangular one) of eyes of `w`×`h` pixels in `stereo`.
-pub fn xml(mapping: &Mapping, stereo: StereoMode, w: u32, h: u32) -> Result<String, String> {
+pub fn xml(mapping: &Mapping, stereo: StereoMode, w: u32, h: u32) -> Result<String, Error> {
     if !matches!(mapping, Mapping::Equirect { .. }) {
-        return Err(
-            "Spherical Video V1 describes only equirectangular video; leave out --v1 for a cube"
-                .into(),
-        );
+        return Err(Error::unfit(
+            "Spherical Video V1 describes only equirectangular video; leave out --v1 for a cube",
+        ));
     }
     let mut x = String::from(
         "<?xml version=\"1.0\"?><rdf:SphericalVideo\n\
@@ -76,10 +76,10 @@ pub fn xml(mapping: &Mapping, stereo: StereoMode, w: u32, h: u32) -> Result<Stri
             stereo.describe()
         )),
         other => {
-            return Err(format!(
+            return Err(Error::unfit(format!(
                 "Spherical Video V1 has no stereo mode {}",
                 other.describe()
-            ))
+            )))
         }
     }
     if *mapping != Mapping::FULL {
@@ -103,11 +103,11 @@ pub fn is_v1(payload: &[u8]) -> bool {
 }
 
 /// What a V1 `uuid` payload says.
-pub fn parse(payload: &[u8]) -> Result<V1, String> {
+pub fn parse(payload: &[u8]) -> Result<V1, Error> {
     let text = String::from_utf8_lossy(payload.get(16..).unwrap_or_default());
     let get = |k: &str| xml::value(&text, k).map(str::to_string);
     let spherical = get("Spherical")
-        .ok_or("the GSpherical XML has no Spherical element")?
+        .ok_or_else(|| Error::malformed("the GSpherical XML has no Spherical element"))?
         .eq_ignore_ascii_case("true");
     Ok(V1 {
         spherical,

@@ -16,6 +16,7 @@
 //! first, so they are written so.
 
 use crate::bmff::{be_u32, full_box, headers_in, name, FourCC, Node};
+use crate::Error;
 use mirrorball_core::Stereo;
 
 /// The name written in `svhd`.
@@ -186,21 +187,23 @@ pub fn sv3d(s: &Sv3d) -> Node {
 }
 
 /// `st3d`'s mode from its payload.
-pub fn parse_st3d(payload: &[u8]) -> Result<StereoMode, String> {
+pub fn parse_st3d(payload: &[u8]) -> Result<StereoMode, Error> {
     match payload {
         [0, _, _, _, mode, ..] => Ok(StereoMode::from_code(*mode)),
-        [v, _, _, _, _, ..] => Err(format!("'st3d' has version {v}; only version 0 is defined")),
-        _ => Err(format!(
+        [v, _, _, _, _, ..] => Err(Error::malformed(format!(
+            "'st3d' has version {v}; only version 0 is defined"
+        ))),
+        _ => Err(Error::malformed(format!(
             "'st3d' holds {} bytes, fewer than 5",
             payload.len()
-        )),
+        ))),
     }
 }
 
 /// The boxes in a payload, by type, as `(type, payload)`; unknown ones are passed over by
 /// the caller, as the specification asks.
-fn boxes(payload: &[u8], what: &str) -> Result<Vec<(FourCC, Vec<u8>)>, String> {
-    let (hs, _) = headers_in(payload, 0).map_err(|e| format!("in '{what}': {e}"))?;
+fn boxes(payload: &[u8], what: &str) -> Result<Vec<(FourCC, Vec<u8>)>, Error> {
+    let (hs, _) = headers_in(payload, 0).map_err(|e| e.within(format_args!("in '{what}'")))?;
     Ok(hs
         .iter()
         .map(|h| {
@@ -211,25 +214,25 @@ fn boxes(payload: &[u8], what: &str) -> Result<Vec<(FourCC, Vec<u8>)>, String> {
 }
 
 /// A full box's body after version 0 and its flags.
-fn version0<'a>(kind: &FourCC, p: &'a [u8]) -> Result<&'a [u8], String> {
+fn version0<'a>(kind: &FourCC, p: &'a [u8]) -> Result<&'a [u8], Error> {
     match p {
         [0, _, _, _, rest @ ..] => Ok(rest),
-        [v, ..] => Err(format!(
+        [v, ..] => Err(Error::malformed(format!(
             "{} has version {v}; only version 0 is defined",
             name(kind)
-        )),
-        [] => Err(format!("{} is empty", name(kind))),
+        ))),
+        [] => Err(Error::malformed(format!("{} is empty", name(kind)))),
     }
 }
 
 /// What an `sv3d` box's payload says.
-pub fn parse_sv3d(payload: &[u8]) -> Result<Sv3d, String> {
+pub fn parse_sv3d(payload: &[u8]) -> Result<Sv3d, Error> {
     let inner = boxes(payload, "sv3d")?;
     let find = |list: &[(FourCC, Vec<u8>)], k: &FourCC| {
         list.iter()
             .find(|(kind, _)| kind == k)
             .map(|(_, p)| p.clone())
-            .ok_or_else(|| format!("'sv3d' has no {} box", name(k)))
+            .ok_or_else(|| Error::malformed(format!("'sv3d' has no {} box", name(k))))
     };
     let svhd = find(&inner, b"svhd")?;
     let source = version0(b"svhd", &svhd)?;
@@ -241,23 +244,22 @@ pub fn parse_sv3d(payload: &[u8]) -> Result<Sv3d, String> {
     let field = |i: usize| {
         be_u32(body, 4 * i)
             .map(|v| v as i32)
-            .ok_or_else(|| "'prhd' is shorter than its three angles".to_string())
+            .ok_or_else(|| Error::malformed("'prhd' is shorter than its three angles"))
     };
     let pose = Pose {
         yaw: field(0)?,
         pitch: field(1)?,
         roll: field(2)?,
     };
-    let (kind, p) = proj
-        .iter()
-        .find(|(k, _)| k != b"prhd")
-        .ok_or("'proj' has no projection data box ('equi', 'cbmp' or 'mshp')")?;
+    let (kind, p) = proj.iter().find(|(k, _)| k != b"prhd").ok_or_else(|| {
+        Error::malformed("'proj' has no projection data box ('equi', 'cbmp' or 'mshp')")
+    })?;
     let data = projection_data(kind, p)?;
     Ok(Sv3d { source, pose, data })
 }
 
-fn projection_data(kind: &FourCC, p: &[u8]) -> Result<ProjectionData, String> {
-    let short = || format!("{} is shorter than its fields", name(kind));
+fn projection_data(kind: &FourCC, p: &[u8]) -> Result<ProjectionData, Error> {
+    let short = || Error::malformed(format!("{} is shorter than its fields", name(kind)));
     Ok(match kind {
         b"equi" => {
             let b = version0(kind, p)?;
@@ -273,10 +275,10 @@ fn projection_data(kind: &FourCC, p: &[u8]) -> Result<ProjectionData, String> {
             if u64::from(bounds.top) + u64::from(bounds.bottom) >= max
                 || u64::from(bounds.left) + u64::from(bounds.right) >= max
             {
-                return Err(format!(
+                return Err(Error::malformed(format!(
                     "'equi' crops everything (bounds top {}, bottom {}, left {}, right {} of 2^32)",
                     bounds.top, bounds.bottom, bounds.left, bounds.right
-                ));
+                )));
             }
             ProjectionData::Equirect(bounds)
         }
@@ -335,6 +337,7 @@ mod tests {
     fn bad_boxes_are_described() {
         assert!(parse_st3d(&[1, 0, 0, 0, 0])
             .unwrap_err()
+            .to_string()
             .contains("version 1"));
         assert!(parse_sv3d(&[0, 0, 0, 9, b'x']).is_err());
         let cube = Sv3d {
@@ -356,7 +359,9 @@ mod tests {
             }),
             ..cube
         };
-        let e = parse_sv3d(&sv3d(&all).to_bytes()[8..]).unwrap_err();
+        let e = parse_sv3d(&sv3d(&all).to_bytes()[8..])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("crops everything"), "{e}");
     }
 }

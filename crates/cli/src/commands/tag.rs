@@ -100,7 +100,7 @@ pub fn is_movie(input: &str) -> bool {
 /// `info` of a video: each video track's spherical metadata and how mirrorball reads it.
 pub fn info(input: &str, json: bool) -> Result<(), CliError> {
     let tracks = mirrorball_spherical::read(Path::new(input))?;
-    let described: Vec<(String, Result<Option<Reading>, String>)> =
+    let described: Vec<(String, Result<Option<Reading>, mirrorball_spherical::Error>)> =
         tracks.iter().map(|t| (boxes(t), t.reading())).collect();
     if json {
         let list: Vec<serde_json::Value> = tracks
@@ -163,7 +163,11 @@ fn boxes(t: &VideoTrack) -> String {
     }
 }
 
-fn track_json(t: &VideoTrack, b: &str, r: &Result<Option<Reading>, String>) -> serde_json::Value {
+fn track_json(
+    t: &VideoTrack,
+    b: &str,
+    r: &Result<Option<Reading>, mirrorball_spherical::Error>,
+) -> serde_json::Value {
     let (projection, layout, stereo, from, problem) = match r {
         Ok(Some(r)) => (
             Some(r.mapping.projection().to_string()),
@@ -173,7 +177,7 @@ fn track_json(t: &VideoTrack, b: &str, r: &Result<Option<Reading>, String>) -> s
             None,
         ),
         Ok(None) => (None, None, None, None, None),
-        Err(e) => (None, None, None, None, Some(e.clone())),
+        Err(e) => (None, None, None, None, Some(e.to_string())),
     };
     serde_json::json!({
         "codec": t.codec,

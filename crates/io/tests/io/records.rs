@@ -6,6 +6,7 @@ use mirrorball_core::glam::DVec3;
 use mirrorball_core::projection::ProjectionSpec;
 use mirrorball_core::{Fisheye, Frame, Image, Layout, Lens, Projection, ProjectionKind};
 use mirrorball_io::{read, write_cube, write_image, MapInfo, WriteOptions, LAYOUT_KEY};
+use std::path::Path;
 
 fn declared(info: MapInfo) -> WriteOptions {
     WriteOptions {
@@ -118,18 +119,23 @@ fn files_without_a_record_say_nothing_and_bad_records_say_what_they_hold() {
     }
 
     // A record this version cannot read: an error quoting it, not a guess.
-    let bad = MapInfo::from_texts("banana:fov=3", None, 8, 8).unwrap_err();
+    let bad = MapInfo::from_texts(Path::new("f.exr"), "banana:fov=3", None, 8, 8).unwrap_err();
+    assert_eq!(bad.fault(), mirrorball_io::Fault::Input);
+    assert_eq!(bad.path(), Path::new("f.exr"));
+    let bad = bad.to_string();
     assert!(
         bad.contains("mirrorball:projection = 'banana:fov=3'"),
         "{bad}"
     );
-    let bad = MapInfo::from_texts("cube", Some("diagonal"), 8, 8).unwrap_err();
+    let bad = MapInfo::from_texts(Path::new("f.exr"), "cube", Some("diagonal"), 8, 8)
+        .unwrap_err()
+        .to_string();
     assert!(
         bad.contains(LAYOUT_KEY) && bad.contains("diagonal"),
         "{bad}"
     );
     // A Mercator record without its limit takes it from the picture's shape.
-    let m = MapInfo::from_texts("mercator", None, 200, 100).unwrap();
+    let m = MapInfo::from_texts(Path::new("f.exr"), "mercator", None, 200, 100).unwrap();
     let want = ProjectionSpec::parse("mercator")
         .unwrap()
         .build(Some((200, 100)))
@@ -204,8 +210,12 @@ fn a_stereo_pair_is_recorded_with_its_eyes_layout() {
         }
     }
     // A pair that cannot halve is an unreadable record, said by name.
-    let e = MapInfo::from_texts("latlong", Some("sbs/separate"), 33, 16).unwrap_err();
+    let e = MapInfo::from_texts(Path::new("f.exr"), "latlong", Some("sbs/separate"), 33, 16)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains(LAYOUT_KEY) && e.contains("even width"), "{e}");
-    let e = MapInfo::from_texts("latlong", Some("3d/separate"), 32, 16).unwrap_err();
+    let e = MapInfo::from_texts(Path::new("f.exr"), "latlong", Some("3d/separate"), 32, 16)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("3d/separate"), "{e}");
 }
