@@ -128,6 +128,24 @@ pub fn pictures(
     pictures_into(obj, arg, lead_ok, linear, invalid, Vec::new())
 }
 
+/// `obj` as a numpy array: itself, or, for another array library's array on the CPU (a
+/// torch tensor, a JAX array: anything with `__dlpack__`), `numpy.from_dlpack(obj)`, the
+/// same memory without a copy. A tensor on a GPU is refused, naming `arg`.
+pub fn numpy_of<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, PyAny>> {
+    if obj.cast::<PyUntypedArray>().is_ok() || !obj.hasattr("__dlpack__")? {
+        return Ok(obj.clone());
+    }
+    let py = obj.py();
+    py.import("numpy")?
+        .call_method1("from_dlpack", (obj,))
+        .map_err(|e| {
+            PyTypeError::new_err(format!(
+                "{arg}: read through DLPack: {} (a tensor on a GPU: move it to the CPU first, tensor.cpu())",
+                e.value(py)
+            ))
+        })
+}
+
 /// [`pictures`] into `spare` (an earlier call's buffers, from [`Pictures::spare_of`]) where
 /// they are the right length: no allocation and no page faults for the frames of a loop.
 pub fn pictures_into(
@@ -138,6 +156,7 @@ pub fn pictures_into(
     invalid: Invalid,
     spare: Vec<Vec<f32>>,
 ) -> PyResult<Pictures> {
+    let obj = &numpy_of(obj, arg)?;
     let arr = obj.cast::<PyUntypedArray>().map_err(|_| {
         let ty = obj
             .get_type()
@@ -145,7 +164,7 @@ pub fn pictures_into(
             .map(|n| n.to_string())
             .unwrap_or_default();
         PyTypeError::new_err(format!(
-            "{arg}: a numpy array (H×W×C, C 3 or 4) is needed, not {ty} (torch: tensor.numpy())"
+            "{arg}: a numpy array (H×W×C, C 3 or 4), or an array with __dlpack__ on the CPU, is needed, not {ty}"
         ))
     })?;
     let shape = arr.shape().to_vec();

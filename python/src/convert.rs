@@ -821,6 +821,7 @@ impl Remap {
     ) -> PyResult<Bound<'py, PyAny>> {
         let want = arrays::dtype_arg(py, dtype)?;
         let invalid: Invalid = arrays::invalid_arg(invalid)?;
+        let array = &arrays::numpy_of(array, "array")?;
         if let Some(made) = self.apply_in_place(py, array, out, want, linear, invalid)? {
             return Ok(made);
         }

@@ -89,3 +89,37 @@ def test_ctrl_c_interrupts_a_long_call():
         signal.signal(signal.SIGALRM, old)
     # One band of rows at most after the signal, not the rest of the call.
     assert elapsed < 3.0, elapsed
+
+
+class Tensorish:
+    """Another library's CPU array as mirrorball meets it: only the DLPack protocol (what
+    torch tensors and JAX arrays offer), over a numpy array's memory."""
+
+    def __init__(self, a, device=(1, 0)):
+        self.a = a
+        self.device = device
+
+    def __dlpack__(self, **kwargs):
+        if self.device[0] != 1:
+            # What numpy meets in a GPU tensor's capsule.
+            raise BufferError("Unsupported device in DLTensor.")
+        return self.a.__dlpack__(**kwargs)
+
+    def __dlpack_device__(self):
+        return self.device
+
+
+def test_arrays_come_through_dlpack(smooth):
+    cube = mb.convert(smooth, dst="cube", size=16, layout="separate")
+    assert np.array_equal(mb.convert(Tensorish(smooth), dst="cube", size=16, layout="separate"), cube)
+    plan = mb.Remap(smooth.shape, dst="cube", size=16, layout="separate")
+    assert np.array_equal(plan.apply(Tensorish(smooth)), plan.apply(smooth))
+    codes = (smooth.clip(0, 1) * 255).astype(np.uint8)
+    assert np.array_equal(plan.apply(Tensorish(codes)), plan.apply(codes))
+    assert np.array_equal(mb.sh9(Tensorish(smooth)), mb.sh9(smooth))
+    # A tensor on a GPU (DLPack's device 2, CUDA) is refused, naming the argument.
+    with pytest.raises(TypeError, match="array: read through DLPack"):
+        mb.convert(Tensorish(smooth, device=(2, 0)), dst="cube", size=16)
+    # Neither numpy nor DLPack: a TypeError naming what is needed.
+    with pytest.raises(TypeError, match="__dlpack__"):
+        mb.convert([[1.0, 2.0, 3.0]], dst="cube", size=16)

@@ -17,6 +17,7 @@
 //!   complete ([`mirrorball_io::with_scratch`], [`mirrorball_io::atomic_write`]): a failure
 //!   or Ctrl-C leaves no half file.
 
+mod matroska;
 pub mod planes;
 
 extern crate ffmpeg_next as ffmpeg;
@@ -111,9 +112,16 @@ fn container(path: &str) -> &'static str {
     }
 }
 
-/// Whether the output is an ISO BMFF file that carries Spherical Video metadata.
+/// Whether the file is an ISO BMFF file that carries Spherical Video metadata (tagged
+/// after muxing by `mirrorball-spherical`).
 fn takes_metadata(path: &str) -> bool {
     matches!(container(path), "mp4" | "mov")
+}
+
+/// Whether the file is Matroska or WebM, whose 360° metadata FFmpeg muxes and demuxes as
+/// the video stream's side data ([`matroska`]).
+fn is_matroska(path: &str) -> bool {
+    matches!(container(path), "matroska" | "webm")
 }
 
 fn ff_input(input: &str, what: &str, e: ffmpeg::Error) -> Error {
@@ -178,23 +186,34 @@ pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
 
     // What the file's metadata says, unless the flags say it.
     let mut req = c.clone();
-    if takes_metadata(input) && (req.input_plan.from.is_none() || req.in_stereo.is_none()) {
+    let asks = req.input_plan.from.is_none() || req.in_stereo.is_none();
+    let mut said: Option<(Mapping, mirrorball_core::Stereo, String)> = None;
+    if takes_metadata(input) && asks {
         if let Ok(tracks) = spherical::read(Path::new(input)) {
-            if let Some(Ok(Some(said))) = tracks.first().map(|t| t.reading()) {
-                if req.input_plan.from.is_none() {
-                    let p = said.mapping.projection();
-                    req.input_plan.from = ProjSpec::parse(&p.to_string()).ok();
-                    req.input_plan.layout = req.input_plan.layout.or(said.mapping.layout());
-                }
-                req.in_stereo = req.in_stereo.or(Some(said.stereo));
-                hooks.note(&format!(
-                    "{input}: Spherical Video {} says {}, {}",
-                    said.from,
-                    said.mapping.projection(),
-                    said.stereo
-                ));
+            if let Some(Ok(Some(r))) = tracks.first().map(|t| t.reading()) {
+                said = Some((r.mapping, r.stereo, format!("Spherical Video {}", r.from)));
             }
         }
+    } else if asks {
+        match matroska::read(&vstream, extent) {
+            Some(Ok((mapping, stereo))) => {
+                said = Some((mapping, stereo, "its Projection element".into()));
+            }
+            Some(Err(e)) => hooks.note(&format!("{input}: {}; give --from", e.message)),
+            None => {}
+        }
+    }
+    if let Some((mapping, stereo, by)) = said {
+        if req.input_plan.from.is_none() {
+            let p = mapping.projection();
+            req.input_plan.from = ProjSpec::parse(&p.to_string()).ok();
+            req.input_plan.layout = req.input_plan.layout.or(mapping.layout());
+        }
+        req.in_stereo = req.in_stereo.or(Some(stereo));
+        hooks.note(&format!(
+            "{input}: {by} says {}, {stereo}",
+            mapping.projection()
+        ));
     }
     // The picture's plan, checked as for a frame written as PNG (what its layout, size and
     // stereo arrangement may be).
@@ -226,14 +245,32 @@ pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
     };
     let converter = Converter::new(fmt, extent, reading, &target)?;
     hooks.note(&format!("{input}: {}", converter.said));
-    let mapping = takes_metadata(output)
+    let states = takes_metadata(output) || is_matroska(output);
+    let mapping = states
         .then(|| Mapping::of(&dst, (dst.layer_count() > 1).then_some(layout)))
-        .flatten();
-    if takes_metadata(output) && mapping.is_none() {
+        .flatten()
+        .filter(|m| !is_matroska(output) || matroska::states(m));
+    if states && mapping.is_none() {
         hooks.note(&format!(
-            "{output}: Spherical Video metadata cannot state {dst}: written without it"
+            "{output}: {} cannot state {dst}: written without it",
+            if is_matroska(output) {
+                "Matroska's Projection element, as FFmpeg writes it,"
+            } else {
+                "Spherical Video metadata"
+            }
         ));
     }
+    // Matroska states it as it is muxed; an MP4 is tagged once muxed.
+    let (w, h) = converter.out_extent;
+    let eye = match plan.stereo {
+        mirrorball_core::Stereo::Mono => (w, h),
+        mirrorball_core::Stereo::SideBySide => (w / 2, h),
+        mirrorball_core::Stereo::TopBottom => (w, h / 2),
+    };
+    let muxed = mapping
+        .filter(|_| is_matroska(output))
+        .map(|m| (m, plan.stereo, eye));
+    let tagged = mapping.filter(|_| takes_metadata(output));
 
     let out_path = PathBuf::from(output);
     let started = Instant::now();
@@ -244,14 +281,14 @@ pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
             result = transcode(
                 r,
                 (source.take(), scratch),
-                &converter,
+                (&converter, muxed),
                 (vindex, in_tb, rate, pix),
                 counter,
             );
         });
         let frames = result?;
         // The file lands complete, with its metadata.
-        match mapping {
+        match tagged {
             Some(mapping) => {
                 let change = Change::Set {
                     mapping,
@@ -276,14 +313,15 @@ pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
         Ok::<_, Error>(frames)
     })?;
     let secs = started.elapsed().as_secs_f64();
-    let (w, h) = converter.out_extent;
     hooks.note(&format!(
         "wrote {output}: {frames} frames, {w}x{h} {}, {}{} in {secs:.1} s ({:.1} frames/s)",
         fmt.name,
         r.codec.as_deref().unwrap_or(default_codec(output)),
-        mapping
-            .map(|m| format!(", Spherical Video V2 {m:?}, {}", plan.stereo))
-            .unwrap_or_default(),
+        match (tagged, muxed) {
+            (Some(m), _) => format!(", Spherical Video V2 {m:?}, {}", plan.stereo),
+            (_, Some((m, stereo, _))) => format!(", Matroska Projection {m:?}, {stereo}"),
+            _ => String::new(),
+        },
         frames as f64 / secs.max(1e-9)
     ));
     Ok(())
@@ -300,12 +338,16 @@ fn default_codec(output: &str) -> &'static str {
 
 type Source = (format::context::Input, ffmpeg::decoder::Video);
 
+/// What a Matroska output states as it is muxed: the mapping, the stereo arrangement and
+/// one eye's size ([`matroska::state`]).
+type Muxed = (Mapping, mirrorball_core::Stereo, (u32, u32));
+
 /// Decodes, converts, encodes and muxes into `scratch` on three threads; returns the
 /// frames written.
 fn transcode(
     r: &VideoRequest,
     (source, scratch): (Option<Source>, &Path),
-    conv: &Converter,
+    (conv, muxed): (&Converter, Option<Muxed>),
     (vindex, in_tb, rate, pix): (usize, Rational, Rational, format::Pixel),
     counter: Arc<AtomicU64>,
 ) -> Result<u64, Error> {
@@ -372,6 +414,10 @@ fn transcode(
         .map_err(|e| Error::system(format!("{output}: {e}")))?;
     ost.set_parameters(&enc);
     ost.set_time_base(in_tb);
+    if let Some((mapping, stereo, eye)) = muxed {
+        // SAFETY: the stream is the output context's, its header not yet written.
+        unsafe { matroska::state(ost.as_mut_ptr(), &mapping, stereo, eye)? };
+    }
     let vost = ost.index();
     // Audio and subtitles copied as they are.
     let mut map: Vec<Option<usize>> = vec![None; ictx.nb_streams() as usize];

@@ -239,6 +239,111 @@ fn the_stereo_mode_is_written_and_read_back() {
     );
 }
 
+/// Matroska and WebM state the projection and stereo mode as their `Projection` and
+/// `StereoMode` elements (FFmpeg's muxer, from the stream's side data): ffprobe reads them
+/// back, a second conversion with no --from takes them from the file, and EAC (a mesh,
+/// which FFmpeg's muxer cannot write) is written without one, saying so.
+#[test]
+fn matroska_and_webm_state_the_projection_and_stereo_mode() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = source(dir.path(), "in.mp4", "yuv420p");
+    // WebM holds no AAC: its case reads the same video without the audio.
+    let silent = dir.path().join("silent.mp4");
+    ffmpeg(&[
+        "-i",
+        input.to_str().unwrap(),
+        "-an",
+        "-c",
+        "copy",
+        silent.to_str().unwrap(),
+    ]);
+    let cases = [
+        ("cube.mkv", "cube", mirrorball_core::Stereo::Mono, "cubemap"),
+        (
+            "ll.mkv",
+            "latlong",
+            mirrorball_core::Stereo::TopBottom,
+            "equirectangular",
+        ),
+        (
+            "ll.webm",
+            "latlong",
+            mirrorball_core::Stereo::SideBySide,
+            "equirectangular",
+        ),
+        (
+            "vr180.mkv",
+            "half-equirect",
+            mirrorball_core::Stereo::Mono,
+            "tiled equirectangular",
+        ),
+    ];
+    for (name, to, stereo, projection) in cases {
+        let out = dir.path().join(name);
+        let from = if name.ends_with(".webm") {
+            &silent
+        } else {
+            &input
+        };
+        let mut r = request(from, &out, to);
+        r.convert.stereo = Some(stereo);
+        r.convert.size = Some(64);
+        let notes = convert(&r).unwrap();
+        assert!(
+            notes.iter().any(|n| n.contains("Matroska Projection")),
+            "{name}: {notes:?}"
+        );
+        let sph = side_data(&out, "Spherical Mapping").expect("ffprobe reads the projection");
+        assert_eq!(sph["projection"], projection, "{name}: {sph}");
+        let st = side_data(&out, "Stereo 3D");
+        match stereo {
+            mirrorball_core::Stereo::Mono => assert!(st.is_none(), "{name}: {st:?}"),
+            mirrorball_core::Stereo::TopBottom => {
+                assert_eq!(st.unwrap()["type"], "top and bottom", "{name}")
+            }
+            mirrorball_core::Stereo::SideBySide => {
+                assert_eq!(st.unwrap()["type"], "side by side", "{name}")
+            }
+        }
+        // Read back by mirrorball with no --from: one eye, as the file says.
+        let again = dir.path().join(format!("again-{name}.mp4"));
+        let mut r = request(&out, &again, "cube");
+        r.convert.size = Some(16);
+        let notes = convert(&r).unwrap();
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains("its Projection element says")),
+            "{name}: {notes:?}"
+        );
+        let v = probe(
+            &again,
+            &[
+                "-select_streams",
+                "v:0",
+                "-show_entries",
+                "stream=width,height",
+            ],
+        );
+        // One eye read: 16² faces in c3x2, not a stereo pair's picture.
+        assert_eq!(
+            (
+                v["streams"][0]["width"].as_u64(),
+                v["streams"][0]["height"].as_u64()
+            ),
+            (Some(48), Some(32)),
+            "{name}"
+        );
+    }
+    let eac = dir.path().join("eac.mkv");
+    let notes = convert(&request(&input, &eac, "eac")).unwrap();
+    assert!(
+        notes.iter().any(|n| n.contains("written without it")),
+        "{notes:?}"
+    );
+    assert!(side_data(&eac, "Spherical Mapping").is_none());
+}
+
 /// Raw yuv420p frames of `path` decoded by ffmpeg, through `filter` if any.
 fn raw_frames(path: &Path, filter: Option<&str>) -> Vec<u8> {
     raw_frames_as(path, filter, "yuv420p")
