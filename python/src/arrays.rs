@@ -6,7 +6,7 @@
 use crate::errors::request;
 use half::f16;
 use mirrorball::frames::pipe::{PixFmt, SrgbTable};
-use mirrorball_core::Image;
+use mirrorball_core::{EnvMap, Image, Layout};
 use numpy::{
     Element, PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
 };
@@ -167,47 +167,8 @@ pub fn pictures_into(
             "{arg}: a numpy array (H×W×C, C 3 or 4), or an array with __dlpack__ on the CPU, is needed, not {ty}"
         ))
     })?;
-    let shape = arr.shape().to_vec();
-    let dims = |s: &[usize]| {
-        s.iter()
-            .map(|d| d.to_string())
-            .collect::<Vec<_>>()
-            .join("×")
-    };
+    let (shape, (h, w, c)) = checked_shape(arr, arg, lead_ok)?;
     let nd = shape.len();
-    if nd < 3 || !lead_ok.contains(&(nd - 3)) {
-        let want = match (*lead_ok.start(), *lead_ok.end()) {
-            (0, 0) => "H×W×C".to_string(),
-            (0, 1) => "H×W×C or N×H×W×C".to_string(),
-            (a, b) => format!("H×W×C with {a} to {b} dimensions before"),
-        };
-        return Err(request(
-            arg,
-            format!(
-                "an array of shape {} ({nd} dimensions); give {want} (a grey H×W array: np.dstack([a]*3))",
-                dims(&shape)
-            ),
-        ));
-    }
-    let (h, w, c) = (shape[nd - 3], shape[nd - 2], shape[nd - 1]);
-    if c != 3 && c != 4 {
-        return Err(request(
-            arg,
-            format!(
-                "shape {}: {c} channels; give 3 (RGB) or 4 (RGBA)",
-                dims(&shape)
-            ),
-        ));
-    }
-    if shape.contains(&0) {
-        return Err(request(
-            arg,
-            format!("shape {}: the array is empty", dims(&shape)),
-        ));
-    }
-    if h > u32::MAX as usize / 2 || w > u32::MAX as usize / 2 {
-        return Err(request(arg, format!("shape {}: too large", dims(&shape))));
-    }
     let lead = shape[..nd - 3].to_vec();
     let count: usize = lead.iter().product();
     let per = h * w * c;
@@ -266,6 +227,58 @@ pub fn pictures_into(
         lead,
         dtype,
     })
+}
+
+/// The shape of `arr` (the argument `arg`), checked: pictures H×W×C (C 3 or 4, none
+/// empty, each side within 2³¹) after a number of leading dimensions in `lead_ok`; the
+/// shape and (H, W, C).
+fn checked_shape(
+    arr: &Bound<'_, PyUntypedArray>,
+    arg: &str,
+    lead_ok: std::ops::RangeInclusive<usize>,
+) -> PyResult<(Vec<usize>, (usize, usize, usize))> {
+    let shape = arr.shape().to_vec();
+    let dims = |s: &[usize]| {
+        s.iter()
+            .map(|d| d.to_string())
+            .collect::<Vec<_>>()
+            .join("×")
+    };
+    let nd = shape.len();
+    if nd < 3 || !lead_ok.contains(&(nd - 3)) {
+        let want = match (*lead_ok.start(), *lead_ok.end()) {
+            (0, 0) => "H×W×C".to_string(),
+            (0, 1) => "H×W×C or N×H×W×C".to_string(),
+            (a, b) => format!("H×W×C with {a} to {b} dimensions before"),
+        };
+        return Err(request(
+            arg,
+            format!(
+                "an array of shape {} ({nd} dimensions); give {want} (a grey H×W array: np.dstack([a]*3))",
+                dims(&shape)
+            ),
+        ));
+    }
+    let (h, w, c) = (shape[nd - 3], shape[nd - 2], shape[nd - 1]);
+    if c != 3 && c != 4 {
+        return Err(request(
+            arg,
+            format!(
+                "shape {}: {c} channels; give 3 (RGB) or 4 (RGBA)",
+                dims(&shape)
+            ),
+        ));
+    }
+    if shape.contains(&0) {
+        return Err(request(
+            arg,
+            format!("shape {}: the array is empty", dims(&shape)),
+        ));
+    }
+    if h > u32::MAX as usize / 2 || w > u32::MAX as usize / 2 {
+        return Err(request(arg, format!("shape {}: too large", dims(&shape))));
+    }
+    Ok((shape, (h, w, c)))
 }
 
 /// `invalid='raise'` refusing an array holding `bad` NaN or infinite values.
@@ -534,6 +547,34 @@ pub fn to_numpy<'py>(
         Dtype::U8 => typed::<u8>(py, parts, shape, c, linear),
         Dtype::U16 => typed::<u16>(py, parts, shape, c, linear),
     }
+}
+
+/// A map as one numpy array: its layers L×H×W×C (H×W×C for one layer) with
+/// `Layout::Separate`, else packed into one picture by `layout`.
+pub fn map_to_numpy<'py>(
+    py: Python<'py>,
+    env: &EnvMap,
+    layout: Layout,
+    dtype: Dtype,
+    linear: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let c = env.channels();
+    if layout == Layout::Separate {
+        let parts: Vec<&[f32]> = env.layers().iter().map(Image::data).collect();
+        let mut shape = vec![env.height() as usize, env.width() as usize, c];
+        if parts.len() > 1 {
+            shape.insert(0, parts.len());
+        }
+        return to_numpy(py, &parts, &shape, c, dtype, linear);
+    }
+    let picture = layout.pack(env).ok_or_else(|| {
+        request(
+            "layout",
+            format!("{layout} does not fit a {} map", env.projection().kind()),
+        )
+    })?;
+    let shape = [picture.height() as usize, picture.width() as usize, c];
+    to_numpy(py, &[picture.data()], &shape, c, dtype, linear)
 }
 
 /// `out=`: a writable C-contiguous array of `shape` and `dtype`, checked.

@@ -8,7 +8,7 @@ use crate::errors::{self, by_fault, request};
 use crate::threads::run;
 use mirrorball::io::{ExrCompression, Format, Limits, Precision, WriteOptions};
 use mirrorball::save::SaveOptions;
-use mirrorball_core::{Choice, Image};
+use mirrorball_core::Choice;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
@@ -79,14 +79,45 @@ pub fn read<'py>(
     info.set_item("decided", &source.decided)?;
     info.set_item("description", &source.description)?;
     info.set_item("invalid", source.invalid)?;
-    let c = env.channels();
-    let parts: Vec<&[f32]> = env.layers().iter().map(Image::data).collect();
-    let mut shape = vec![env.height() as usize, env.width() as usize, c];
-    if parts.len() > 1 {
-        shape.insert(0, parts.len());
-    }
-    let array = arrays::to_numpy(py, &parts, &shape, c, dtype, linear)?;
+    let array = arrays::map_to_numpy(py, env, mirrorball::Layout::Separate, dtype, linear)?;
     Ok((array, info))
+}
+
+/// `write`'s arguments about the container, checked against `format`: the precision asked
+/// for and OpenEXR's compression.
+fn container_args(
+    format: Format,
+    precision: Option<&str>,
+    compression: Option<&str>,
+    quality: i64,
+    mips: bool,
+) -> PyResult<(Option<Precision>, ExrCompression)> {
+    let precision = precision
+        .map(|p| p.parse::<Precision>().map_err(|e| request("precision", e)))
+        .transpose()?;
+    if let Some(p) = precision.filter(|p| !format.precisions().contains(p)) {
+        return Err(request(
+            "precision",
+            format!("{} does not apply to {}", p.name(), format.name()),
+        ));
+    }
+    let exr_compression = compression
+        .map(|c| {
+            c.parse::<ExrCompression>()
+                .map_err(|e| request("compression", e))
+        })
+        .transpose()?
+        .unwrap_or_default();
+    if compression.is_some() && format != Format::Exr {
+        return Err(request("compression", "applies to .exr only"));
+    }
+    if mips && !format.is_cube_container() {
+        return Err(request("mips", "applies to .ktx2 and .dds only"));
+    }
+    if !(1..=100).contains(&quality) {
+        return Err(request("quality", format!("{quality} is outside 1..=100")));
+    }
+    Ok((precision, exr_compression))
 }
 
 /// Writes a map to `path` as the CLI's `convert` writes its output (the extension picks the
@@ -122,31 +153,8 @@ pub fn write(
     let invalid = arrays::invalid_arg(invalid)?;
     let format =
         mirrorball::save::check_container(&text).map_err(|e| request("path", e.message))?;
-    let precision = precision
-        .map(|p| p.parse::<Precision>().map_err(|e| request("precision", e)))
-        .transpose()?;
-    if let Some(p) = precision.filter(|p| !format.precisions().contains(p)) {
-        return Err(request(
-            "precision",
-            format!("{} does not apply to {}", p.name(), format.name()),
-        ));
-    }
-    let exr_compression = compression
-        .map(|c| {
-            c.parse::<ExrCompression>()
-                .map_err(|e| request("compression", e))
-        })
-        .transpose()?
-        .unwrap_or_default();
-    if compression.is_some() && format != Format::Exr {
-        return Err(request("compression", "applies to .exr only"));
-    }
-    if mips && !format.is_cube_container() {
-        return Err(request("mips", "applies to .ktx2 and .dds only"));
-    }
-    if !(1..=100).contains(&quality) {
-        return Err(request("quality", format!("{quality} is outside 1..=100")));
-    }
+    let (precision, exr_compression) =
+        container_args(format, precision, compression, quality, mips)?;
     let layout = layout_arg("layout", layout)?;
     let write_precision = |dtype: Dtype| {
         precision.or_else(|| {

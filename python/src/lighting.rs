@@ -62,6 +62,58 @@ pub fn prefilter<'py>(
     invalid: &str,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let source = Source::new(src, src_layout)?;
+    let req = chain_request(
+        lobe,
+        dst,
+        (size, levels, mapping),
+        (samples, cube_size),
+        irradiance,
+    )?;
+    let out = req.to;
+    let layout = crate::convert::layout_arg("layout", layout)?
+        .unwrap_or_else(|| Layout::default_for(out.kind()));
+    if !layout.fits(out.layer_count()) {
+        return Err(request(
+            "layout",
+            format!("{layout} does not fit a {} map", out.kind()),
+        ));
+    }
+    let want = arrays::dtype_arg(py, dtype)?;
+    let pics_dtype = array
+        .getattr("dtype")
+        .and_then(|d| d.getattr("name"))
+        .and_then(|n| n.extract::<String>())
+        .ok();
+    let env = one_map(array, &source, linear, invalid)?;
+    let dtype = want.unwrap_or(match pics_dtype.as_deref() {
+        Some("float16") => Dtype::F16,
+        Some("uint8") => Dtype::U8,
+        Some("uint16") => Dtype::U16,
+        _ => Dtype::F32,
+    });
+    let chain = py
+        .detach(|| {
+            run(|| {
+                let shape = shape(&env, &req)?;
+                chain(&env, &req, &shape, &Quiet)
+            })
+        })
+        .map_err(lib_error)?
+        .levels;
+    chain
+        .iter()
+        .map(|level| arrays::map_to_numpy(py, level, layout, dtype, linear))
+        .collect()
+}
+
+/// `prefilter`'s arguments as the library's chain request, each checked by its name.
+fn chain_request(
+    lobe: &str,
+    dst: &str,
+    (size, levels, mapping): (Option<i64>, Option<usize>, &str),
+    (samples, cube_size): (u32, Option<u32>),
+    irradiance: &str,
+) -> PyResult<ChainRequest> {
     let kind = lobe.parse::<LobeKind>().map_err(|e| request("lobe", e))?;
     let out = spec_arg("dst", dst)?
         .build(None)
@@ -89,33 +141,12 @@ pub fn prefilter<'py>(
     if levels == Some(0) {
         return Err(request("levels", "0; give 1 or more"));
     }
-    let layout = crate::convert::layout_arg("layout", layout)?
-        .unwrap_or_else(|| Layout::default_for(out.kind()));
-    if !layout.fits(out.layer_count()) {
-        return Err(request(
-            "layout",
-            format!("{layout} does not fit a {} map", out.kind()),
-        ));
-    }
-    let want = arrays::dtype_arg(py, dtype)?;
-    let pics_dtype = array
-        .getattr("dtype")
-        .and_then(|d| d.getattr("name"))
-        .and_then(|n| n.extract::<String>())
-        .ok();
-    let env = one_map(array, &source, linear, invalid)?;
-    let dtype = want.unwrap_or(match pics_dtype.as_deref() {
-        Some("float16") => Dtype::F16,
-        Some("uint8") => Dtype::U8,
-        Some("uint16") => Dtype::U16,
-        _ => Dtype::F32,
-    });
     let size = match size {
         Some(s) if (1..=16384).contains(&s) => Some(s as u32),
         Some(s) => return Err(request("size", format!("{s} is outside 1..=16384"))),
         None => None,
     };
-    let req = ChainRequest {
+    Ok(ChainRequest {
         size,
         levels,
         mapping,
@@ -126,55 +157,7 @@ pub fn prefilter<'py>(
             ..Default::default()
         },
         ..ChainRequest::new(kind, out)
-    };
-    let chain = py
-        .detach(|| {
-            run(|| {
-                let shape = shape(&env, &req)?;
-                chain(&env, &req, &shape, &Quiet)
-            })
-        })
-        .map_err(lib_error)?
-        .levels;
-    let c = env.channels();
-    chain
-        .iter()
-        .map(|level| {
-            let (parts, shape) = if layout == Layout::Separate {
-                let parts: Vec<&[f32]> = level.layers().iter().map(|l| l.data()).collect();
-                let mut shape = vec![
-                    level.height() as usize,
-                    level.width() as usize,
-                    level.channels(),
-                ];
-                if parts.len() > 1 {
-                    shape.insert(0, parts.len());
-                }
-                (parts, shape)
-            } else {
-                (Vec::new(), Vec::new())
-            };
-            if layout == Layout::Separate {
-                return arrays::to_numpy(py, &parts, &shape, c, dtype, linear);
-            }
-            let picture = layout
-                .pack(level)
-                .ok_or_else(|| request("layout", "does not fit"))?;
-            let shape = [
-                picture.height() as usize,
-                picture.width() as usize,
-                picture.channels(),
-            ];
-            arrays::to_numpy(
-                py,
-                &[picture.data()],
-                &shape,
-                picture.channels(),
-                dtype,
-                linear,
-            )
-        })
-        .collect()
+    })
 }
 
 /// The radiance's nine spherical-harmonic coefficients (orthonormal real basis, world axes:
