@@ -51,7 +51,7 @@ pub mod tone;
 pub use camera::{Camera, CameraLens, Rays};
 pub use capture::{capture_cube, render_fisheye};
 pub use cpu::set_portable;
-pub use load::{load_mesh, MeshError, MAX_EXTENT};
+pub use load::{load_mesh, load_mesh_bytes, MeshError, MAX_EXTENT};
 pub use lookup::{EnvCache, SpecularLobe};
 pub use maps::phong_sphere_map;
 pub use mesh::{Builtin, Mesh};

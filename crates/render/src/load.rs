@@ -79,13 +79,48 @@ fn open_failure(path: &Path) -> (Fault, Option<String>) {
 /// assert_eq!(err.to_string(), "no/such/mesh.obj: no such file");
 /// ```
 pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
+    let ext = mesh_ext(path)?;
+    if let Some((fault, problem)) = mirrorball_core::input_file_problem(&std::fs::metadata(path)) {
+        return Err(MeshError::new(path, fault, problem));
+    }
+    parsed(path, &ext, || match ext.as_str() {
+        "glb" | "gltf" => load_gltf(path),
+        _ => load_obj(path),
+    })
+}
+
+/// Reads a mesh from the bytes of a `.glb`, `.gltf` or `.obj` file called `name` (its
+/// extension says which; messages name it), as [`load_mesh`] reads the file: an uploaded
+/// mesh, with no file written. A `.gltf` must carry its buffers inside (data URIs): a file
+/// it names beside it is refused, naming the file.
+///
+/// ```
+/// use mirrorball_render::load_mesh_bytes;
+/// let mesh = load_mesh_bytes("tri.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+/// assert_eq!(mesh.triangles.len(), 1);
+/// let err = load_mesh_bytes("empty.glb", b"").unwrap_err();
+/// assert_eq!(err.to_string(), "empty.glb: the file is empty");
+/// ```
+pub fn load_mesh_bytes(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let path = Path::new(name);
+    let ext = mesh_ext(path)?;
+    if bytes.is_empty() {
+        return Err(MeshError::input(path, "the file is empty"));
+    }
+    parsed(path, &ext, || match ext.as_str() {
+        "glb" | "gltf" => gltf_slice(path, bytes),
+        _ => obj_bytes(path, bytes),
+    })
+}
+
+/// The lower-case extension of a mesh file's name, or the request's error when no reader
+/// takes it (whatever the file holds).
+fn mesh_ext(path: &Path) -> Result<String, MeshError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
-    // A format no reader takes is the request's fault, whatever the file; then missing, a
-    // directory or empty: said so before a parser sees it.
     if !matches!(ext.as_str(), "glb" | "gltf" | "obj") {
         return Err(MeshError::new(
             path,
@@ -93,15 +128,18 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
             "unknown mesh format (known: .glb .gltf .obj)",
         ));
     }
-    if let Some((fault, problem)) = mirrorball_core::input_file_problem(&std::fs::metadata(path)) {
-        return Err(MeshError::new(path, fault, problem));
-    }
-    // The parsers are other crates': a panic on malformed data (gltf-json 1.4 indexes the
-    // accessors with a POSITION attribute's index before checking it) becomes an error.
-    let parse = || match ext.as_str() {
-        "glb" | "gltf" => load_gltf(path),
-        _ => load_obj(path),
-    };
+    Ok(ext)
+}
+
+/// The mesh `parse` reads from `path` (of extension `ext`), checked: a parser's panic on
+/// malformed data (the parsers are other crates': gltf-json 1.4 indexes the accessors with
+/// a POSITION attribute's index before checking it) becomes an error, and a mesh with no
+/// triangles, invalid indices or an extent too large to frame is refused.
+fn parsed(
+    path: &Path,
+    ext: &str,
+    parse: impl FnOnce() -> Result<Mesh, MeshError>,
+) -> Result<Mesh, MeshError> {
     let mesh =
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse)).unwrap_or_else(|_| {
             Err(MeshError::input(
@@ -149,24 +187,53 @@ fn check_extent(mesh: &Mesh) -> Result<(), String> {
     Ok(())
 }
 
+const DRACO: &str =
+    "Draco-compressed glTF (KHR_draco_mesh_compression) is not supported; decompress it first";
+
+/// glTF's import error as the mesh's: Draco named, an I/O failure the file's own or what
+/// it refers to ([`open_failure`], `fault_of_io`), else the content's.
+fn gltf_error(path: &Path, e: gltf::Error, fault_of_io: impl FnOnce() -> Fault) -> MeshError {
+    let msg = e.to_string();
+    if msg.contains("draco") || msg.contains("KHR_draco") {
+        MeshError::input(
+            path,
+            format!("{DRACO} (e.g. gltf-transform, or the OBJ in assets/meshes)"),
+        )
+    } else {
+        let fault = match e {
+            gltf::Error::Io(_) => fault_of_io(),
+            _ => Fault::Input,
+        };
+        MeshError::new(path, fault, msg)
+    }
+}
+
 fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
-    const DRACO: &str =
-        "Draco-compressed glTF (KHR_draco_mesh_compression) is not supported; decompress it first";
-    let (doc, buffers, _images) = gltf::import(path).map_err(|e| {
-        let msg = e.to_string();
-        if msg.contains("draco") || msg.contains("KHR_draco") {
-            MeshError::input(
-                path,
-                format!("{DRACO} (e.g. gltf-transform, or the OBJ in assets/meshes)"),
-            )
-        } else {
-            let fault = match e {
-                gltf::Error::Io(_) => open_failure(path).0,
-                _ => Fault::Input,
-            };
-            MeshError::new(path, fault, msg)
-        }
+    let (doc, buffers, _images) =
+        gltf::import(path).map_err(|e| gltf_error(path, e, || open_failure(path).0))?;
+    gltf_mesh(path, &doc, &buffers)
+}
+
+/// A `.glb` or self-contained `.gltf` from its bytes (`path` names it in messages); a
+/// buffer in another file is the input's fault, named.
+fn gltf_slice(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let (doc, buffers, _images) = gltf::import_slice(bytes).map_err(|e| match e {
+        gltf::Error::ExternalReferenceInSliceImport => MeshError::input(
+            path,
+            "names a buffer or image in another file: give a .glb, or a .gltf with its buffers inside",
+        ),
+        e => gltf_error(path, e, || Fault::Input),
     })?;
+    gltf_mesh(path, &doc, &buffers)
+}
+
+/// Every triangle primitive of every mesh instanced in the default (or first) scene of
+/// `doc`, with its node's world transform.
+fn gltf_mesh(
+    path: &Path,
+    doc: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+) -> Result<Mesh, MeshError> {
     if doc
         .extensions_required()
         .any(|e| e == "KHR_draco_mesh_compression")
@@ -231,13 +298,17 @@ fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
     Ok(out)
 }
 
-fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
-    let opts = tobj::LoadOptions {
+/// How OBJ files are read: triangulated, one index per vertex.
+fn obj_options() -> tobj::LoadOptions {
+    tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
-    };
-    let (models, _mtl) = tobj::load_obj(path, &opts).map_err(|e| {
+    }
+}
+
+fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
+    let (models, _mtl) = tobj::load_obj(path, &obj_options()).map_err(|e| {
         // tobj keeps no I/O error kind. Its read error is, on a file that opened, a line
         // that is not UTF-8: the content, as is every other error.
         match (&e, open_failure(path)) {
@@ -247,6 +318,22 @@ fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
             _ => MeshError::input(path, e.to_string()),
         }
     })?;
+    obj_mesh(path, models)
+}
+
+/// An OBJ from its bytes (`path` names it in messages); the materials it names are not
+/// read (the renderer takes none from them).
+fn obj_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let (models, _mtl) =
+        tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &obj_options(), |_| {
+            Ok(Default::default())
+        })
+        .map_err(|e| MeshError::input(path, e.to_string()))?;
+    obj_mesh(path, models)
+}
+
+/// OBJ's models as one mesh: normals made where the file has none.
+fn obj_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<Mesh, MeshError> {
     let mut out = Mesh::default();
     for m in models {
         let mm = m.mesh;

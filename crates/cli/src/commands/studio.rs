@@ -172,21 +172,11 @@ impl CliHost {
             .map_err(|e| studio_error(CliError::from(e), &shown, name))
     }
 
-    /// `read` of `bytes` stored as a file with extension `ext` in a folder of its own,
-    /// removed afterwards (the readers take paths).
-    fn stored<T>(
-        name: &str,
-        ext: &str,
-        bytes: &[u8],
-        read: impl FnOnce(&Path) -> Result<T, StudioError>,
-    ) -> Result<T, StudioError> {
-        let dir = private_dir("upload").map_err(|e| cannot_store(name, e))?;
-        let path = dir.join(format!("upload.{ext}"));
-        let result = std::fs::write(&path, bytes)
-            .map_err(|e| StudioError::io(format!("{name}: cannot store the upload"), &e))
-            .and_then(|()| read(&path));
-        let _ = std::fs::remove_dir_all(&dir);
-        result
+    /// The mesh uploaded as `name` (its extension says the format), read from its bytes as
+    /// `render` reads mesh files.
+    fn mesh_bytes(name: &str, bytes: &[u8]) -> Result<mirrorball_render::Mesh, StudioError> {
+        mirrorball_render::load_mesh_bytes(name, bytes)
+            .map_err(|e| studio_error(CliError::from(e), name, name))
     }
 }
 
@@ -328,12 +318,9 @@ impl Host for CliHost {
             return CliHost::uploaded_scene(name, ext, bytes, alongside);
         }
         if is_mesh(Path::new(name)) {
-            return CliHost::stored(name, ext, bytes, |path| {
-                let mesh = CliHost::mesh(path, name)?;
-                Ok(Opened::Mesh {
-                    name: name.to_string(),
-                    mesh: Box::new(mesh),
-                })
+            return Ok(Opened::Mesh {
+                name: name.to_string(),
+                mesh: Box::new(CliHost::mesh_bytes(name, bytes)?),
             });
         }
         CliHost::uploaded_environment(name, bytes)
@@ -345,7 +332,7 @@ impl Host for CliHost {
 
     fn bundled_mesh(&self, name: &str) -> Result<mirrorball_render::Mesh, StudioError> {
         match name {
-            "bunny" => CliHost::stored(name, "obj", BUNNY, |path| CliHost::mesh(path, name)),
+            "bunny" => CliHost::mesh_bytes("bunny.obj", BUNNY),
             _ => Err(StudioError::request(format!("no bundled mesh {name}"))),
         }
     }

@@ -6,9 +6,9 @@
 #[path = "../../../io/tests/io/mutate.rs"]
 mod mutate;
 
-use mirrorball_render::load_mesh;
 use mirrorball_render::mesh::MAX_TRIANGLES;
 use mirrorball_render::Builtin;
+use mirrorball_render::{load_mesh, load_mesh_bytes};
 use mutate::{apply_script, mutations};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -34,11 +34,21 @@ fn corpus(format: &str) -> Vec<PathBuf> {
 }
 
 /// Loads `path`: an error that starts with the file's name, or a mesh that validates and
-/// has triangles. Returns how long it took.
+/// has triangles; and its bytes, as an upload is read: the same mesh, or an error where
+/// the file's is (or where the file names another, which bytes alone cannot hold). Returns
+/// how long the file took.
 fn check_load(path: &Path) -> Duration {
     let start = Instant::now();
     let result = load_mesh(path);
     let took = start.elapsed();
+    let name = path.file_name().unwrap().to_string_lossy().into_owned();
+    let from_bytes = load_mesh_bytes(&name, &std::fs::read(path).unwrap());
+    match (&result, &from_bytes) {
+        (Ok(a), Ok(b)) => assert_eq!(a, b, "{name}: the bytes' mesh is the file's"),
+        (Err(_), Err(e)) => assert!(e.to_string().starts_with(&name), "{e}"),
+        (Ok(_), Err(e)) => assert!(e.to_string().contains("another file"), "{name}: {e}"),
+        (Err(e), Ok(_)) => panic!("{name}: read from its bytes, though the file gives {e}"),
+    }
     match result {
         Err(e) => {
             assert_eq!(e.fault(), mirrorball_core::Fault::Input, "{e}");
