@@ -22,7 +22,7 @@ use crate::envmap::{bilinear_blend, bilinear_mix, lerp4, seam_taps};
 use crate::projection::{Projection, WorldProjection};
 use crate::resample::{Job, PointScratch, Pyramid, PyramidPlan, PyramidSpare, RowScratch};
 use crate::{Codes, EnvMap, Image, ResampleOptions};
-use mirrorball_simd::{prefetch, F32x4};
+use mirrorball_simd::{prefetch, F32x4, Pairs};
 use rayon::prelude::*;
 use std::fmt;
 use std::sync::Mutex;
@@ -660,10 +660,94 @@ fn gather_row<const C: usize>(
     stride: usize,
     row: &mut [f32],
 ) {
+    if C == 1 {
+        // One channel (a plane of a YUV frame): four texels at a time.
+        if single {
+            if let Some(p) = Pairs::new([planes[0]], stride) {
+                return gather_row_one(entries, &p, planes, stride, row);
+            }
+        } else {
+            // Every slot a layer: those past the source's layers (never named by an entry)
+            // read the first.
+            let all = planes.map(|p| if p.is_empty() { planes[0] } else { p });
+            if let Some(p) = Pairs::new(all, stride) {
+                return gather_row_one(entries, &p, planes, stride, row);
+            }
+        }
+    }
     if single {
         gather_row_lanes::<C, true>(entries, planes, stride, row)
     } else {
         gather_row_lanes::<C, false>(entries, planes, stride, row)
+    }
+}
+
+/// The bilinear pass of a one-channel source, four output texels at a time: each texel's
+/// top and bottom pairs read at once ([`Pairs`]), turned into lanes and blended with
+/// `lerp4`'s arithmetic lane by lane, so the same bits as [`gather_one`], which makes the
+/// texels [`Pairs`] cannot read (an empty entry, a footprint past the end) and the row's
+/// last few. `N`: 1 for a one-layer source (the layer bits not decoded), else
+/// [`MAX_LAYERS`].
+#[inline(always)]
+fn gather_row_one<const N: usize>(
+    entries: &[Texel],
+    pairs: &Pairs<'_, N>,
+    planes: &[&[f32]; MAX_LAYERS],
+    stride: usize,
+    row: &mut [f32],
+) {
+    const Q: f32 = 1.0 / 65536.0;
+    let n = row.len().min(entries.len());
+    let last = pairs.last();
+    let layer = |idx: u32| {
+        if N == 1 {
+            0
+        } else {
+            (idx >> INDEX_BITS) as usize & (N - 1)
+        }
+    };
+    let slices = if N == 1 {
+        [planes[0]; MAX_LAYERS]
+    } else {
+        *planes
+    };
+    let blocks = n / 4 * 4;
+    for x in (0..blocks).step_by(4) {
+        // The source texels of the entries a few ahead, asked for now (see
+        // `gather_row_lanes`).
+        if let Some(ahead) = entries.get(x + AHEAD..x + AHEAD + 4) {
+            for a in ahead {
+                let data = slices[layer(a.idx)];
+                let i = (a.idx & INDEX_MASK) as usize;
+                if i <= last {
+                    let p = data.as_ptr().wrapping_add(i);
+                    prefetch(p);
+                    prefetch(p.wrapping_add(stride));
+                }
+            }
+        }
+        let e: &[Texel; 4] = entries[x..x + 4].try_into().expect("four entries");
+        let i = e.map(|t| (t.idx & INDEX_MASK) as usize);
+        let [a, b, c, d] = pairs.get(e.map(|t| layer(t.idx)), i);
+        let q = F32x4::splat(Q);
+        let fx = F32x4::from_array(e.map(|t| t.fx as f32)) * q;
+        let fy = F32x4::from_array(e.map(|t| t.fy as f32)) * q;
+        let top = a + fx * (b - a);
+        let bot = c + fx * (d - c);
+        (top + fy * (bot - top)).store(&mut row[x..x + 4]);
+        // An empty entry's index (NO_TEXEL's, all ones) is past `last`, as is a footprint
+        // that would read past the end: those lanes were read clamped and are made again.
+        for (k, t) in e.iter().enumerate() {
+            if i[k] > last {
+                gather_one::<1>(t, planes, stride, &mut row[x + k..x + k + 1]);
+            }
+        }
+    }
+    for x in blocks..row.len() {
+        match entries.get(x) {
+            Some(t) => gather_one::<1>(t, planes, stride, &mut row[x..x + 1]),
+            None => row[x] = 0.0,
+        }
     }
 }
 
@@ -1024,7 +1108,9 @@ fn push_bilinear(
 
 #[cfg(test)]
 mod tests {
-    use super::quantize_fraction;
+    use super::{
+        gather_one, gather_row, quantize_fraction, Texel, INDEX_BITS, MAX_LAYERS, NO_TEXEL,
+    };
     use crate::{EnvMap, Image, ProjectionKind, Remap, ResampleOptions};
 
     /// A one-channel source (one plane of a YUV frame) is converted as the first channel of
@@ -1062,6 +1148,69 @@ mod tests {
                         (x - t[0]).abs() <= 1e-4 * t[0].abs().max(1.0),
                         "{x} {}",
                         t[0]
+                    );
+                }
+            }
+        }
+    }
+
+    /// The one-channel pass (four texels at a time) gives [`gather_one`]'s bits for every
+    /// entry: empty ones, footprints at the image's last texels and past them, rows whose
+    /// length is not a multiple of four, one layer and several.
+    #[test]
+    fn one_channel_rows_are_the_reference_bits() {
+        let (sw, sh) = (37usize, 11usize);
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 33) as u32
+        };
+        let layers: Vec<Vec<f32>> = (0..3)
+            .map(|_| {
+                (0..sw * sh)
+                    .map(|_| next() as f32 / 7919.0 - 1000.0)
+                    .collect()
+            })
+            .collect();
+        let len = sw * sh;
+        for n_layers in [1usize, 3] {
+            let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
+            for (p, l) in planes.iter_mut().zip(&layers[..n_layers]) {
+                *p = l;
+            }
+            for w in [1usize, 3, 4, 5, 8, 31, 64] {
+                let entries: Vec<Texel> = (0..w)
+                    .map(|x| {
+                        let r = next();
+                        let idx = match r % 8 {
+                            0 => NO_TEXEL,
+                            // The last footprints that fit, and the first that do not.
+                            1 => (len - sw - 2 + (r as usize / 8) % 3) as u32,
+                            _ => (r as usize / 8 % (len - sw - 1)) as u32,
+                        };
+                        let layer = if idx == NO_TEXEL {
+                            0
+                        } else {
+                            (x % n_layers) as u32
+                        };
+                        Texel {
+                            idx: idx | layer << INDEX_BITS,
+                            fx: next() as u16,
+                            fy: if x % 5 == 0 { 0 } else { next() as u16 },
+                        }
+                    })
+                    .collect();
+                let mut fast = vec![f32::NAN; w];
+                gather_row::<1>(&entries, &planes, n_layers == 1, sw, &mut fast);
+                for (x, t) in entries.iter().enumerate() {
+                    let mut want = [f32::NAN];
+                    gather_one::<1>(t, &planes, sw, &mut want);
+                    assert_eq!(
+                        fast[x].to_bits(),
+                        want[0].to_bits(),
+                        "{n_layers} layers, width {w}, texel {x}: {t:?}"
                     );
                 }
             }

@@ -143,6 +143,68 @@ impl<'a, const N: usize> Taps<'a, N> {
     }
 }
 
+/// Bilinear footprints of one-channel layers, four at a time: for four base indices, the
+/// two floats at `i` and `i + 1` and the two at `i + dy` and `i + dy + 1` (a footprint's
+/// top and bottom pairs, `dy` the row stride), each pair read at once and the four bases'
+/// reads turned into lanes. As [`Taps`], safe by construction: [`Pairs::new`] checks once
+/// that the reads from base [`Pairs::last`] stay inside, and [`Pairs::get`] clamps each
+/// base to it.
+///
+/// ```
+/// use mirrorball_simd::Pairs;
+/// let a: Vec<f32> = (0..16).map(|i| i as f32).collect();
+/// let p = Pairs::new([&a[..]], 8).unwrap();
+/// assert_eq!(p.last(), 6); // 6 + 8 + 2 = 16
+/// let [t0, t1, b0, b1] = p.get([0; 4], [0, 2, 5, 99]);
+/// assert_eq!((t0.to_array(), t1.to_array()), ([0.0, 2.0, 5.0, 6.0], [1.0, 3.0, 6.0, 7.0]));
+/// assert_eq!((b0.to_array(), b1.to_array()), ([8.0, 10.0, 13.0, 14.0], [9.0, 11.0, 14.0, 15.0]));
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct Pairs<'a, const N: usize> {
+    slices: [&'a [f32]; N],
+    dy: usize,
+    last: usize,
+}
+
+impl<'a, const N: usize> Pairs<'a, N> {
+    /// `None` unless there is a slice, every slice has the first one's length, and that
+    /// length holds two floats from `dy`.
+    pub fn new(slices: [&'a [f32]; N], dy: usize) -> Option<Pairs<'a, N>> {
+        let len = slices.first()?.len();
+        let reach = dy.checked_add(2)?;
+        if len < reach || slices.iter().any(|s| s.len() != len) {
+            return None;
+        }
+        Some(Pairs {
+            slices,
+            dy,
+            last: len - reach,
+        })
+    }
+
+    /// The largest base index whose reads all lie inside: `i + dy + 2 ≤ len` exactly when
+    /// `i ≤ last`.
+    #[inline(always)]
+    pub fn last(&self) -> usize {
+        self.last
+    }
+
+    /// For lane `j`, the footprint at base `i[j]` (clamped to [`last`](Self::last)) of
+    /// slice `k[j]`: `[s[i], s[i + 1], s[i + dy], s[i + dy + 1]]` as four lanes each
+    /// (panics when a `k[j] ≥ N`).
+    #[inline(always)]
+    pub fn get(&self, k: [usize; 4], i: [usize; 4]) -> [F32x4; 4] {
+        let s = k.map(|k| self.slices[k]);
+        let i = i.map(|i| i.min(self.last));
+        let j = i.map(|i| i + self.dy);
+        // SAFETY: `i ≤ last = len − (dy + 2)`, so both pairs end at most at
+        // `i + dy + 2 ≤ len`, and every slice has length `len` (`new`); the fields are never
+        // changed.
+        let ([a, b], [c, d]) = unsafe { (F32x4::pairs_at(s, i), F32x4::pairs_at(s, j)) };
+        [a, b, c, d]
+    }
+}
+
 /// Defines an eight-lane kernel: a safe function whose first argument is the [`X8`] token
 /// and whose body is compiled with AVX2 enabled on x86-64 (with the portable lanes, an
 /// ordinary function).
