@@ -205,6 +205,87 @@ impl<'a, const N: usize> Pairs<'a, N> {
     }
 }
 
+/// [`Pairs`] of one channel of integer codes, `B` bytes each (1, or 2 little-endian): for
+/// four base indices (in codes), the codes at `i`, `i + 1`, `i + dy` and `i + dy + 1` as
+/// `i32` lanes, each pair read at once. Safe by construction as [`Pairs`]: [`CodePairs::new`]
+/// checks once that the reads from base [`CodePairs::last`] stay inside, and
+/// [`CodePairs::get`] clamps each base to it.
+///
+/// ```
+/// use mirrorball_simd::CodePairs;
+/// let a: Vec<u8> = (0..16).collect();
+/// let p = CodePairs::<1>::new(&a, 8).unwrap();
+/// assert_eq!(p.last(), 6);
+/// let [t0, t1, b0, _] = p.get([0, 2, 5, 99]);
+/// assert_eq!((t0.to_array(), t1.to_array()), ([0, 2, 5, 6], [1, 3, 6, 7]));
+/// assert_eq!(b0.to_array(), [8, 10, 13, 14]);
+/// let b: Vec<u8> = [1u16, 1023, 7, 300].iter().flat_map(|c| c.to_le_bytes()).collect();
+/// let [t0, t1, b0, b1] = CodePairs::<2>::new(&b, 2).unwrap().get([0; 4]);
+/// assert_eq!((t0.to_array()[0], t1.to_array()[0], b0.to_array()[0], b1.to_array()[0]), (1, 1023, 7, 300));
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct CodePairs<'a, const B: usize> {
+    bytes: &'a [u8],
+    dy: usize,
+    last: usize,
+}
+
+impl<'a, const B: usize> CodePairs<'a, B> {
+    /// `None` unless `B` is 1 or 2 and `bytes` holds two codes from `dy` (a trailing odd
+    /// byte of 2-byte codes is not a code).
+    pub fn new(bytes: &'a [u8], dy: usize) -> Option<CodePairs<'a, B>> {
+        if B != 1 && B != 2 {
+            return None;
+        }
+        let codes = bytes.len() / B;
+        let reach = dy.checked_add(2)?;
+        if codes < reach {
+            return None;
+        }
+        Some(CodePairs {
+            bytes,
+            dy,
+            last: codes - reach,
+        })
+    }
+
+    /// The largest base index whose reads all lie inside: `i + dy + 2 ≤ codes` exactly when
+    /// `i ≤ last`.
+    #[inline(always)]
+    pub fn last(&self) -> usize {
+        self.last
+    }
+
+    /// For lane `j`, the codes at base `i[j]` (clamped to [`last`](Self::last)):
+    /// `[c(i), c(i + 1), c(i + dy), c(i + dy + 1)]` as four lanes each.
+    #[inline(always)]
+    pub fn get(&self, i: [usize; 4]) -> [I32x4; 4] {
+        let i = i.map(|i| i.min(self.last));
+        let p = self.bytes.as_ptr();
+        // Both codes of the pair at code `k`, the first in the low bits.
+        let pair = |k: usize| -> u32 {
+            // SAFETY: `k ≤ last + dy = codes − 2`, so the pair's `2·B` bytes end at most at
+            // `codes · B ≤ len` (`new`); the fields are never changed; reads are unaligned.
+            unsafe {
+                if B == 1 {
+                    u16::from_le(std::ptr::read_unaligned(p.add(k) as *const u16)) as u32
+                } else {
+                    u32::from_le(std::ptr::read_unaligned(p.add(2 * k) as *const u32))
+                }
+            }
+        };
+        let (bits, mask) = (8 * B as u32, (1u32 << (8 * B)) - 1);
+        let top = i.map(pair);
+        let bottom = i.map(|i| pair(i + self.dy));
+        [
+            I32x4::from_array(top.map(|p| (p & mask) as i32)),
+            I32x4::from_array(top.map(|p| (p >> bits) as i32)),
+            I32x4::from_array(bottom.map(|p| (p & mask) as i32)),
+            I32x4::from_array(bottom.map(|p| (p >> bits) as i32)),
+        ]
+    }
+}
+
 /// Defines an eight-lane kernel: a safe function whose first argument is the [`X8`] token
 /// and whose body is compiled with AVX2 enabled on x86-64 (with the portable lanes, an
 /// ordinary function).
