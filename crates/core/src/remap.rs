@@ -560,7 +560,15 @@ impl Remap {
                         CodeKind::Float => sum_taps_codes::<Float>(group, c.bytes(), (), n, o),
                     }
                 }
-                Base::Plane(p) if g.level == 0 => sum_taps_plane(group, p, o),
+                Base::Plane(p) if g.level == 0 => {
+                    // The next groups' taps' source texels asked for now (the integrated
+                    // texels' footprints wander over many source rows).
+                    let ahead = taps.get(k..).unwrap_or(&[]);
+                    match p.wide() {
+                        true => sum_taps_plane::<2>(group, ahead, p, o),
+                        false => sum_taps_plane::<1>(group, ahead, p, o),
+                    }
+                }
                 _ => sum_taps::<C>(group, pyr.level(g.level as usize), o),
             }
         }
@@ -1040,16 +1048,35 @@ fn plane_one(t: &Texel, plane: Plane<'_>, sw: usize) -> f32 {
 /// [`sum_taps`] of a one-layer plane held as codes: the same sums in the same order (the
 /// last three texels, which [`sum_taps`] cannot read four floats at, added apart as
 /// there), so the same bits.
+/// `ahead`: the taps after these, whose first source texels are prefetched.
 #[inline(always)]
-fn sum_taps_plane(taps: &[Tap], plane: Plane<'_>, out: &mut [f32]) {
+fn sum_taps_plane<const B: usize>(taps: &[Tap], ahead: &[Tap], plane: Plane<'_>, out: &mut [f32]) {
+    const AHEAD_TAPS: usize = 16;
     let (mut acc, mut tail) = (0.0f32, 0.0f32);
-    let n = plane.len();
-    for t in taps {
+    let bytes = plane.bytes();
+    let n = bytes.len() / B;
+    let off = plane.offset();
+    let value = |i: usize| -> f32 {
+        let code = if B == 1 {
+            bytes[i] as f32
+        } else {
+            u16::from_le_bytes([bytes[2 * i], bytes[2 * i + 1]]) as f32
+        };
+        code - off
+    };
+    for (j, t) in taps.iter().enumerate() {
+        if let Some(a) = ahead.get(j + AHEAD_TAPS) {
+            prefetch(
+                bytes
+                    .as_ptr()
+                    .wrapping_add((a.idx & INDEX_MASK) as usize * B),
+            );
+        }
         let i = (t.idx & INDEX_MASK) as usize;
         if i + 4 <= n {
-            acc += t.w * plane.value(i);
+            acc += t.w * value(i);
         } else if i < n {
-            tail += t.w * plane.value(i);
+            tail += t.w * value(i);
         }
     }
     out[0] = acc + tail;
