@@ -1025,8 +1025,8 @@ fn gather_row_plane<const B: usize>(
             }
         }
     }
-    for x in blocks..row.len() {
-        row[x] = entries.get(x).map_or(0.0, |t| plane_one(t, plane, sw));
+    for (x, o) in row.iter_mut().enumerate().skip(blocks) {
+        *o = entries.get(x).map_or(0.0, |t| plane_one(t, plane, sw));
     }
 }
 
