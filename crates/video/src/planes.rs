@@ -314,16 +314,20 @@ impl Converter {
             ),
             ..reading
         };
-        // A plane read as the picture is its eye's one layer as it is when a picture of
-        // distinct values comes back unchanged.
-        let whole = |(w, h): (u32, u32)| {
-            let mut img = Image::new(w, h, 1);
-            for (i, v) in img.data_mut().iter_mut().enumerate() {
-                *v = (i % 16_777_213) as f32;
-            }
-            reading.eyes(img.clone()).is_ok_and(|(eyes, _)| {
-                eyes.len() == 1 && eyes[0].layers().len() == 1 && eyes[0].layers()[0] == img
-            })
+        // A plane read as the picture is its eye's one layer as it is (moved, not cut or
+        // copied) where the picture is one eye and one layer laid out alone.
+        let whole = |ext: (u32, u32)| {
+            reading.stereo.0 == Stereo::Mono
+                && load::decide(
+                    &reading.input,
+                    ext,
+                    reading.from.as_ref(),
+                    reading.layout,
+                    None,
+                    None,
+                    |_| String::new(),
+                )
+                .is_ok_and(|(p, l, _)| l == Layout::Separate && p.layer_count() == 1)
         };
         let direct = mono
             && plans
