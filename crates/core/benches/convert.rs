@@ -5,7 +5,7 @@
 //! scripts run the same conversion on a real HDR beside OpenCV).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use mirrorball_core::{resample, Codes, EnvMap, ProjectionKind, Remap, ResampleOptions};
+use mirrorball_core::{resample, Codes, EnvMap, Plane, ProjectionKind, Remap, ResampleOptions};
 use std::hint::black_box;
 
 fn source() -> EnvMap {
@@ -68,6 +68,21 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    // One plane of a YUV frame (a video's Y): one channel of floats, and its 8-bit codes
+    // read as they are (`Remap::rows_plane`).
+    let luma: Vec<u8> = (0..4096 * 2048).map(|i| (i * 7 % 251) as u8).collect();
+    let plane = Plane::u8(&luma, 16.0, (4096, 2048)).expect("a plane of the frame's size");
+    let one = EnvMap::new(latlong, vec![plane.to_image()]).expect("one layer");
+    let mut out1 = fwd.apply(&one).expect("plan fits");
+    g.bench_function("forward_1ch_into", |b| {
+        b.iter(|| fwd.apply_into(&one, &mut out1).expect("plan fits"))
+    });
+    g.bench_function("forward_plane8_into", |b| {
+        b.iter(|| {
+            let rows = fwd.rows_plane(plane).expect("plan takes codes");
+            rows.fill(&mut out1).expect("plan fits")
+        })
+    });
     g.throughput(Throughput::Elements(4096 * 2048));
     let mut ll = back.apply(&faces).expect("plan fits");
     g.bench_function("back_into", |b| {

@@ -209,6 +209,118 @@ impl<'a> Codes<'a> {
     }
 }
 
+/// One plane of a planar picture (a YUV frame's Y, U or V) held as its integer codes, one
+/// byte or two little-endian a texel, each read as the value `code − offset` (computed in
+/// `f32`), so that a planned [`Remap`](crate::Remap) reads the plane as it arrives
+/// ([`Remap::rows_plane`](crate::Remap::rows_plane)) with the same bits as from the
+/// one-channel float image of those values ([`Plane::to_image`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Plane<'a> {
+    bytes: &'a [u8],
+    wide: bool,
+    offset: f32,
+    width: u32,
+    height: u32,
+}
+
+impl<'a> Plane<'a> {
+    /// 8-bit codes: `bytes` holds `width × height` of them.
+    pub fn u8(
+        bytes: &'a [u8],
+        offset: f32,
+        (width, height): (u32, u32),
+    ) -> Result<Plane<'a>, CodesError> {
+        Plane::new(bytes, false, offset, (width, height))
+    }
+
+    /// 16-bit little-endian codes (10-, 12- and 16-bit planes): `bytes` holds
+    /// `width × height × 2` bytes.
+    pub fn u16le(
+        bytes: &'a [u8],
+        offset: f32,
+        (width, height): (u32, u32),
+    ) -> Result<Plane<'a>, CodesError> {
+        Plane::new(bytes, true, offset, (width, height))
+    }
+
+    fn new(
+        bytes: &'a [u8],
+        wide: bool,
+        offset: f32,
+        (width, height): (u32, u32),
+    ) -> Result<Plane<'a>, CodesError> {
+        let expected = width as usize * height as usize * (1 + wide as usize);
+        if bytes.len() != expected {
+            return Err(CodesError::Length {
+                expected,
+                found: bytes.len(),
+            });
+        }
+        Ok(Plane {
+            bytes,
+            wide,
+            offset,
+            width,
+            height,
+        })
+    }
+
+    /// The plane's width and height.
+    pub fn extent(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Whether a code takes two bytes.
+    pub(crate) fn wide(&self) -> bool {
+        self.wide
+    }
+
+    /// The codes' bytes.
+    pub(crate) fn bytes(&self) -> &'a [u8] {
+        self.bytes
+    }
+
+    /// What every code is read less.
+    pub(crate) fn offset(&self) -> f32 {
+        self.offset
+    }
+
+    /// Texels in the plane.
+    pub(crate) fn len(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// The value of texel `i` (row-major): its code less the offset.
+    ///
+    /// # Panics
+    /// If `i` is outside the plane.
+    #[inline(always)]
+    pub fn value(&self, i: usize) -> f32 {
+        let code = if self.wide {
+            u16::from_le_bytes([self.bytes[2 * i], self.bytes[2 * i + 1]]) as f32
+        } else {
+            self.bytes[i] as f32
+        };
+        code - self.offset
+    }
+
+    /// The one-channel float image of the plane's values (what its reads are equal to,
+    /// texel for texel).
+    pub fn to_image(&self) -> Image {
+        let mut img = Image::new(self.width, self.height, 1);
+        let w = self.width as usize;
+        img.data_mut()
+            .par_chunks_mut(w.max(1))
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, v) in row.iter_mut().enumerate() {
+                    *v = self.value(y * w + x);
+                }
+            });
+        img
+    }
+}
+
 /// How a code width reads a texel: monomorphised into the hot loops, so that they never
 /// branch on the width, and the table's length is checked once, when it becomes a
 /// [`CodeWidth::Table`].

@@ -33,7 +33,7 @@ pub mod work;
 
 pub use axis_map::AxisMap;
 pub use choice::{count, Choice, UnknownName};
-pub use codes::{Codes, CodesError};
+pub use codes::{Codes, CodesError, Plane};
 pub use envmap::{
     bilinear_blend, bilinear_corner, bilinear_corner4, bilinear_corner8, bilinear_mix,
     bilinear_taps, count_invalid, sample_texels, sanitize_layer, CornerLanes, EnvMap, EnvMapError,

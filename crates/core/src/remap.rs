@@ -21,8 +21,8 @@ use crate::codes::{CodeKind, CodeWidth, Float, Narrow, Wide};
 use crate::envmap::{bilinear_blend, bilinear_mix, lerp4, seam_taps};
 use crate::projection::{Projection, WorldProjection};
 use crate::resample::{Job, PointScratch, Pyramid, PyramidPlan, PyramidSpare, RowScratch};
-use crate::{Codes, EnvMap, Image, ResampleOptions};
-use mirrorball_simd::{prefetch, F32x4};
+use crate::{Codes, EnvMap, Image, Plane, ResampleOptions};
+use mirrorball_simd::{prefetch, CodePairs, F32x4, Pairs};
 use rayon::prelude::*;
 use std::fmt;
 use std::sync::Mutex;
@@ -473,6 +473,25 @@ impl Remap {
         Ok(RemapRows::coded(self, src))
     }
 
+    /// [`Remap::rows`] of a one-channel source held as a plane's codes (a YUV frame's Y, U
+    /// or V as it arrives): every row the same bits as [`Remap::rows`] of the one-channel
+    /// float map of the plane's values ([`Plane::to_image`]), with no float copy of the
+    /// plane made (only its mip levels, where the plan reads any). The plan must [take
+    /// codes](Remap::takes_codes), and the plane be the plan's source extent.
+    pub fn rows_plane<'a>(&'a self, src: Plane<'a>) -> Result<RemapRows<'a>, RemapError> {
+        if !self.takes_codes() {
+            return Err(RemapError::Codes);
+        }
+        if src.extent() != self.src_extent {
+            let (w, h) = src.extent();
+            return Err(RemapError::Extent {
+                expected: (1, self.src_extent.0, self.src_extent.1),
+                found: (1, w, h),
+            });
+        }
+        Ok(RemapRows::plane(self, src))
+    }
+
     /// Fills output row `y` of `layer`: the bilinear pass, then the taps, then exposure.
     #[inline(always)]
     fn fill_row<const C: usize>(
@@ -513,6 +532,8 @@ impl Remap {
                     gather_row::<3>(entries, &planes, true, sw * 3, row)
                 }
             },
+            Base::Plane(p) if p.wide() => gather_row_plane::<2>(entries, p, sw, row),
+            Base::Plane(p) => gather_row_plane::<1>(entries, p, sw, row),
         }
         let ((g0, t0), (g1, _)) = (starts[y], starts[y + 1]);
         let mut k = t0 as usize;
@@ -539,6 +560,15 @@ impl Remap {
                         CodeKind::Float => sum_taps_codes::<Float>(group, c.bytes(), (), n, o),
                     }
                 }
+                Base::Plane(p) if g.level == 0 => {
+                    // The next groups' taps' source texels asked for now (the integrated
+                    // texels' footprints wander over many source rows).
+                    let ahead = taps.get(k..).unwrap_or(&[]);
+                    match p.wide() {
+                        true => sum_taps_plane::<2>(group, ahead, p, o),
+                        false => sum_taps_plane::<1>(group, ahead, p, o),
+                    }
+                }
                 _ => sum_taps::<C>(group, pyr.level(g.level as usize), o),
             }
         }
@@ -558,6 +588,7 @@ impl Remap {
 enum Base<'a> {
     Floats(&'a [&'a [f32]; MAX_LAYERS]),
     Codes(Codes<'a>),
+    Plane(Plane<'a>),
 }
 
 /// A source made ready for a [`Remap`]: output rows made one at a time (see
@@ -568,6 +599,8 @@ pub struct RemapRows<'a> {
     c: usize,
     /// The base level as codes, where [`Remap::rows_coded`] made these rows.
     codes: Option<Codes<'a>>,
+    /// The base level as a plane's codes, where [`Remap::rows_plane`] made these rows.
+    plane: Option<Plane<'a>>,
 }
 
 impl<'a> RemapRows<'a> {
@@ -578,6 +611,7 @@ impl<'a> RemapRows<'a> {
             pyr: Pyramid::planned(src, &remap.pyramid, spare),
             c: src.channels(),
             codes: None,
+            plane: None,
         }
     }
 
@@ -588,6 +622,18 @@ impl<'a> RemapRows<'a> {
             pyr: Pyramid::planned_codes(src, &remap.pyramid, spare),
             c: 3,
             codes: Some(src),
+            plane: None,
+        }
+    }
+
+    fn plane(remap: &'a Remap, src: Plane<'a>) -> RemapRows<'a> {
+        let spare = std::mem::take(&mut *remap.spare.lock().unwrap_or_else(|e| e.into_inner()));
+        RemapRows {
+            remap,
+            pyr: Pyramid::planned_plane(src, &remap.pyramid, spare),
+            c: 1,
+            codes: None,
+            plane: Some(src),
         }
     }
 
@@ -628,6 +674,10 @@ impl<'a> RemapRows<'a> {
             let base = Base::Codes(codes);
             return self.remap.fill_row::<3>(&self.pyr, base, layer, y, row);
         }
+        if let Some(plane) = self.plane {
+            let base = Base::Plane(plane);
+            return self.remap.fill_row::<1>(&self.pyr, base, layer, y, row);
+        }
         // The base as the pyramid holds it (a dual fisheye's overlap blended).
         let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
         for (p, l) in planes.iter_mut().zip(self.pyr.level(0)) {
@@ -660,10 +710,94 @@ fn gather_row<const C: usize>(
     stride: usize,
     row: &mut [f32],
 ) {
+    if C == 1 {
+        // One channel (a plane of a YUV frame): four texels at a time.
+        if single {
+            if let Some(p) = Pairs::new([planes[0]], stride) {
+                return gather_row_one(entries, &p, planes, stride, row);
+            }
+        } else {
+            // Every slot a layer: those past the source's layers (never named by an entry)
+            // read the first.
+            let all = planes.map(|p| if p.is_empty() { planes[0] } else { p });
+            if let Some(p) = Pairs::new(all, stride) {
+                return gather_row_one(entries, &p, planes, stride, row);
+            }
+        }
+    }
     if single {
         gather_row_lanes::<C, true>(entries, planes, stride, row)
     } else {
         gather_row_lanes::<C, false>(entries, planes, stride, row)
+    }
+}
+
+/// The bilinear pass of a one-channel source, four output texels at a time: each texel's
+/// top and bottom pairs read at once ([`Pairs`]), turned into lanes and blended with
+/// `lerp4`'s arithmetic lane by lane, so the same bits as [`gather_one`], which makes the
+/// texels [`Pairs`] cannot read (an empty entry, a footprint past the end) and the row's
+/// last few. `N`: 1 for a one-layer source (the layer bits not decoded), else
+/// [`MAX_LAYERS`].
+#[inline(always)]
+fn gather_row_one<const N: usize>(
+    entries: &[Texel],
+    pairs: &Pairs<'_, N>,
+    planes: &[&[f32]; MAX_LAYERS],
+    stride: usize,
+    row: &mut [f32],
+) {
+    const Q: f32 = 1.0 / 65536.0;
+    let n = row.len().min(entries.len());
+    let last = pairs.last();
+    let layer = |idx: u32| {
+        if N == 1 {
+            0
+        } else {
+            (idx >> INDEX_BITS) as usize & (N - 1)
+        }
+    };
+    let slices = if N == 1 {
+        [planes[0]; MAX_LAYERS]
+    } else {
+        *planes
+    };
+    let blocks = n / 4 * 4;
+    for x in (0..blocks).step_by(4) {
+        // The source texels of the entries a few ahead, asked for now (see
+        // `gather_row_lanes`).
+        if let Some(ahead) = entries.get(x + AHEAD..x + AHEAD + 4) {
+            for a in ahead {
+                let data = slices[layer(a.idx)];
+                let i = (a.idx & INDEX_MASK) as usize;
+                if i <= last {
+                    let p = data.as_ptr().wrapping_add(i);
+                    prefetch(p);
+                    prefetch(p.wrapping_add(stride));
+                }
+            }
+        }
+        let e: &[Texel; 4] = entries[x..x + 4].try_into().expect("four entries");
+        let i = e.map(|t| (t.idx & INDEX_MASK) as usize);
+        let [a, b, c, d] = pairs.get(e.map(|t| layer(t.idx)), i);
+        let q = F32x4::splat(Q);
+        let fx = F32x4::from_array(e.map(|t| t.fx as f32)) * q;
+        let fy = F32x4::from_array(e.map(|t| t.fy as f32)) * q;
+        let top = a + fx * (b - a);
+        let bot = c + fx * (d - c);
+        (top + fy * (bot - top)).store(&mut row[x..x + 4]);
+        // An empty entry's index (NO_TEXEL's, all ones) is past `last`, as is a footprint
+        // that would read past the end: those lanes were read clamped and are made again.
+        for (k, t) in e.iter().enumerate() {
+            if i[k] > last {
+                gather_one::<1>(t, planes, stride, &mut row[x + k..x + k + 1]);
+            }
+        }
+    }
+    for x in blocks..row.len() {
+        match entries.get(x) {
+            Some(t) => gather_one::<1>(t, planes, stride, &mut row[x..x + 1]),
+            None => row[x] = 0.0,
+        }
     }
 }
 
@@ -840,6 +974,112 @@ fn sum_taps_codes<W: CodeWidth>(
     for c in 0..3 {
         out[c] = lanes[c] + tail[c];
     }
+}
+
+/// [`gather_row_one`] of a one-layer plane held as codes of `B` bytes (`sw` texels a row):
+/// each corner read as `code − offset`, as [`Plane::value`] reads it, so the same bits as
+/// the float path from [`Plane::to_image`]; [`plane_one`] makes the texels the four-lane
+/// reads cannot (empty entries, footprints past the end, the row's last few).
+#[inline(always)]
+fn gather_row_plane<const B: usize>(
+    entries: &[Texel],
+    plane: Plane<'_>,
+    sw: usize,
+    row: &mut [f32],
+) {
+    const Q: f32 = 1.0 / 65536.0;
+    let n = row.len().min(entries.len());
+    let Some(pairs) = CodePairs::<B>::new(plane.bytes(), sw) else {
+        for (x, o) in row.iter_mut().enumerate() {
+            *o = entries.get(x).map_or(0.0, |t| plane_one(t, plane, sw));
+        }
+        return;
+    };
+    let last = pairs.last();
+    let bytes = plane.bytes();
+    let off = F32x4::splat(plane.offset());
+    let blocks = n / 4 * 4;
+    for x in (0..blocks).step_by(4) {
+        if let Some(ahead) = entries.get(x + AHEAD..x + AHEAD + 4) {
+            for a in ahead {
+                let i = (a.idx & INDEX_MASK) as usize;
+                if i <= last {
+                    let p = bytes.as_ptr().wrapping_add(i * B);
+                    prefetch(p);
+                    prefetch(p.wrapping_add(sw * B));
+                }
+            }
+        }
+        let e: &[Texel; 4] = entries[x..x + 4].try_into().expect("four entries");
+        let i = e.map(|t| (t.idx & INDEX_MASK) as usize);
+        let [a, b, c, d] = pairs.get(i).map(|v| v.to_f32() - off);
+        let q = F32x4::splat(Q);
+        let fx = F32x4::from_array(e.map(|t| t.fx as f32)) * q;
+        let fy = F32x4::from_array(e.map(|t| t.fy as f32)) * q;
+        let top = a + fx * (b - a);
+        let bot = c + fx * (d - c);
+        (top + fy * (bot - top)).store(&mut row[x..x + 4]);
+        for (k, t) in e.iter().enumerate() {
+            if i[k] > last {
+                row[x + k] = plane_one(t, plane, sw);
+            }
+        }
+    }
+    for (x, o) in row.iter_mut().enumerate().skip(blocks) {
+        *o = entries.get(x).map_or(0.0, |t| plane_one(t, plane, sw));
+    }
+}
+
+/// [`gather_one`] of a plane's codes: one texel in plain arithmetic.
+#[inline(always)]
+fn plane_one(t: &Texel, plane: Plane<'_>, sw: usize) -> f32 {
+    const Q: f32 = 1.0 / 65536.0;
+    let i = (t.idx & INDEX_MASK) as usize;
+    if t.idx == NO_TEXEL || i + sw + 2 > plane.len() {
+        return 0.0;
+    }
+    let v = |k: usize| plane.value(k);
+    let mut out = [0.0];
+    let (r0, r1) = ([v(i), v(i + 1)], [v(i + sw), v(i + sw + 1)]);
+    lerp4::<1>(&r0, &r1, t.fx as f32 * Q, t.fy as f32 * Q, &mut out);
+    out[0]
+}
+
+/// [`sum_taps`] of a one-layer plane held as codes: the same sums in the same order (the
+/// last three texels, which [`sum_taps`] cannot read four floats at, added apart as
+/// there), so the same bits.
+/// `ahead`: the taps after these, whose first source texels are prefetched.
+#[inline(always)]
+fn sum_taps_plane<const B: usize>(taps: &[Tap], ahead: &[Tap], plane: Plane<'_>, out: &mut [f32]) {
+    const AHEAD_TAPS: usize = 16;
+    let (mut acc, mut tail) = (0.0f32, 0.0f32);
+    let bytes = plane.bytes();
+    let n = bytes.len() / B;
+    let off = plane.offset();
+    let value = |i: usize| -> f32 {
+        let code = if B == 1 {
+            bytes[i] as f32
+        } else {
+            u16::from_le_bytes([bytes[2 * i], bytes[2 * i + 1]]) as f32
+        };
+        code - off
+    };
+    for (j, t) in taps.iter().enumerate() {
+        if let Some(a) = ahead.get(j + AHEAD_TAPS) {
+            prefetch(
+                bytes
+                    .as_ptr()
+                    .wrapping_add((a.idx & INDEX_MASK) as usize * B),
+            );
+        }
+        let i = (t.idx & INDEX_MASK) as usize;
+        if i + 4 <= n {
+            acc += t.w * value(i);
+        } else if i < n {
+            tail += t.w * value(i);
+        }
+    }
+    out[0] = acc + tail;
 }
 
 /// One planned output row's taps (its lookups are written into the plan in place).
@@ -1024,7 +1264,9 @@ fn push_bilinear(
 
 #[cfg(test)]
 mod tests {
-    use super::quantize_fraction;
+    use super::{
+        gather_one, gather_row, quantize_fraction, Texel, INDEX_BITS, MAX_LAYERS, NO_TEXEL,
+    };
     use crate::{EnvMap, Image, ProjectionKind, Remap, ResampleOptions};
 
     /// A one-channel source (one plane of a YUV frame) is converted as the first channel of
@@ -1066,6 +1308,123 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The one-channel pass (four texels at a time) gives [`gather_one`]'s bits for every
+    /// entry: empty ones, footprints at the image's last texels and past them, rows whose
+    /// length is not a multiple of four, one layer and several.
+    #[test]
+    fn one_channel_rows_are_the_reference_bits() {
+        let (sw, sh) = (37usize, 11usize);
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 33) as u32
+        };
+        let layers: Vec<Vec<f32>> = (0..3)
+            .map(|_| {
+                (0..sw * sh)
+                    .map(|_| next() as f32 / 7919.0 - 1000.0)
+                    .collect()
+            })
+            .collect();
+        let len = sw * sh;
+        for n_layers in [1usize, 3] {
+            let mut planes: [&[f32]; MAX_LAYERS] = [&[]; MAX_LAYERS];
+            for (p, l) in planes.iter_mut().zip(&layers[..n_layers]) {
+                *p = l;
+            }
+            for w in [1usize, 3, 4, 5, 8, 31, 64] {
+                let entries: Vec<Texel> = (0..w)
+                    .map(|x| {
+                        let r = next();
+                        let idx = match r % 8 {
+                            0 => NO_TEXEL,
+                            // The last footprints that fit, and the first that do not.
+                            1 => (len - sw - 2 + (r as usize / 8) % 3) as u32,
+                            _ => (r as usize / 8 % (len - sw - 1)) as u32,
+                        };
+                        let layer = if idx == NO_TEXEL {
+                            0
+                        } else {
+                            (x % n_layers) as u32
+                        };
+                        Texel {
+                            idx: idx | layer << INDEX_BITS,
+                            fx: next() as u16,
+                            fy: if x % 5 == 0 { 0 } else { next() as u16 },
+                        }
+                    })
+                    .collect();
+                let mut fast = vec![f32::NAN; w];
+                gather_row::<1>(&entries, &planes, n_layers == 1, sw, &mut fast);
+                for (x, t) in entries.iter().enumerate() {
+                    let mut want = [f32::NAN];
+                    gather_one::<1>(t, &planes, sw, &mut want);
+                    assert_eq!(
+                        fast[x].to_bits(),
+                        want[0].to_bits(),
+                        "{n_layers} layers, width {w}, texel {x}: {t:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// A plane read as codes ([`Remap::rows_plane`]) gives, row for row, the bits of the
+    /// float map of its values: 8- and 16-bit codes, integrated texels and their mip
+    /// levels, seams, bilinear lookups, a laid-out plan.
+    #[test]
+    fn planes_read_as_codes_are_the_float_planes_bits() {
+        use crate::Plane;
+        let (ll, cube) = (
+            ProjectionKind::LatLong.default_projection(),
+            ProjectionKind::Cube.default_projection(),
+        );
+        let (w, h) = (96u32, 48u32);
+        let n = (w * h) as usize;
+        let narrow: Vec<u8> = (0..n).map(|i| ((i * 37 + i / 7) % 256) as u8).collect();
+        let wide: Vec<u8> = (0..n)
+            .flat_map(|i| (((i * 389 + i / 5) % 1024) as u16).to_le_bytes())
+            .collect();
+        let planes = [
+            Plane::u8(&narrow, 16.0, (w, h)).unwrap(),
+            Plane::u16le(&wide, 512.0, (w, h)).unwrap(),
+        ];
+        for size in [5, 24, 64] {
+            let plan = Remap::new(ll, (w, h), 1, cube, size, &ResampleOptions::default());
+            assert!(size > 5 || plan.tap_count() > 0, "integrated texels tested");
+            let turned = plan.laid_out((size * 2, size), |px, py| {
+                (px < size).then_some((2, size - 1 - py, px))
+            });
+            for p in planes {
+                let floats = EnvMap::new(ll, vec![p.to_image()]).unwrap();
+                for plan in [&plan, &turned] {
+                    let (a, b) = (plan.rows(&floats).unwrap(), plan.rows_plane(p).unwrap());
+                    let (mut ra, mut rb) = (vec![0.0; a.row_len()], vec![0.0; b.row_len()]);
+                    let (layers, rows) = match plan.picture() {
+                        Some((_, ph)) => (1, ph),
+                        None => (6, plan.extent().1),
+                    };
+                    for layer in 0..layers {
+                        for y in 0..rows as usize {
+                            a.row_into(layer, y, &mut ra);
+                            b.row_into(layer, y, &mut rb);
+                            let bits =
+                                |r: &[f32]| r.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                            assert_eq!(bits(&ra), bits(&rb), "size {size}, layer {layer}, row {y}");
+                        }
+                    }
+                }
+            }
+        }
+        // A plane of another size is refused.
+        let plan = Remap::new(ll, (w, h), 1, cube, 8, &ResampleOptions::default());
+        let small = Plane::u8(&narrow[..n / 2], 0.0, (w, h / 2)).unwrap();
+        assert!(plan.rows_plane(small).is_err());
+        assert!(Plane::u8(&narrow[..n - 1], 0.0, (w, h)).is_err());
     }
 
     #[test]

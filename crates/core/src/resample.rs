@@ -18,7 +18,7 @@
 use crate::codes::{CodeKind, CodeWidth, Narrow, Wide};
 use crate::envmap::{bilinear32, bilinear32_quad, bilinear_corner, bilinear_corner4, lerp_quad};
 use crate::projection::{DirRun, Lookup, OverlapBlend, Projection, WorldProjection};
-use crate::{Codes, EnvMap, Image};
+use crate::{Codes, EnvMap, Image, Plane};
 use glam::{DMat3, DVec3};
 use mirrorball_simd::{prefetch as prefetch_line, F32x4, M32x4};
 use rayon::prelude::*;
@@ -237,7 +237,7 @@ impl<'a> Pyramid<'a> {
             }
             None => std::borrow::Cow::Borrowed(src.layers()),
         };
-        Pyramid::build(base, None, plan, spare.levels)
+        Pyramid::build(base, None, None, plan, spare.levels)
     }
 
     /// [`Pyramid::planned`] of a one-layer source held as codes: the levels below the base
@@ -252,6 +252,24 @@ impl<'a> Pyramid<'a> {
         Pyramid::build(
             std::borrow::Cow::Owned(Vec::new()),
             Some(src),
+            None,
+            plan,
+            spare.levels,
+        )
+    }
+
+    /// [`Pyramid::planned_codes`] of a one-layer, one-channel source held as a plane's
+    /// codes: the first level made from the plane's values, so the same bits as from the
+    /// float layer of them; the base not kept.
+    pub(crate) fn planned_plane(
+        src: Plane<'_>,
+        plan: &PyramidPlan,
+        spare: PyramidSpare,
+    ) -> Pyramid<'a> {
+        Pyramid::build(
+            std::borrow::Cow::Owned(Vec::new()),
+            None,
+            Some(src),
             plan,
             spare.levels,
         )
@@ -260,6 +278,7 @@ impl<'a> Pyramid<'a> {
     fn build(
         base: std::borrow::Cow<'a, [Image]>,
         codes: Option<Codes<'_>>,
+        plane: Option<Plane<'_>>,
         plan: &PyramidPlan,
         mut spare: Vec<Vec<Image>>,
     ) -> Pyramid<'a> {
@@ -277,6 +296,10 @@ impl<'a> Pyramid<'a> {
                     .map(|i| (i.width(), i.height(), i.channels()))
                     .collect(),
                 (None, Some(c)) => vec![(c.extent().0, c.extent().1, 3)],
+                (None, None) if plane.is_some() => plane
+                    .map(|p| (p.extent().0, p.extent().1, 1))
+                    .into_iter()
+                    .collect(),
                 (None, None) => base
                     .iter()
                     .map(|i| (i.width(), i.height(), i.channels()))
@@ -314,7 +337,10 @@ impl<'a> Pyramid<'a> {
                             )
                         }
                     },
-                    (None, None) => downsample_into(&base[layer], wts, out),
+                    (None, None) => match plane {
+                        Some(p) => downsample_texels((w, h), |i| [p.value(i)], wts, out),
+                        None => downsample_into(&base[layer], wts, out),
+                    },
                 }
             }
             levels.push(next);

@@ -143,6 +143,149 @@ impl<'a, const N: usize> Taps<'a, N> {
     }
 }
 
+/// Bilinear footprints of one-channel layers, four at a time: for four base indices, the
+/// two floats at `i` and `i + 1` and the two at `i + dy` and `i + dy + 1` (a footprint's
+/// top and bottom pairs, `dy` the row stride), each pair read at once and the four bases'
+/// reads turned into lanes. As [`Taps`], safe by construction: [`Pairs::new`] checks once
+/// that the reads from base [`Pairs::last`] stay inside, and [`Pairs::get`] clamps each
+/// base to it.
+///
+/// ```
+/// use mirrorball_simd::Pairs;
+/// let a: Vec<f32> = (0..16).map(|i| i as f32).collect();
+/// let p = Pairs::new([&a[..]], 8).unwrap();
+/// assert_eq!(p.last(), 6); // 6 + 8 + 2 = 16
+/// let [t0, t1, b0, b1] = p.get([0; 4], [0, 2, 5, 99]);
+/// assert_eq!((t0.to_array(), t1.to_array()), ([0.0, 2.0, 5.0, 6.0], [1.0, 3.0, 6.0, 7.0]));
+/// assert_eq!((b0.to_array(), b1.to_array()), ([8.0, 10.0, 13.0, 14.0], [9.0, 11.0, 14.0, 15.0]));
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct Pairs<'a, const N: usize> {
+    slices: [&'a [f32]; N],
+    dy: usize,
+    last: usize,
+}
+
+impl<'a, const N: usize> Pairs<'a, N> {
+    /// `None` unless there is a slice, every slice has the first one's length, and that
+    /// length holds two floats from `dy`.
+    pub fn new(slices: [&'a [f32]; N], dy: usize) -> Option<Pairs<'a, N>> {
+        let len = slices.first()?.len();
+        let reach = dy.checked_add(2)?;
+        if len < reach || slices.iter().any(|s| s.len() != len) {
+            return None;
+        }
+        Some(Pairs {
+            slices,
+            dy,
+            last: len - reach,
+        })
+    }
+
+    /// The largest base index whose reads all lie inside: `i + dy + 2 ≤ len` exactly when
+    /// `i ≤ last`.
+    #[inline(always)]
+    pub fn last(&self) -> usize {
+        self.last
+    }
+
+    /// For lane `j`, the footprint at base `i[j]` (clamped to [`last`](Self::last)) of
+    /// slice `k[j]`: `[s[i], s[i + 1], s[i + dy], s[i + dy + 1]]` as four lanes each
+    /// (panics when a `k[j] ≥ N`).
+    #[inline(always)]
+    pub fn get(&self, k: [usize; 4], i: [usize; 4]) -> [F32x4; 4] {
+        let s = k.map(|k| self.slices[k]);
+        let i = i.map(|i| i.min(self.last));
+        let j = i.map(|i| i + self.dy);
+        // SAFETY: `i ≤ last = len − (dy + 2)`, so both pairs end at most at
+        // `i + dy + 2 ≤ len`, and every slice has length `len` (`new`); the fields are never
+        // changed.
+        let ([a, b], [c, d]) = unsafe { (F32x4::pairs_at(s, i), F32x4::pairs_at(s, j)) };
+        [a, b, c, d]
+    }
+}
+
+/// [`Pairs`] of one channel of integer codes, `B` bytes each (1, or 2 little-endian): for
+/// four base indices (in codes), the codes at `i`, `i + 1`, `i + dy` and `i + dy + 1` as
+/// `i32` lanes, each pair read at once. Safe by construction as [`Pairs`]: [`CodePairs::new`]
+/// checks once that the reads from base [`CodePairs::last`] stay inside, and
+/// [`CodePairs::get`] clamps each base to it.
+///
+/// ```
+/// use mirrorball_simd::CodePairs;
+/// let a: Vec<u8> = (0..16).collect();
+/// let p = CodePairs::<1>::new(&a, 8).unwrap();
+/// assert_eq!(p.last(), 6);
+/// let [t0, t1, b0, _] = p.get([0, 2, 5, 99]);
+/// assert_eq!((t0.to_array(), t1.to_array()), ([0, 2, 5, 6], [1, 3, 6, 7]));
+/// assert_eq!(b0.to_array(), [8, 10, 13, 14]);
+/// let b: Vec<u8> = [1u16, 1023, 7, 300].iter().flat_map(|c| c.to_le_bytes()).collect();
+/// let [t0, t1, b0, b1] = CodePairs::<2>::new(&b, 2).unwrap().get([0; 4]);
+/// assert_eq!((t0.to_array()[0], t1.to_array()[0], b0.to_array()[0], b1.to_array()[0]), (1, 1023, 7, 300));
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct CodePairs<'a, const B: usize> {
+    bytes: &'a [u8],
+    dy: usize,
+    last: usize,
+}
+
+impl<'a, const B: usize> CodePairs<'a, B> {
+    /// `None` unless `B` is 1 or 2 and `bytes` holds two codes from `dy` (a trailing odd
+    /// byte of 2-byte codes is not a code).
+    pub fn new(bytes: &'a [u8], dy: usize) -> Option<CodePairs<'a, B>> {
+        if B != 1 && B != 2 {
+            return None;
+        }
+        let codes = bytes.len() / B;
+        let reach = dy.checked_add(2)?;
+        if codes < reach {
+            return None;
+        }
+        Some(CodePairs {
+            bytes,
+            dy,
+            last: codes - reach,
+        })
+    }
+
+    /// The largest base index whose reads all lie inside: `i + dy + 2 ≤ codes` exactly when
+    /// `i ≤ last`.
+    #[inline(always)]
+    pub fn last(&self) -> usize {
+        self.last
+    }
+
+    /// For lane `j`, the codes at base `i[j]` (clamped to [`last`](Self::last)):
+    /// `[c(i), c(i + 1), c(i + dy), c(i + dy + 1)]` as four lanes each.
+    #[inline(always)]
+    pub fn get(&self, i: [usize; 4]) -> [I32x4; 4] {
+        let i = i.map(|i| i.min(self.last));
+        let p = self.bytes.as_ptr();
+        // Both codes of the pair at code `k`, the first in the low bits.
+        let pair = |k: usize| -> u32 {
+            // SAFETY: `k ≤ last + dy = codes − 2`, so the pair's `2·B` bytes end at most at
+            // `codes · B ≤ len` (`new`); the fields are never changed; reads are unaligned.
+            unsafe {
+                if B == 1 {
+                    u16::from_le(std::ptr::read_unaligned(p.add(k) as *const u16)) as u32
+                } else {
+                    u32::from_le(std::ptr::read_unaligned(p.add(2 * k) as *const u32))
+                }
+            }
+        };
+        let (bits, mask) = (8 * B as u32, (1u32 << (8 * B)) - 1);
+        let top = i.map(pair);
+        let bottom = i.map(|i| pair(i + self.dy));
+        [
+            I32x4::from_array(top.map(|p| (p & mask) as i32)),
+            I32x4::from_array(top.map(|p| (p >> bits) as i32)),
+            I32x4::from_array(bottom.map(|p| (p & mask) as i32)),
+            I32x4::from_array(bottom.map(|p| (p >> bits) as i32)),
+        ]
+    }
+}
+
 /// Defines an eight-lane kernel: a safe function whose first argument is the [`X8`] token
 /// and whose body is compiled with AVX2 enabled on x86-64 (with the portable lanes, an
 /// ordinary function).

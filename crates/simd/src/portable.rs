@@ -300,6 +300,23 @@ impl F32x4 {
         F32x4::load(&s[i..])
     }
 
+    /// Two neighbouring floats at each of four places, as lanes (checked here), for
+    /// [`crate::Pairs`].
+    ///
+    /// # Safety
+    /// None needed; `unsafe` to match the SSE2 form, which needs `i_j + 2 ≤ s_j.len()`.
+    #[cfg_attr(
+        all(target_arch = "x86_64", not(feature = "portable")),
+        allow(dead_code)
+    )]
+    #[inline(always)]
+    pub(crate) unsafe fn pairs_at(s: [&[f32]; 4], i: [usize; 4]) -> [F32x4; 2] {
+        [
+            F32x4(std::array::from_fn(|j| s[j][i[j]])),
+            F32x4(std::array::from_fn(|j| s[j][i[j] + 1])),
+        ]
+    }
+
     /// Writes the lanes as sixteen little-endian bytes to the start of `s` (panics when `s`
     /// is shorter).
     #[inline(always)]

@@ -66,6 +66,30 @@ impl F32x4 {
         // SAFETY: the caller's promise: the four floats are inside `s`.
         F32x4(unsafe { _mm_loadu_ps(s.as_ptr().add(i)) })
     }
+    /// Two neighbouring floats at each of four places, as lanes: lane `j` of the first
+    /// result is `s_j[i_j]`, of the second `s_j[i_j + 1]`, for [`crate::Pairs`].
+    ///
+    /// # Safety
+    /// `i_j + 2 ≤ s_j.len()` for every `j`.
+    // Called only where these are the lanes in use.
+    #[cfg_attr(feature = "portable", allow(dead_code))]
+    #[inline(always)]
+    pub(crate) unsafe fn pairs_at(s: [&[f32]; 4], i: [usize; 4]) -> [F32x4; 2] {
+        // SAFETY: the caller's promise: each pair of floats (eight bytes, read unaligned)
+        // is inside its slice.
+        unsafe {
+            let q = |k: usize| {
+                debug_assert!(i[k] + 2 <= s[k].len());
+                std::ptr::read_unaligned(s[k].as_ptr().add(i[k]) as *const i64)
+            };
+            let p01 = _mm_castsi128_ps(_mm_set_epi64x(q(1), q(0)));
+            let p23 = _mm_castsi128_ps(_mm_set_epi64x(q(3), q(2)));
+            [
+                F32x4(_mm_shuffle_ps::<0b10_00_10_00>(p01, p23)),
+                F32x4(_mm_shuffle_ps::<0b11_01_11_01>(p01, p23)),
+            ]
+        }
+    }
     /// The lanes as an array.
     #[inline(always)]
     pub fn to_array(self) -> [f32; 4] {

@@ -343,3 +343,57 @@ fn taps_read_what_checked_loads_read_and_clamp_to_last() {
     assert!(crate::Taps::<0>::new([], 3, 18).is_none());
     assert!(crate::Taps::new([&a[..]], usize::MAX, 0).is_none());
 }
+
+#[test]
+fn pairs_read_what_checked_loads_read_and_clamp_to_last() {
+    let a: Vec<f32> = (0..40).map(|i| i as f32 * 0.5 - 3.0).collect();
+    let b: Vec<f32> = a.iter().map(|x| -x).collect();
+    let p = crate::Pairs::new([&a[..], &b[..]], 18).unwrap();
+    assert_eq!(p.last(), 40 - 20);
+    let slices = [&a, &b];
+    for i in 0..60 {
+        let k = [i % 2, (i / 2) % 2, 1, 0];
+        let bases = [i, i + 1, i / 3, 59 - i];
+        let got = p.get(k, bases).map(|v| v.to_array());
+        for j in 0..4 {
+            let (s, at) = (slices[k[j]], bases[j].min(p.last()));
+            let want = [s[at], s[at + 1], s[at + 18], s[at + 19]];
+            assert_eq!(got.map(|v| v[j]), want, "{i} {j}");
+        }
+    }
+    // Too short, lengths differ, no slice.
+    assert!(crate::Pairs::new([&a[..19]], 18).is_none());
+    assert!(crate::Pairs::new([&a[..20]], 18).is_some());
+    assert!(crate::Pairs::new([&a[..], &b[..39]], 18).is_none());
+    assert!(crate::Pairs::<0>::new([], 18).is_none());
+    assert!(crate::Pairs::new([&a[..]], usize::MAX).is_none());
+}
+
+#[test]
+fn code_pairs_read_each_code_and_clamp_to_last() {
+    let a: Vec<u8> = (0..41).map(|i| (i * 37 % 256) as u8).collect();
+    let p1 = crate::CodePairs::<1>::new(&a, 18).unwrap();
+    assert_eq!(p1.last(), 41 - 20);
+    let p2 = crate::CodePairs::<2>::new(&a, 7).unwrap();
+    assert_eq!(p2.last(), 20 - 9);
+    let c2 = |k: usize| u16::from_le_bytes([a[2 * k], a[2 * k + 1]]) as i32;
+    for i in 0..60 {
+        let bases = [i, i + 1, i / 3, 59 - i];
+        let got = p1.get(bases).map(|v| v.to_array());
+        let got2 = p2.get(bases).map(|v| v.to_array());
+        for j in 0..4 {
+            let at = bases[j].min(p1.last());
+            let want = [at, at + 1, at + 18, at + 19].map(|k| a[k] as i32);
+            assert_eq!(got.map(|v| v[j]), want, "{i} {j}");
+            let at = bases[j].min(p2.last());
+            let want = [at, at + 1, at + 7, at + 8].map(c2);
+            assert_eq!(got2.map(|v| v[j]), want, "{i} {j}");
+        }
+    }
+    assert!(crate::CodePairs::<1>::new(&a[..19], 18).is_none());
+    assert!(crate::CodePairs::<1>::new(&a[..20], 18).is_some());
+    assert!(crate::CodePairs::<2>::new(&a[..17], 7).is_none());
+    assert!(crate::CodePairs::<2>::new(&a[..18], 7).is_some());
+    assert!(crate::CodePairs::<3>::new(&a, 1).is_none());
+    assert!(crate::CodePairs::<1>::new(&a, usize::MAX).is_none());
+}

@@ -12,7 +12,7 @@ use mirrorball::frames::packing::{Packing, Picture, PlaneCodes};
 use mirrorball::load;
 use mirrorball::{Error, ProjSpec};
 use mirrorball_core::{
-    EnvMap, Image, Layout, Projection, Remap, ResampleOptions, Stereo, WorldProjection,
+    EnvMap, Image, Layout, Plane, Projection, Remap, ResampleOptions, Stereo, WorldProjection,
 };
 use rayon::prelude::*;
 use std::sync::Mutex;
@@ -165,6 +165,10 @@ pub struct Converter {
     pub said: String,
     /// Each plane's floats of the last frame, filled again by the next.
     scratch: Mutex<[Option<Image>; 3]>,
+    /// Planes read by the plans as their codes ([`Remap::rows_plane`]), with no float copy:
+    /// where each plane, read as the picture, is its one eye's one layer as it is, and the
+    /// plans take codes.
+    direct: bool,
 }
 
 /// What the output is: its projection, size (`None`: the input's natural size, made even),
@@ -310,7 +314,29 @@ impl Converter {
             ),
             ..reading
         };
+        // A plane read as the picture is its eye's one layer as it is (moved, not cut or
+        // copied) where the picture is one eye and one layer laid out alone.
+        let whole = |ext: (u32, u32)| {
+            reading.stereo.0 == Stereo::Mono
+                && load::decide(
+                    &reading.input,
+                    ext,
+                    reading.from.as_ref(),
+                    reading.layout,
+                    None,
+                    None,
+                    |_| String::new(),
+                )
+                .is_ok_and(|(p, l, _)| l == Layout::Separate && p.layer_count() == 1)
+        };
+        let direct = mono
+            && plans
+                .iter()
+                .all(|p| p.packed.is_some() && p.remap.takes_codes())
+            && whole(extent)
+            && whole(chroma);
         Ok(Converter {
+            direct,
             format,
             reading,
             plans,
@@ -344,6 +370,27 @@ impl Converter {
         for k in 0..3 {
             let plan = &self.plans[k.min(1)];
             let (w, h) = frame.extent[k];
+            if let (true, Some(packed)) = (self.direct, &plan.packed) {
+                let bytes = &frame.data[k];
+                let plane = match self.format.bytes() {
+                    1 => Plane::u8(bytes, plan.neutral, (w, h)),
+                    _ => Plane::u16le(bytes, plan.neutral, (w, h)),
+                }
+                .map_err(|e| Error::input(format!("{}: {e}", self.reading.input)))?;
+                let codes = self.plane_codes(plan.neutral);
+                match &packed.laid {
+                    Some((laid, picture)) => {
+                        let rows = laid.rows_plane(plane).map_err(failed)?;
+                        picture.encode_rows(codes, &rows, &mut out.data[k]);
+                    }
+                    None => {
+                        let rows = plan.remap.rows_plane(plane).map_err(failed)?;
+                        packed.packing.encode_rows(codes, &rows, &mut out.data[k]);
+                    }
+                }
+                out.extent[k] = packed.packing.extent();
+                continue;
+            }
             let img = scratch[k].take();
             let img = self.read_plane(&frame.data[k], (w, h), plan.neutral, img);
             let (mut eyes, _) = self.reading.eyes(img)?;
@@ -548,6 +595,10 @@ mod tests {
                 let general = Converter::planned(fmt, extent, reading(), &target, false).unwrap();
                 let what = format!("{} {to} {layout}", fmt.name);
                 assert!(fast.plans[0].packed.is_some(), "{what}");
+                assert!(
+                    fast.direct && !general.direct,
+                    "{what}: planes read as codes"
+                );
                 let f = frame(fmt, extent);
                 // Twice: the second frame reads into the first one's memory.
                 for _ in 0..2 {

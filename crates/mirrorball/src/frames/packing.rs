@@ -697,7 +697,21 @@ fn gather_c<'s, 'r, const C: usize, R: Fn(usize) -> &'r [f32]>(
     into: &'s mut Vec<f32>,
     row: R,
 ) -> &'s [f32] {
-    into.resize(run.len as usize * C, 0.0);
+    let n = run.len as usize;
+    if run.dy == 0 && run.dx == -1 && n <= run.x as usize + 1 {
+        // A row piece reversed (a mirrored cell): one slice, its texels in reverse order.
+        let src = &row(run.y as usize)[(run.x as usize + 1 - n) * C..(run.x as usize + 1) * C];
+        into.clear();
+        if C == 1 {
+            into.extend(src.iter().rev());
+        } else {
+            for t in src.chunks_exact(C).rev() {
+                into.extend_from_slice(t);
+            }
+        }
+        return into;
+    }
+    into.resize(n * C, 0.0);
     for (k, t) in into.chunks_exact_mut(C).enumerate() {
         let x = (run.x as i64 + run.dx as i64 * k as i64) as usize;
         let y = (run.y as i64 + run.dy as i64 * k as i64) as usize;
