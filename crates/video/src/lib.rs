@@ -132,23 +132,7 @@ fn ff_input(input: &str, what: &str, e: ffmpeg::Error) -> Error {
 pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
     let c = &r.convert;
     let (input, output) = (c.input.as_str(), c.output.as_str());
-    let mut files = mirrorball::guard::Files::new();
-    files
-        .input_arg("the input", input)
-        .output("the output", output);
-    files.check()?;
-    if !is_video(output) {
-        return Err(Error::request(format!(
-            "{output}: a video's output is a video file ({})",
-            EXTENSIONS.join(", ")
-        )));
-    }
-    if c.exposure != 0.0 || c.mips || c.compression.is_some() || c.precision.is_some() {
-        return Err(Error::request(
-            "--exposure, --mips, --compression and --precision are for pictures: a video's \
-             frames are converted in their own codes",
-        ));
-    }
+    check_request(c)?;
     ffmpeg::init().map_err(|e| Error::system(format!("FFmpeg: {e}")))?;
     ffmpeg::log::set_level(ffmpeg::log::Level::Error);
     let ictx =
@@ -186,35 +170,7 @@ pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
 
     // What the file's metadata says, unless the flags say it.
     let mut req = c.clone();
-    let asks = req.input_plan.from.is_none() || req.in_stereo.is_none();
-    let mut said: Option<(Mapping, mirrorball_core::Stereo, String)> = None;
-    if takes_metadata(input) && asks {
-        if let Ok(tracks) = spherical::read(Path::new(input)) {
-            if let Some(Ok(Some(r))) = tracks.first().map(|t| t.reading()) {
-                said = Some((r.mapping, r.stereo, format!("Spherical Video {}", r.from)));
-            }
-        }
-    } else if asks {
-        match matroska::read(&vstream, extent) {
-            Some(Ok((mapping, stereo))) => {
-                said = Some((mapping, stereo, "its Projection element".into()));
-            }
-            Some(Err(e)) => hooks.note(&format!("{input}: {}; give --from", e.message)),
-            None => {}
-        }
-    }
-    if let Some((mapping, stereo, by)) = said {
-        if req.input_plan.from.is_none() {
-            let p = mapping.projection();
-            req.input_plan.from = ProjSpec::parse(&p.to_string()).ok();
-            req.input_plan.layout = req.input_plan.layout.or(mapping.layout());
-        }
-        req.in_stereo = req.in_stereo.or(Some(stereo));
-        hooks.note(&format!(
-            "{input}: {by} says {}, {stereo}",
-            mapping.projection()
-        ));
-    }
+    said_by_file(&mut req, &vstream, extent, hooks);
     // The picture's plan, checked as for a frame written as PNG (what its layout, size and
     // stereo arrangement may be).
     let mut as_picture = req.clone();
@@ -245,32 +201,8 @@ pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
     };
     let converter = Converter::new(fmt, extent, reading, &target)?;
     hooks.note(&format!("{input}: {}", converter.said));
-    let states = takes_metadata(output) || is_matroska(output);
-    let mapping = states
-        .then(|| Mapping::of(&dst, (dst.layer_count() > 1).then_some(layout)))
-        .flatten()
-        .filter(|m| !is_matroska(output) || matroska::states(m));
-    if states && mapping.is_none() {
-        hooks.note(&format!(
-            "{output}: {} cannot state {dst}: written without it",
-            if is_matroska(output) {
-                "Matroska's Projection element, as FFmpeg writes it,"
-            } else {
-                "Spherical Video metadata"
-            }
-        ));
-    }
-    // Matroska states it as it is muxed; an MP4 is tagged once muxed.
     let (w, h) = converter.out_extent;
-    let eye = match plan.stereo {
-        mirrorball_core::Stereo::Mono => (w, h),
-        mirrorball_core::Stereo::SideBySide => (w / 2, h),
-        mirrorball_core::Stereo::TopBottom => (w, h / 2),
-    };
-    let muxed = mapping
-        .filter(|_| is_matroska(output))
-        .map(|m| (m, plan.stereo, eye));
-    let tagged = mapping.filter(|_| takes_metadata(output));
+    let (tagged, muxed) = stating(output, (&dst, layout), ((w, h), plan.stereo), hooks);
 
     let out_path = PathBuf::from(output);
     let started = Instant::now();
@@ -287,29 +219,7 @@ pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
             );
         });
         let frames = result?;
-        // The file lands complete, with its metadata.
-        match tagged {
-            Some(mapping) => {
-                let change = Change::Set {
-                    mapping,
-                    stereo: plan.stereo,
-                    v1: matches!(mapping, Mapping::Equirect { .. }),
-                };
-                let tagging = spherical::tag::plan(scratch, &change)?;
-                mirrorball_io::atomic_write(&out_path, |w| {
-                    tagging
-                        .write_to(w)
-                        .map_err(|e| mirrorball_io::Error::io(&out_path, e))
-                })?;
-            }
-            None => mirrorball_io::atomic_write(&out_path, |w| {
-                let mut f = std::fs::File::open(scratch)
-                    .map_err(|e| mirrorball_io::Error::io(&out_path, e))?;
-                std::io::copy(&mut f, w)
-                    .map(|_| ())
-                    .map_err(|e| mirrorball_io::Error::io(&out_path, e))
-            })?,
-        }
+        land(scratch, &out_path, tagged, plan.stereo)?;
         Ok::<_, Error>(frames)
     })?;
     let secs = started.elapsed().as_secs_f64();
@@ -324,6 +234,140 @@ pub fn run(r: &VideoRequest, hooks: &dyn Hooks) -> Result<(), Error> {
         },
         frames as f64 / secs.max(1e-9)
     ));
+    Ok(())
+}
+
+/// Refuses, before any work, a request a video cannot take: its files (the input readable,
+/// the output writable and not the input), an output that is no video, picture-only flags.
+fn check_request(c: &ConvertRequest) -> Result<(), Error> {
+    let (input, output) = (c.input.as_str(), c.output.as_str());
+    let mut files = mirrorball::guard::Files::new();
+    files
+        .input_arg("the input", input)
+        .output("the output", output);
+    files.check()?;
+    if !is_video(output) {
+        return Err(Error::request(format!(
+            "{output}: a video's output is a video file ({})",
+            EXTENSIONS.join(", ")
+        )));
+    }
+    if c.exposure != 0.0 || c.mips || c.compression.is_some() || c.precision.is_some() {
+        return Err(Error::request(
+            "--exposure, --mips, --compression and --precision are for pictures: a video's \
+             frames are converted in their own codes",
+        ));
+    }
+    Ok(())
+}
+
+/// `req` with what the input's 360° metadata says where the request does not say it
+/// (`--from`, `--in-layout`, `--in-stereo`): MP4/MOV's Spherical Video boxes, Matroska's
+/// `Projection` (as the demuxer gives `vstream`'s side data, for an `extent` picture).
+fn said_by_file(
+    req: &mut ConvertRequest,
+    vstream: &format::stream::Stream,
+    extent: (u32, u32),
+    hooks: &dyn Hooks,
+) {
+    if req.input_plan.from.is_some() && req.in_stereo.is_some() {
+        return;
+    }
+    let input = req.input.clone();
+    let said = if takes_metadata(&input) {
+        spherical::read(Path::new(&input)).ok().and_then(|tracks| {
+            match tracks.first().map(|t| t.reading()) {
+                Some(Ok(Some(r))) => {
+                    Some((r.mapping, r.stereo, format!("Spherical Video {}", r.from)))
+                }
+                _ => None,
+            }
+        })
+    } else {
+        match matroska::read(vstream, extent) {
+            Some(Ok((mapping, stereo))) => Some((mapping, stereo, "its Projection element".into())),
+            Some(Err(e)) => {
+                hooks.note(&format!("{input}: {}; give --from", e.message));
+                None
+            }
+            None => None,
+        }
+    };
+    if let Some((mapping, stereo, by)) = said {
+        if req.input_plan.from.is_none() {
+            let p = mapping.projection();
+            req.input_plan.from = ProjSpec::parse(&p.to_string()).ok();
+            req.input_plan.layout = req.input_plan.layout.or(mapping.layout());
+        }
+        req.in_stereo = req.in_stereo.or(Some(stereo));
+        hooks.note(&format!(
+            "{input}: {by} says {}, {stereo}",
+            mapping.projection()
+        ));
+    }
+}
+
+/// How the output states its projection: an MP4/MOV tagged once muxed (the mapping), a
+/// Matroska/WebM file as it is muxed ([`Muxed`]); neither where the container cannot state
+/// `dst` in `layout` (said through `hooks`). `out` is the whole picture, `stereo` its
+/// arrangement.
+fn stating(
+    output: &str,
+    (dst, layout): (&mirrorball_core::Projection, Layout),
+    (out, stereo): ((u32, u32), mirrorball_core::Stereo),
+    hooks: &dyn Hooks,
+) -> (Option<Mapping>, Option<Muxed>) {
+    let states = takes_metadata(output) || is_matroska(output);
+    let mapping = states
+        .then(|| Mapping::of(dst, (dst.layer_count() > 1).then_some(layout)))
+        .flatten()
+        .filter(|m| !is_matroska(output) || matroska::states(m));
+    if states && mapping.is_none() {
+        hooks.note(&format!(
+            "{output}: {} cannot state {dst}: written without it",
+            if is_matroska(output) {
+                "Matroska's Projection element, as FFmpeg writes it,"
+            } else {
+                "Spherical Video metadata"
+            }
+        ));
+    }
+    let (w, h) = out;
+    let eye = match stereo {
+        mirrorball_core::Stereo::Mono => (w, h),
+        mirrorball_core::Stereo::SideBySide => (w / 2, h),
+        mirrorball_core::Stereo::TopBottom => (w, h / 2),
+    };
+    let muxed = mapping
+        .filter(|_| is_matroska(output))
+        .map(|m| (m, stereo, eye));
+    (mapping.filter(|_| takes_metadata(output)), muxed)
+}
+
+/// Lands the muxed `scratch` file at `out_path`, complete, through `tagged`'s Spherical
+/// Video metadata (V2, and V1 for lat-long) where there is one.
+fn land(
+    scratch: &Path,
+    out_path: &Path,
+    tagged: Option<Mapping>,
+    stereo: mirrorball_core::Stereo,
+) -> Result<(), Error> {
+    let io = |e| mirrorball_io::Error::io(out_path, e);
+    match tagged {
+        Some(mapping) => {
+            let change = Change::Set {
+                mapping,
+                stereo,
+                v1: matches!(mapping, Mapping::Equirect { .. }),
+            };
+            let tagging = spherical::tag::plan(scratch, &change)?;
+            mirrorball_io::atomic_write(out_path, |w| tagging.write_to(w).map_err(io))?;
+        }
+        None => mirrorball_io::atomic_write(out_path, |w| {
+            let mut f = std::fs::File::open(scratch).map_err(io)?;
+            std::io::copy(&mut f, w).map(|_| ()).map_err(io)
+        })?,
+    }
     Ok(())
 }
 
@@ -356,6 +400,79 @@ fn transcode(
     let mut octx = format::output_as(&scratch, container(output))
         .map_err(|e| Error::system(format!("{output}: cannot be written: {e}")))?;
     let name = r.codec.as_deref().unwrap_or(default_codec(output));
+    let (codec, enc) = open_encoder(r, name, conv, (&decoder, pix, in_tb, rate), &octx)?;
+    let fmt = conv.format();
+    let mut ost = octx
+        .add_stream(codec)
+        .map_err(|e| Error::system(format!("{output}: {e}")))?;
+    ost.set_parameters(&enc);
+    ost.set_time_base(in_tb);
+    if let Some((mapping, stereo, eye)) = muxed {
+        // SAFETY: the stream is the output context's, its header not yet written.
+        unsafe { matroska::state(ost.as_mut_ptr(), &mapping, stereo, eye)? };
+    }
+    let vost = ost.index();
+    let map = copied_streams(&ictx, &mut octx, vindex, output)?;
+    octx.set_metadata(ictx.metadata().to_owned());
+    octx.write_header().map_err(|e| {
+        Error::request(format!(
+            "{output}: the {} container cannot hold these streams ({name} video and the \
+             input's others, copied): {e}",
+            container(output)
+        ))
+    })?;
+    let out_tbs: Vec<Rational> = octx.streams().map(|s| s.time_base()).collect();
+    let (tx1, rx1) = sync_channel::<Item>(IN_FLIGHT);
+    let (tx2, rx2) = sync_channel::<Item>(IN_FLIGHT);
+    let writer = Writer {
+        octx,
+        enc,
+        vost,
+        in_tb,
+        out_tbs,
+        pix,
+        frames: 0,
+        last: None,
+        step: (f64::from(rate.invert()) / f64::from(in_tb))
+            .round()
+            .max(1.0) as i64,
+        durations: std::collections::HashMap::new(),
+        output: output.to_string(),
+        frame: None,
+    };
+    let (decoded, converted) = (Pool::default(), Pool::default());
+    std::thread::scope(|s| {
+        let pools = (decoded.clone(), converted.clone());
+        let converting = s.spawn(move || convert_stage(conv, rx1, tx2, pools));
+        let done = converted.clone();
+        let writing = s.spawn(move || writer.run(rx2, &counter, &done));
+        let read = read_stage(
+            &mut ictx,
+            decoder,
+            (input, vindex, fmt),
+            &map,
+            tx1,
+            &decoded,
+        );
+        let panicked = |_| Error::system("a video thread stopped unexpectedly");
+        let converted = converting.join().map_err(panicked)?;
+        let written = writing.join().map_err(panicked)?;
+        read?;
+        converted?;
+        written
+    })
+}
+
+/// The encoder `name` opened for `conv`'s frames (the decoder's pixel format `pix`, colour
+/// space and range, the input's time base and rate; `--crf`, `--preset`), refused by name
+/// where it cannot take them.
+fn open_encoder(
+    r: &VideoRequest,
+    name: &str,
+    conv: &Converter,
+    (decoder, pix, in_tb, rate): (&ffmpeg::decoder::Video, format::Pixel, Rational, Rational),
+    octx: &format::context::Output,
+) -> Result<(ffmpeg::Codec, encoder::Video), Error> {
     let codec = encoder::find_by_name(name).ok_or_else(|| {
         Error::request(format!(
             "--codec: this FFmpeg has no encoder named '{name}' (`ffmpeg -encoders` lists them)"
@@ -409,17 +526,17 @@ fn transcode(
             fmt.name
         ))
     })?;
-    let mut ost = octx
-        .add_stream(codec)
-        .map_err(|e| Error::system(format!("{output}: {e}")))?;
-    ost.set_parameters(&enc);
-    ost.set_time_base(in_tb);
-    if let Some((mapping, stereo, eye)) = muxed {
-        // SAFETY: the stream is the output context's, its header not yet written.
-        unsafe { matroska::state(ost.as_mut_ptr(), &mapping, stereo, eye)? };
-    }
-    let vost = ost.index();
-    // Audio and subtitles copied as they are.
+    Ok((codec, enc))
+}
+
+/// Adds to `octx` a stream for each of `ictx`'s audio and subtitle streams, copied as they
+/// are (not the video stream `vindex`): the output stream of each input stream, if any.
+fn copied_streams(
+    ictx: &format::context::Input,
+    octx: &mut format::context::Output,
+    vindex: usize,
+    output: &str,
+) -> Result<Vec<Option<usize>>, Error> {
     let mut map: Vec<Option<usize>> = vec![None; ictx.nb_streams() as usize];
     for ist in ictx.streams() {
         let medium = ist.parameters().medium();
@@ -437,54 +554,7 @@ fn transcode(
         }
         map[ist.index()] = Some(ost.index());
     }
-    octx.set_metadata(ictx.metadata().to_owned());
-    octx.write_header().map_err(|e| {
-        Error::request(format!(
-            "{output}: the {} container cannot hold these streams ({name} video and the \
-             input's others, copied): {e}",
-            container(output)
-        ))
-    })?;
-    let out_tbs: Vec<Rational> = octx.streams().map(|s| s.time_base()).collect();
-    let (tx1, rx1) = sync_channel::<Item>(IN_FLIGHT);
-    let (tx2, rx2) = sync_channel::<Item>(IN_FLIGHT);
-    let writer = Writer {
-        octx,
-        enc,
-        vost,
-        in_tb,
-        out_tbs,
-        pix,
-        frames: 0,
-        last: None,
-        step: (f64::from(rate.invert()) / f64::from(in_tb))
-            .round()
-            .max(1.0) as i64,
-        durations: std::collections::HashMap::new(),
-        output: output.to_string(),
-        frame: None,
-    };
-    let (decoded, converted) = (Pool::default(), Pool::default());
-    std::thread::scope(|s| {
-        let pools = (decoded.clone(), converted.clone());
-        let converting = s.spawn(move || convert_stage(conv, rx1, tx2, pools));
-        let done = converted.clone();
-        let writing = s.spawn(move || writer.run(rx2, &counter, &done));
-        let read = read_stage(
-            &mut ictx,
-            decoder,
-            (input, vindex, fmt),
-            &map,
-            tx1,
-            &decoded,
-        );
-        let panicked = |_| Error::system("a video thread stopped unexpectedly");
-        let converted = converting.join().map_err(panicked)?;
-        let written = writing.join().map_err(panicked)?;
-        read?;
-        converted?;
-        written
-    })
+    Ok(map)
 }
 
 /// Demuxes and decodes: every video frame's planes, and the copied streams' packets, in
