@@ -460,17 +460,23 @@ impl Remap {
     /// assert_eq!(ra, rb); // the same bits
     /// ```
     pub fn rows_coded<'a>(&'a self, src: Codes<'a>) -> Result<RemapRows<'a>, RemapError> {
+        self.check_codes(src.extent())?;
+        Ok(RemapRows::coded(self, src))
+    }
+
+    /// Whether a source of codes of `extent` can be read by this plan: one that [takes
+    /// codes](Remap::takes_codes), of that source extent.
+    fn check_codes(&self, (w, h): (u32, u32)) -> Result<(), RemapError> {
         if !self.takes_codes() {
             return Err(RemapError::Codes);
         }
-        if src.extent() != self.src_extent {
-            let (w, h) = src.extent();
+        if (w, h) != self.src_extent {
             return Err(RemapError::Extent {
                 expected: (1, self.src_extent.0, self.src_extent.1),
                 found: (1, w, h),
             });
         }
-        Ok(RemapRows::coded(self, src))
+        Ok(())
     }
 
     /// [`Remap::rows`] of a one-channel source held as a plane's codes (a YUV frame's Y, U
@@ -479,16 +485,7 @@ impl Remap {
     /// plane made (only its mip levels, where the plan reads any). The plan must [take
     /// codes](Remap::takes_codes), and the plane be the plan's source extent.
     pub fn rows_plane<'a>(&'a self, src: Plane<'a>) -> Result<RemapRows<'a>, RemapError> {
-        if !self.takes_codes() {
-            return Err(RemapError::Codes);
-        }
-        if src.extent() != self.src_extent {
-            let (w, h) = src.extent();
-            return Err(RemapError::Extent {
-                expected: (1, self.src_extent.0, self.src_extent.1),
-                found: (1, w, h),
-            });
-        }
+        self.check_codes(src.extent())?;
         Ok(RemapRows::plane(self, src))
     }
 
