@@ -602,35 +602,38 @@ pub struct RemapRows<'a> {
 
 impl<'a> RemapRows<'a> {
     fn new(remap: &'a Remap, src: &'a EnvMap) -> RemapRows<'a> {
-        let spare = std::mem::take(&mut *remap.spare.lock().unwrap_or_else(|e| e.into_inner()));
-        RemapRows {
-            remap,
-            pyr: Pyramid::planned(src, &remap.pyramid, spare),
-            c: src.channels(),
-            codes: None,
-            plane: None,
-        }
+        let pyr = Pyramid::planned(src, &remap.pyramid, RemapRows::spare(remap));
+        RemapRows::with(remap, pyr, src.channels(), None, None)
     }
 
     fn coded(remap: &'a Remap, src: Codes<'a>) -> RemapRows<'a> {
-        let spare = std::mem::take(&mut *remap.spare.lock().unwrap_or_else(|e| e.into_inner()));
-        RemapRows {
-            remap,
-            pyr: Pyramid::planned_codes(src, &remap.pyramid, spare),
-            c: 3,
-            codes: Some(src),
-            plane: None,
-        }
+        let pyr = Pyramid::planned_codes(src, &remap.pyramid, RemapRows::spare(remap));
+        RemapRows::with(remap, pyr, 3, Some(src), None)
     }
 
     fn plane(remap: &'a Remap, src: Plane<'a>) -> RemapRows<'a> {
-        let spare = std::mem::take(&mut *remap.spare.lock().unwrap_or_else(|e| e.into_inner()));
+        let pyr = Pyramid::planned_plane(src, &remap.pyramid, RemapRows::spare(remap));
+        RemapRows::with(remap, pyr, 1, None, Some(src))
+    }
+
+    /// The mip levels the plan's last rows gave back, for this source to fill.
+    fn spare(remap: &Remap) -> PyramidSpare {
+        std::mem::take(&mut *remap.spare.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+
+    fn with(
+        remap: &'a Remap,
+        pyr: Pyramid<'a>,
+        c: usize,
+        codes: Option<Codes<'a>>,
+        plane: Option<Plane<'a>>,
+    ) -> RemapRows<'a> {
         RemapRows {
             remap,
-            pyr: Pyramid::planned_plane(src, &remap.pyramid, spare),
-            c: 1,
-            codes: None,
-            plane: Some(src),
+            pyr,
+            c,
+            codes,
+            plane,
         }
     }
 
